@@ -1,0 +1,100 @@
+"""Adapters from plain Python samplers to the one form every stream is called in.
+
+A stream is called as ``list_gen_fn(*inputs)`` and returns an iterator; each ``next`` gives a
+list of output tuples (possibly empty: no output this call) or a :class:`WildOutput`. The
+adapters below wrap the usual shapes of samplers into that form (PDDLStream's names):
+
+- ``from_gen_fn(g)``: ``g(*inputs)`` yields one output tuple (or None) per call;
+- ``from_list_gen_fn(g)``: ``g(*inputs)`` yields lists of output tuples;
+- ``from_sampler(s)``: ``s(*inputs)`` returns one output tuple (or None), called forever;
+- ``from_fn(f)``: ``f(*inputs)`` returns one tuple or None, called once;
+- ``from_list_fn(f)``: ``f(*inputs)`` returns a list of tuples, called once;
+- ``from_test(t)``: ``t(*inputs)`` returns a truth value, called once (no outputs);
+- ``from_constant(c)``: always the tuple ``c``, once; ``fn_from_constant(c)``: a function
+  (for ``:function``/``:predicate``) that always returns ``c``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+Outputs = list[tuple[Any, ...]]
+ListGenFn = Callable[..., Iterator["Outputs | WildOutput"]]
+
+
+@dataclass(frozen=True)
+class WildOutput:
+    """Outputs plus extra certified facts the stream did not declare (PDDLStream's wild streams)."""
+
+    values: Sequence[tuple[Any, ...]] = ()
+    facts: Sequence[tuple[Any, ...]] = field(default_factory=tuple)
+
+
+def _one(output: Any) -> Outputs:
+    return [] if output is None else [tuple(output)]
+
+
+def from_list_gen_fn(list_gen_fn: Callable[..., Iterable[Any]]) -> ListGenFn:
+    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
+        for outputs in list_gen_fn(*inputs):
+            if isinstance(outputs, WildOutput):
+                yield outputs
+            else:
+                yield [tuple(output) for output in (outputs or [])]
+
+    return stream
+
+
+def from_gen_fn(gen_fn: Callable[..., Iterable[Any]]) -> ListGenFn:
+    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
+        for output in gen_fn(*inputs):
+            yield output if isinstance(output, WildOutput) else _one(output)
+
+    return stream
+
+
+def from_sampler(sampler: Callable[..., Any], max_attempts: int | None = None) -> ListGenFn:
+    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
+        attempt = 0
+        while max_attempts is None or attempt < max_attempts:
+            attempt += 1
+            yield _one(sampler(*inputs))
+
+    return stream
+
+
+def from_list_fn(list_fn: Callable[..., Any]) -> ListGenFn:
+    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
+        outputs = list_fn(*inputs)
+        yield outputs if isinstance(outputs, WildOutput) else [tuple(o) for o in (outputs or [])]
+
+    return stream
+
+
+def from_fn(fn: Callable[..., Any]) -> ListGenFn:
+    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
+        output = fn(*inputs)
+        yield output if isinstance(output, WildOutput) else _one(output)
+
+    return stream
+
+
+def from_test(test: Callable[..., Any]) -> ListGenFn:
+    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
+        yield [()] if test(*inputs) else []
+
+    return stream
+
+
+def from_constant(constant: Sequence[Any]) -> ListGenFn:
+    return from_fn(lambda *_inputs: tuple(constant))
+
+
+def fn_from_constant(constant: Any) -> Callable[..., Any]:
+    return lambda *_inputs: constant
+
+
+def negate_test(test: Callable[..., Any]) -> Callable[..., bool]:
+    return lambda *inputs: not test(*inputs)

@@ -1,0 +1,300 @@
+"""Shared grammar pieces: typed lists, formulas and effects, with scope and arity checks."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.errors import (
+    ArityError,
+    DuplicateError,
+    PddlSyntaxError,
+    UnboundVariableError,
+    UndeclaredError,
+    UnsupportedFeatureError,
+)
+from sdar_tamp.language.model import (
+    EQUALITY,
+    OBJECT_TYPE,
+    TOTAL_COST,
+    And,
+    AndEffect,
+    Atom,
+    Effect,
+    Exists,
+    ForAll,
+    ForAllEffect,
+    Formula,
+    FunctionTerm,
+    Imply,
+    IncreaseCost,
+    Literal,
+    Not,
+    NumericExpr,
+    Or,
+    Parameter,
+    When,
+)
+from sdar_tamp.language.sexpr import SExpr, SList, Symbol
+
+
+def expect_list(node: SExpr, what: str) -> SList:
+    if not isinstance(node, SList):
+        raise PddlSyntaxError(f"expected {what} in parentheses, found {node.text!r}", node.location)
+    return node
+
+
+def expect_symbol(node: SExpr, what: str) -> Symbol:
+    if not isinstance(node, Symbol):
+        raise PddlSyntaxError(f"expected {what}, found a list {node}", node.location)
+    return node
+
+
+def expect_head(node: SExpr, keyword: str, what: str) -> SList:
+    """``node`` must be a list starting with ``keyword``."""
+    lst = expect_list(node, what)
+    if not lst.items or not isinstance(lst.items[0], Symbol) or lst.items[0].text != keyword:
+        raise PddlSyntaxError(f"expected {what} starting with '{keyword}'", lst.location)
+    return lst
+
+
+def parse_name_header(node: SExpr, keyword: str) -> str:
+    """``(domain NAME)``, ``(problem NAME)`` or ``(stream NAME)``."""
+    header = expect_head(node, keyword, f"a header '({keyword} NAME)'")
+    if len(header.items) != 2:
+        raise PddlSyntaxError(f"expected '({keyword} NAME)'", header.location)
+    return expect_symbol(header.items[1], f"the {keyword} name").text
+
+
+def parse_typed_list(
+    items: Sequence[SExpr], what: str, types: frozenset[str] | None, variables: bool
+) -> list[tuple[str, str, SourceLocation]]:
+    """Parse ``a b - t c`` into ``[(a, t), (b, t), (c, object)]`` with locations.
+
+    ``types`` None means the caller does not check types (type declarations themselves).
+    ``variables`` requires every name to start with ``?``; otherwise none may.
+    """
+    result: list[tuple[str, str, SourceLocation]] = []
+    pending: list[Symbol] = []
+    index = 0
+    while index < len(items):
+        token = expect_symbol(items[index], what)
+        if token.text == "-":
+            if index + 1 >= len(items):
+                raise PddlSyntaxError(f"expected a type name after '-' in {what}", token.location)
+            type_node = items[index + 1]
+            if isinstance(type_node, SList):
+                raise UnsupportedFeatureError(
+                    "'(either ...)' types are not supported: declare a common supertype",
+                    type_node.location,
+                )
+            if not pending:
+                raise PddlSyntaxError(f"expected a name before '-' in {what}", token.location)
+            check_type(type_node, types)
+            result.extend((name.text, type_node.text, name.location) for name in pending)
+            pending = []
+            index += 2
+            continue
+        if variables != token.text.startswith("?"):
+            expected = "a variable starting with '?'" if variables else "a name (no '?')"
+            raise PddlSyntaxError(
+                f"expected {expected} in {what}, found {token.text!r}", token.location
+            )
+        pending.append(token)
+        index += 1
+    result.extend((name.text, OBJECT_TYPE, name.location) for name in pending)
+    seen: set[str] = set()
+    for name, _, location in result:
+        if name in seen:
+            raise DuplicateError(f"{name!r} appears twice in {what}", location)
+        seen.add(name)
+    return result
+
+
+def check_type(node: Symbol, types: frozenset[str] | None) -> None:
+    if types is not None and node.text not in types:
+        raise UndeclaredError(
+            f"undeclared type {node.text!r} (declared: {sorted(types)})", node.location
+        )
+
+
+@dataclass
+class Vocabulary:
+    """What formulas may mention: predicate and function arities, types and constants."""
+
+    predicates: dict[str, int]
+    types: frozenset[str]
+    constants: Mapping[str, str]
+    functions: dict[str, int] = field(default_factory=dict)
+    derived: frozenset[str] = frozenset()
+    allow_new_functions: bool = False
+    filename: str | None = None
+
+
+class FormulaReader:
+    """Turns s-expressions into model formulas and effects, checking names and scopes."""
+
+    def __init__(self, vocabulary: Vocabulary) -> None:
+        self.vocabulary = vocabulary
+
+    # --- terms and atoms ----------------------------------------------------------------------
+
+    def parameters(self, node: SExpr, what: str) -> tuple[Parameter, ...]:
+        lst = expect_list(node, what)
+        parsed = parse_typed_list(lst.items, what, self.vocabulary.types, variables=True)
+        return tuple(Parameter(name, type_name) for name, type_name, _ in parsed)
+
+    def term(self, node: SExpr, scope: Mapping[str, str]) -> str:
+        token = expect_symbol(node, "a term (a variable or an object name)")
+        text = token.text
+        if text.startswith("?"):
+            if text not in scope:
+                raise UnboundVariableError(f"variable {text} is not bound here", token.location)
+        elif text not in self.vocabulary.constants:
+            raise UndeclaredError(f"undeclared constant or object {text!r}", token.location)
+        return text
+
+    def atom(self, node: SList, scope: Mapping[str, str]) -> Atom:
+        head = expect_symbol(node.items[0] if node.items else node, "a predicate name")
+        name = head.text
+        args = tuple(self.term(arg, scope) for arg in node.items[1:])
+        if name == EQUALITY:
+            expected = 2
+        elif name in self.vocabulary.predicates:
+            expected = self.vocabulary.predicates[name]
+        elif name in self.vocabulary.types:
+            expected = 1
+        else:
+            raise UndeclaredError(f"undeclared predicate {name!r}", head.location)
+        if len(args) != expected:
+            raise ArityError(
+                f"predicate {name!r} takes {expected} argument(s), got {len(args)}", node.location
+            )
+        return Atom(name, args)
+
+    # --- formulas -----------------------------------------------------------------------------
+
+    def formula(self, node: SExpr, scope: Mapping[str, str]) -> Formula:
+        lst = expect_list(node, "a formula")
+        if not lst.items:
+            return And(())
+        head = lst.items[0]
+        keyword = head.text if isinstance(head, Symbol) else ""
+        rest = lst.items[1:]
+        if keyword == "and":
+            return And(tuple(self.formula(part, scope) for part in rest))
+        if keyword == "or":
+            return Or(tuple(self.formula(part, scope) for part in rest))
+        if keyword == "not":
+            self._arity(lst, 1, "'not' takes one formula")
+            return Not(self.formula(rest[0], scope))
+        if keyword == "imply":
+            self._arity(lst, 2, "'imply' takes two formulas")
+            return Imply(self.formula(rest[0], scope), self.formula(rest[1], scope))
+        if keyword in ("exists", "forall"):
+            self._arity(lst, 2, f"'{keyword}' takes a parameter list and a formula")
+            params = self.parameters(rest[0], f"the parameters of '{keyword}'")
+            inner = {**scope, **{p.name: p.type for p in params}}
+            body = self.formula(rest[1], inner)
+            return Exists(params, body) if keyword == "exists" else ForAll(params, body)
+        return self.atom(lst, scope)
+
+    def conjunction(self, node: SExpr, scope: Mapping[str, str], what: str) -> tuple[Atom, ...]:
+        """A conjunction of positive atoms (stream domains and certified facts)."""
+        formula = self.formula(node, scope)
+        parts = formula.parts if isinstance(formula, And) else (formula,)
+        atoms: list[Atom] = []
+        for part in parts:
+            if not isinstance(part, Atom):
+                raise PddlSyntaxError(f"{what} must be a conjunction of atoms", node.location)
+            atoms.append(part)
+        return tuple(atoms)
+
+    # --- effects ------------------------------------------------------------------------------
+
+    def effect(self, node: SExpr, scope: Mapping[str, str]) -> Effect:
+        lst = expect_list(node, "an effect")
+        if not lst.items:
+            return AndEffect(())
+        head = lst.items[0]
+        keyword = head.text if isinstance(head, Symbol) else ""
+        rest = lst.items[1:]
+        if keyword == "and":
+            return AndEffect(tuple(self.effect(part, scope) for part in rest))
+        if keyword == "not":
+            self._arity(lst, 1, "'not' takes one atom")
+            return Literal(self._effect_atom(rest[0], scope), negated=True)
+        if keyword == "forall":
+            self._arity(lst, 2, "'forall' takes a parameter list and an effect")
+            params = self.parameters(rest[0], "the parameters of 'forall'")
+            inner = {**scope, **{p.name: p.type for p in params}}
+            return ForAllEffect(params, self.effect(rest[1], inner))
+        if keyword == "when":
+            self._arity(lst, 2, "'when' takes a condition and an effect")
+            return When(self.formula(rest[0], scope), self.effect(rest[1], scope))
+        if keyword == "increase":
+            return self._increase(lst, scope)
+        if keyword in ("decrease", "assign", "scale-up", "scale-down"):
+            raise UnsupportedFeatureError(
+                f"numeric effect '{keyword}' is not supported; only '(increase (total-cost) N)' is",
+                lst.location,
+            )
+        return Literal(self._effect_atom(lst, scope))
+
+    def _effect_atom(self, node: SExpr, scope: Mapping[str, str]) -> Atom:
+        lst = expect_list(node, "an atom")
+        atom = self.atom(lst, scope)
+        if atom.predicate == EQUALITY or atom.predicate in self.vocabulary.derived:
+            raise PddlSyntaxError(
+                f"{atom.predicate!r} cannot appear in an effect (equality or derived predicate)",
+                lst.location,
+            )
+        return atom
+
+    def _increase(self, node: SList, scope: Mapping[str, str]) -> IncreaseCost:
+        self._arity(node, 2, "'increase' takes '(total-cost)' and an amount")
+        target = expect_list(node.items[1], "'(total-cost)'")
+        if (
+            len(target.items) != 1
+            or expect_symbol(target.items[0], "total-cost").text != TOTAL_COST
+        ):
+            raise UnsupportedFeatureError(
+                "only '(increase (total-cost) ...)' is supported", target.location
+            )
+        return IncreaseCost(self.numeric(node.items[2], scope))
+
+    def numeric(self, node: SExpr, scope: Mapping[str, str]) -> NumericExpr:
+        if isinstance(node, Symbol):
+            try:
+                value = float(node.text)
+            except ValueError:
+                raise PddlSyntaxError(
+                    f"expected a number or a function term, found {node.text!r}", node.location
+                ) from None
+            if value < 0:
+                raise PddlSyntaxError(
+                    f"action costs must be non-negative, got {value}", node.location
+                )
+            return value
+        head = expect_symbol(node.items[0] if node.items else node, "a function name")
+        args = tuple(self.term(arg, scope) for arg in node.items[1:])
+        self.function_arity(head, len(args), node.location)
+        return FunctionTerm(head.text, args)
+
+    def function_arity(self, head: Symbol, arity: int, location: SourceLocation) -> None:
+        functions = self.vocabulary.functions
+        if head.text not in functions:
+            if not self.vocabulary.allow_new_functions:
+                raise UndeclaredError(f"undeclared function {head.text!r}", head.location)
+            functions[head.text] = arity
+        if functions[head.text] != arity:
+            raise ArityError(
+                f"function {head.text!r} takes {functions[head.text]} argument(s), got {arity}",
+                location,
+            )
+
+    @staticmethod
+    def _arity(node: SList, count: int, message: str) -> None:
+        if len(node.items) != count + 1:
+            raise PddlSyntaxError(message, node.location)

@@ -1,0 +1,85 @@
+"""Per-stream options and plan constraints (PDDLStream's ``StreamInfo``, ``FunctionInfo``,
+``PlanConstraints``). Options that a solver does not implement yet are accepted and reported
+with a logged warning by that solver, never ignored silently (see :func:`unsupported_options`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, fields
+from typing import Any, Final
+
+
+class _Wild:
+    """The type of ``WILD``: a skeleton argument that matches anything (compare with ``is``)."""
+
+    def __repr__(self) -> str:
+        return "WILD"
+
+
+WILD: Final = _Wild()
+
+
+@dataclass(frozen=True)
+class StreamInfo:
+    """How a solver should treat one stream.
+
+    Attributes:
+        eager: evaluate the stream as soon as its inputs exist (like an incremental stream).
+        p_success: prior probability that one call succeeds, in (0, 1].
+        overhead: expected cost of one call [s], >= 0.
+        effort: fixed effort used in place of the one derived from p_success and overhead.
+        opt_gen_fn: optimistic generator for placeholder outputs (None: one shared placeholder).
+        negate: for tests/predicates: the certified fact may be used negated.
+        simultaneous: evaluate all instances of this stream together.
+        verbose: log each call.
+        defer_fn: decides whether the stream is evaluated only after a plan is found.
+    """
+
+    eager: bool = False
+    p_success: float | None = None
+    overhead: float | None = None
+    effort: float | None = None
+    opt_gen_fn: Callable[..., Any] | None = None
+    negate: bool = False
+    simultaneous: bool = False
+    verbose: bool = True
+    defer_fn: Callable[..., Any] | None = None
+
+    def __post_init__(self) -> None:
+        if self.p_success is not None and not 0.0 < self.p_success <= 1.0:
+            raise ValueError(f"StreamInfo.p_success must be in (0, 1], got {self.p_success}")
+        if self.overhead is not None and self.overhead < 0:
+            raise ValueError(f"StreamInfo.overhead must be >= 0, got {self.overhead}")
+
+
+@dataclass(frozen=True)
+class FunctionInfo:
+    """How a solver should treat one ``:function``: ``opt_fn`` gives its optimistic value."""
+
+    opt_fn: Callable[..., Any] | None = None
+    eager: bool = False
+    p_success: float | None = None
+    overhead: float | None = None
+    effort: float | None = None
+    verbose: bool = True
+
+
+@dataclass(frozen=True)
+class PlanConstraints:
+    """Restricts plans to ``skeletons`` (action name + arguments, ``WILD`` matches anything)."""
+
+    skeletons: Sequence[Sequence[tuple[str, Sequence[Any]]]] | None = None
+    exact: bool = True
+    max_cost: float = math.inf
+
+
+def unsupported_options(info: StreamInfo | FunctionInfo, supported: set[str]) -> list[str]:
+    """Names of options set to a non-default value that are not in ``supported``."""
+    defaults = type(info)()
+    return [
+        f.name
+        for f in fields(info)
+        if f.name not in supported and getattr(info, f.name) != getattr(defaults, f.name)
+    ]

@@ -1,0 +1,385 @@
+"""PDDL domain and problem parser.
+
+Supported requirements: ``:strips :typing :negative-preconditions :disjunctive-preconditions
+:equality :existential-preconditions :universal-preconditions :quantified-preconditions
+:conditional-effects :derived-predicates :action-costs :adl``. Names are case-insensitive.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.errors import (
+    ArityError,
+    DuplicateError,
+    PddlSyntaxError,
+    UndeclaredError,
+    UnknownKeywordError,
+)
+from sdar_tamp.language.grammar import (
+    FormulaReader,
+    Vocabulary,
+    expect_head,
+    expect_list,
+    expect_symbol,
+    parse_name_header,
+    parse_typed_list,
+)
+from sdar_tamp.language.model import (
+    OBJECT_TYPE,
+    TOTAL_COST,
+    TRUE,
+    Action,
+    AndEffect,
+    Atom,
+    Axiom,
+    Domain,
+    Function,
+    Parameter,
+    Predicate,
+    Problem,
+    TypeHierarchy,
+)
+from sdar_tamp.language.sexpr import SExpr, SList, Symbol, read_sexpr
+
+REQUIREMENTS = frozenset(
+    {
+        ":strips",
+        ":typing",
+        ":negative-preconditions",
+        ":disjunctive-preconditions",
+        ":equality",
+        ":existential-preconditions",
+        ":universal-preconditions",
+        ":quantified-preconditions",
+        ":conditional-effects",
+        ":derived-predicates",
+        ":action-costs",
+        ":adl",
+    }
+)
+DOMAIN_SECTIONS = (
+    ":requirements",
+    ":types",
+    ":constants",
+    ":predicates",
+    ":functions",
+    ":action",
+    ":derived",
+)
+PROBLEM_SECTIONS = (":domain", ":requirements", ":objects", ":init", ":goal", ":metric")
+
+
+def _sections(root: SList, kind: str, allowed: Iterable[str]) -> list[tuple[str, SList]]:
+    expect_head(root, "define", f"a {kind} '(define ({kind} NAME) ...)'")
+    if len(root.items) < 2:
+        raise PddlSyntaxError(f"expected '({kind} NAME)' after 'define'", root.location)
+    result: list[tuple[str, SList]] = []
+    allowed = tuple(allowed)
+    for node in root.items[2:]:
+        section = expect_list(node, f"a {kind} section such as ({allowed[0]} ...)")
+        keyword = expect_symbol(section.items[0] if section.items else section, "a keyword")
+        if keyword.text not in allowed:
+            raise UnknownKeywordError(
+                f"unknown {kind} section {keyword.text!r}; expected one of {', '.join(allowed)}",
+                keyword.location,
+            )
+        result.append((keyword.text, section))
+    return result
+
+
+def parse_domain(text: str, filename: str | None = None) -> Domain:
+    """Parse a PDDL domain.
+
+    Raises:
+        PddlError: a subclass naming ``file:line:col`` and what was expected.
+    """
+    root = read_sexpr(text, filename)
+    name = parse_name_header(root.items[1] if len(root.items) > 1 else root, "domain")
+    requirements: set[str] = set()
+    parents: dict[str, str] = {}
+    constants: dict[str, str] = {}
+    predicates: dict[str, Predicate] = {}
+    functions: dict[str, Function] = {}
+    vocabulary = Vocabulary(
+        {}, frozenset({OBJECT_TYPE}), constants, {}, filename=filename, allow_new_functions=True
+    )
+    reader = FormulaReader(vocabulary)
+    pending: list[tuple[str, SList]] = []
+    for keyword, section in _sections(root, "domain", DOMAIN_SECTIONS):
+        body = section.items[1:]
+        if keyword == ":requirements":
+            for token in body:
+                symbol = expect_symbol(token, "a requirement")
+                if symbol.text not in REQUIREMENTS:
+                    raise UnknownKeywordError(
+                        f"unsupported requirement {symbol.text!r}; supported: "
+                        f"{', '.join(sorted(REQUIREMENTS))}",
+                        symbol.location,
+                    )
+                requirements.add(symbol.text)
+        elif keyword == ":types":
+            _declare_types(body, parents)
+            vocabulary.types = frozenset({OBJECT_TYPE, *parents})
+        elif keyword == ":constants":
+            for const, type_name, location in parse_typed_list(
+                body, "the constants", vocabulary.types, variables=False
+            ):
+                if const in constants:
+                    raise DuplicateError(f"constant {const!r} is declared twice", location)
+                constants[const] = type_name
+        elif keyword == ":predicates":
+            for node in body:
+                predicate = _declaration(node, reader, "a predicate declaration")
+                if predicate.name in predicates or predicate.name in vocabulary.types:
+                    raise DuplicateError(
+                        f"predicate {predicate.name!r} is declared twice or clashes with a type",
+                        node.location,
+                    )
+                predicates[predicate.name] = predicate
+                vocabulary.predicates[predicate.name] = predicate.arity
+        elif keyword == ":functions":
+            _declare_functions(body, reader, functions)
+        else:
+            pending.append((keyword, section))
+    vocabulary.derived = frozenset(
+        _derived_name(section) for keyword, section in pending if keyword == ":derived"
+    )
+    actions: list[Action] = []
+    axioms: list[Axiom] = []
+    for keyword, section in pending:
+        if keyword == ":action":
+            action = _action(section, reader)
+            if any(existing.name == action.name for existing in actions):
+                raise DuplicateError(f"action {action.name!r} is defined twice", section.location)
+            actions.append(action)
+        else:
+            axioms.append(_axiom(section, reader, predicates))
+    for fname, arity in vocabulary.functions.items():
+        if fname not in functions:
+            params = tuple(Parameter(f"?x{i}") for i in range(arity))
+            functions[fname] = Function(fname, params)
+    return Domain(
+        name=name,
+        requirements=frozenset(requirements),
+        types=TypeHierarchy(dict(parents)),
+        constants=dict(constants),
+        predicates=dict(predicates),
+        functions=dict(functions),
+        actions=tuple(actions),
+        axioms=tuple(axioms),
+        source=filename,
+    )
+
+
+def _derived_name(section: SList) -> str:
+    if len(section.items) != 3:
+        raise PddlSyntaxError("expected '(:derived (predicate ?params) formula)'", section.location)
+    head = expect_list(section.items[1], "the derived predicate '(name ?params)'")
+    return expect_symbol(head.items[0] if head.items else head, "a predicate name").text
+
+
+def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str]) -> None:
+    for child, parent, location in parse_typed_list(body, "the types", None, variables=False):
+        if child == OBJECT_TYPE:
+            continue
+        if child in parents:
+            raise DuplicateError(f"type {child!r} is declared twice", location)
+        parents[child] = parent
+    for child, parent in list(parents.items()):
+        seen = {child}
+        while parent != OBJECT_TYPE:
+            if parent not in parents:
+                parents[parent] = OBJECT_TYPE  # an undeclared supertype is implicitly an object
+                break
+            if parent in seen:
+                raise PddlSyntaxError(
+                    f"type {child!r} is its own ancestor", body[0].location if body else None
+                )
+            seen.add(parent)
+            parent = parents[parent]
+
+
+def _declaration(node: SExpr, reader: FormulaReader, what: str) -> Predicate:
+    lst = expect_list(node, what)
+    head = expect_symbol(lst.items[0] if lst.items else lst, "a name")
+    params = parse_typed_list(
+        lst.items[1:], f"the parameters of {head.text!r}", reader.vocabulary.types, variables=True
+    )
+    return Predicate(head.text, tuple(Parameter(n, t) for n, t, _ in params))
+
+
+def _declare_functions(
+    body: tuple[SExpr, ...], reader: FormulaReader, functions: dict[str, Function]
+) -> None:
+    index = 0
+    while index < len(body):
+        node = body[index]
+        if isinstance(node, Symbol) and node.text == "-":
+            index += 2  # "- number": the only function type
+            continue
+        declaration = _declaration(node, reader, "a function declaration")
+        functions[declaration.name] = Function(declaration.name, declaration.parameters)
+        reader.vocabulary.functions[declaration.name] = declaration.arity
+        index += 1
+
+
+def _options(section: SList, allowed: tuple[str, ...], what: str) -> dict[str, SExpr]:
+    options: dict[str, SExpr] = {}
+    items = section.items[2:]
+    if len(items) % 2:
+        raise PddlSyntaxError(f"{what}: expected ':keyword value' pairs", section.location)
+    for key_node, value in zip(items[::2], items[1::2], strict=True):
+        key = expect_symbol(key_node, "a keyword")
+        if key.text not in allowed:
+            raise UnknownKeywordError(
+                f"unknown keyword {key.text!r} in {what}; expected one of {', '.join(allowed)}",
+                key.location,
+            )
+        if key.text in options:
+            raise DuplicateError(f"{key.text} is given twice in {what}", key.location)
+        options[key.text] = value
+    return options
+
+
+def _action(section: SList, reader: FormulaReader) -> Action:
+    if len(section.items) < 2:
+        raise PddlSyntaxError("expected an action name after ':action'", section.location)
+    name = expect_symbol(section.items[1], "an action name").text
+    what = f"action {name!r}"
+    options = _options(section, (":parameters", ":precondition", ":effect"), what)
+    params = (
+        reader.parameters(options[":parameters"], f"the parameters of {what}")
+        if ":parameters" in options
+        else ()
+    )
+    scope = {p.name: p.type for p in params}
+    precondition = (
+        reader.formula(options[":precondition"], scope) if (":precondition" in options) else TRUE
+    )
+    effect = reader.effect(options[":effect"], scope) if ":effect" in options else AndEffect(())
+    return Action(name, params, precondition, effect, section.location)
+
+
+def _axiom(section: SList, reader: FormulaReader, predicates: dict[str, Predicate]) -> Axiom:
+    head = expect_list(section.items[1], "the derived predicate '(name ?params)'")
+    declared = _declaration(head, reader, "the derived predicate")
+    if declared.name not in predicates:
+        raise UndeclaredError(
+            f"derived predicate {declared.name!r} is not declared in :predicates", head.location
+        )
+    if declared.arity != predicates[declared.name].arity:
+        raise ArityError(
+            f"predicate {declared.name!r} takes {predicates[declared.name].arity} argument(s), "
+            f"got {declared.arity}",
+            head.location,
+        )
+    params = tuple(
+        Parameter(p.name, decl.type if p.type == OBJECT_TYPE else p.type)
+        for p, decl in zip(declared.parameters, predicates[declared.name].parameters, strict=True)
+    )
+    body = reader.formula(section.items[2], {p.name: p.type for p in params})
+    return Axiom(declared.name, params, body, section.location)
+
+
+def parse_problem(text: str, domain: Domain, filename: str | None = None) -> Problem:
+    """Parse a PDDL problem for ``domain``.
+
+    Raises:
+        PddlError: a subclass naming ``file:line:col`` and what was expected.
+    """
+    root = read_sexpr(text, filename)
+    name = parse_name_header(root.items[1] if len(root.items) > 1 else root, "problem")
+    types = frozenset(domain.types.types())
+    objects: dict[str, str] = dict(domain.constants)
+    vocabulary = Vocabulary(
+        {p.name: p.arity for p in domain.predicates.values()},
+        types,
+        objects,
+        {f.name: len(f.parameters) for f in domain.functions.values()},
+        derived=domain.derived_predicates,
+        filename=filename,
+    )
+    reader = FormulaReader(vocabulary)
+    domain_name = domain.name
+    sections = _sections(root, "problem", PROBLEM_SECTIONS)
+    own: dict[str, str] = {}
+    for keyword, section in sections:
+        if keyword == ":domain":
+            domain_name = expect_symbol(
+                section.items[1] if len(section.items) > 1 else section, "the domain name"
+            ).text
+            if domain_name != domain.name:
+                raise PddlSyntaxError(
+                    f"problem is for domain {domain_name!r}, but the domain is {domain.name!r}",
+                    section.location,
+                )
+        elif keyword == ":objects":
+            for obj, type_name, location in parse_typed_list(
+                section.items[1:], "the objects", types, variables=False
+            ):
+                if obj in own:
+                    raise DuplicateError(f"object {obj!r} is declared twice", location)
+                own[obj] = type_name
+                objects[obj] = type_name
+    init: list[Atom] = []
+    numeric: dict[tuple[str, tuple[str, ...]], float] = {}
+    goal = TRUE
+    minimize = False
+    for keyword, section in sections:
+        if keyword == ":init":
+            for node in section.items[1:]:
+                _init_fact(node, reader, init, numeric)
+        elif keyword == ":goal":
+            if len(section.items) != 2:
+                raise PddlSyntaxError("expected '(:goal formula)'", section.location)
+            goal = reader.formula(section.items[1], {})
+        elif keyword == ":metric":
+            minimize = _metric(section)
+    return Problem(name, domain_name, dict(own), tuple(init), numeric, goal, minimize, filename)
+
+
+def _init_fact(
+    node: SExpr,
+    reader: FormulaReader,
+    init: list[Atom],
+    numeric: dict[tuple[str, tuple[str, ...]], float],
+) -> None:
+    lst = expect_list(node, "an initial fact")
+    head = lst.items[0] if lst.items else lst
+    if (
+        isinstance(head, Symbol)
+        and head.text == "="
+        and len(lst.items) == 3
+        and isinstance(lst.items[1], SList)
+    ):
+        term = lst.items[1]
+        fname = expect_symbol(term.items[0] if term.items else term, "a function name")
+        args = tuple(reader.term(arg, {}) for arg in term.items[1:])
+        reader.function_arity(fname, len(args), term.location)
+        value = expect_symbol(lst.items[2], "a number")
+        try:
+            numeric[(fname.text, args)] = float(value.text)
+        except ValueError:
+            raise PddlSyntaxError(
+                f"expected a number, found {value.text!r}", value.location
+            ) from None
+        return
+    atom = reader.atom(lst, {})
+    if atom.predicate in reader.vocabulary.derived:
+        raise PddlSyntaxError(
+            f"derived predicate {atom.predicate!r} cannot be in :init", lst.location
+        )
+    init.append(atom)
+
+
+def _metric(section: SList) -> bool:
+    items = section.items[1:]
+    text = " ".join(str(item) for item in items)
+    if text != f"minimize ({TOTAL_COST})":
+        location: SourceLocation = section.location
+        raise UnknownKeywordError(
+            f"unsupported metric {text!r}; expected 'minimize (total-cost)'", location
+        )
+    return True
