@@ -45,6 +45,14 @@ class ObjectTable:
             self._keep.append(value)
         return found
 
+    def copy(self) -> ObjectTable:
+        """An independent table with the same names so far (one per solve keeps runs alike)."""
+        other = ObjectTable()
+        other._names = dict(self._names)
+        other._values = dict(self._values)
+        other._keep = list(self._keep)
+        return other
+
     def value(self, name: str) -> Any:
         """The Python value behind ``name``."""
         return self._values[name]

@@ -30,7 +30,8 @@ class StreamInfo:
         p_success: prior probability that one call succeeds, in (0, 1].
         overhead: expected cost of one call [s], >= 0.
         effort: fixed effort used in place of the one derived from p_success and overhead.
-        opt_gen_fn: optimistic generator for placeholder outputs (None: one shared placeholder).
+        opt_gen_fn: placeholder outputs: ``"unique"`` (default, one per instance) or
+            ``"shared"`` (one per stream); a callable is accepted but not used yet.
         negate: for tests/predicates: the certified fact may be used negated.
         simultaneous: evaluate all instances of this stream together.
         verbose: log each call.
@@ -41,7 +42,7 @@ class StreamInfo:
     p_success: float | None = None
     overhead: float | None = None
     effort: float | None = None
-    opt_gen_fn: Callable[..., Any] | None = None
+    opt_gen_fn: Callable[..., Any] | str | None = None
     negate: bool = False
     simultaneous: bool = False
     verbose: bool = True
@@ -50,6 +51,11 @@ class StreamInfo:
     def __post_init__(self) -> None:
         if self.p_success is not None and not 0.0 < self.p_success <= 1.0:
             raise ValueError(f"StreamInfo.p_success must be in (0, 1], got {self.p_success}")
+        if isinstance(self.opt_gen_fn, str) and self.opt_gen_fn not in ("shared", "unique"):
+            raise ValueError(
+                f"StreamInfo.opt_gen_fn must be 'shared', 'unique' or a callable, "
+                f"got {self.opt_gen_fn!r}"
+            )
         if self.overhead is not None and self.overhead < 0:
             raise ValueError(f"StreamInfo.overhead must be >= 0, got {self.overhead}")
 

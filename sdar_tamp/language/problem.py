@@ -263,21 +263,33 @@ def _ground(problem: PDDLProblem) -> GroundFacts:
 
 def _object_types(problem: PDDLProblem, init: set[Atom]) -> dict[str, str]:
     """Each object's most specific type, from the domain's constants and init type facts."""
-    hierarchy = problem.domain.types
-    objects = {
-        name: problem.domain.constants.get(name, OBJECT_TYPE) for name in problem.objects.names()
-    }
-    for atom in init:
+    declared = {name: problem.domain.constants.get(name, OBJECT_TYPE)
+                for name in problem.objects.names()}
+    try:
+        return infer_object_types(declared, init, problem.domain.types)
+    except ValueError as error:
+        raise ProblemDefinitionError(str(error), _where("init")) from None
+
+
+def infer_object_types(
+    declared: Mapping[str, str], facts: Iterable[Atom], hierarchy: TypeHierarchy
+) -> dict[str, str]:
+    """Refine ``declared`` (name -> type) by unary type facts to the most specific type.
+
+    Raises:
+        ValueError: an object is given two unrelated types.
+    """
+    objects = dict(declared)
+    for atom in facts:
         if atom.predicate in hierarchy.parents and len(atom.args) == 1:
-            current = objects[atom.args[0]]
+            current = objects.get(atom.args[0], OBJECT_TYPE)
             new = atom.predicate
             if hierarchy.is_subtype(new, current):
                 objects[atom.args[0]] = new
             elif not hierarchy.is_subtype(current, new):
-                raise ProblemDefinitionError(
-                    f"object {problem.objects.value(atom.args[0])!r} is given both type "
-                    f"{current!r} and the unrelated type {new!r}",
-                    _where("init"),
+                raise ValueError(
+                    f"object {atom.args[0]!r} is given both type {current!r} and the unrelated "
+                    f"type {new!r}"
                 )
     return objects
 

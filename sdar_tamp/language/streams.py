@@ -202,6 +202,7 @@ def _stream(section: SList, reader: FormulaReader) -> Stream:
     domain = reader.conjunction(
         domain_node, _scope_for(domain_node, input_scope, "an input", what), f"the domain of {what}"
     )
+    _inputs_in_domain(inputs, domain, what)
     full_scope = {**input_scope, **{n: "object" for n, _ in outputs}}
     certified_node = options.get(":certified", empty)
     certified = reader.conjunction(
@@ -226,6 +227,17 @@ def _stream(section: SList, reader: FormulaReader) -> Stream:
         tuple(fluents),
         section.location,
     )
+
+
+def _inputs_in_domain(
+    inputs: Iterable[tuple[str, SourceLocation]], domain: tuple[Atom, ...], what: str
+) -> None:
+    """Every input must be constrained by the domain, or instances would range over all objects."""
+    used = {term for atom in domain for term in atom.args}
+    for name, location in inputs:
+        if name not in used:
+            raise StreamDefinitionError(f"input {name} of {what} must appear in its :domain",
+                                        location)
 
 
 def _scope_for(node: SExpr, scope: dict[str, str], role: str, what: str) -> dict[str, str]:
@@ -256,6 +268,7 @@ def _function(section: SList, reader: FormulaReader) -> StreamFunctionDecl:
     scope = {n: "object" for n, _ in inputs}
     reader.function_arity(name, len(inputs), head.location)
     domain = _optional_domain(section, reader, scope, f"function {name.text!r}")
+    _inputs_in_domain(inputs, domain, f"function {name.text!r}")
     return StreamFunctionDecl(FunctionTerm(name.text, tuple(scope)), domain, section.location)
 
 
@@ -266,6 +279,7 @@ def _predicate(section: SList, reader: FormulaReader) -> StreamPredicateDecl:
     scope = {n: "object" for n, _ in inputs}
     atom = reader.atom(head, scope)
     domain = _optional_domain(section, reader, scope, f"predicate {name.text!r}")
+    _inputs_in_domain(inputs, domain, f"predicate {name.text!r}")
     return StreamPredicateDecl(atom, domain, section.location)
 
 

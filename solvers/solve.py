@@ -1,0 +1,126 @@
+"""``solve(problem, algorithm=..., **options)``: PDDLStream's entry point and arguments."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import random
+from collections.abc import Mapping
+from typing import Any
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.options import FunctionInfo, PlanConstraints, StreamInfo
+from sdar_tamp.language.problem import PDDLProblem
+from solvers.solution import Solution
+from solvers.stream_planning.algorithms import ALGORITHMS, StreamOptions, StreamSolver
+
+LOG = logging.getLogger(__name__)
+INF = math.inf
+
+
+def _positive(name: str, value: float, allow_zero: bool = False) -> float:
+    if (
+        not isinstance(value, int | float)
+        or math.isnan(value)
+        or value < 0
+        or (value == 0 and not allow_zero)
+    ):
+        rule = ">= 0" if allow_zero else "> 0"
+        raise ParameterError(f"{name} must be a number {rule}, got {value!r}")
+    return float(value)
+
+
+def solve(
+    problem: PDDLProblem,
+    algorithm: str = "adaptive",
+    stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None,
+    constraints: PlanConstraints | None = None,
+    unit_costs: bool = False,
+    success_cost: float = INF,
+    max_time: float = INF,
+    max_iterations: float = INF,
+    max_skeletons: float = INF,
+    search_sample_ratio: float = 1.0,
+    initial_complexity: int = 0,
+    complexity_step: int = 1,
+    max_complexity: float = INF,
+    unit_efforts: bool = False,
+    effort_weight: float | None = None,
+    max_planner_time: float = INF,
+    verbose: bool = True,
+    seed: int | None = None,
+    planner: str = "wastar-ff",
+    **unknown: Any,
+) -> Solution:
+    """Solve ``problem``; returns a :class:`Solution` (``plan, cost, certificate = solution``).
+
+    Args:
+        algorithm: one of ``incremental``, ``focused``, ``binding``, ``adaptive``.
+        stream_info: per-stream :class:`StreamInfo` / :class:`FunctionInfo`, by stream name.
+        unit_costs: every action costs 1 instead of its ``total-cost`` increase.
+        success_cost: stop at the first plan of at most this cost (else keep improving until
+            ``max_time``).
+        max_time: wall-clock limit [s].
+        planner: ``SEARCH-HEURISTIC`` of the classical planner, e.g. ``wastar-ff``,
+            ``gbfs-ff``, ``astar-max``.
+        seed: seeds Python's ``random`` and NumPy's global generator before solving, so
+            samplers that draw from them give the same plan for the same seed.
+
+    Raises:
+        ParameterError: an argument out of range or unknown; the message names it.
+        StreamError: a user sampler raised (chained) or returned the wrong shape.
+    """
+    if unknown:
+        raise ParameterError(f"unknown solve() argument(s): {', '.join(sorted(unknown))}")
+    if algorithm not in ALGORITHMS:
+        raise ParameterError(f"algorithm must be one of {', '.join(ALGORITHMS)}; got {algorithm!r}")
+    if not isinstance(problem, PDDLProblem):
+        raise ParameterError(f"problem must be a PDDLProblem, got {type(problem).__name__}")
+    search, _, heuristic = planner.partition("-")
+    options = StreamOptions(
+        algorithm=algorithm,
+        unit_costs=unit_costs,
+        success_cost=_positive("success_cost", success_cost, allow_zero=True),
+        max_time=_positive("max_time", max_time),
+        max_iterations=_positive("max_iterations", max_iterations),
+        max_skeletons=_positive("max_skeletons", max_skeletons),
+        search_sample_ratio=_positive("search_sample_ratio", search_sample_ratio),
+        initial_complexity=int(_positive("initial_complexity", initial_complexity, True)),
+        complexity_step=int(_positive("complexity_step", complexity_step)),
+        max_complexity=_positive("max_complexity", max_complexity, allow_zero=True),
+        max_planner_time=_positive("max_planner_time", max_planner_time),
+        search=search,
+        heuristic=heuristic or "ff",
+    )
+    for name, value, default in (
+        ("constraints", constraints, None),
+        ("unit_efforts", unit_efforts, False),
+        ("effort_weight", effort_weight, None),
+    ):
+        if value != default:
+            LOG.warning("solve(%s=...) is accepted but not implemented; it has no effect", name)
+    logging.getLogger("solvers").setLevel(logging.INFO if verbose else logging.WARNING)
+    if seed is not None:
+        random.seed(seed)
+        try:
+            import numpy
+
+            numpy.random.seed(seed % 2**32)
+        except ImportError:  # pragma: no cover - numpy is a dependency
+            pass
+    return StreamSolver(problem, options, stream_info).solve()
+
+
+def create_parser(default_algorithm: str = "adaptive") -> argparse.ArgumentParser:
+    """PDDLStream's example parser: ``-a/--algorithm`` and ``-u/--unit``."""
+    parser = argparse.ArgumentParser()
+    parser.add_argument(
+        "-a",
+        "--algorithm",
+        default=default_algorithm,
+        choices=ALGORITHMS,
+        help="stream planning algorithm (default: %(default)s)",
+    )
+    parser.add_argument("-u", "--unit", action="store_true", help="use unit action costs")
+    return parser

@@ -1,0 +1,451 @@
+"""The stream planning algorithms: incremental, focused, binding and adaptive.
+
+- incremental: call every stream instance up to the complexity level, plan on real facts, raise
+  the level.
+- focused: plan in the optimistic world, extract the stream plan the optimistic plan needs, call
+  the instances of its first layer (real inputs) once each, disable failures until the level
+  rises, plan again.
+- binding: as focused, but walk the whole stream plan, binding placeholders to the outputs of
+  earlier calls, so one pass can turn an optimistic plan into a real one.
+- adaptive: binding with a queue of skeletons (optimistic plans) that are revisited; time spent
+  sampling is balanced against time spent searching by ``search_sample_ratio``.
+"""
+
+from __future__ import annotations
+
+import heapq
+import logging
+import math
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from sdar_tamp.language.model import AndEffect, Atom, Domain, FunctionTerm, IncreaseCost
+from sdar_tamp.language.objects import ObjectTable
+from sdar_tamp.language.problem import PDDLProblem, infer_object_types
+from solvers.classical import PlanningTask, PlanStatus
+from solvers.classical import plan as classical_plan
+from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
+from solvers.stream_planning.costs import guard_costs
+from solvers.stream_planning.diagnosis import diagnose
+from solvers.stream_planning.engine import Engine
+from solvers.stream_planning.optimistic import (
+    OptimisticBuilder,
+    OptimisticWorld,
+    OptResult,
+    is_placeholder,
+    negated_predicates,
+)
+from solvers.stream_planning.preimage import simulate
+
+LOG = logging.getLogger(__name__)
+ALGORITHMS = ("incremental", "focused", "binding", "adaptive")
+PlanSteps = list[tuple[str, tuple[str, ...]]]
+
+
+@dataclass(frozen=True)
+class StreamOptions:
+    """The solve() options the stream algorithms use (validated by :func:`solvers.solve`)."""
+
+    algorithm: str = "adaptive"
+    unit_costs: bool = False
+    success_cost: float = math.inf
+    max_time: float = math.inf
+    max_iterations: float = math.inf
+    max_skeletons: float = math.inf
+    search_sample_ratio: float = 1.0
+    initial_complexity: int = 0
+    complexity_step: int = 1
+    max_complexity: float = math.inf
+    max_planner_time: float = math.inf
+    search: str = "wastar"
+    heuristic: str = "ff"
+    weight: float = 2.0
+
+
+@dataclass(order=True)
+class Skeleton:
+    """An optimistic plan and the stream plan that would make it real."""
+
+    priority: tuple[int, float, int]
+    actions: PlanSteps = field(compare=False)
+    stream_plan: list[OptResult] = field(compare=False)
+    attempts: int = field(default=0, compare=False)
+    chosen: dict[int, tuple[str, ...]] = field(default_factory=dict, compare=False)
+
+
+class _Timeout(Exception):
+    pass
+
+
+class StreamSolver:
+    """One solve of one problem (all state lives here, nothing is global)."""
+
+    def __init__(
+        self,
+        problem: PDDLProblem,
+        options: StreamOptions,
+        stream_info: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.problem = problem
+        self.options = options
+        self.start = time.perf_counter()
+        self.engine = Engine(problem, stream_info)
+        self.domain: Domain = guard_costs(problem.domain)
+        self.goal = problem.facts.goal
+        self.builder = OptimisticBuilder(self.engine, negated_predicates(problem.domain, self.goal))
+        self.stats: dict[str, float] = {
+            "iterations": 0,
+            "skeletons": 0,
+            "search_time": 0.0,
+            "sample_time": 0.0,
+            "complexity": 0,
+        }
+        self.best: tuple[float, PlanSteps, frozenset[Atom]] | None = None
+        self.queue: list[Skeleton] = []
+        self._order = 0
+
+    # --- helpers --------------------------------------------------------------------------
+
+    @property
+    def table(self) -> ObjectTable:
+        return self.engine.table
+
+    def remaining(self) -> float:
+        return self.options.max_time - (time.perf_counter() - self.start)
+
+    def _check_time(self) -> None:
+        if self.remaining() <= 0:
+            raise _Timeout
+
+    def _objects(self, facts: Iterable[Atom]) -> dict[str, str]:
+        names = dict.fromkeys(self.problem.facts.objects, "object")
+        names.update(dict.fromkeys(self.problem.domain.constants, "object"))
+        for atom in facts:
+            for arg in atom.args:
+                names.setdefault(arg, "object")
+        declared = {n: self.problem.domain.constants.get(n, "object") for n in names}
+        return infer_object_types(
+            declared, (a for a in facts if len(a.args) == 1), self.problem.domain.types
+        )
+
+    def plan(
+        self, facts: Mapping[Atom, int], numeric: Mapping[tuple[str, tuple[str, ...]], float]
+    ) -> tuple[PlanSteps, float] | None:
+        """A classical plan over ``facts``; None when there is none."""
+        self._check_time()
+        limit = min(self.remaining(), self.options.max_planner_time)
+        task = PlanningTask(
+            self.domain,
+            self._objects(facts),
+            frozenset(facts),
+            self.goal,
+            numeric,
+            use_costs=not self.options.unit_costs,
+        )
+        start = time.perf_counter()
+        result = classical_plan(
+            task,
+            search=self.options.search,
+            heuristic=self.options.heuristic,
+            weight=self.options.weight,
+            time_limit=limit,
+        )
+        self.stats["search_time"] += time.perf_counter() - start
+        if result.status is PlanStatus.TIMEOUT:
+            self._check_time()
+            return None
+        if result.plan is None:
+            return None
+        return [(step.name, step.args) for step in result.plan], result.cost
+
+    def _sample(self, name: str, inputs: tuple[str, ...]) -> bool | None:
+        """Call a real instance once; None when it does not exist."""
+        state = self.engine.instance(name, inputs)
+        if state is None:
+            return None
+        start = time.perf_counter()
+        produced = self.engine.sample(state)
+        self.stats["sample_time"] += time.perf_counter() - start
+        return produced
+
+    def _real_check(self, actions: PlanSteps) -> tuple[bool, frozenset[Atom]]:
+        facts = self.engine.store.levels
+        check = simulate(self.problem.domain, self._objects(facts), facts, actions, self.goal)
+        return check.valid, check.needed
+
+    def _record(self, actions: PlanSteps, needed: frozenset[Atom]) -> bool:
+        """Keep a real plan if it is the best so far; True when it is good enough to stop."""
+        cost = plan_cost(self.problem.domain, actions, self.engine.numeric, self.options.unit_costs)
+        if self.best is None or cost < self.best[0]:
+            self.best = (cost, actions, needed)
+        return self.best[0] <= self.options.success_cost
+
+    # --- algorithms ---------------------------------------------------------------------
+
+    def solve(self) -> Solution:
+        try:
+            if self.options.algorithm == "incremental":
+                status = self._incremental()
+            else:
+                status = self._focused()
+        except _Timeout:
+            status = Status.TIMEOUT
+        if self.best is not None:
+            status = Status.SOLVED
+        return self._solution(status)
+
+    def _incremental(self) -> Status:
+        level = self.options.initial_complexity
+        while True:
+            self.stats["iterations"] += 1
+            self.stats["complexity"] = level
+            progress = True
+            while progress:
+                progress = False
+                for key in sorted(self.engine.instances):
+                    self._check_time()
+                    state = self.engine.instances[key]
+                    if not state.instance.exhausted and state.next_level <= level:
+                        self._sample(*key)
+                        progress = True
+            found = self.plan(self.engine.store.levels, self.engine.numeric)
+            if found is not None:
+                valid, needed = self._real_check(found[0])
+                if valid and self._record(found[0], needed):
+                    return Status.SOLVED
+            pending = [s for s in self.engine.instances.values() if not s.instance.exhausted]
+            if not pending and found is None:
+                return Status.INFEASIBLE
+            if self.stats["iterations"] >= self.options.max_iterations:
+                return Status.TIMEOUT
+            level += self.options.complexity_step
+            if level > self.options.max_complexity:
+                return Status.INFEASIBLE
+
+    def _focused(self) -> Status:
+        options = self.options
+        level = options.initial_complexity
+        while True:
+            if self.stats["iterations"] >= options.max_iterations:
+                return Status.TIMEOUT
+            self.stats["iterations"] += 1
+            self.stats["complexity"] = level
+            world = self.builder.build(level)
+            search_start = time.perf_counter()
+            found = (
+                self.plan(world.facts, world.numeric)
+                if self.stats["skeletons"] < options.max_skeletons
+                else None
+            )
+            search_time = time.perf_counter() - search_start
+            if found is None:
+                if self.queue:
+                    if self._process_queue(max(search_time, 0.01) * options.search_sample_ratio):
+                        return Status.SOLVED
+                    continue
+                disabled = [s for s in self.engine.instances.values() if s.instance.disabled]
+                if world.complete and not disabled:
+                    return Status.INFEASIBLE
+                level += options.complexity_step
+                if level > options.max_complexity:
+                    return Status.INFEASIBLE
+                for state in disabled:
+                    state.instance.disabled = False
+                continue
+            actions, cost = found
+            check = simulate(
+                self.problem.domain, self._objects(world.facts), world.facts, actions, self.goal
+            )
+            stream_plan = extract_stream_plan(check.needed, world)
+            if not any(r.kind == "stream" for r in stream_plan) and not any(
+                is_placeholder(a) for _, args in actions for a in args
+            ):
+                valid, needed = self._real_check(actions)
+                if valid and self._record(actions, needed):
+                    return Status.SOLVED
+                if not valid:
+                    LOG.debug("plan on real facts failed validation; raising complexity")
+                    level += options.complexity_step
+                continue
+            self.stats["skeletons"] += 1
+            skeleton = Skeleton((0, cost, self._order), actions, stream_plan)
+            self._order += 1
+            if options.algorithm == "focused":
+                self._sample_first_layer(stream_plan)
+            elif options.algorithm == "binding":
+                if self._process(skeleton) is True:
+                    return Status.SOLVED
+            else:
+                heapq.heappush(self.queue, skeleton)
+                if self._process_queue(max(search_time, 0.01) * options.search_sample_ratio):
+                    return Status.SOLVED
+
+    def _sample_first_layer(self, stream_plan: Sequence[OptResult]) -> None:
+        for result in stream_plan:
+            if result.kind != "stream" or any(is_placeholder(n) for n in result.inputs):
+                continue
+            self._check_time()
+            produced = self._sample(result.external, result.inputs)
+            state = self.engine.instance(result.external, result.inputs)
+            if produced is False and state is not None:
+                state.instance.disabled = True
+
+    def _process_queue(self, budget: float) -> bool:
+        """Work on queued skeletons for about ``budget`` seconds; True when solved."""
+        deadline = time.perf_counter() + budget
+        while self.queue and time.perf_counter() < deadline:
+            self._check_time()
+            skeleton = heapq.heappop(self.queue)
+            outcome = self._process(skeleton)
+            if outcome is True:
+                return True
+            if outcome is False:  # still possible: requeue behind the others
+                skeleton.attempts += 1
+                skeleton.priority = (skeleton.attempts, skeleton.priority[1], self._order)
+                self._order += 1
+                heapq.heappush(self.queue, skeleton)
+        return False
+
+    def _process(self, skeleton: Skeleton) -> bool | None:
+        """Bind a skeleton's stream plan. True: solved; False: retry later; None: dead.
+
+        A placeholder stands for a *new* output of its instance (outputs already produced are
+        real objects the planner can use directly), so each stream step samples afresh unless
+        this skeleton already holds an output for it.
+        """
+        bindings: dict[str, str] = {}
+        store = self.engine.store
+        for index, result in enumerate(skeleton.stream_plan):
+            inputs = tuple(bindings.get(n, n) for n in result.inputs)
+            if any(is_placeholder(n) for n in inputs):
+                return None
+            if result.kind == "predicate":
+                if Atom(result.external, inputs) not in store:
+                    return self._upstream_retry(skeleton, index)
+                continue
+            if result.kind in ("rule", "function"):
+                continue
+            self._check_time()
+            state = self.engine.instance(result.external, inputs)
+            if state is None:
+                return None
+            if index not in skeleton.chosen:
+                before = len(state.instance.results)
+                if not state.instance.exhausted:
+                    self._sample(result.external, inputs)
+                if len(state.instance.results) == before:
+                    if self.options.algorithm == "binding":
+                        state.instance.disabled = True
+                    if not state.instance.exhausted:
+                        return False
+                    return self._upstream_retry(skeleton, index)
+                skeleton.chosen[index] = state.instance.results[-1].outputs
+            bindings.update(zip(result.outputs, skeleton.chosen[index], strict=True))
+        actions = [
+            (name, tuple(bindings.get(a, a) for a in args)) for name, args in skeleton.actions
+        ]
+        if any(is_placeholder(a) for _, args in actions for a in args):
+            return None
+        valid, needed = self._real_check(actions)
+        if valid:
+            return True if self._record(actions, needed) else None
+        return self._upstream_retry(skeleton, len(skeleton.stream_plan))
+
+    def _upstream_retry(self, skeleton: Skeleton, index: int) -> bool | None:
+        """Step ``index`` cannot succeed with the outputs chosen before it: resample those."""
+        upstream = [i for i in skeleton.chosen if i < index]
+        for i in upstream:
+            del skeleton.chosen[i]
+        live = any(
+            (state := self.engine.instance(r.external, r.inputs)) is None
+            or not state.instance.exhausted
+            for i, r in enumerate(skeleton.stream_plan[:index])
+            if r.kind == "stream"
+        )
+        return False if upstream and live else None
+
+    # --- result -------------------------------------------------------------------------
+
+    def _solution(self, status: Status) -> Solution:
+        engine = self.engine
+        table = engine.table
+        streams = {
+            name: StreamStatistics(c.calls, c.successes, c.outputs, c.time)
+            for name, c in (
+                *((n, e.counters) for n, e in engine.streams.items()),
+                *((n, e.counters) for n, e in engine.functions.items()),
+            )
+        }
+        self.stats["time"] = time.perf_counter() - self.start
+        self.stats["facts"] = len(engine.store)
+
+        def fact(atom: Atom) -> tuple[Any, ...]:
+            return (atom.predicate, *(table.value(a) for a in atom.args))
+
+        real = [a for a in engine.store.levels if not a.predicate.startswith("@")]
+        if self.best is None:
+            return Solution(
+                None,
+                math.inf,
+                Certificate(tuple(fact(a) for a in real), ()),
+                status,
+                dict(self.stats),
+                streams,
+                diagnose(self, status),
+            )
+        cost, actions, needed = self.best
+        plan = [Action(name, tuple(table.value(a) for a in args)) for name, args in actions]
+        certificate = Certificate(
+            tuple(fact(a) for a in real),
+            tuple(fact(a) for a in sorted(needed, key=str) if not a.predicate.startswith("@")),
+        )
+        return Solution(plan, cost, certificate, Status.SOLVED, dict(self.stats), streams)
+
+
+def extract_stream_plan(needed: Iterable[Atom], world: OptimisticWorld) -> list[OptResult]:
+    """The optimistic results behind ``needed`` facts, dependencies first."""
+    order: list[OptResult] = []
+    seen: set[int] = set()
+
+    def visit(atom: Atom) -> None:
+        result = world.provenance.get(atom)
+        if result is None or id(result) in seen:
+            return
+        seen.add(id(result))
+        for dependency in result.domain:
+            visit(dependency)
+        order.append(result)
+
+    for atom in sorted(needed, key=str):
+        visit(atom)
+    return order
+
+
+def plan_cost(
+    domain: Domain,
+    actions: PlanSteps,
+    numeric: Mapping[tuple[str, tuple[str, ...]], float],
+    unit_costs: bool,
+) -> float:
+    """The cost of a plan: its length with unit costs, else the sum of its top-level costs."""
+    if unit_costs:
+        return float(len(actions))
+    total = 0.0
+    for name, args in actions:
+        action = domain.action(name)
+        binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
+        stack = [action.effect]
+        while stack:
+            effect = stack.pop()
+            if isinstance(effect, AndEffect):
+                stack.extend(effect.parts)
+            elif isinstance(effect, IncreaseCost):
+                amount = effect.amount
+                if isinstance(amount, FunctionTerm):
+                    key = (amount.name, tuple(binding.get(a, a) for a in amount.args))
+                    total += numeric.get(key, 0.0)
+                else:
+                    total += amount
+    return total

@@ -1,0 +1,80 @@
+"""Why a stream solve found no plan, in a few short sentences."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from sdar_tamp.language.model import iter_atoms, iter_effect_literals
+from solvers.solution import Status
+
+if TYPE_CHECKING:
+    from solvers.stream_planning.algorithms import StreamSolver
+
+
+def _produced_predicates(solver: StreamSolver) -> set[str]:
+    domain = solver.problem.domain
+    produced = {a.predicate for a in solver.engine.store.levels}
+    for action in domain.actions:
+        produced |= {lit.atom.predicate for lit in iter_effect_literals(action.effect)}
+    produced |= {axiom.predicate for axiom in domain.axioms}
+    for external in solver.engine.streams.values():
+        produced |= {a.predicate for a in external.declaration.certified}
+    produced |= set(domain.types.parents)
+    produced.add("=")
+    return produced
+
+
+def diagnose(solver: StreamSolver, status: Status) -> list[str]:
+    """Short sentences: goals never reachable, streams never instantiated, streams that failed."""
+    reasons: list[str] = []
+    if status is Status.TIMEOUT:
+        reasons.append(
+            f"the time limit ({solver.options.max_time:g} s) or the iteration limit "
+            "ended the search"
+        )
+    produced = _produced_predicates(solver)
+    table = solver.engine.table
+    for atom in iter_atoms(solver.goal):
+        if atom.predicate not in produced:
+            args = " ".join(repr(table.value(a)) if a in table else a for a in atom.args)
+            reasons.append(
+                f"goal fact ({atom.predicate} {args}) is never reached: nothing "
+                f"makes '{atom.predicate}' true (no init fact, action, axiom or stream)"
+            )
+    known = solver.engine.store.predicates()
+    certified = {
+        a.predicate for s in solver.engine.streams.values() for a in s.declaration.certified
+    }
+    instantiated = {name for name, _ in solver.engine.instances}
+    for name, external in sorted(solver.engine.streams.items()):
+        if name not in instantiated:
+            missing = sorted(
+                {a.predicate for a in external.declaration.domain if a.predicate not in known}
+            )
+            detail = (
+                (
+                    f"no fact of {', '.join(missing)} was ever known"
+                    + (
+                        " (only streams could certify it, and none did)"
+                        if set(missing) <= certified
+                        else ""
+                    )
+                )
+                if missing
+                else ("its domain facts never held together")
+            )
+            reasons.append(f"stream '{name}' was never instantiated: {detail}")
+        elif external.counters.calls and not external.counters.successes:
+            reasons.append(
+                f"stream '{name}' was called {external.counters.calls} time(s) and "
+                "never produced an output"
+            )
+    exhausted = sum(1 for s in solver.engine.instances.values() if s.instance.exhausted)
+    if exhausted:
+        reasons.append(f"{exhausted} stream instance(s) were exhausted")
+    if not reasons:
+        reasons.append(
+            "no plan exists over every fact the streams could certify "
+            f"(complexity {solver.stats['complexity']:g})"
+        )
+    return reasons

@@ -1,0 +1,197 @@
+"""The state every stream algorithm shares: externals, known (real) facts, stream instances.
+
+Real facts have complexity levels: init facts are level 0; a result of an instance whose domain
+facts reach level ``d`` and that was called ``k`` times before has level ``d + k + 1``.
+``:function`` and ``:predicate`` instances are evaluated as soon as their domain holds (they are
+cheap, and negated predicates need their value); ``:rule`` facts are added at once.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from sdar_tamp.language.model import Atom, Rule, StreamFunction, StreamPredicate
+from sdar_tamp.language.objects import ObjectTable
+from sdar_tamp.language.options import FunctionInfo, StreamInfo, unsupported_options
+from sdar_tamp.language.problem import PDDLProblem
+from solvers.stream_planning.externals import (
+    FunctionExternal,
+    StreamExternal,
+    StreamInstance,
+    debug_gen_fn,
+)
+from solvers.stream_planning.facts import FactStore, Instantiator, Query
+
+LOG = logging.getLogger(__name__)
+SUPPORTED_STREAM_OPTIONS = {
+    "eager",
+    "p_success",
+    "overhead",
+    "effort",
+    "negate",
+    "opt_gen_fn",
+    "verbose",
+}
+SUPPORTED_FUNCTION_OPTIONS = {"opt_fn", "verbose"}
+RULE_PREFIX = "@rule"
+
+
+def function_guard(name: str) -> str:
+    """The predicate that says a function's value is known for some arguments."""
+    return f"@fn:{name}"
+
+
+@dataclass(frozen=True)
+class InstanceState:
+    """A pending stream instance and the level of its domain facts."""
+
+    instance: StreamInstance
+    domain_level: int
+
+    @property
+    def next_level(self) -> int:
+        return self.domain_level + self.instance.calls + 1
+
+
+class Engine:
+    """Real facts and stream instances of one solve."""
+
+    def __init__(
+        self,
+        problem: PDDLProblem,
+        stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None,
+    ) -> None:
+        self.problem = problem
+        self.table: ObjectTable = problem.objects.copy()
+        info = {k.lower(): v for k, v in (stream_info or {}).items()}
+        _warn_unsupported(info)
+        debug = isinstance(problem.stream_map, str)
+        functions = problem.stream_functions
+        streams = problem.streams
+        self.streams = {
+            s.name: StreamExternal(
+                s,
+                debug_gen_fn(s) if debug else functions[s.name],
+                _as_stream_info(info.get(s.name)),
+            )
+            for s in streams.streams
+        }
+        self.functions: dict[str, FunctionExternal] = {}
+        declarations: list[StreamFunction | StreamPredicate] = [
+            *streams.functions,
+            *streams.predicates,
+        ]
+        for decl in declarations:
+            fn: Callable[..., Any]
+            if not debug:
+                fn = functions[decl.name]
+            elif isinstance(decl, StreamFunction):
+                fn = _debug_cost
+            else:
+                fn = _debug_predicate
+            self.functions[decl.name] = FunctionExternal(
+                decl, fn, info.get(decl.name) or FunctionInfo()
+            )
+        self.rules = {f"{RULE_PREFIX}{i}": rule for i, rule in enumerate(streams.rules)}
+        self.store = FactStore()
+        self.numeric: dict[tuple[str, tuple[str, ...]], float] = dict(problem.facts.numeric)
+        self.instances: dict[tuple[str, tuple[str, ...]], InstanceState] = {}
+        queries = [
+            Query(s.name, s.declaration.inputs, s.declaration.domain) for s in self.streams.values()
+        ]
+        queries += [
+            Query(f.name, f.declaration.inputs, f.declaration.domain)
+            for f in self.functions.values()
+        ]
+        queries += [Query(name, rule.parameters, rule.domain) for name, rule in self.rules.items()]
+        self.instantiator = Instantiator(queries, self.store)
+        for atom in sorted(problem.facts.init, key=str):
+            self.store.add(atom, 0)
+        for key in self.numeric:
+            self.store.add(Atom(function_guard(key[0]), key[1]), 0)
+        self.add_facts(self._instantiate(self.instantiator.initial()), 0)
+
+    # --- adding facts ---------------------------------------------------------------------
+
+    def add_facts(self, atoms: Iterable[Atom], level: int) -> list[Atom]:
+        """Add real facts and everything that follows at once (instances, rules, functions)."""
+        new: list[Atom] = []
+        pending = list(atoms)
+        while pending:
+            atom = pending.pop()
+            if self.store.add(atom, level):
+                new.append(atom)
+                pending.extend(self._instantiate(self.instantiator.new_fact(atom)))
+        return new
+
+    def _instantiate(self, found: Iterable[tuple[Query, tuple[str, ...], int]]) -> list[Atom]:
+        derived: list[Atom] = []
+        for query, inputs, level in found:
+            if query.name in self.streams:
+                instance = StreamInstance(self.streams[query.name], inputs)
+                self.instances[(query.name, inputs)] = InstanceState(instance, level)
+            elif query.name in self.functions:
+                external = self.functions[query.name]
+                value = external.evaluate(inputs, self.table)
+                if external.is_predicate:
+                    if value:
+                        derived.append(Atom(query.name, inputs))
+                else:
+                    self.numeric[(query.name, inputs)] = float(value)
+                    derived.append(Atom(function_guard(query.name), inputs))
+            else:
+                rule: Rule = self.rules[query.name]
+                mapping = dict(zip(rule.parameters, inputs, strict=True))
+                derived.extend(
+                    Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args))
+                    for a in rule.certified
+                )
+        return derived  # rules and predicates take the level of the fact that completed them
+
+    # --- sampling -------------------------------------------------------------------------
+
+    def sample(self, state: InstanceState) -> bool:
+        """Call one instance once; True when it produced an output (or, for a test, passed)."""
+        instance = state.instance
+        level = state.next_level
+        results, wild = instance.next(self.table)
+        facts = [atom for result in results for atom in result.certified]
+        self.add_facts([*facts, *wild], level)
+        return bool(results)
+
+    def instance(self, name: str, inputs: tuple[str, ...]) -> InstanceState | None:
+        return self.instances.get((name, inputs))
+
+
+def _debug_cost(*_inputs: Any) -> float:
+    return 1.0
+
+
+def _debug_predicate(*_inputs: Any) -> bool:
+    return False
+
+
+def _as_stream_info(info: StreamInfo | FunctionInfo | None) -> StreamInfo:
+    return info if isinstance(info, StreamInfo) else StreamInfo()
+
+
+def _warn_unsupported(info: Mapping[str, StreamInfo | FunctionInfo]) -> None:
+    for name, options in info.items():
+        supported = (
+            SUPPORTED_STREAM_OPTIONS
+            if isinstance(options, StreamInfo)
+            else SUPPORTED_FUNCTION_OPTIONS
+        )
+        if isinstance(options, StreamInfo) and callable(options.opt_gen_fn):
+            LOG.warning(
+                "stream_info[%r].opt_gen_fn as a callable is not implemented; "
+                "placeholders are per instance",
+                name,
+            )
+        for option in unsupported_options(options, supported):
+            LOG.warning(
+                "stream_info[%r].%s is accepted but not implemented; it has no effect", name, option
+            )

@@ -1,0 +1,121 @@
+"""Known facts with their complexity levels, and the instantiation of stream domains over them."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+
+from sdar_tamp.language.model import Atom, is_variable
+
+
+class FactStore:
+    """Ground atoms, each with the lowest complexity level at which it is known."""
+
+    def __init__(self) -> None:
+        self.levels: dict[Atom, int] = {}
+        self._by_predicate: dict[str, dict[tuple[str, ...], int]] = {}
+
+    def add(self, atom: Atom, level: int) -> bool:
+        """Record ``atom``; True when it is new (a lower level for a known atom is kept too)."""
+        old = self.levels.get(atom)
+        if old is not None and old <= level:
+            return False
+        self.levels[atom] = level
+        self._by_predicate.setdefault(atom.predicate, {})[atom.args] = level
+        return old is None
+
+    def __contains__(self, atom: object) -> bool:
+        return atom in self.levels
+
+    def __len__(self) -> int:
+        return len(self.levels)
+
+    def predicates(self) -> frozenset[str]:
+        return frozenset(self._by_predicate)
+
+    def join(
+        self, atoms: Sequence[Atom], binding: dict[str, str], level: int = 0
+    ) -> Iterator[tuple[dict[str, str], int]]:
+        """Every extension of ``binding`` under which all ``atoms`` are known, with the highest
+        level among the facts used."""
+        if not atoms:
+            yield binding, level
+            return
+        # bind the most constrained atom first
+        index = max(
+            range(len(atoms)),
+            key=lambda i: sum(1 for t in atoms[i].args if not is_variable(t) or t in binding),
+        )
+        atom, rest = atoms[index], [*atoms[:index], *atoms[index + 1 :]]
+        for args, fact_level in self._by_predicate.get(atom.predicate, {}).items():
+            extended = _unify(atom.args, args, binding)
+            if extended is not None:
+                yield from self.join(rest, extended, max(level, fact_level))
+
+
+def _unify(
+    pattern: tuple[str, ...], args: tuple[str, ...], binding: dict[str, str]
+) -> dict[str, str] | None:
+    if len(pattern) != len(args):
+        return None
+    result = binding
+    for term, value in zip(pattern, args, strict=True):
+        if is_variable(term):
+            bound = result.get(term)
+            if bound is None:
+                if result is binding:
+                    result = dict(binding)
+                result[term] = value
+            elif bound != value:
+                return None
+        elif term != value:
+            return None
+    return result
+
+
+@dataclass(frozen=True)
+class Query:
+    """The domain of an external: which inputs make an instance."""
+
+    name: str
+    inputs: tuple[str, ...]
+    domain: tuple[Atom, ...]
+
+
+class Instantiator:
+    """Finds new instances of queries as facts arrive (each instance once)."""
+
+    def __init__(self, queries: Sequence[Query], store: FactStore) -> None:
+        self.queries = tuple(queries)
+        self.store = store
+        self.seen: set[tuple[str, tuple[str, ...]]] = set()
+        self._by_predicate: dict[str, list[tuple[Query, int]]] = {}
+        for query in self.queries:
+            for position, atom in enumerate(query.domain):
+                self._by_predicate.setdefault(atom.predicate, []).append((query, position))
+
+    def initial(self) -> Iterator[tuple[Query, tuple[str, ...], int]]:
+        """Instances from the facts already in the store (and those of empty domains)."""
+        for query in self.queries:
+            for binding, level in self.store.join(query.domain, {}):
+                yield from self._emit(query, binding, level)
+
+    def new_fact(self, atom: Atom) -> Iterator[tuple[Query, tuple[str, ...], int]]:
+        """Instances whose domain uses ``atom`` (just added to the store)."""
+        level = self.store.levels[atom]
+        for query, position in self._by_predicate.get(atom.predicate, ()):
+            start = _unify(query.domain[position].args, atom.args, {})
+            if start is None:
+                continue
+            rest = [*query.domain[:position], *query.domain[position + 1 :]]
+            for binding, used in self.store.join(rest, start, level):
+                yield from self._emit(query, binding, used)
+
+    def _emit(
+        self, query: Query, binding: dict[str, str], level: int
+    ) -> Iterator[tuple[Query, tuple[str, ...], int]]:
+        inputs = tuple(binding[v] for v in query.inputs)
+        key = (query.name, inputs)
+        if key not in self.seen:
+            self.seen.add(key)
+            yield query, inputs, level

@@ -1,0 +1,208 @@
+"""The optimistic world: real facts plus what every stream instance *could* certify.
+
+Each instance whose next result stays within the complexity limit contributes placeholder
+outputs (``#o<k>``). By default a placeholder belongs to its instance (``unique``); with
+``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output.
+Functions on placeholders take their optimistic value (``FunctionInfo.opt_fn``, default 1);
+predicates on placeholders are optimistically true unless the domain uses them negated.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from sdar_tamp.language.model import Atom, Domain, Formula, Not, iter_atoms
+from solvers.stream_planning.engine import Engine, function_guard
+from solvers.stream_planning.externals import FunctionExternal
+from solvers.stream_planning.facts import FactStore, Instantiator, Query
+
+PLACEHOLDER = "#o"
+
+
+def is_placeholder(name: str) -> bool:
+    return name.startswith(PLACEHOLDER)
+
+
+@dataclass(frozen=True)
+class OptResult:
+    """An optimistic result: what ``external`` would certify on ``inputs``."""
+
+    external: str
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    domain: tuple[Atom, ...]
+    certified: tuple[Atom, ...]
+    level: int
+    kind: str  # "stream", "function", "predicate" or "rule"
+
+
+@dataclass
+class OptimisticWorld:
+    facts: dict[Atom, int]
+    provenance: dict[Atom, OptResult]
+    numeric: dict[tuple[str, tuple[str, ...]], float]
+    placeholders: list[str] = field(default_factory=list)
+    complete: bool = True  # no instance was left out for the limit or for being disabled
+
+
+def negated_predicates(domain: Domain, goal: Formula) -> frozenset[str]:
+    """Predicates that occur under a negation somewhere in the domain or goal."""
+    formulas: list[Formula] = [
+        goal,
+        *(a.precondition for a in domain.actions),
+        *(x.body for x in domain.axioms),
+    ]
+    found: set[str] = set()
+    for formula in formulas:
+        stack = [formula]
+        while stack:
+            node = stack.pop()
+            if isinstance(node, Not):
+                found.update(a.predicate for a in iter_atoms(node.formula))
+            elif not isinstance(node, Atom):
+                stack.extend(_children(node))
+    return frozenset(found)
+
+
+def _children(node: Formula) -> list[Formula]:
+    parts = getattr(node, "parts", None)
+    if parts is not None:
+        return list(parts)
+    if hasattr(node, "body"):
+        return [node.body]
+    return [node.antecedent, node.consequent]  # type: ignore[union-attr]
+
+
+class OptimisticBuilder:
+    """Builds optimistic worlds for one engine (placeholders keep their names across builds)."""
+
+    def __init__(self, engine: Engine, negated: frozenset[str]) -> None:
+        self.engine = engine
+        self.negated = negated
+        self._placeholders: dict[tuple[object, ...], str] = {}
+
+    def placeholder(self, key: tuple[object, ...]) -> str:
+        name = self._placeholders.get(key)
+        if name is None:
+            name = f"{PLACEHOLDER}{len(self._placeholders)}"
+            self._placeholders[key] = name
+        return name
+
+    def build(self, limit: int) -> OptimisticWorld:
+        engine = self.engine
+        store = FactStore()
+        for atom, level in engine.store.levels.items():
+            store.add(atom, level)
+        world = OptimisticWorld(dict(engine.store.levels), {}, dict(engine.numeric))
+        queries = [
+            Query(s.name, s.declaration.inputs, s.declaration.domain)
+            for s in engine.streams.values()
+        ]
+        queries += [
+            Query(f.name, f.declaration.inputs, f.declaration.domain)
+            for f in engine.functions.values()
+        ]
+        queries += [Query(n, r.parameters, r.domain) for n, r in engine.rules.items()]
+        instantiator = Instantiator(queries, store)
+        pending = list(instantiator.initial())
+        while pending:
+            query, inputs, level = pending.pop()
+            for result in self._results(query.name, inputs, level, limit, world):
+                for atom in result.certified:
+                    if store.add(atom, result.level):
+                        world.facts[atom] = result.level
+                        world.provenance[atom] = result
+                        pending.extend(instantiator.new_fact(atom))
+        world.placeholders = sorted(
+            {n for atom in world.provenance for n in atom.args if is_placeholder(n)}
+        )
+        return world
+
+    def _results(
+        self, name: str, inputs: tuple[str, ...], level: int, limit: int, world: OptimisticWorld
+    ) -> list[OptResult]:
+        engine = self.engine
+        real = not any(is_placeholder(n) for n in inputs)
+        if name in engine.streams:
+            external = engine.streams[name]
+            state = engine.instance(name, inputs) if real else None
+            next_level = level + 1
+            if state is not None:
+                if state.instance.exhausted:
+                    return []
+                if state.instance.disabled:
+                    world.complete = False
+                    return []
+                next_level = level + state.instance.calls + 1
+            if next_level > limit:
+                world.complete = False
+                return []
+            shared = external.info.opt_gen_fn == "shared"
+            outputs = tuple(
+                self.placeholder((name, i) if shared else (name, inputs, i))
+                for i in range(len(external.declaration.outputs))
+            )
+            return [
+                OptResult(
+                    name,
+                    inputs,
+                    outputs,
+                    external.domain(inputs),
+                    external.certified(inputs, outputs),
+                    next_level,
+                    "stream",
+                )
+            ]
+        if name in engine.functions:
+            function = engine.functions[name]
+            if real:
+                return []  # evaluated for real by the engine
+            return self._function(function, inputs, level, world)
+        if real:
+            return []  # rules on real facts were applied by the engine
+        rule = engine.rules[name]
+        mapping = dict(zip(rule.parameters, inputs, strict=True))
+        certified = tuple(
+            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.certified
+        )
+        domain = tuple(
+            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.domain
+        )
+        return [OptResult(name, inputs, (), domain, certified, level, "rule")]
+
+    def _function(
+        self,
+        function: FunctionExternal,
+        inputs: tuple[str, ...],
+        level: int,
+        world: OptimisticWorld,
+    ) -> list[OptResult]:
+        domain = function.domain(inputs)
+        if function.is_predicate:
+            if function.name in self.negated:
+                return []
+            return [
+                OptResult(
+                    function.name,
+                    inputs,
+                    (),
+                    domain,
+                    (Atom(function.name, inputs),),
+                    level,
+                    "predicate",
+                )
+            ]
+        opt_fn = getattr(function.info, "opt_fn", None)
+        value = float(opt_fn(*inputs)) if opt_fn is not None else 1.0
+        world.numeric[(function.name, inputs)] = value
+        return [
+            OptResult(
+                function.name,
+                inputs,
+                (),
+                domain,
+                (Atom(function_guard(function.name), inputs),),
+                level,
+                "function",
+            )
+        ]
