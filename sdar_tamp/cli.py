@@ -1,0 +1,139 @@
+"""The ``sdar`` command line. Heavy modules are imported inside the commands that need them."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from sdar_tamp import __version__
+from sdar_tamp.errors import SdarError
+
+DEMO_DOMAIN = "blocksworld"
+DEMO_PROBLEM = "problems/reverse4.pddl"
+
+
+def _read(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise SdarError(f"cannot read {path}: {error.strerror}") from None
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    """Classical planning on a PDDL domain and problem file."""
+    from sdar_tamp.language import parse_domain, parse_problem
+    from solvers.classical import PlanStatus, plan, task_from_problem
+
+    domain = parse_domain(_read(args.domain), str(args.domain))
+    problem = parse_problem(_read(args.problem), domain, str(args.problem))
+    result = plan(
+        task_from_problem(domain, problem, use_costs=not args.unit),
+        search=args.search,
+        heuristic=args.heuristic,
+        weight=args.weight,
+        time_limit=args.time_limit,
+    )
+    stats = result.statistics
+    print(f"status: {result.status.value}")
+    if result.plan is not None:
+        for step, action in enumerate(result.plan, 1):
+            print(f"{step:3d}) {action}")
+        print(f"length: {len(result.plan)}  cost: {result.cost:g}")
+    print(
+        f"expanded: {stats.expanded}  generated: {stats.generated}  "
+        f"grounding: {stats.grounding_time:.3f} s  search: {stats.search_time:.3f} s"
+    )
+    return 0 if result.status is PlanStatus.SOLVED else 1
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """Parse a domain (and optionally a problem and stream files); report what is in them."""
+    from sdar_tamp.language import parse_domain, parse_problem, parse_stream_file
+
+    domain = parse_domain(_read(args.domain), str(args.domain))
+    print(
+        f"domain {domain.name}: {len(domain.types.parents)} types, "
+        f"{len(domain.predicates)} predicates, {len(domain.actions)} actions, "
+        f"{len(domain.axioms)} axioms"
+    )
+    for path in args.streams:
+        streams = parse_stream_file(_read(path), domain, str(path))
+        print(
+            f"stream file {streams.name}: {len(streams.streams)} streams, "
+            f"{len(streams.functions)} functions, {len(streams.predicates)} predicates, "
+            f"{len(streams.rules)} rules"
+        )
+    if args.problem is not None:
+        problem = parse_problem(_read(args.problem), domain, str(args.problem))
+        print(f"problem {problem.name}: {len(problem.objects)} objects, {len(problem.init)} facts")
+    return 0
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    """Solve a shipped teaching problem and print the plan."""
+    from sdar_tamp.resources import domain_file
+
+    plan_args = argparse.Namespace(
+        domain=domain_file(DEMO_DOMAIN),
+        problem=domain_file(DEMO_DOMAIN, DEMO_PROBLEM),
+        search="gbfs",
+        heuristic="ff",
+        weight=2.0,
+        time_limit=args.time_limit,
+        unit=False,
+    )
+    print(f"Solving the shipped {DEMO_DOMAIN} problem {DEMO_PROBLEM}:")
+    return cmd_plan(plan_args)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="sdar",
+        description="Declarative task-and-motion planning with PDDL streams.",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    plan = sub.add_parser(
+        "plan", help="classical planning on PDDL files", description=cmd_plan.__doc__
+    )
+    plan.add_argument("domain", type=Path, help="domain.pddl")
+    plan.add_argument("problem", type=Path, help="problem.pddl")
+    plan.add_argument("--search", default="gbfs", help="gbfs, astar or wastar (default: gbfs)")
+    plan.add_argument("--heuristic", default="ff", help="ff, add, max or blind (default: ff)")
+    plan.add_argument("--weight", type=float, default=2.0, help="weight of wastar (default: 2)")
+    plan.add_argument("--time-limit", type=float, default=None, help="seconds (default: none)")
+    plan.add_argument("--unit", action="store_true", help="ignore action costs")
+    plan.set_defaults(func=cmd_plan)
+
+    check = sub.add_parser(
+        "check", help="parse and summarise PDDL and stream files", description=cmd_check.__doc__
+    )
+    check.add_argument("domain", type=Path, help="domain.pddl")
+    check.add_argument("problem", type=Path, nargs="?", default=None, help="problem.pddl")
+    check.add_argument(
+        "--streams", type=Path, action="append", default=[], help="a stream file (repeatable)"
+    )
+    check.set_defaults(func=cmd_check)
+
+    demo = sub.add_parser("demo", help="solve a built-in example", description=cmd_demo.__doc__)
+    demo.add_argument("--time-limit", type=float, default=60.0, help="seconds (default: 60)")
+    demo.set_defaults(func=cmd_demo)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return func(args)
+    except SdarError as error:
+        print(f"sdar: error: {error}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

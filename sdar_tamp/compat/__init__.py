@@ -1,0 +1,1 @@
+"""Compatibility layers for users coming from other planning frameworks."""

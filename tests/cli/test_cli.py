@@ -1,0 +1,71 @@
+"""The ``sdar`` command line: help, version, demo, plan, check and error paths."""
+
+from pathlib import Path
+
+import pytest
+
+from sdar_tamp import __version__
+from sdar_tamp.cli import build_parser, main
+from sdar_tamp.resources import domain_file
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"sdar {__version__}"
+
+
+def test_every_subcommand_has_help(capsys: pytest.CaptureFixture[str]) -> None:
+    parser = build_parser()
+    subparsers = next(a for a in parser._actions if a.dest == "command")
+    for name in subparsers.choices:  # type: ignore[union-attr]
+        with pytest.raises(SystemExit) as info:
+            main([name, "--help"])
+        assert info.value.code == 0
+        assert "usage: sdar" in capsys.readouterr().out
+
+
+def test_demo_solves_and_prints_a_plan(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["demo"]) == 0
+    out = capsys.readouterr().out
+    assert "status: solved" in out and "1) (" in out
+
+
+def test_plan_on_shipped_files(capsys: pytest.CaptureFixture[str]) -> None:
+    domain = domain_file("blocksworld")
+    problem = domain_file("blocksworld", "problems/sussman.pddl")
+    assert main(["plan", str(domain), str(problem), "--search", "astar", "--heuristic", "max"]) == 0
+    assert "length: 6" in capsys.readouterr().out
+
+
+def test_plan_with_missing_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert main(["plan", str(tmp_path / "none.pddl"), str(tmp_path / "p.pddl")]) == 2
+    assert "cannot read" in capsys.readouterr().err
+
+
+def test_check_reports_located_errors(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    bad = tmp_path / "bad.pddl"
+    bad.write_text("(define (domain d)\n  (:predicates (p ?x))\n  (:action a :effect (q)))")
+    assert main(["check", str(bad)]) == 2
+    assert f"{bad}:3:23: undeclared predicate 'q'" in capsys.readouterr().err
+
+
+def test_check_summarises(capsys: pytest.CaptureFixture[str]) -> None:
+    domain = domain_file("blocksworld")
+    assert main(["check", str(domain)]) == 0
+    assert "4 actions" in capsys.readouterr().out
+
+
+def test_bad_search_name_is_an_error(capsys: pytest.CaptureFixture[str]) -> None:
+    domain = domain_file("blocksworld")
+    problem = domain_file("blocksworld", "problems/sussman.pddl")
+    assert main(["plan", str(domain), str(problem), "--search", "dfs"]) == 2
+    assert "search" in capsys.readouterr().err
+
+
+def test_unknown_shipped_domain() -> None:
+    from sdar_tamp.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="domain must be one of"):
+        domain_file("no-such-domain")
