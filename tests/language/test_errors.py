@@ -196,7 +196,9 @@ def test_stream_certified_uses_unknown_parameter() -> None:
 
 
 def test_stream_duplicate_parameter() -> None:
-    error = stream_error(" (:stream f :inputs (?x) :outputs (?x) :certified (clear ?x))")
+    error = stream_error(
+        " (:stream f :inputs (?x) :domain (clear ?x) :outputs (?x) :certified (clear ?x))"
+    )
     assert isinstance(error, DuplicateError)
 
 
@@ -229,22 +231,35 @@ def test_stream_undeclared_domain_predicate() -> None:
 
 def test_stream_inconsistent_arity_of_stream_only_predicate() -> None:
     error = stream_error(
-        " (:stream f :inputs (?x) :outputs (?p) :certified (Pose ?x ?p))\n"
-        " (:stream g :inputs (?x) :outputs (?p) :certified (Pose ?x))"
+        " (:stream f :inputs (?x) :domain (clear ?x) :outputs (?p) :certified (Pose ?x ?p))\n"
+        " (:stream g :inputs (?x) :domain (clear ?x) :outputs (?p) :certified (Pose ?x))"
     )
     assert isinstance(error, ArityError)
 
 
 def test_stream_duplicate_name() -> None:
-    error = stream_error(" (:stream f :inputs (?x)) (:stream F :inputs (?x))")
+    error = stream_error(
+        " (:stream f :inputs (?x) :domain (clear ?x)) (:stream F :inputs (?x) :domain (clear ?x))"
+    )
     assert isinstance(error, DuplicateError)
 
 
 def test_stream_undeclared_fluent() -> None:
-    error = stream_error(" (:stream f :inputs (?x) :fluents (atpose))")
+    error = stream_error(" (:stream f :inputs (?x) :domain (clear ?x) :fluents (atpose))")
     assert isinstance(error, UndeclaredError)
 
 
 def test_cyclic_type_hierarchy() -> None:
     with pytest.raises(PddlSyntaxError, match="its own ancestor"):
         parse_domain("(define (domain d) (:types a - b b - a))", "d.pddl")
+
+
+def test_stream_input_missing_from_domain() -> None:
+    error = stream_error(" (:stream f :inputs (?x ?y) :domain (clear ?x) :outputs (?z))")
+    assert isinstance(error, StreamDefinitionError)
+    assert "input ?y of stream 'f' must appear in its :domain" in str(error)
+
+
+def test_function_input_missing_from_domain() -> None:
+    error = stream_error(" (:function (dist ?x ?y) (clear ?x))")
+    assert isinstance(error, StreamDefinitionError)

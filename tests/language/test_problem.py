@@ -25,7 +25,8 @@ DOMAIN = """(define (domain pick) (:requirements :strips :typing :equality)
      :effect (and (holding ?b) (not (atpose ?b ?p)))))"""
 STREAM = """(define (stream s)
   (:stream sample :inputs (?b) :domain (block ?b) :outputs (?p) :certified (pose ?b ?p))
-  (:stream free :inputs (?p) :domain (Grasp ?p)) (:stream grasp :inputs (?b) :outputs (?g)
+  (:stream free :inputs (?p) :domain (Grasp ?p))
+  (:stream grasp :inputs (?b) :domain (block ?b) :outputs (?g)
   :certified (Grasp ?g)))"""
 TABLE = object()
 
