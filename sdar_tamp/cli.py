@@ -29,7 +29,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     domain = parse_domain(_read(args.domain), str(args.domain))
     problem = parse_problem(_read(args.problem), domain, str(args.problem))
     result = plan(
-        task_from_problem(domain, problem, use_costs=not args.unit),
+        task_from_problem(domain, problem, use_costs=False if args.unit else None),
         search=args.search,
         heuristic=args.heuristic,
         weight=args.weight,

@@ -27,7 +27,7 @@ from sdar_tamp.language.problem import PDDLProblem, infer_object_types
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
-from solvers.stream_planning.costs import guard_costs
+from solvers.stream_planning.costs import guard_costs, has_costs
 from solvers.stream_planning.diagnosis import diagnose
 from solvers.stream_planning.engine import Engine
 from solvers.stream_planning.optimistic import (
@@ -103,6 +103,8 @@ class StreamSolver:
             "complexity": 0,
         }
         self.best: tuple[float, PlanSteps, frozenset[Atom]] | None = None
+        # a domain without cost effects plans with unit costs (zero costs would blind search)
+        self.use_costs = not options.unit_costs and has_costs(problem.domain)
         self.queue: list[Skeleton] = []
         self._order = 0
 

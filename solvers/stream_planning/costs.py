@@ -16,10 +16,12 @@ from sdar_tamp.language.model import (
     Atom,
     Domain,
     Effect,
+    ForAllEffect,
     FunctionTerm,
     IncreaseCost,
     Parameter,
     Predicate,
+    When,
 )
 from solvers.stream_planning.engine import function_guard
 
@@ -30,6 +32,23 @@ def _cost_terms(effect: Effect) -> list[FunctionTerm]:
     if isinstance(effect, AndEffect):
         return [term for part in effect.parts for term in _cost_terms(part)]
     return []
+
+
+def has_costs(domain: Domain) -> bool:
+    """True when some action increases ``total-cost``."""
+    return any(
+        isinstance(effect, IncreaseCost)
+        for action in domain.actions
+        for effect in _walk(action.effect)
+    )
+
+
+def _walk(effect: Effect) -> list[Effect]:
+    if isinstance(effect, AndEffect):
+        return [e for part in effect.parts for e in _walk(part)]
+    if isinstance(effect, ForAllEffect | When):
+        return _walk(effect.effect)
+    return [effect]
 
 
 def guard_costs(domain: Domain) -> Domain:
