@@ -62,10 +62,19 @@ class _Evaluator:
         self._active: set[Atom] = set()
         self._cut = False
         self._refuting: set[Atom] = set()
+        self._typed: dict[str, list[str]] = {}  # objects_of, per type
 
     def objects_of(self, type_name: str) -> list[str]:
-        hierarchy = self.domain.types
-        return sorted(n for n, t in self.objects.items() if hierarchy.is_subtype(t, type_name))
+        found = self._typed.get(type_name)
+        if found is None:
+            hierarchy = self.domain.types
+            found = sorted(n for n, t in self.objects.items() if hierarchy.is_subtype(t, type_name))
+            self._typed[type_name] = found
+        return found
+
+    def has_type(self, name: str, type_name: str) -> bool:
+        own = self.objects.get(name)
+        return own is not None and self.domain.types.is_subtype(own, type_name)
 
     def support(self, formula: Formula, binding: Mapping[str, str]) -> Support | None:
         if isinstance(formula, Atom):
@@ -198,8 +207,7 @@ class _Evaluator:
         for axiom in self._axioms[atom.predicate]:
             binding = {p.name: a for p, a in zip(axiom.parameters, atom.args, strict=True)}
             if not all(
-                a in self.objects_of(p.type)
-                for p, a in zip(axiom.parameters, atom.args, strict=True)
+                self.has_type(a, p.type) for p, a in zip(axiom.parameters, atom.args, strict=True)
             ):
                 continue
             free = _free_parameters(axiom.body, set(binding))
@@ -282,8 +290,7 @@ def simulate(
         evaluator = _Evaluator(domain, objects, state)
         binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
         if any(
-            a not in evaluator.objects_of(p.type)
-            for p, a in zip(action.parameters, args, strict=True)
+            not evaluator.has_type(a, p.type) for p, a in zip(action.parameters, args, strict=True)
         ):
             return PlanCheck(False, step, frozenset(needed - added), state)
         support = evaluator.support(action.precondition, binding)

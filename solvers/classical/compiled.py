@@ -1,0 +1,142 @@
+"""The ground task packed for search: bitset states, a successor generator, axiom closure.
+
+A state is a Python ``int`` whose bit ``i`` is fact ``i``. Operators are tuples of masks. The
+successor generator is a trie over the operators' (sorted) positive preconditions: a node lists
+the operators whose preconditions end there and branches on further facts, so a state only
+visits the branches whose facts it contains instead of testing every operator.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterable
+
+from solvers.classical.task import GroundTask
+
+# (pre mask, negative pre mask, add mask, delete mask, conditional effects, cost)
+# conditional effect: (condition mask, negative condition mask, add mask, delete mask)
+CondMasks = tuple[tuple[int, int, int, int], ...]
+OpMasks = tuple[int, int, int, int, CondMasks, float]
+# successor-generator trie node: (operators ending here, ((fact bit, child), ...))
+Trie = tuple[tuple[int, ...], tuple[tuple[int, "Trie"], ...]]
+
+
+def mask(facts: Iterable[int]) -> int:
+    result = 0
+    for fact in facts:
+        result |= 1 << fact
+    return result
+
+
+def bits(state: int) -> list[int]:
+    """The fact ids set in ``state``."""
+    result = []
+    while state:
+        low = state & -state
+        result.append(low.bit_length() - 1)
+        state ^= low
+    return result
+
+
+class _Node:
+    __slots__ = ("children", "operators")
+
+    def __init__(self) -> None:
+        self.operators: list[int] = []
+        self.children: dict[int, _Node] = {}
+
+
+class CompiledTask:
+    """Masks, successor generator and axiom evaluator of a :class:`GroundTask`."""
+
+    def __init__(self, task: GroundTask) -> None:
+        self.task = task
+        self.operators: list[OpMasks] = [
+            (
+                mask(op.precondition),
+                mask(op.negative_precondition),
+                mask(op.adds),
+                mask(op.deletes),
+                tuple(
+                    (mask(c.condition), mask(c.negative_condition), mask(c.adds), mask(c.deletes))
+                    for c in op.conditional
+                ),
+                op.cost,
+            )
+            for op in task.operators
+        ]
+        self.costs = [op.cost for op in task.operators]
+        self.goal_mask = mask(task.goal)
+        self.negative_goal_mask = mask(task.negative_goal)
+        self.derived_mask = mask(task.derived)
+        strata: dict[int, list[tuple[int, int, int]]] = {}
+        for axiom in task.axioms:
+            strata.setdefault(axiom.stratum, []).append(
+                (1 << axiom.head, mask(axiom.body), mask(axiom.negative_body))
+            )
+        self.strata = [strata[s] for s in sorted(strata)]
+        self._root = self._build_trie()
+        self.init = self.close(mask(task.init))
+
+    def _build_trie(self) -> Trie:
+        frequency = Counter(f for op in self.task.operators for f in op.precondition)
+        root = _Node()
+        for index, op in enumerate(self.task.operators):
+            node = root
+            for fact in sorted(op.precondition, key=lambda f: (-frequency[f], f)):
+                node = node.children.setdefault(fact, _Node())
+            node.operators.append(index)
+
+        def freeze(node: _Node) -> Trie:
+            children = tuple((1 << f, freeze(child)) for f, child in node.children.items())
+            return tuple(node.operators), children
+
+        return freeze(root)
+
+    def applicable(self, state: int) -> list[int]:
+        """Indices of the operators applicable in ``state``."""
+        result: list[int] = []
+        stack = [self._root]
+        while stack:
+            ops, children = stack.pop()
+            if ops:
+                result.extend(ops)
+            for fact_bit, child in children:
+                if state & fact_bit:
+                    stack.append(child)
+        operators = self.operators
+        return [i for i in result if not state & operators[i][1]]
+
+    def successor(self, state: int, index: int) -> int:
+        _pre, _neg, add, delete, conditional, _cost = self.operators[index]
+        if conditional:
+            for cond, neg_cond, cond_add, cond_delete in conditional:
+                if state & cond == cond and not state & neg_cond:
+                    add |= cond_add
+                    delete |= cond_delete
+        new = (state & ~delete) | add
+        if self.strata:
+            new = self.close(new)
+        return new
+
+    def close(self, state: int) -> int:
+        """Recompute the derived facts of ``state`` (stratum by stratum, to a fixpoint)."""
+        if not self.strata:
+            return state
+        state &= ~self.derived_mask
+        for layer in self.strata:
+            pending = layer
+            while pending:
+                waiting = []
+                for head, body, negative in pending:
+                    if state & body == body and not state & negative:
+                        state |= head
+                    else:
+                        waiting.append((head, body, negative))
+                if len(waiting) == len(pending):
+                    break
+                pending = waiting
+        return state
+
+    def is_goal(self, state: int) -> bool:
+        return state & self.goal_mask == self.goal_mask and not state & self.negative_goal_mask

@@ -1,0 +1,127 @@
+"""The planner's entry point: ground, search, validate."""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import time
+
+from sdar_tamp.errors import ParameterError
+from solvers.classical.compiled import CompiledTask
+from solvers.classical.errors import PlanValidationError
+from solvers.classical.ground import ground
+from solvers.classical.heuristics import HEURISTICS, RelaxedHeuristic
+from solvers.classical.postprocess import eliminate_redundant_actions
+from solvers.classical.problem import (
+    PlanningTask,
+    PlanStatus,
+    SearchResult,
+    SearchStatistics,
+)
+from solvers.classical.reachability import GroundingTimeout
+from solvers.classical.search import SearchOutcome, best_first_search
+from solvers.classical.task import GroundTask
+from solvers.classical.validate import validate_plan
+
+SEARCHES = ("gbfs", "astar", "wastar")
+logger = logging.getLogger(__name__)
+
+
+def _check(name: str, value: object, choices: tuple[str, ...]) -> None:
+    if value not in choices:
+        raise ParameterError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
+
+
+def plan(
+    task: PlanningTask,
+    *,
+    search: str = "gbfs",
+    heuristic: str = "ff",
+    weight: float = 2.0,
+    preferred_operators: bool = True,
+    lazy: bool = False,
+    time_limit: float | None = None,
+) -> SearchResult:
+    """Find a plan for ``task``.
+
+    ``search``: ``"gbfs"`` (greedy best-first), ``"astar"`` or ``"wastar"`` (f = g + weight·h).
+    ``heuristic``: ``"ff"``, ``"add"``, ``"max"`` or ``"blind"``. Preferred operators (from the
+    relaxed plan; not used by ``"blind"``) feed a second, boosted queue; A* ignores them so that
+    with an admissible heuristic (``"max"``, ``"blind"``) its plans stay optimal. ``lazy`` defers
+    evaluation to expansion time. Plans of greedy and weighted search are post-processed by
+    greedy action elimination (steps whose removal still reaches the goal are dropped; the
+    cost never rises); A* plans are returned as found. Greedy search adds 1 to every action
+    cost inside the heuristic (so zero-cost actions still count as steps); plan costs are always
+    the true costs.
+    ``time_limit`` [s] covers grounding and search.
+    """
+    _check("search", search, SEARCHES)
+    _check("heuristic", heuristic, HEURISTICS)
+    if not weight >= 1.0:
+        raise ParameterError(f"weight must be >= 1; got {weight!r}")
+    if time_limit is not None and not time_limit > 0:
+        raise ParameterError(f"time_limit must be > 0 seconds or None; got {time_limit!r}")
+    start = time.perf_counter()
+    deadline = None if time_limit is None else start + time_limit
+    try:
+        ground_task = ground(task, deadline=deadline)
+    except GroundingTimeout:
+        elapsed = time.perf_counter() - start
+        return SearchResult(
+            PlanStatus.TIMEOUT, None, 0.0, SearchStatistics(0, 0, 0, 0, 0, 0, elapsed, 0.0)
+        )
+    grounded = time.perf_counter()
+    outcome = _search(ground_task, search, heuristic, weight, preferred_operators, lazy, deadline)
+    searched = time.perf_counter()
+    statistics = SearchStatistics(
+        expanded=outcome.expanded,
+        generated=outcome.generated,
+        evaluated=outcome.evaluated,
+        ground_actions=len(ground_task.operators),
+        ground_axioms=len(ground_task.axioms),
+        reachable_facts=len(ground_task.facts),
+        grounding_time=grounded - start,
+        search_time=searched - grounded,
+    )
+    if outcome.status != "solved":
+        return SearchResult(PlanStatus(outcome.status), None, 0.0, statistics)
+    steps = tuple(ground_task.operators[i].action for i in outcome.operators)
+    try:
+        cost = validate_plan(task, ground_task, steps)
+    except PlanValidationError as error:  # a bug in the planner, never a user error
+        raise PlanValidationError(f"planner bug: the plan found is invalid: {error}") from error
+    return SearchResult(PlanStatus.SOLVED, steps, cost, statistics)
+
+
+def _search(
+    ground_task: GroundTask,
+    search: str,
+    heuristic: str,
+    weight: float,
+    preferred: bool,
+    lazy: bool,
+    deadline: float | None,
+) -> SearchOutcome:
+    if not ground_task.goal_reachable:
+        logger.info("goal not relaxed-reachable: unsolvable")
+        return SearchOutcome("unsolvable", (), 0, 0, 0)
+    compiled = CompiledTask(ground_task)
+    costs = compiled.costs
+    if search == "gbfs" and ground_task.source.use_costs:
+        costs = [c + 1.0 for c in costs]  # "plusone": zero-cost actions still count
+    evaluator = RelaxedHeuristic(compiled, heuristic, costs)
+    g_weight, h_weight = {"gbfs": (0.0, 1.0), "astar": (1.0, 1.0), "wastar": (1.0, weight)}[search]
+    outcome = best_first_search(
+        compiled,
+        evaluator,
+        g_weight=g_weight,
+        h_weight=h_weight,
+        preferred=preferred and heuristic != "blind" and search != "astar",
+        lazy=lazy,
+        reopen=search != "gbfs",
+        deadline=deadline,
+    )
+    if outcome.status == "solved" and search != "astar":
+        shorter = eliminate_redundant_actions(compiled, list(outcome.operators), deadline)
+        outcome = dataclasses.replace(outcome, operators=tuple(shorter))
+    return outcome
