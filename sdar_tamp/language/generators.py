@@ -1,6 +1,7 @@
 """Adapters from plain Python samplers to the one form every stream is called in.
 
-A stream is called as ``list_gen_fn(*inputs)`` and returns an iterator; each ``next`` gives a
+A stream is called as ``list_gen_fn(*inputs)`` (plus ``fluents=`` for a fluent stream, which
+the adapters pass on to the sampler) and returns an iterator; each ``next`` gives a
 list of output tuples (possibly empty: no output this call) or a :class:`WildOutput`. The
 adapters below wrap the usual shapes of samplers into that form (PDDLStream's names):
 
@@ -32,58 +33,66 @@ class WildOutput:
     facts: Sequence[tuple[Any, ...]] = field(default_factory=tuple)
 
 
+def _as_tuple(output: Any) -> Any:
+    """A list becomes a tuple; anything else is passed on as it is, so that the solver's shape
+    check can name what the sampler really returned."""
+    return tuple(output) if isinstance(output, list | tuple) else output
+
+
 def _one(output: Any) -> Outputs:
-    return [] if output is None else [tuple(output)]
+    return [] if output is None else [_as_tuple(output)]
 
 
 def from_list_gen_fn(list_gen_fn: Callable[..., Iterable[Any]]) -> ListGenFn:
-    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
-        for outputs in list_gen_fn(*inputs):
+    def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
+        for outputs in list_gen_fn(*inputs, **kwargs):
             if isinstance(outputs, WildOutput):
                 yield outputs
             else:
-                yield [tuple(output) for output in (outputs or [])]
+                yield [_as_tuple(output) for output in (outputs or [])]
 
     return stream
 
 
 def from_gen_fn(gen_fn: Callable[..., Iterable[Any]]) -> ListGenFn:
-    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
-        for output in gen_fn(*inputs):
+    def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
+        for output in gen_fn(*inputs, **kwargs):
             yield output if isinstance(output, WildOutput) else _one(output)
 
     return stream
 
 
 def from_sampler(sampler: Callable[..., Any], max_attempts: int | None = None) -> ListGenFn:
-    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
+    def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
         attempt = 0
         while max_attempts is None or attempt < max_attempts:
             attempt += 1
-            yield _one(sampler(*inputs))
+            yield _one(sampler(*inputs, **kwargs))
 
     return stream
 
 
 def from_list_fn(list_fn: Callable[..., Any]) -> ListGenFn:
-    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
-        outputs = list_fn(*inputs)
-        yield outputs if isinstance(outputs, WildOutput) else [tuple(o) for o in (outputs or [])]
+    def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
+        outputs = list_fn(*inputs, **kwargs)
+        yield (
+            outputs if isinstance(outputs, WildOutput) else [_as_tuple(o) for o in (outputs or [])]
+        )
 
     return stream
 
 
 def from_fn(fn: Callable[..., Any]) -> ListGenFn:
-    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
-        output = fn(*inputs)
+    def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
+        output = fn(*inputs, **kwargs)
         yield output if isinstance(output, WildOutput) else _one(output)
 
     return stream
 
 
 def from_test(test: Callable[..., Any]) -> ListGenFn:
-    def stream(*inputs: Any) -> Iterator[Outputs | WildOutput]:
-        yield [()] if test(*inputs) else []
+    def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
+        yield [()] if test(*inputs, **kwargs) else []
 
     return stream
 

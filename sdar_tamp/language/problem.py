@@ -263,8 +263,9 @@ def _ground(problem: PDDLProblem) -> GroundFacts:
 
 def _object_types(problem: PDDLProblem, init: set[Atom]) -> dict[str, str]:
     """Each object's most specific type, from the domain's constants and init type facts."""
-    declared = {name: problem.domain.constants.get(name, OBJECT_TYPE)
-                for name in problem.objects.names()}
+    declared = {
+        name: problem.domain.constants.get(name, OBJECT_TYPE) for name in problem.objects.names()
+    }
     try:
         return infer_object_types(declared, init, problem.domain.types)
     except ValueError as error:

@@ -236,8 +236,9 @@ def _inputs_in_domain(
     used = {term for atom in domain for term in atom.args}
     for name, location in inputs:
         if name not in used:
-            raise StreamDefinitionError(f"input {name} of {what} must appear in its :domain",
-                                        location)
+            raise StreamDefinitionError(
+                f"input {name} of {what} must appear in its :domain", location
+            )
 
 
 def _scope_for(node: SExpr, scope: dict[str, str], role: str, what: str) -> dict[str, str]:

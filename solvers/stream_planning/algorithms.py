@@ -7,8 +7,9 @@
   rises, plan again.
 - binding: as focused, but walk the whole stream plan, binding placeholders to the outputs of
   earlier calls, so one pass can turn an optimistic plan into a real one.
-- adaptive: binding with a queue of skeletons (optimistic plans) that are revisited; time spent
-  sampling is balanced against time spent searching by ``search_sample_ratio``.
+- adaptive: binding with a queue of skeletons (optimistic plans) that are revisited; after each
+  search, each queued skeleton is worked on about ``search_sample_ratio`` times. The balance is
+  counted in visits, not measured in seconds, so a seeded run is reproducible.
 """
 
 from __future__ import annotations
@@ -235,16 +236,14 @@ class StreamSolver:
             self.stats["iterations"] += 1
             self.stats["complexity"] = level
             world = self.builder.build(level)
-            search_start = time.perf_counter()
             found = (
                 self.plan(world.facts, world.numeric)
                 if self.stats["skeletons"] < options.max_skeletons
                 else None
             )
-            search_time = time.perf_counter() - search_start
             if found is None:
                 if self.queue:
-                    if self._process_queue(max(search_time, 0.01) * options.search_sample_ratio):
+                    if self._process_queue():
                         return Status.SOLVED
                     continue
                 disabled = [s for s in self.engine.instances.values() if s.instance.disabled]
@@ -281,7 +280,7 @@ class StreamSolver:
                     return Status.SOLVED
             else:
                 heapq.heappush(self.queue, skeleton)
-                if self._process_queue(max(search_time, 0.01) * options.search_sample_ratio):
+                if self._process_queue():
                     return Status.SOLVED
 
     def _sample_first_layer(self, stream_plan: Sequence[OptResult]) -> None:
@@ -294,10 +293,12 @@ class StreamSolver:
             if produced is False and state is not None:
                 state.instance.disabled = True
 
-    def _process_queue(self, budget: float) -> bool:
-        """Work on queued skeletons for about ``budget`` seconds; True when solved."""
-        deadline = time.perf_counter() + budget
-        while self.queue and time.perf_counter() < deadline:
+    def _process_queue(self) -> bool:
+        """Work on queued skeletons, ``search_sample_ratio`` visits each; True when solved."""
+        visits = max(1, math.ceil(self.options.search_sample_ratio * len(self.queue)))
+        for _ in range(visits):
+            if not self.queue:
+                break
             self._check_time()
             skeleton = heapq.heappop(self.queue)
             outcome = self._process(skeleton)

@@ -10,6 +10,8 @@ from solvers.solution import Status
 if TYPE_CHECKING:
     from solvers.stream_planning.algorithms import StreamSolver
 
+MAX_LISTED = 5  # instances named one by one before the rest are counted
+
 
 def _produced_predicates(solver: StreamSolver) -> set[str]:
     domain = solver.problem.domain
@@ -69,7 +71,22 @@ def diagnose(solver: StreamSolver, status: Status) -> list[str]:
                 f"stream '{name}' was called {external.counters.calls} time(s) and "
                 "never produced an output"
             )
-    exhausted = sum(1 for s in solver.engine.instances.values() if s.instance.exhausted)
+    states = list(solver.engine.instances.values())
+    dry = [
+        s.instance
+        for s in states
+        if s.instance.exhausted
+        and not s.instance.results
+        and not s.instance.external.declaration.is_test
+    ]
+    for instance in dry[:MAX_LISTED]:
+        reasons.append(
+            f"{instance.describe(table)} ran dry after {instance.calls} call(s) "
+            "without producing an output"
+        )
+    if len(dry) > MAX_LISTED:
+        reasons.append(f"... and {len(dry) - MAX_LISTED} more stream instance(s) ran dry")
+    exhausted = sum(1 for s in states if s.instance.exhausted)
     if exhausted:
         reasons.append(f"{exhausted} stream instance(s) were exhausted")
     if not reasons:

@@ -3,7 +3,8 @@
 Real facts have complexity levels: init facts are level 0; a result of an instance whose domain
 facts reach level ``d`` and that was called ``k`` times before has level ``d + k + 1``.
 ``:function`` and ``:predicate`` instances are evaluated as soon as their domain holds (they are
-cheap, and negated predicates need their value); ``:rule`` facts are added at once.
+cheap, and negated predicates need their value); ``:rule`` facts are added at once. A
+``:fluents`` stream is called with ``fluents=`` the initial state's facts of those predicates.
 """
 
 from __future__ import annotations
@@ -131,7 +132,8 @@ class Engine:
         derived: list[Atom] = []
         for query, inputs, level in found:
             if query.name in self.streams:
-                instance = StreamInstance(self.streams[query.name], inputs)
+                stream = self.streams[query.name]
+                instance = StreamInstance(stream, inputs, self._fluents(stream))
                 self.instances[(query.name, inputs)] = InstanceState(instance, level)
             elif query.name in self.functions:
                 external = self.functions[query.name]
@@ -150,6 +152,17 @@ class Engine:
                     for a in rule.certified
                 )
         return derived  # rules and predicates take the level of the fact that completed them
+
+    def _fluents(self, external: StreamExternal) -> tuple[Atom, ...]:
+        """The facts a fluent stream sees: the initial state's facts of its ``:fluents``.
+
+        (Instances are shared by every plan, so they see the initial state, not the state at
+        the plan step that uses their output.)
+        """
+        wanted = set(external.declaration.fluents)
+        if not wanted:
+            return ()
+        return tuple(sorted((a for a in self.problem.facts.init if a.predicate in wanted), key=str))
 
     # --- sampling -------------------------------------------------------------------------
 

@@ -11,7 +11,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from sdar_tamp.language.model import Atom, Domain, Formula, Not, iter_atoms
+from sdar_tamp.language.model import (
+    AndEffect,
+    Atom,
+    Domain,
+    Effect,
+    ForAllEffect,
+    Formula,
+    Imply,
+    Not,
+    When,
+)
 from solvers.stream_planning.engine import Engine, function_guard
 from solvers.stream_planning.externals import FunctionExternal
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
@@ -46,31 +56,52 @@ class OptimisticWorld:
 
 
 def negated_predicates(domain: Domain, goal: Formula) -> frozenset[str]:
-    """Predicates that occur under a negation somewhere in the domain or goal."""
-    formulas: list[Formula] = [
-        goal,
-        *(a.precondition for a in domain.actions),
-        *(x.body for x in domain.axioms),
-    ]
+    """Predicates that some action precondition, effect condition or the goal uses negated.
+
+    Polarity flows through derived predicates: an atom in the body of an axiom whose head is used
+    negated counts as used negated too (``(not (unsafe ?t))`` with ``unsafe`` derived from
+    ``(collides ?t ?o)`` negates ``collides``), and an ``Imply`` negates its antecedent.
+    """
+    axioms: dict[str, list[Formula]] = {}
+    for axiom in domain.axioms:
+        axioms.setdefault(axiom.predicate, []).append(axiom.body)
+    roots: list[Formula] = [goal, *(a.precondition for a in domain.actions)]
+    roots += [w.condition for a in domain.actions for w in _conditions(a.effect)]
     found: set[str] = set()
-    for formula in formulas:
-        stack = [formula]
-        while stack:
-            node = stack.pop()
-            if isinstance(node, Not):
-                found.update(a.predicate for a in iter_atoms(node.formula))
-            elif not isinstance(node, Atom):
-                stack.extend(_children(node))
+    seen: set[tuple[str, bool]] = set()
+    stack: list[tuple[Formula, bool]] = [(formula, True) for formula in roots]
+    while stack:
+        node, positive = stack.pop()
+        if isinstance(node, Atom):
+            if not positive:
+                found.add(node.predicate)
+            if node.predicate in axioms and (node.predicate, positive) not in seen:
+                seen.add((node.predicate, positive))
+                stack.extend((body, positive) for body in axioms[node.predicate])
+        elif isinstance(node, Not):
+            stack.append((node.formula, not positive))
+        elif isinstance(node, Imply):
+            stack += [(node.antecedent, not positive), (node.consequent, positive)]
+        else:
+            stack.extend((child, positive) for child in _children(node))
     return frozenset(found)
+
+
+def _conditions(effect: Effect) -> list[When]:
+    if isinstance(effect, When):
+        return [effect, *_conditions(effect.effect)]
+    if isinstance(effect, AndEffect):
+        return [w for part in effect.parts for w in _conditions(part)]
+    if isinstance(effect, ForAllEffect):
+        return _conditions(effect.effect)
+    return []
 
 
 def _children(node: Formula) -> list[Formula]:
     parts = getattr(node, "parts", None)
     if parts is not None:
         return list(parts)
-    if hasattr(node, "body"):
-        return [node.body]
-    return [node.antecedent, node.consequent]  # type: ignore[union-attr]
+    return [node.body]  # type: ignore[union-attr]
 
 
 class OptimisticBuilder:
@@ -101,6 +132,9 @@ class OptimisticBuilder:
         queries += [
             Query(f.name, f.declaration.inputs, f.declaration.domain)
             for f in engine.functions.values()
+            # a negated predicate adds nothing here: real values come from the engine and
+            # placeholders are optimistically false
+            if not (f.is_predicate and f.name in self.negated)
         ]
         queries += [Query(n, r.parameters, r.domain) for n, r in engine.rules.items()]
         instantiator = Instantiator(queries, store)
@@ -177,10 +211,10 @@ class OptimisticBuilder:
         level: int,
         world: OptimisticWorld,
     ) -> list[OptResult]:
+        if function.is_predicate and function.name in self.negated:
+            return []  # optimistically false: a negated use must not be blocked by a guess
         domain = function.domain(inputs)
         if function.is_predicate:
-            if function.name in self.negated:
-                return []
             return [
                 OptResult(
                     function.name,
