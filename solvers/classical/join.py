@@ -85,9 +85,14 @@ def compile_join(
         if first is not None and not steps:
             chosen = first
         else:
+            # most bound terms first; on a tie the later atom, since callers put the broad
+            # type literals ``(type ?x)`` before the body atoms, which are usually smaller
             chosen = max(
                 remaining,
-                key=lambda i: sum(1 for a in atoms[i].args if not a.startswith("?") or a in bound),
+                key=lambda i: (
+                    sum(1 for a in atoms[i].args if not a.startswith("?") or a in bound),
+                    i,
+                ),
             )
         remaining.remove(chosen)
         atom = atoms[chosen]
