@@ -345,7 +345,9 @@ class StreamSolver:
                         return False
                     return self._upstream_retry(skeleton, index)
                 skeleton.chosen[index] = state.instance.results[-1].outputs
-            bindings.update(zip(result.outputs, skeleton.chosen[index], strict=True))
+            for placeholder, value in zip(result.outputs, skeleton.chosen[index], strict=True):
+                if bindings.setdefault(placeholder, value) != value:
+                    return None  # a shared placeholder would need two values: not this skeleton
         actions = [
             (name, tuple(bindings.get(a, a) for a in args)) for name, args in skeleton.actions
         ]
