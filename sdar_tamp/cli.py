@@ -88,6 +88,29 @@ def cmd_demo(args: argparse.Namespace) -> int:
     return cmd_plan(plan_args)
 
 
+def cmd_generate(args: argparse.Namespace) -> int:
+    """Generate a rearrangement instance (one family) or a whole suite of instance files."""
+    from sdar_tamp.world.commands import generate, generate_suite
+
+    if args.suite is not None:
+        paths = generate_suite(args.suite, args.output)
+        print(f"wrote {len(paths)} instances of suite {args.suite!r} to {args.output}")
+        return 0
+    if args.family is None or args.objects is None:
+        raise SdarError("sdar generate needs --family and --objects, or --suite")
+    path = generate(args.family, args.objects, args.seed, args.output)
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    """Draw an instance top-down: start and goal side by side with the dependency graph."""
+    from sdar_tamp.world.commands import show_instance
+
+    print(f"wrote {show_instance(args.instance, args.output)}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sdar",
@@ -117,6 +140,23 @@ def build_parser() -> argparse.ArgumentParser:
         "--streams", type=Path, action="append", default=[], help="a stream file (repeatable)"
     )
     check.set_defaults(func=cmd_check)
+
+    generate = sub.add_parser(
+        "generate", help="generate rearrangement instances", description=cmd_generate.__doc__
+    )
+    generate.add_argument("--family", choices=("R", "S", "D", "M"), help="instance family")
+    generate.add_argument("--objects", type=int, help="number of objects")
+    generate.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    generate.add_argument("--suite", choices=("paper", "stress"), help="a whole suite")
+    generate.add_argument(
+        "-o", "--output", type=Path, required=True, help="instance file (or folder with --suite)"
+    )
+    generate.set_defaults(func=cmd_generate)
+
+    show = sub.add_parser("show", help="draw an instance", description=cmd_show.__doc__)
+    show.add_argument("instance", type=Path, help="instance YAML")
+    show.add_argument("-o", "--output", type=Path, required=True, help="picture (.png)")
+    show.set_defaults(func=cmd_show)
 
     demo = sub.add_parser("demo", help="solve a built-in example", description=cmd_demo.__doc__)
     demo.add_argument("--time-limit", type=float, default=60.0, help="seconds (default: 60)")

@@ -69,3 +69,31 @@ def test_unknown_shipped_domain() -> None:
 
     with pytest.raises(ParameterError, match="domain must be one of"):
         domain_file("no-such-domain")
+
+
+def test_generate_and_show(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from sdar_tamp.world.dependency import instance_dependency_graph
+    from sdar_tamp.world.instance import load_instance
+
+    out = tmp_path / "S8.yaml"
+    assert main(["generate", "--family", "S", "--objects", "8", "--seed", "3", "-o", str(out)]) == 0
+    instance = load_instance(out)
+    assert len(instance.objects) == 8
+    assert len(instance_dependency_graph(instance).structure().cycles) == 1
+    picture = tmp_path / "S8.png"
+    assert main(["show", str(out), "-o", str(picture)]) == 0
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_generate_needs_family_and_objects(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    assert main(["generate", "--objects", "3", "-o", str(tmp_path / "x.yaml")]) == 2
+    assert "needs --family and --objects" in capsys.readouterr().err
+
+
+def test_generate_impossible_structure(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert (
+        main(["generate", "--family", "R", "--objects", "400", "-o", str(tmp_path / "x.yaml")]) == 2
+    )
+    assert "no instance with the promised structure" in capsys.readouterr().err

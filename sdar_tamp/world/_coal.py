@@ -1,0 +1,34 @@
+"""Typed adapter over coal: the primitive shapes of the world and a direct pair query.
+
+coal ships without type stubs; shapes are returned as ``Any`` and only passed on to
+pinocchio geometry objects or to :func:`shape_distance`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import coal
+import numpy as np
+
+from sdar_tamp.world.transforms import FloatArray
+
+
+def box(size: tuple[float, float, float] | FloatArray) -> Any:
+    """A box of full side lengths ``size`` ``(3,)`` [m], centred on its frame."""
+    x, y, z = (float(v) for v in size)
+    return coal.Box(x, y, z)
+
+
+def _transform(T: FloatArray) -> Any:
+    return coal.Transform3s(np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3]))
+
+
+def shape_distance(
+    shape_a: Any, T_world_a: FloatArray, shape_b: Any, T_world_b: FloatArray
+) -> float:
+    """Signed distance between two shapes [m]; negative is penetration depth."""
+    request = coal.DistanceRequest()
+    result = coal.DistanceResult()
+    coal.distance(shape_a, _transform(T_world_a), shape_b, _transform(T_world_b), request, result)
+    return float(result.min_distance)

@@ -1,0 +1,218 @@
+"""Collision checking of the dual-arm scene with coal (through pinocchio's broad phase).
+
+Checked pairs:
+
+* arm against arm (every link and gripper shape of one arm against every one of the other);
+* one arm against itself, links at least two joints apart (adjacent links are excluded);
+* arm against table (except ``base_link`` and ``shoulder_link``, which stand on it);
+* arm against every resting object;
+* a held object against the other arm, its own arm up to ``wrist_2`` (never its own wrist_3
+  link and gripper, which hold it), the table, every resting object and the other held object.
+
+Resting objects are not checked against each other or the table (that is the arrangement's
+job, see :mod:`sdar_tamp.world.instance`). Object boxes are shrunk by ``tolerance`` on every
+face, so an object resting on the table or touching a neighbour does not count as colliding.
+
+A query costs one pinocchio call: forward kinematics, placements, an AABB-tree broad phase and
+the coal narrow phase on the surviving pairs, all in C++.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.world import collision_model as cm
+from sdar_tamp.world.errors import CollisionModelError
+from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import FloatArray, inverse
+
+
+@dataclass(frozen=True)
+class ObjectBox:
+    """A cuboid: pose of its centre ``T_world_obj`` ``(4, 4)`` and side lengths [m]."""
+
+    T_world_obj: FloatArray
+    size: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class CollisionPair:
+    """Two colliding (or closest) shapes, e.g. ``left_forearm_link_0`` and ``object:o3``."""
+
+    first: str
+    second: str
+
+
+@dataclass(frozen=True)
+class Clearance:
+    """The smallest signed distance over all checked pairs [m] and the pair realising it."""
+
+    distance: float
+    pair: CollisionPair | None
+
+
+class CollisionWorld:
+    """Both arms, the table, resting and held objects; answers collision queries.
+
+    Arm configurations are given in the scene's arm order (``q_left`` is ``scene.arms[0]``).
+    Changing objects or grasps rebuilds the geometry lazily (about a millisecond); queries at
+    a fixed object set are the fast path.
+    """
+
+    def __init__(self, scene: Scene, *, tolerance: float = 1e-3) -> None:
+        self._scene = scene
+        self._tolerance = tolerance
+        self._arms = cm.build_dual_arm(scene)
+        self._resting: dict[str, ObjectBox] = {}
+        self._held: dict[str, tuple[str, FloatArray, ObjectBox]] = {}
+        self._q = np.concatenate([np.array(a.home) for a in scene.arms])
+        self._geometry: cm.SceneGeometry | None = None
+
+    # -- objects and grasps ---------------------------------------------------------------
+    @property
+    def objects(self) -> dict[str, ObjectBox]:
+        """Resting objects, name -> box (a copy)."""
+        return dict(self._resting)
+
+    def set_objects(self, objects: Mapping[str, ObjectBox]) -> None:
+        """Replace every resting object (held objects stay held)."""
+        clash = set(objects) & {name for name, _, _ in self._held.values()}
+        if clash:
+            raise CollisionModelError(f"objects {sorted(clash)} are held; detach them first")
+        self._resting = dict(objects)
+        self._geometry = None
+
+    def set_object(self, name: str, box: ObjectBox) -> None:
+        self.set_objects({**self._resting, name: box})
+
+    def remove_object(self, name: str) -> None:
+        if name not in self._resting:
+            raise CollisionModelError(f"no resting object {name!r}")
+        self.set_objects({k: v for k, v in self._resting.items() if k != name})
+
+    def held_by(self, arm: str) -> str | None:
+        self._arm(arm)
+        held = self._held.get(arm)
+        return held[0] if held else None
+
+    def attach(self, arm: str, name: str, q_arm: FloatArray | None = None) -> None:
+        """Let ``arm`` hold resting object ``name`` rigidly, in its pose relative to the
+        tool at ``q_arm`` (default: the arm's current configuration)."""
+        self._arm(arm)
+        if arm in self._held:
+            raise CollisionModelError(f"arm {arm!r} already holds {self._held[arm][0]!r}")
+        if name not in self._resting:
+            raise CollisionModelError(f"no resting object {name!r} to attach")
+        T_world_tool0 = self.tool0_pose(arm, q_arm)
+        box = self._resting.pop(name)
+        self._held[arm] = (name, inverse(T_world_tool0) @ box.T_world_obj, box)
+        self._geometry = None
+
+    def detach(self, arm: str, q_arm: FloatArray | None = None) -> ObjectBox:
+        """Release the object held by ``arm``; it rests where the tool leaves it."""
+        self._arm(arm)
+        if arm not in self._held:
+            raise CollisionModelError(f"arm {arm!r} holds nothing")
+        name, T_tool0_obj, box = self._held.pop(arm)
+        placed = ObjectBox(self.tool0_pose(arm, q_arm) @ T_tool0_obj, box.size)
+        self._resting[name] = placed
+        self._geometry = None
+        return placed
+
+    # -- configurations -------------------------------------------------------------------
+    def set_configuration(self, q_left: FloatArray, q_right: FloatArray) -> None:
+        self._q[:6] = q_left
+        self._q[6:] = q_right
+
+    @property
+    def configuration(self) -> tuple[FloatArray, FloatArray]:
+        return self._q[:6].copy(), self._q[6:].copy()
+
+    def tool0_pose(self, arm: str, q_arm: FloatArray | None = None) -> FloatArray:
+        """``T_world_tool0`` of ``arm`` at ``q_arm`` (default: current configuration)."""
+        q = self._q.copy()
+        if q_arm is not None:
+            q[self._arm(arm)] = q_arm
+        else:
+            self._arm(arm)
+        return cm.tool0_pose(self._arms, q, arm)
+
+    # -- queries --------------------------------------------------------------------------
+    def in_collision(
+        self, q_left: FloatArray | None = None, q_right: FloatArray | None = None
+    ) -> bool:
+        """True if any checked pair collides at ``(q_left, q_right)`` (default: current)."""
+        geometry = self._geometry or self._scene_geometry()
+        self._set(q_left, q_right)
+        return cm.any_collision(self._arms, geometry, self._q)
+
+    def report(
+        self, q_left: FloatArray | None = None, q_right: FloatArray | None = None
+    ) -> tuple[CollisionPair, ...]:
+        """Every colliding pair, by shape names (empty when collision-free)."""
+        geometry = self._scene_geometry()
+        self._set(q_left, q_right)
+        return tuple(
+            CollisionPair(*geometry.pair_names[i])
+            for i in cm.colliding_pairs(self._arms, geometry, self._q)
+        )
+
+    def min_distance(
+        self, q_left: FloatArray | None = None, q_right: FloatArray | None = None
+    ) -> Clearance:
+        """Smallest signed distance over every checked pair [m] (negative: penetration)."""
+        geometry = self._scene_geometry()
+        self._set(q_left, q_right)
+        d = cm.pair_distances(self._arms, geometry, self._q)
+        if d.size == 0:
+            return Clearance(float("inf"), None)
+        i = int(np.argmin(d))
+        return Clearance(float(d[i]), CollisionPair(*geometry.pair_names[i]))
+
+    # -- internals ------------------------------------------------------------------------
+    def _set(self, q_left: FloatArray | None, q_right: FloatArray | None) -> None:
+        if q_left is not None:
+            self._q[:6] = q_left
+        if q_right is not None:
+            self._q[6:] = q_right
+
+    def _arm(self, arm: str) -> slice:
+        if arm not in self._arms.arm_names:
+            raise CollisionModelError(
+                f"unknown arm {arm!r}; expected one of {self._arms.arm_names}"
+            )
+        return self._arms.q_slice(arm)
+
+    def _shrunk(self, box: ObjectBox) -> FloatArray:
+        return np.maximum(np.array(box.size) - 2.0 * self._tolerance, 1e-6)
+
+    def _scene_geometry(self) -> cm.SceneGeometry:
+        if self._geometry is None:
+            resting = {n: (b.T_world_obj, self._shrunk(b)) for n, b in self._resting.items()}
+            held = {a: (n, T, self._shrunk(b)) for a, (n, T, b) in self._held.items()}
+            self._geometry = cm.build_scene_geometry(
+                self._arms, self._scene.table.size, resting, held, self._pairs()
+            )
+        return self._geometry
+
+    def _pairs(self) -> list[tuple[str, str]]:
+        shapes = self._arms.shapes
+        pairs: list[tuple[str, str]] = []
+        for i, a in enumerate(shapes):
+            for b in shapes[i + 1 :]:
+                if a.arm != b.arm or abs(a.link_index - b.link_index) >= 2:
+                    pairs.append((a.name, b.name))
+            if a.link_index >= 2:
+                pairs.append((a.name, "table"))
+            pairs.extend((a.name, f"object:{o}") for o in self._resting)
+        held = list(self._held.items())
+        for k, (arm, (name, _, _)) in enumerate(held):
+            h = f"held:{name}"
+            pairs.extend((s.name, h) for s in shapes if s.arm != arm or s.link_index < 6)
+            pairs.append((h, "table"))
+            pairs.extend((h, f"object:{o}") for o in self._resting)
+            pairs.extend((h, f"held:{other}") for _, (other, _, _) in held[k + 1 :])
+        return pairs

@@ -1,0 +1,175 @@
+"""Typed adapter building the pinocchio model of both arms and the scene geometry.
+
+The two arms are one 12-DoF pinocchio model (left joints first). Scene geometry is added as
+pinocchio geometry objects: the table and resting objects on the universe joint, held objects
+on the wrist_3 joint of the arm holding them. Collision pairs encode the filtering rules of
+:class:`sdar_tamp.world.collision.CollisionWorld`.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from sdar_tamp.world import _coal
+from sdar_tamp.world._pin import array_to_se3, se3_to_array
+from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import FloatArray, translation
+
+
+@dataclass(frozen=True)
+class ArmGeometry:
+    """One collision shape of an arm: its index in the arm-only geometry model."""
+
+    name: str
+    arm: str
+    link_index: int  # 0 base_link, 1 shoulder ... 6 wrist_3 + gripper
+    index: int
+
+
+@dataclass(frozen=True)
+class DualArmModel:
+    """The combined kinematic model and the arms' collision shapes."""
+
+    model: Any
+    data: Any = field(repr=False)
+    arm_geometry: Any = field(repr=False)  # pin.GeometryModel holding the arm shapes only
+    shapes: tuple[ArmGeometry, ...]
+    arm_names: tuple[str, ...]
+    wrist_joint: dict[str, int]  # arm -> joint id of wrist_3
+    tool0_frame: dict[str, int]  # arm -> frame id of tool0
+    T_wrist_tool0: FloatArray  # tool0 in the wrist_3 joint frame
+
+    def q_slice(self, arm: str) -> slice:
+        i = self.arm_names.index(arm)
+        return slice(6 * i, 6 * i + 6)
+
+
+def _prefixed_urdf(text: str, prefix: str) -> str:
+    text = re.sub(r'(<(?:link|joint)\s+name=")', rf"\g<1>{prefix}", text)
+    return re.sub(r'(<(?:parent|child)\s+link=")', rf"\g<1>{prefix}", text)
+
+
+def build_dual_arm(scene: Scene) -> DualArmModel:
+    """Both arms of ``scene`` in one pinocchio model, bases at their world poses."""
+    text = scene.robot_urdf.read_text(encoding="utf-8")
+    model = pin.Model()
+    geometry = pin.GeometryModel()
+    for spec in scene.arms:
+        arm_text = _prefixed_urdf(text, f"{spec.name}_")
+        arm_model = pin.buildModelFromXML(arm_text)
+        arm_geom = pin.buildGeomFromUrdfString(arm_model, arm_text, pin.COLLISION)
+        model, geometry = pin.appendModel(
+            model, arm_model, geometry, arm_geom, 0, array_to_se3(spec.T_world_base)
+        )
+    shapes: list[ArmGeometry] = []
+    wrist: dict[str, int] = {}
+    for spec in scene.arms:
+        joints = [model.getJointId(f"{spec.name}_{j}_joint") for j in _JOINTS]
+        wrist[spec.name] = int(joints[-1])
+        for gi, obj in enumerate(geometry.geometryObjects):
+            if not obj.name.startswith(f"{spec.name}_"):
+                continue
+            link = joints.index(obj.parentJoint) + 1 if obj.parentJoint in joints else 0
+            shapes.append(ArmGeometry(str(obj.name), spec.name, link, gi))
+    tool0 = {a.name: int(model.getFrameId(f"{a.name}_tool0")) for a in scene.arms}
+    T_wrist_tool0 = se3_to_array(model.frames[tool0[scene.arms[0].name]].placement)
+    return DualArmModel(
+        model,
+        model.createData(),
+        geometry,
+        tuple(shapes),
+        scene.arm_names,
+        wrist,
+        tool0,
+        T_wrist_tool0,
+    )
+
+
+def tool0_pose(arms: DualArmModel, q: FloatArray, arm: str) -> FloatArray:
+    """``T_world_tool0`` of ``arm`` at the dual-arm configuration ``q`` ``(12,)``."""
+    pin.framesForwardKinematics(arms.model, arms.data, q)
+    return se3_to_array(arms.data.oMf[arms.tool0_frame[arm]])
+
+
+_JOINTS = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
+
+
+@dataclass(frozen=True)
+class SceneGeometry:
+    """A ready-to-query geometry model: pairs, names and a broad-phase manager."""
+
+    geometry: Any
+    data: Any
+    manager: Any
+    pair_names: tuple[tuple[str, str], ...]
+
+
+def build_scene_geometry(
+    arms: DualArmModel,
+    table_size: tuple[float, float, float],
+    resting: dict[str, tuple[FloatArray, FloatArray]],
+    held: dict[str, tuple[str, FloatArray, FloatArray]],
+    pairs: list[tuple[str, str]],
+) -> SceneGeometry:
+    """Add table, resting objects ``name -> (T_world_obj, size)`` and held objects
+    ``arm -> (name, T_tool0_obj, size)`` to the arm shapes; activate the named ``pairs``."""
+    geometry = arms.arm_geometry.copy()
+    sx, sy, sz = table_size
+    table = pin.GeometryObject(
+        "table", 0, array_to_se3(translation(0.0, 0.0, -sz / 2)), _coal.box((sx, sy, sz))
+    )
+    geometry.addGeometryObject(table)
+    for name, (T, size) in resting.items():
+        geometry.addGeometryObject(
+            pin.GeometryObject(f"object:{name}", 0, array_to_se3(T), _coal.box(size))
+        )
+    for arm, (name, T_tool0_obj, size) in held.items():
+        placement = array_to_se3(arms.T_wrist_tool0 @ T_tool0_obj)
+        geometry.addGeometryObject(
+            pin.GeometryObject(f"held:{name}", arms.wrist_joint[arm], placement, _coal.box(size))
+        )
+    for a, b in pairs:
+        geometry.addCollisionPair(
+            pin.CollisionPair(geometry.getGeometryId(a), geometry.getGeometryId(b))
+        )
+    names = tuple(
+        (
+            str(geometry.geometryObjects[p.first].name),
+            str(geometry.geometryObjects[p.second].name),
+        )
+        for p in geometry.collisionPairs
+    )
+    data = geometry.createData()
+    manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(arms.model, geometry, data)
+    return SceneGeometry(geometry, data, manager, names)
+
+
+def any_collision(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> bool:
+    """Broad phase then narrow phase; stops at the first colliding pair."""
+    return bool(pin.computeCollisions(arms.model, arms.data, scene.manager, q, True))
+
+
+def colliding_pairs(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> list[int]:
+    """Indices (into ``scene.pair_names``) of every colliding pair, narrow phase on all."""
+    pin.computeCollisions(arms.model, arms.data, scene.geometry, scene.data, q, False)
+    return [i for i, r in enumerate(scene.data.collisionResults) if r.isCollision()]
+
+
+def pair_distances(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> FloatArray:
+    """Signed distance of every active pair ``(n_pairs,)`` [m]."""
+    pin.computeDistances(arms.model, arms.data, scene.geometry, scene.data, q)
+    return np.array([r.min_distance for r in scene.data.distanceResults], dtype=np.float64)
+
+
+def link_poses(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> dict[str, FloatArray]:
+    """World pose of every geometry ``name -> (4, 4)`` at ``q`` ``(12,)``."""
+    pin.updateGeometryPlacements(arms.model, arms.data, scene.geometry, scene.data, q)
+    return {
+        str(obj.name): se3_to_array(scene.data.oMg[i])
+        for i, obj in enumerate(scene.geometry.geometryObjects)
+    }

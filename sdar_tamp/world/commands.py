@@ -1,0 +1,28 @@
+"""Plain functions behind the ``sdar`` command line for the dual-arm world.
+
+Each writes files only where it is told to and returns what it wrote.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from sdar_tamp.world.draw import draw_instance
+from sdar_tamp.world.generators import generate_instance
+from sdar_tamp.world.instance import load_instance, save_instance
+from sdar_tamp.world.suites import generate_suite as _generate_suite
+
+
+def generate(family: str, objects: int, seed: int, out: Path) -> Path:
+    """Generate one instance of ``family`` (R, S, D, M) and write it to ``out`` (YAML)."""
+    return save_instance(generate_instance(family, objects, seed), Path(out))
+
+
+def generate_suite(suite: str, out_dir: Path) -> list[Path]:
+    """Write the named suite (``paper`` or ``stress``) into ``out_dir``."""
+    return _generate_suite(suite, Path(out_dir))
+
+
+def show_instance(instance_path: Path, out: Path) -> Path:
+    """Draw the instance file at ``instance_path`` to the image ``out`` (e.g. ``.png``)."""
+    return draw_instance(load_instance(Path(instance_path)), Path(out))

@@ -1,0 +1,80 @@
+"""Named suites of instances, as folders of YAML files.
+
+* ``paper``: R, S and D with every object count 4 to 12 (27 instances, names ``R4`` ... ``D12``)
+  and the mixed cases ``M1`` to ``M10`` (12 objects each): 37 instances.
+* ``stress``: R, S, D and mixed with 16, 20 and 24 objects (``R16`` ... ``D24``; the mixed ones
+  are named ``Mn16``, ``Mn20``, ``Mn24`` since ``M#`` is an index in the paper): 12 instances.
+
+Seeds are fixed per instance (:func:`suite_members`), so a suite regenerates identically. The
+shipped copies live in ``domains/dual_arm_rearrangement/suites/<suite>/``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib.resources import files
+from pathlib import Path
+
+from sdar_tamp.world.errors import SuiteError
+from sdar_tamp.world.generators import generate_instance
+from sdar_tamp.world.instance import Instance, load_instance, save_instance
+
+SUITES = ("paper", "stress")
+_FAMILY_SEED = {"R": 1000, "S": 2000, "D": 3000, "M": 4000}
+
+
+@dataclass(frozen=True)
+class SuiteMember:
+    """How one instance of a suite is generated."""
+
+    name: str
+    family: str
+    n_objects: int
+    seed: int
+
+
+def suite_members(suite: str) -> tuple[SuiteMember, ...]:
+    """The instances of a named suite, in order."""
+    if suite == "paper":
+        members = [
+            SuiteMember(f"{f}{n}", f, n, _FAMILY_SEED[f] + n) for f in "RSD" for n in range(4, 13)
+        ]
+        members += [SuiteMember(f"M{k}", "M", 12, _FAMILY_SEED["M"] + k) for k in range(1, 11)]
+        return tuple(members)
+    if suite == "stress":
+        members = [
+            SuiteMember(f"{f}{n}", f, n, _FAMILY_SEED[f] + n) for f in "RSD" for n in (16, 20, 24)
+        ]
+        members += [
+            SuiteMember(f"Mn{n}", "M", n, _FAMILY_SEED["M"] + 100 + n) for n in (16, 20, 24)
+        ]
+        return tuple(members)
+    raise SuiteError(f"unknown suite {suite!r}; expected one of {list(SUITES)}")
+
+
+def build_suite(suite: str) -> tuple[Instance, ...]:
+    """Generate every instance of a suite in memory."""
+    return tuple(
+        generate_instance(m.family, m.n_objects, m.seed, name=m.name) for m in suite_members(suite)
+    )
+
+
+def generate_suite(suite: str, out_dir: Path) -> list[Path]:
+    """Write a suite as ``out_dir/<name>.yaml`` files; returns the paths in suite order."""
+    out = Path(out_dir)
+    return [save_instance(inst, out / f"{inst.name}.yaml") for inst in build_suite(suite)]
+
+
+def shipped_suite_dir(suite: str) -> Path:
+    suite_members(suite)  # validates the name
+    return Path(str(files("domains") / "dual_arm_rearrangement" / "suites" / suite))
+
+
+def load_suite(suite: str, directory: Path | None = None) -> tuple[Instance, ...]:
+    """Load a suite: from ``directory`` if given, else the shipped copy, in suite order."""
+    folder = Path(directory) if directory is not None else shipped_suite_dir(suite)
+    members = suite_members(suite)
+    missing = [m.name for m in members if not (folder / f"{m.name}.yaml").is_file()]
+    if missing:
+        raise SuiteError(f"suite {suite!r} in {folder}: missing instance files {missing}")
+    return tuple(load_instance(folder / f"{m.name}.yaml") for m in members)

@@ -1,0 +1,97 @@
+"""Buffer sampling: free, reachable temporary poses for an object on the workspace.
+
+A buffer is a planar pose ``(x, y, yaw)`` of the object such that its footprint (grown by
+``margin``) lies inside the workspace, overlaps no footprint in ``occupied`` (current object
+footprints and goal footprints still to be filled) nor another returned buffer, and the arm
+reaches it with a top-down grasp (closed-form IK, any branch within the joint limits, for the
+grasp and its pre-grasp). Randomness comes from ``numpy.random.default_rng(seed)`` only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
+from sdar_tamp.world.instance import Pose2D
+from sdar_tamp.world.scene import Workspace
+from sdar_tamp.world.transforms import BoolArray, FloatArray, pose_xyz_yaw
+from streams.context import WorldContext
+from streams.grasps import Grasp, pregrasp_offset, sample_grasps
+
+
+def reachable_top_down(
+    ctx: WorldContext,
+    arm: str,
+    poses: FloatArray,
+    size: tuple[float, float, float],
+    lift: float = 0.08,
+    grasps: Sequence[Grasp] | None = None,
+) -> BoolArray:
+    """``(n,)``: the arm reaches object poses ``(n, 3)`` (x, y, yaw) with a top-down grasp."""
+    p = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+    if len(p) == 0:
+        return np.zeros(0, dtype=np.bool_)
+    top = [
+        g
+        for g in (grasps or sample_grasps(size, ctx.scene.gripper.max_graspable_width, ()))
+        if g.is_top_down
+    ]
+    if not top:
+        return np.zeros(len(p), dtype=np.bool_)
+    T_obj = pose_xyz_yaw(p[:, 0], p[:, 1], size[2] / 2.0, p[:, 2])  # (n, 4, 4)
+    T_tcp = (T_obj[:, None] @ np.stack([g.T_object_tcp for g in top])[None]).reshape(-1, 4, 4)
+    both = ctx.kinematics[arm].ik_tcp(np.concatenate([T_tcp, pregrasp_offset(T_tcp, lift)]))
+    m = len(T_tcp)
+    ok = both.valid[:m] & both.valid[m:]
+    return np.asarray(ok.reshape(len(p), len(top), 8).any(axis=(1, 2)), dtype=np.bool_)
+
+
+def sample_buffers(
+    ctx: WorldContext,
+    arm: str,
+    size: tuple[float, float, float],
+    occupied: FloatArray,
+    k: int,
+    seed: int,
+    workspace: Workspace | None = None,
+    margin: float = 0.01,
+    batch: int = 256,
+    max_batches: int = 20,
+) -> list[Pose2D]:
+    """Up to ``k`` buffer poses for an object of ``size`` [m] (fewer if space runs out).
+
+    ``occupied``: footprints ``(m, 4, 2)`` [m] to keep clear (see
+    :func:`sdar_tamp.world.footprint.corners`).
+    """
+    if k < 0:
+        raise ValueError(f"k must be >= 0, got {k}")
+    ws = workspace or ctx.scene.workspace
+    rng = np.random.default_rng(seed)
+    taken = np.asarray(occupied, dtype=np.float64).reshape(-1, 4, 2)
+    grown = np.array([size[0] + 2 * margin, size[1] + 2 * margin])
+    out: list[Pose2D] = []
+    for _ in range(max_batches):
+        if len(out) >= k:
+            break
+        cand = np.stack(
+            [rng.uniform(*ws.x, batch), rng.uniform(*ws.y, batch),
+             rng.choice([0.0, np.pi / 2], batch) + rng.uniform(-0.3, 0.3, batch)], axis=1,
+        )  # fmt: skip
+        rect = corners(cand, np.broadcast_to(grown, (batch, 2)))
+        keep = inside_rectangle(corners(cand, np.broadcast_to(size[:2], (batch, 2))), ws.x, ws.y)
+        if len(taken):
+            keep &= ~overlap_matrix(rect, taken).any(axis=1)
+        idx = np.flatnonzero(keep)
+        if len(idx) == 0:
+            continue
+        idx = idx[reachable_top_down(ctx, arm, cand[idx], size)]
+        for i in idx:
+            if len(out) >= k:
+                break
+            if len(taken) and overlap_matrix(rect[i : i + 1], taken).any():
+                continue
+            out.append(Pose2D(float(cand[i, 0]), float(cand[i, 1]), float(cand[i, 2])))
+            taken = np.concatenate([taken, rect[i : i + 1]])
+    return out

@@ -1,0 +1,48 @@
+"""Straight tool moves (approach and retreat) by closed-form IK interpolation."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.transforms import FloatArray
+
+
+def straight_tool_move(
+    kin: ArmKinematics,
+    q: FloatArray,
+    distance: float,
+    step: float = 0.01,
+    max_joint_step: float = 0.3,
+) -> FloatArray | None:
+    """Configurations ``(n + 1, 6)`` [rad] moving the TCP by ``distance`` [m] along its own
+    z axis (negative: backwards, i.e. a retreat), orientation fixed, starting at ``q``.
+
+    Each step takes the IK branch nearest to the previous configuration; None when a step is
+    unreachable or jumps by more than ``max_joint_step`` [rad] on some joint.
+    """
+    q = np.asarray(q, dtype=np.float64)
+    T0 = kin.fk_tcp(q)
+    n = max(1, int(np.ceil(abs(distance) / step)))
+    T = np.repeat(T0[None], n, axis=0)
+    T[:, :3, 3] += (distance * np.arange(1, n + 1) / n)[:, None] * T0[:3, 2][None]
+    sol = kin.ik_tcp(T)
+    out = [q]
+    for k in range(n):
+        d = np.where(sol.valid[k], np.abs(sol.q[k] - out[-1]).max(axis=1), np.inf)
+        b = int(np.argmin(d))
+        if not np.isfinite(d[b]) or d[b] > max_joint_step:
+            return None
+        out.append(sol.q[k, b])
+    return np.stack(out)
+
+
+def tool_pose_ik(
+    kin: ArmKinematics, T_world_tcp: FloatArray, q_near: FloatArray
+) -> FloatArray | None:
+    """The valid IK branch ``(6,)`` for a TCP pose nearest to ``q_near``, or None."""
+    sol = kin.ik_tcp(T_world_tcp[None])
+    if not sol.valid[0].any():
+        return None
+    d = np.where(sol.valid[0], np.linalg.norm(sol.q[0] - q_near, axis=1), np.inf)
+    return np.asarray(sol.q[0, int(np.argmin(d))], dtype=np.float64)

@@ -1,0 +1,99 @@
+"""Grasp sampling for cuboids with a two-finger gripper.
+
+Tool frame convention (the scene's ``tcp``): the gripper approaches along its z axis and the
+fingers close along its y axis. A grasp is the pose of the tool centre point in the object
+frame, ``T_object_tcp``; the TCP sits at the object's centre.
+
+Order (the paper's expanding grasp angles): every top-down grasp first, then tilted grasps
+with growing approach angles ``+t, -t`` for ``t`` in ``tilts``. The tilt turns the tool about
+its closing axis, i.e. in the plane perpendicular to the closing axis. Closing axes are tried
+short side first; a side wider than the gripper's graspable width is rejected. With
+``symmetric=True`` both 180-degree variants (tool turned by pi about its approach axis) are
+returned; they are distinct wrist configurations of the same physical grasp.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.world.transforms import FloatArray
+
+#: The paper's grasp set: top-down, then 45 degrees either way.
+DEFAULT_TILTS = (np.pi / 4,)
+
+
+@dataclass(frozen=True, eq=False)
+class Grasp:
+    """A grasp of a cuboid.
+
+    ``T_object_tcp`` ``(4, 4)``; ``width`` is the object side between the fingers [m];
+    ``approach`` ``(3,)`` is the unit approach direction (tool z) in the object frame; ``tilt``
+    [rad] is the angle away from top-down; ``index`` is the rank in the sampling order.
+    Grasps hold arrays, so they compare (and hash) by identity.
+    """
+
+    index: int
+    T_object_tcp: FloatArray
+    width: float
+    approach: FloatArray
+    tilt: float
+    closing_axis: int  # 0: fingers close along the object's x axis, 1: along y
+    flipped: bool
+
+    @property
+    def is_top_down(self) -> bool:
+        return abs(self.tilt) < 1e-12
+
+
+def _rot_y(angle: float) -> FloatArray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def grasp_rotation(closing_axis: int, tilt: float, flipped: bool) -> FloatArray:
+    """``R_object_tcp`` ``(3, 3)``: tool z down (then tilted about tool y), y along the axis."""
+    y = np.zeros(3)
+    y[closing_axis] = 1.0
+    z = np.array([0.0, 0.0, -1.0])
+    R = np.stack([np.cross(y, z), y, z], axis=1) @ _rot_y(tilt)
+    if flipped:
+        R = R @ np.diag([-1.0, -1.0, 1.0])
+    return R
+
+
+def sample_grasps(
+    size: tuple[float, float, float],
+    max_width: float,
+    tilts: Sequence[float] = DEFAULT_TILTS,
+    symmetric: bool = True,
+    min_width: float = 0.0,
+) -> tuple[Grasp, ...]:
+    """All grasps of a cuboid of ``size`` (lx, ly, lz) [m], in the order described above.
+
+    ``max_width`` [m]: the largest side the fingers can close on (opening minus margin);
+    ``tilts`` [rad]: growing positive tilt angles, each tried as ``+t`` then ``-t``.
+    """
+    if any(t <= 0.0 or t >= np.pi / 2 for t in tilts):
+        raise ValueError(f"tilts must lie in (0, pi/2) [rad], got {list(tilts)}")
+    axes = [a for a in sorted((0, 1), key=lambda a: size[a]) if min_width <= size[a] <= max_width]
+    angles = [0.0] + [s * t for t in sorted(tilts) for s in (1.0, -1.0)]
+    flips = (False, True) if symmetric else (False,)
+    out: list[Grasp] = []
+    for tilt in angles:
+        for axis in axes:
+            for flip in flips:
+                R = grasp_rotation(axis, tilt, flip)
+                T = np.eye(4)
+                T[:3, :3] = R
+                out.append(Grasp(len(out), T, float(size[axis]), R[:, 2].copy(), tilt, axis, flip))
+    return tuple(out)
+
+
+def pregrasp_offset(T_world_tcp: FloatArray, lift: float) -> FloatArray:
+    """Poses ``(..., 4, 4)`` backed off by ``lift`` [m] against the approach (tool z)."""
+    out = np.array(T_world_tcp, dtype=np.float64, copy=True)
+    out[..., :3, 3] -= lift * out[..., :3, 2]
+    return out

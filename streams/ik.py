@@ -1,0 +1,181 @@
+"""Batched inverse kinematics for grasp candidates, filtered by collision and ranked.
+
+For many ``(arm, object pose, grasp)`` requests at once: the closed-form IK of the grasp pose
+and of its pre-grasp (``lift`` back along the approach) for every branch; a branch survives if
+both are real and within the joint limits, the pre-grasp lies on the same branch (joint
+distance below ``max_branch_jump``), and neither configuration collides with the table, the
+other resting objects, itself or the other arm (held at ``other_q``, default its home pose).
+The gripper may touch the object being grasped (the fingers close on it); every other
+contact counts. Survivors are ranked by the joint distance of their pre-grasp from the arm's
+current configuration. :func:`compatible_pairs` then pairs candidates of the two arms whose
+configurations are collision-free together (the sub-task instantiation of SDAR-M).
+
+Values holding arrays (:class:`IKRequest`, :class:`IKCandidate`) compare by identity.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.world.collision import CollisionWorld, ObjectBox
+from sdar_tamp.world.transforms import FloatArray
+from streams.context import WorldContext
+from streams.grasps import Grasp, pregrasp_offset
+
+
+@dataclass(frozen=True, eq=False)
+class IKRequest:
+    """Grasp ``obj`` (a box at its pose, start or goal) with ``arm`` using any of ``grasps``."""
+
+    arm: str
+    obj: str
+    box: ObjectBox
+    grasps: tuple[Grasp, ...]
+
+
+@dataclass(frozen=True, eq=False)
+class IKCandidate:
+    """One collision-free IK branch: grasp and pre-grasp configurations ``(6,)`` [rad]."""
+
+    arm: str
+    obj: str
+    grasp: Grasp
+    branch: int
+    q: FloatArray
+    q_pre: FloatArray
+    cost: float  # joint distance of q_pre from the arm's current configuration [rad]
+
+
+def solve_ik_candidates(
+    ctx: WorldContext,
+    world: CollisionWorld,
+    objects: Mapping[str, ObjectBox],
+    requests: Sequence[IKRequest],
+    q_current: Mapping[str, FloatArray],
+    lift: float = 0.08,
+    other_q: Mapping[str, FloatArray] | None = None,
+    max_branch_jump: float = 1.0,
+) -> list[IKCandidate]:
+    """All collision-free candidates of every request, cheapest first.
+
+    ``world`` is used as scratch space (its resting objects are replaced); ``objects`` are the
+    resting objects of the current arrangement, name -> box.
+    """
+    park = {a: ctx.home(a) for a in ctx.arm_names}
+    if other_q is not None:
+        park.update({a: np.asarray(q, dtype=np.float64) for a, q in other_q.items()})
+    ensure_objects(world, objects)
+    out: list[IKCandidate] = []
+    by_object: dict[tuple[str, str], list[IKRequest]] = {}
+    for r in requests:
+        by_object.setdefault((r.arm, r.obj), []).append(r)
+    for (arm, obj), reqs in by_object.items():
+        kin = ctx.kinematics[arm]
+        grasps = [g for r in reqs for g in r.grasps]
+        boxes = [r.box for r in reqs for _ in r.grasps]
+        if not grasps:
+            continue
+        T_obj = np.stack([b.T_world_obj for b in boxes])
+        T_tcp = T_obj @ np.stack([g.T_object_tcp for g in grasps])
+        both = kin.ik_tcp(np.concatenate([T_tcp, pregrasp_offset(T_tcp, lift)]))
+        n = len(grasps)
+        q, q_pre = both.q[:n], both.q[n:]
+        ok = both.valid[:n] & both.valid[n:]
+        ok &= np.abs(q - q_pre).max(axis=-1) < max_branch_jump
+        if not ok.any():
+            continue
+        ref = np.asarray(q_current[arm], dtype=np.float64)
+        dual = dict(park)
+        for gi, b in zip(*np.nonzero(ok), strict=True):
+            if _collides(ctx, world, dual, arm, obj, q[gi, b]) or _collides(
+                ctx, world, dual, arm, obj, q_pre[gi, b]
+            ):
+                continue
+            cost = float(np.linalg.norm(q_pre[gi, b] - ref))
+            out.append(
+                IKCandidate(
+                    arm, obj, grasps[gi], int(b), q[gi, b].copy(), q_pre[gi, b].copy(), cost
+                )
+            )
+    out.sort(key=lambda c: c.cost)
+    return out
+
+
+def _collides(
+    ctx: WorldContext,
+    world: CollisionWorld,
+    park: dict[str, FloatArray],
+    arm: str,
+    obj: str,
+    q: FloatArray,
+) -> bool:
+    """Collision of ``arm`` at ``q``, except its gripper touching the object it grasps."""
+    left, right = ctx.arm_names
+    q_left = q if arm == left else park[left]
+    q_right = q if arm == right else park[right]
+    if not world.in_collision(q_left, q_right):
+        return False
+    target = f"object:{obj}"
+    return any(not _is_gripper_contact(p.first, p.second, arm, target) for p in world.report())
+
+
+def _is_gripper_contact(a: str, b: str, arm: str, target: str) -> bool:
+    shape = a if b == target else b if a == target else None
+    return shape is not None and shape.startswith(f"{arm}_") and _GRIPPER in shape
+
+
+_GRIPPER = "gripper"
+
+
+def ensure_objects(world: CollisionWorld, objects: Mapping[str, ObjectBox]) -> None:
+    """Give ``world`` exactly these resting objects, rebuilding its geometry only on change."""
+    current = world.objects
+    same = current.keys() == objects.keys() and all(
+        np.array_equal(current[k].T_world_obj, v.T_world_obj) and current[k].size == v.size
+        for k, v in objects.items()
+    )
+    if not same:
+        world.set_objects(objects)
+
+
+def compatible_pairs(
+    ctx: WorldContext,
+    world: CollisionWorld,
+    objects: Mapping[str, ObjectBox],
+    first: Sequence[IKCandidate],
+    second: Sequence[IKCandidate],
+    limit: int = 1,
+) -> list[tuple[IKCandidate, IKCandidate]]:
+    """Up to ``limit`` pairs (one candidate per arm, different objects), cheapest total cost
+    first, whose grasp and pre-grasp configurations are collision-free *together*.
+
+    ``first`` must hold candidates of the scene's first arm and ``second`` of the other.
+    """
+    ensure_objects(world, objects)
+    pairs = sorted(
+        ((a, b) for a in first for b in second if a.obj != b.obj),
+        key=lambda p: p[0].cost + p[1].cost,
+    )
+    out: list[tuple[IKCandidate, IKCandidate]] = []
+    for a, b in pairs:
+        if len(out) >= limit:
+            break
+        if _pair_collides(world, a, b, a.q, b.q) or _pair_collides(world, a, b, a.q_pre, b.q_pre):
+            continue
+        out.append((a, b))
+    return out
+
+
+def _pair_collides(
+    world: CollisionWorld, a: IKCandidate, b: IKCandidate, qa: FloatArray, qb: FloatArray
+) -> bool:
+    if not world.in_collision(qa, qb):
+        return False
+    allowed = {(a.arm, f"object:{a.obj}"), (b.arm, f"object:{b.obj}")}
+    return any(
+        not any(_is_gripper_contact(p.first, p.second, arm, t) for arm, t in allowed)
+        for p in world.report()
+    )

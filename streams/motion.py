@@ -1,0 +1,374 @@
+"""SDAR-M synchronous dual-arm motion with fallbacks (the paper's Alg. 2).
+
+A synchronous segment takes both arms from ``q_start`` to ``q_goal`` (``(12,)`` [rad]) with
+the held objects fixed for the whole segment (gripper actions happen between segments):
+
+1. retreat: arms flagged ``retreat`` first move their tool ``lift`` [m] straight back along
+   the tool axis (IK interpolation), both arms at once;
+2. transfer: between the two lifted (pre-grasp) configurations, produced by a *strategy*;
+3. approach: arms flagged ``approach`` move ``lift`` straight down the tool axis to the goal.
+
+Every phase and stage is timed rest to rest (:mod:`streams.timing`), the whole trajectory is
+then checked exactly with coal (:mod:`streams.validate`), and only a trajectory that passes
+is returned as a success. Strategies, tried in order until one passes:
+
+* ``plain`` (:class:`PlainStrategy`): one synchronous optimisation, warm-started from the
+  straight line, then from a lifted via-point;
+* ``untangle`` (:class:`UntangleStrategy`, rules in ``docs/arm_untangling.md``): the arm that
+  reaches deeper into the other arm's half yields: it moves to a lifted park pose above its
+  own half while the other arm goes straight to its goal; then it moves to its own goal while
+  the other waits. If that fails, the roles swap;
+* ``sequential`` (:class:`SequentialStrategy`): one arm at a time; the first arm retracts to
+  its home pose, the second moves to its goal, then the first moves to its goal.
+
+``plan_dual_motion(..., fallbacks=False)`` is the paper's "plain" planner (no fallbacks);
+``sequential_only=True`` is the baseline motion planner.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from sdar_tamp.world.collision import ObjectBox
+from sdar_tamp.world.transforms import FloatArray
+from streams.cartesian import straight_tool_move, tool_pose_ik
+from streams.context import WorldContext
+from streams.sphere_pairs import HeldSpheres
+from streams.spheres import object_spheres
+from streams.timing import TimedTrajectory, time_parameterize
+from streams.trajopt import DualArmTrajOpt, TrajOptOptions, TransferQuery, straight_line
+from streams.validate import HeldObject, ValidationReport, configure_world, validate_trajectory
+
+
+@dataclass(frozen=True)
+class MotionRequest:
+    """One synchronous segment. Arms are in the scene's order (left first)."""
+
+    q_start: FloatArray  # (12,) [rad]
+    q_goal: FloatArray  # (12,) [rad]
+    objects: Mapping[str, ObjectBox]  # resting objects
+    held: Mapping[str, HeldObject] = field(default_factory=dict)  # arm -> held object
+    retreat: tuple[bool, bool] = (False, False)
+    approach: tuple[bool, bool] = (False, False)
+    lift: float = 0.08  # [m]
+
+
+@dataclass(frozen=True)
+class MotionResult:
+    """``level`` is the strategy that produced the motion (None on failure)."""
+
+    success: bool
+    level: str | None
+    trajectory: TimedTrajectory | None
+    optimisation_time: float  # [s] spent in the trajectory optimiser, all attempts
+    planning_time: float  # [s] wall time of the whole call
+    attempts: tuple[str, ...]  # "level: outcome" for every strategy tried
+    validation: ValidationReport | None = None
+    reason: str = ""
+    ipopt_solves: int = 0  # optimiser calls that ran IPOPT (a feasible straight line needs none)
+
+
+@dataclass(frozen=True)
+class TransferProblem:
+    """The transfer between the lifted configurations, with everything a strategy needs."""
+
+    q_from: FloatArray  # (12,)
+    q_to: FloatArray  # (12,)
+    held: tuple[HeldSpheres, HeldSpheres]
+    obstacles: tuple[FloatArray, FloatArray]
+
+
+class TransferStrategy(Protocol):
+    """Produces the transfer as a list of stages (each a ``(k, 12)`` path) or None."""
+
+    @property
+    def name(self) -> str: ...
+
+    def __call__(
+        self, planner: DualMotionPlanner, problem: TransferProblem
+    ) -> list[FloatArray] | None: ...
+
+
+class DualMotionPlanner:
+    """Owns the optimiser (built once) and a scratch collision world."""
+
+    def __init__(self, ctx: WorldContext, options: TrajOptOptions | None = None) -> None:
+        self.ctx = ctx
+        self.trajopt = DualArmTrajOpt(ctx, options)
+        self.world = ctx.new_world()
+        self._v = np.concatenate([ctx.scene.arm(a).velocity_limit for a in ctx.arm_names])
+        self._a = np.concatenate([ctx.scene.arm(a).acceleration_limit for a in ctx.arm_names])
+        self.optimisation_time = 0.0  # reset per plan_dual_motion call
+        self.ipopt_solves = 0
+
+    # -- building blocks used by strategies ----------------------------------------------
+    def nominal_duration(self, q_a: FloatArray, q_b: FloatArray) -> float:
+        """A generous duration [s] for the optimiser's velocity/acceleration rows."""
+        d = np.abs(np.asarray(q_b) - np.asarray(q_a))
+        t = np.maximum(d / self._v + self._v / self._a, 2.0 * np.sqrt(d / self._a))
+        return float(2.0 * t.max() + 0.5)
+
+    def optimise(
+        self,
+        problem: TransferProblem,
+        q_a: FloatArray,
+        q_b: FloatArray,
+        warm_start: FloatArray | None = None,
+        fixed: tuple[bool, bool] = (False, False),
+    ) -> FloatArray | None:
+        """One optimised transfer from ``q_a`` to ``q_b`` (sphere model), or None.
+
+        An arm whose two end configurations are equal waits: its joints are held fixed.
+        """
+        if np.allclose(q_a, q_b):
+            return np.stack([q_a, q_b])
+        still = [bool(np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6])) for i in (0, 1)]
+        fixed = (fixed[0] or still[0], fixed[1] or still[1])
+        query = TransferQuery(
+            q_a, q_b, problem.held, problem.obstacles, self.nominal_duration(q_a, q_b), fixed
+        )
+        result = self.trajopt.solve(query, warm_start)
+        self.optimisation_time += result.solve_time
+        self.ipopt_solves += int(result.rounds > 0)
+        return result.path if result.success else None
+
+    def lifted_via(self, q_a: FloatArray, q_b: FloatArray, height: float = 0.15) -> FloatArray:
+        """A warm start ``(K, 12)`` through a via configuration whose TCPs are ``height`` [m]
+        above the higher end, half-way between the two."""
+        K = self.trajopt.options.knots
+        mid = 0.5 * (q_a + q_b)
+        via = mid.copy()
+        for i, arm in enumerate(self.ctx.arm_names):
+            kin = self.ctx.kinematics[arm]
+            sl = slice(6 * i, 6 * i + 6)
+            Ta, Tb = kin.fk_tcp(q_a[sl]), kin.fk_tcp(q_b[sl])
+            T = Tb.copy()
+            T[:3, 3] = 0.5 * (Ta[:3, 3] + Tb[:3, 3])
+            T[2, 3] = max(Ta[2, 3], Tb[2, 3]) + height
+            q = tool_pose_ik(kin, T, mid[sl])
+            if q is not None:
+                via[sl] = q
+        half = K // 2
+        return np.concatenate(
+            [straight_line(q_a, via, half + 1)[:-1], straight_line(via, q_b, K - half)]
+        )
+
+    def park(self, arm: str, q_goal_arm: FloatArray, height: float = 0.30) -> FloatArray | None:
+        """The untangling park pose of ``arm``: TCP above its own half of the table at the
+        goal's ``y``, ``height`` [m] up, with the goal's orientation."""
+        kin = self.ctx.kinematics[arm]
+        spec = self.ctx.scene.arm(arm)
+        T = kin.fk_tcp(q_goal_arm)
+        ws = self.ctx.scene.workspace
+        base_x = spec.base_xyz[0]
+        T[0, 3] = base_x + np.sign(-base_x) * 0.40
+        T[1, 3] = float(np.clip(T[1, 3], *ws.y))
+        T[2, 3] = height
+        return tool_pose_ik(kin, T, q_goal_arm)
+
+    def depth(self, q: FloatArray) -> FloatArray:
+        """``(2,)``: how far [m] each arm's TCP reaches past the table centre line towards
+        the other arm's base."""
+        out = np.zeros(2)
+        for i, arm in enumerate(self.ctx.arm_names):
+            p = self.ctx.kinematics[arm].fk_tcp(q[6 * i : 6 * i + 6])[:3, 3]
+            out[i] = p[0] * np.sign(-self.ctx.scene.arm(arm).base_xyz[0])
+        return out
+
+    # -- assembling ------------------------------------------------------------------------
+    def phases(self, request: MotionRequest) -> tuple[FloatArray, FloatArray] | None:
+        """Retreat and approach paths ``(n, 12)`` (synchronised, padded), or None."""
+        ret, app = [], []
+        for i, arm in enumerate(self.ctx.arm_names):
+            kin = self.ctx.kinematics[arm]
+            sl = slice(6 * i, 6 * i + 6)
+            r = straight_tool_move(kin, request.q_start[sl], -request.lift) if request.retreat[
+                i] else request.q_start[sl][None]  # fmt: skip
+            a = straight_tool_move(kin, request.q_goal[sl], -request.lift) if request.approach[
+                i] else request.q_goal[sl][None]  # fmt: skip
+            if r is None or a is None:
+                return None
+            ret.append(r)
+            app.append(a[::-1])
+        return _sync(ret), _sync(app)
+
+    def transfer_problem(
+        self, request: MotionRequest, q_from: FloatArray, q_to: FloatArray
+    ) -> TransferProblem:
+        o = self.trajopt.options
+        held = []
+        for arm in self.ctx.arm_names:
+            h = request.held.get(arm)
+            if h is None:
+                held.append(HeldSpheres.empty())
+            else:
+                c, r = object_spheres(h.size, h.T_tool0_obj, o.held_slots)
+                held.append(HeldSpheres(c, r))
+        cs, rs = [], []
+        for box in request.objects.values():
+            c, r = object_spheres(box.size, box.T_world_obj, 2)
+            cs.append(c)
+            rs.append(r)
+        obstacles = (
+            (np.concatenate(cs), np.concatenate(rs)) if cs else (np.zeros((0, 3)), np.zeros(0))
+        )
+        return TransferProblem(q_from, q_to, (held[0], held[1]), obstacles)
+
+    def assemble(
+        self, retreat: FloatArray, stages: Sequence[FloatArray], approach: FloatArray
+    ) -> TimedTrajectory:
+        traj = time_parameterize(retreat, self._v, self._a)
+        for stage in stages:
+            traj = traj.then(time_parameterize(stage, self._v, self._a))
+        return traj.then(time_parameterize(approach, self._v, self._a))
+
+
+def _sync(paths: list[FloatArray]) -> FloatArray:
+    """Two arm paths ``(n_i, 6)`` as one ``(max n, 12)`` path (the shorter one waits)."""
+    n = max(len(p) for p in paths)
+    padded = [np.concatenate([p, np.repeat(p[-1:], n - len(p), axis=0)]) for p in paths]
+    return np.concatenate(padded, axis=1)
+
+
+# -- strategies ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PlainStrategy:
+    """One synchronous optimisation: straight-line warm start, then a lifted via-point."""
+
+    name: str = "plain"
+    lifted_warm_start: bool = True
+
+    def __call__(
+        self, planner: DualMotionPlanner, problem: TransferProblem
+    ) -> list[FloatArray] | None:
+        path = planner.optimise(problem, problem.q_from, problem.q_to)
+        if path is None and self.lifted_warm_start:
+            ws = planner.lifted_via(problem.q_from, problem.q_to)
+            path = planner.optimise(problem, problem.q_from, problem.q_to, ws)
+        return None if path is None else [path]
+
+
+@dataclass(frozen=True)
+class UntangleStrategy:
+    """Arm untangling (see the module docstring and ``docs/arm_untangling.md``)."""
+
+    name: str = "untangle"
+    park_height: float = 0.30  # [m]
+
+    def __call__(
+        self, planner: DualMotionPlanner, problem: TransferProblem
+    ) -> list[FloatArray] | None:
+        ctx = planner.ctx
+        order = np.argsort(-planner.depth(problem.q_from))
+        for y in (int(order[0]), int(order[1])):
+            arm = ctx.arm_names[y]
+            sl = slice(6 * y, 6 * y + 6)
+            park = planner.park(arm, problem.q_to[sl], self.park_height)
+            if park is None:
+                continue
+            q_mid = problem.q_to.copy()
+            q_mid[sl] = park
+            first = planner.optimise(problem, problem.q_from, q_mid)
+            if first is None:
+                first = planner.optimise(
+                    problem, problem.q_from, q_mid, planner.lifted_via(problem.q_from, q_mid)
+                )
+            if first is None:
+                continue
+            fixed = (y != 0, y != 1)
+            second = planner.optimise(problem, q_mid, problem.q_to, fixed=fixed)
+            if second is not None:
+                return [first, second]
+        return None
+
+
+@dataclass(frozen=True)
+class SequentialStrategy:
+    """One arm at a time: retract the first to home, move the second, move the first."""
+
+    name: str = "sequential"
+
+    def __call__(
+        self, planner: DualMotionPlanner, problem: TransferProblem
+    ) -> list[FloatArray] | None:
+        ctx = planner.ctx
+        order = np.argsort(-planner.depth(problem.q_from))
+        for f in (int(order[0]), int(order[1])):
+            s = 1 - f
+            sf, ss = slice(6 * f, 6 * f + 6), slice(6 * s, 6 * s + 6)
+            q1 = problem.q_from.copy()
+            q1[sf] = ctx.home(ctx.arm_names[f])
+            q2 = q1.copy()
+            q2[ss] = problem.q_to[ss]
+            stages = []
+            for qa, qb, moving in ((problem.q_from, q1, f), (q1, q2, s), (q2, problem.q_to, f)):
+                fixed = (moving != 0, moving != 1)
+                path = planner.optimise(problem, qa, qb, fixed=fixed)
+                if path is None:
+                    path = planner.optimise(
+                        problem, qa, qb, planner.lifted_via(qa, qb), fixed=fixed
+                    )
+                if path is None:
+                    break
+                stages.append(path)
+            else:
+                return stages
+        return None
+
+
+def default_strategies(
+    fallbacks: bool = True, sequential_only: bool = False
+) -> tuple[TransferStrategy, ...]:
+    """The ladder of Alg. 2: plain, untangle, sequential (or a part of it)."""
+    if sequential_only:
+        return (SequentialStrategy(),)
+    if not fallbacks:
+        return (PlainStrategy(),)
+    return (PlainStrategy(), UntangleStrategy(), SequentialStrategy())
+
+
+def plan_dual_motion(
+    planner: DualMotionPlanner,
+    request: MotionRequest,
+    fallbacks: bool = True,
+    sequential_only: bool = False,
+    strategies: Sequence[TransferStrategy] | None = None,
+) -> MotionResult:
+    """Plan one synchronous segment; see the module docstring."""
+    t0 = time.perf_counter()
+    planner.optimisation_time = 0.0
+    planner.ipopt_solves = 0
+    ladder = tuple(strategies) if strategies is not None else default_strategies(
+        fallbacks, sequential_only)  # fmt: skip
+    ctx = planner.ctx
+    q_start = np.asarray(request.q_start, dtype=np.float64)
+    configure_world(ctx, planner.world, request.objects, request.held, q_start)
+    phases = planner.phases(request)
+    if phases is None:
+        return MotionResult(False, None, None, 0.0, time.perf_counter() - t0, (),
+                            reason="approach or retreat unreachable")  # fmt: skip
+    retreat, approach = phases
+    problem = planner.transfer_problem(request, retreat[-1], approach[0])
+    attempts: list[str] = []
+    report: ValidationReport | None = None
+    for strategy in ladder:
+        stages = strategy(planner, problem)
+        if stages is None:
+            attempts.append(f"{strategy.name}: optimisation failed")
+            continue
+        traj = planner.assemble(retreat, stages, approach)
+        report = validate_trajectory(ctx, planner.world, traj.q, traj.t)
+        if report.ok:
+            attempts.append(f"{strategy.name}: ok")
+            return MotionResult(True, strategy.name, traj, planner.optimisation_time,
+                                time.perf_counter() - t0, tuple(attempts), report,
+                                ipopt_solves=planner.ipopt_solves)  # fmt: skip
+        attempts.append(f"{strategy.name}: validation failed ({report.reason})")
+    return MotionResult(False, None, None, planner.optimisation_time, time.perf_counter() - t0,
+                        tuple(attempts), report, reason="; ".join(attempts),
+                        ipopt_solves=planner.ipopt_solves)  # fmt: skip

@@ -1,0 +1,91 @@
+"""Numeric sphere clearances along a dual-arm path, for choosing the optimiser's pair slots.
+
+Arm spheres are those of :class:`streams.spheres.ArmSpheres` followed by the held-object
+spheres of that arm (given in the tool0 frame). Clearance of a sphere pair is
+``|c_i - c_j| - r_i - r_j`` [m]; of a sphere and the table, ``z - r``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.world.transforms import FloatArray
+from streams.context import WorldContext
+
+
+@dataclass(frozen=True)
+class HeldSpheres:
+    """Spheres covering a held object, in the tool0 frame: ``(h, 3)`` [m], ``(h,)`` [m]."""
+
+    centre: FloatArray
+    radius: FloatArray
+
+    @staticmethod
+    def empty() -> HeldSpheres:
+        return HeldSpheres(np.zeros((0, 3)), np.zeros(0))
+
+
+@dataclass(frozen=True)
+class PathSpheres:
+    """Sphere centres of both arms along a path: ``(s, n_arm, 3)`` each, and radii."""
+
+    centres: tuple[FloatArray, FloatArray]
+    radii: tuple[FloatArray, FloatArray]
+    moving_link: tuple[FloatArray, FloatArray]  # (n_arm,) bool: sphere may touch the table check
+    coarse_centres: tuple[FloatArray, FloatArray]  # the coarse arm spheres + held spheres
+    coarse_radii: tuple[FloatArray, FloatArray]
+
+
+def path_spheres(
+    ctx: WorldContext, path: FloatArray, held: tuple[HeldSpheres, HeldSpheres]
+) -> PathSpheres:
+    """Centres of every arm and held sphere at each configuration of ``path`` ``(s, 12)``."""
+    cs: list[FloatArray] = []
+    rs: list[FloatArray] = []
+    ms: list[FloatArray] = []
+    ccs: list[FloatArray] = []
+    crs: list[FloatArray] = []
+    for i, arm in enumerate(ctx.arm_names):
+        fk = ctx.fk[arm]
+        q = path[:, 6 * i : 6 * i + 6]
+        c, cc = fk.centres(q), fk.centres(q, coarse=True)
+        h = held[i]
+        if len(h.radius):
+            T = fk.tool0_batch(q)  # (s, 4, 4)
+            hc = np.einsum("sij,hj->shi", T[:, :3, :3], h.centre) + T[:, None, :3, 3]
+            c = np.concatenate([c, hc], axis=1)
+            cc = np.concatenate([cc, hc], axis=1)
+        cs.append(c)
+        ccs.append(cc)
+        rs.append(np.concatenate([fk.spheres.radius, h.radius]))
+        crs.append(np.concatenate([fk.coarse.radius, h.radius]))
+        ms.append(np.concatenate([fk.spheres.joint >= 2, np.ones(len(h.radius), dtype=bool)]))
+    return PathSpheres(
+        (cs[0], cs[1]), (rs[0], rs[1]), (ms[0], ms[1]), (ccs[0], ccs[1]), (crs[0], crs[1])
+    )
+
+
+def arm_arm_clearance(ps: PathSpheres) -> FloatArray:
+    """``(s, n_left, n_right)`` clearances between the two arms' coarse spheres [m]."""
+    c, r = ps.coarse_centres, ps.coarse_radii
+    d = np.linalg.norm(c[0][:, :, None] - c[1][:, None], axis=-1)
+    out: FloatArray = d - r[0][:, None] - r[1][None]
+    return out
+
+
+def obstacle_clearance(
+    ps: PathSpheres, arm: int, centres: FloatArray, radii: FloatArray
+) -> FloatArray:
+    """``(s, n_arm, m)`` clearances between one arm's spheres and obstacle spheres [m]."""
+    d = np.linalg.norm(ps.centres[arm][:, :, None] - centres[None, None], axis=-1)
+    out: FloatArray = d - ps.radii[arm][:, None] - radii[None, None]
+    return out
+
+
+def table_clearance(ps: PathSpheres, arm: int) -> FloatArray:
+    """``(s, n_arm)`` heights of the spheres' lowest points above the table [m] (inf for
+    spheres on the base and shoulder, which stand on the table)."""
+    z = ps.centres[arm][..., 2] - ps.radii[arm][None]
+    return np.where(ps.moving_link[arm][None], z, np.inf)

@@ -1,0 +1,167 @@
+"""Time parameterisation of a joint-space path under velocity and acceleration limits.
+
+The waypoints ``(N, n)`` are joined by a natural cubic spline ``q(s)`` over the cumulative
+chord length ``s`` [rad]; on a grid of ``s`` the path speed is found by a backward pass (the
+largest ``x = sdot^2`` from which the end can still be reached at rest) and a forward pass
+(accelerate as hard as the joint limits allow), with ``u = sddot`` constant between grid
+points and the constraints
+
+    |q'(s)_j| sqrt(x) <= v_j,     |q'(s)_j u + q''(s)_j x| <= a_j     (every joint j)
+
+at both ends of every grid step. The backward pass solves a two-variable linear programme per
+grid point by enumerating the vertices of its polygon. Limits are scaled by ``safety``
+(default 0.95) to absorb the discretisation. The motion starts and ends at rest; the result
+is resampled at a uniform step of at most ``dt``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.world.transforms import FloatArray
+
+
+@dataclass(frozen=True)
+class TimedTrajectory:
+    """Samples ``q`` ``(m, n)`` [rad] at times ``t`` ``(m,)`` [s], starting at ``t = 0``."""
+
+    t: FloatArray
+    q: FloatArray
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1]) if len(self.t) else 0.0
+
+    def then(self, other: TimedTrajectory) -> TimedTrajectory:
+        """This trajectory followed by ``other`` (which must start where this one ends)."""
+        if len(self.t) == 0:
+            return other
+        return TimedTrajectory(
+            np.concatenate([self.t, self.duration + other.t[1:]]),
+            np.concatenate([self.q, other.q[1:]]),
+        )
+
+
+def natural_spline(s: FloatArray, y: FloatArray) -> FloatArray:
+    """Second derivatives ``(N, n)`` of the natural cubic spline through ``(s_i, y_i)``."""
+    N = len(s)
+    M = np.zeros_like(y)
+    if N < 3:
+        return M
+    h = np.diff(s)
+    A = np.zeros((N - 2, N - 2))
+    idx = np.arange(N - 2)
+    A[idx, idx] = 2.0 * (h[:-1] + h[1:])
+    A[idx[1:], idx[:-1]] = h[1:-1]
+    A[idx[:-1], idx[1:]] = h[1:-1]
+    d = np.diff(y, axis=0) / h[:, None]
+    rhs = 6.0 * (d[1:] - d[:-1])
+    M[1:-1] = np.linalg.solve(A, rhs)
+    return M
+
+
+def spline_eval(
+    s: FloatArray, y: FloatArray, M: FloatArray, x: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Value, first and second derivative ``(k, n)`` of the spline at ``x`` ``(k,)``."""
+    i = np.clip(np.searchsorted(s, x, side="right") - 1, 0, len(s) - 2)
+    h = (s[i + 1] - s[i])[:, None]
+    a = (s[i + 1][:, None] - x[:, None]) / h
+    b = 1.0 - a
+    y0, y1, m0, m1 = y[i], y[i + 1], M[i], M[i + 1]
+    val = a * y0 + b * y1 + ((a**3 - a) * m0 + (b**3 - b) * m1) * h * h / 6.0
+    der = (y1 - y0) / h + (-(3 * a * a - 1) * m0 + (3 * b * b - 1) * m1) * h / 6.0
+    dd = a * m0 + b * m1
+    return val, der, dd
+
+
+def _accel_rows(
+    dq: FloatArray, ddq: FloatArray, dq1: FloatArray, ddq1: FloatArray, ds: float
+) -> FloatArray:
+    """Rows ``(2n, 2)`` in ``(x, u)`` of the joint accelerations at both ends of a step
+    (``x_{i+1} = x + 2 u ds``); each row times ``(x, u)`` must stay in ``[-a, a]``."""
+    return np.concatenate([np.stack([ddq, dq], 1), np.stack([ddq1, dq1 + 2 * ds * ddq1], 1)])
+
+
+def _max_x(rows: FloatArray, a2: FloatArray, xv: float, xn: float, ds: float) -> float:
+    """Largest ``x`` in the polygon of the backward pass at one grid point."""
+    box = np.array([[1.0, 0.0], [-1.0, 0.0], [1.0, 2 * ds], [-1.0, -2 * ds]])
+    G = np.concatenate([box, rows, -rows])
+    h = np.concatenate([np.array([xv, 0.0, xn, 0.0]), a2, a2])
+    i, j = np.triu_indices(len(G), 1)
+    det = G[i, 0] * G[j, 1] - G[i, 1] * G[j, 0]
+    ok = np.abs(det) > 1e-12
+    i, j, det = i[ok], j[ok], det[ok]
+    x = (h[i] * G[j, 1] - G[i, 1] * h[j]) / det
+    u = (G[i, 0] * h[j] - h[i] * G[j, 0]) / det
+    feas = np.all(G @ np.stack([x, u]) <= h[:, None] + 1e-9, axis=0)
+    return float(max(0.0, x[feas].max())) if feas.any() else 0.0
+
+
+def _u_range(rows: FloatArray, a2: FloatArray, x: float) -> tuple[float, float]:
+    """Interval of ``u`` with ``|rows @ (x, u)| <= a2`` at a given ``x``."""
+    c, d = rows[:, 0] * x, rows[:, 1]
+    use = np.abs(d) > 1e-12
+    b1 = (a2[use] - c[use]) / d[use]
+    b2 = (-a2[use] - c[use]) / d[use]
+    lo = float(np.max(np.minimum(b1, b2), initial=-np.inf))
+    hi = float(np.min(np.maximum(b1, b2), initial=np.inf))
+    return lo, hi
+
+
+def time_parameterize(
+    waypoints: FloatArray,
+    v_max: FloatArray,
+    a_max: FloatArray,
+    dt: float = 0.02,
+    grid_step: float = 0.02,
+    safety: float = 0.95,
+    max_grid: int = 150,
+) -> TimedTrajectory:
+    """A rest-to-rest trajectory through ``waypoints`` ``(N, n)`` [rad] within ``v_max``
+    [rad/s] and ``a_max`` [rad/s^2] ``(n,)``, sampled every ``<= dt`` [s].
+
+    The speed grid has a spacing of ``grid_step`` [rad] of path length, at most ``max_grid``
+    points."""
+    W = np.asarray(waypoints, dtype=np.float64)
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(W, axis=0), axis=1) > 1e-9])
+    W = W[keep]
+    if len(W) < 2:
+        return TimedTrajectory(np.zeros(1), W[:1].copy())
+    v, a = safety * np.asarray(v_max, dtype=np.float64), safety * np.asarray(a_max)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(W, axis=0), axis=1))])
+    M = natural_spline(s, W)
+    n_grid = int(np.clip(np.ceil(s[-1] / grid_step) + 1, 8, max_grid))
+    sg = np.linspace(0.0, s[-1], n_grid)
+    ds = sg[1] - sg[0]
+    _, dq, ddq = spline_eval(s, W, M, sg)
+    with np.errstate(divide="ignore"):
+        xv = np.min(np.where(np.abs(dq) > 1e-12, (v / np.abs(dq)) ** 2, np.inf), axis=1)
+    a2 = np.concatenate([a, a])
+    rows = [_accel_rows(dq[i], ddq[i], dq[i + 1], ddq[i + 1], ds) for i in range(n_grid - 1)]
+    xmax = np.zeros(n_grid)
+    for i in range(n_grid - 2, -1, -1):
+        xmax[i] = _max_x(rows[i], a2, float(xv[i]), float(xmax[i + 1]), ds)
+    x = np.zeros(n_grid)
+    u = np.zeros(n_grid - 1)
+    for i in range(n_grid - 1):
+        lo, hi = _u_range(rows[i], a2, x[i])
+        ui = min(hi, (xmax[i + 1] - x[i]) / (2 * ds))
+        ui = max(ui, lo, -x[i] / (2 * ds))
+        u[i] = ui
+        x[i + 1] = float(np.clip(x[i] + 2 * ui * ds, 0.0, xmax[i + 1]))
+        u[i] = (x[i + 1] - x[i]) / (2 * ds)
+    sq = np.sqrt(x)
+    step = 2 * ds / np.maximum(sq[:-1] + sq[1:], 1e-12)
+    tg = np.concatenate([[0.0], np.cumsum(step)])
+    T = float(tg[-1])
+    n_samples = max(1, int(np.ceil(T / dt)))
+    t = np.linspace(0.0, T, n_samples + 1)
+    k = np.clip(np.searchsorted(tg, t, side="right") - 1, 0, n_grid - 2)
+    tau = t - tg[k]
+    s_t = np.clip(sg[k] + sq[k] * tau + 0.5 * u[k] * tau * tau, 0.0, s[-1])
+    s_t[-1] = s[-1]
+    q, _, _ = spline_eval(s, W, M, s_t)
+    return TimedTrajectory(t, q)

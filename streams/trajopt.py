@@ -1,0 +1,451 @@
+"""Synchronous dual-arm trajectory optimisation (CasADi + IPOPT), built once per shape.
+
+Decision variables: the interior knots of a path ``q_0 .. q_{K-1}`` over both arms (12 joints);
+``q_0`` and ``q_{K-1}`` are parameters. Cost: squared second differences (smoothness) plus a
+small weight on squared first differences (length). Constraints at every interior knot:
+
+* joint limits (variable bounds);
+* per-step joint velocity ``|q_{k+1} - q_k| <= v_max dt`` and acceleration
+  ``|q_{k+1} - 2 q_k + q_{k-1}| <= a_max dt^2`` on the nominal time grid ``dt = T / (K - 1)``
+  (``T`` per call; the exact timing is :mod:`streams.timing`'s job);
+* sphere clearances in *slots*: arm-arm (coarse spheres, held objects included, so the two
+  held objects are checked against each other), arm-obstacle per arm, arm-table per arm.
+  A slot picks one sphere of an arm with a one-hot parameter row, so the NLP is built once
+  and each call chooses the pairs that matter: the ones closest along the warm start,
+  refreshed by an active-set round when the solution comes near a pair without a slot.
+
+The evenly spaced straight line is the unconstrained minimiser of the cost; when it satisfies
+every constraint (and no pair without a slot comes too close) it is returned without calling
+IPOPT (``status == "straight line feasible"``).
+
+Each slot constraint is ``|c_i - c_j|^2 - (r_i + r_j + margin)^2 >= lb`` (table:
+``z - r - margin >= lb``) with ``lb = 0`` unless an end point itself is closer (the fixed
+end points may touch, e.g. a held object on the table at a place), then ``lb`` is that value.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sdar_tamp.world.transforms import FloatArray
+from streams._casadi import ca, sx_sym, to_array
+from streams.context import WorldContext
+from streams.fk_casadi import joint_frames, sphere_centres
+from streams.sphere_pairs import (
+    HeldSpheres,
+    PathSpheres,
+    arm_arm_clearance,
+    obstacle_clearance,
+    path_spheres,
+    table_clearance,
+)
+
+_log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class TrajOptOptions:
+    """Shape and solver settings; one NLP is built per distinct value."""
+
+    knots: int = 10
+    held_slots: int = 4  # spheres per held object
+    arm_arm_slots: int = 24
+    obstacle_slots: int = 12  # per arm
+    table_slots: int = 6  # per arm
+    margin: float = 0.015  # [m] clearance asked of the spheres
+    select_distance: float = 0.10  # [m] pairs closer than this along the path get a slot
+    w_length: float = 0.05
+    max_iter: int = 25
+    tol: float = 1e-3
+    active_set_rounds: int = 2
+
+
+@dataclass(frozen=True)
+class TransferQuery:
+    """One transfer: end configurations ``(12,)`` [rad], held spheres per arm (scene order),
+    obstacle spheres ``(m, 3)``, ``(m,)`` [m] and the nominal duration ``T`` [s]."""
+
+    q_start: FloatArray
+    q_goal: FloatArray
+    held: tuple[HeldSpheres, HeldSpheres]
+    obstacles: tuple[FloatArray, FloatArray]
+    duration: float
+    fixed: tuple[bool, bool] = (False, False)  # an arm that must wait at its start
+
+
+@dataclass(frozen=True)
+class TrajOptResult:
+    """The optimised knots ``(K, 12)``; ``success`` means IPOPT converged (or stopped at a
+    feasible point) and every sphere pair keeps its clearance on a dense check of the path."""
+
+    path: FloatArray
+    success: bool
+    status: str
+    iterations: int
+    solve_time: float  # [s] wall time of the whole call
+    rounds: int = 1
+    min_clearance: float = field(default=float("nan"))  # [m] over all sphere pairs
+
+
+class _Layout:
+    """Offsets of named blocks in a flat parameter vector."""
+
+    def __init__(self) -> None:
+        self.blocks: dict[str, tuple[int, tuple[int, int]]] = {}
+        self.size = 0
+
+    def add(self, name: str, rows: int, cols: int = 1) -> None:
+        self.blocks[name] = (self.size, (rows, cols))
+        self.size += rows * cols
+
+    def sym(self, p: Any, name: str) -> Any:
+        start, (rows, cols) = self.blocks[name]
+        return ca.reshape(p[start : start + rows * cols], cols, rows).T
+
+    def put(self, p: FloatArray, name: str, value: FloatArray) -> None:
+        start, (rows, cols) = self.blocks[name]
+        p[start : start + rows * cols] = np.asarray(value, dtype=np.float64).reshape(rows * cols)
+
+
+class DualArmTrajOpt:
+    """The NLP for one :class:`TrajOptOptions`, built at construction, solved many times."""
+
+    def __init__(self, ctx: WorldContext, options: TrajOptOptions | None = None) -> None:
+        self.ctx = ctx
+        self.options = o = options or TrajOptOptions()
+        arms = ctx.arm_names
+        self._n_arm = [len(ctx.fk[a].spheres) + o.held_slots for a in arms]
+        self._n_coarse = [len(ctx.fk[a].coarse) + o.held_slots for a in arms]
+        lay = _Layout()
+        lay.add("q0", 1, 12)
+        lay.add("q1", 1, 12)
+        for i in range(2):
+            lay.add(f"held{i}", o.held_slots, 4)
+            lay.add(f"aa_sel{i}", o.arm_arm_slots, self._n_coarse[i])
+            lay.add(f"ao_sel{i}", o.obstacle_slots, self._n_arm[i])
+            lay.add(f"ao_obs{i}", o.obstacle_slots, 4)
+            lay.add(f"t_sel{i}", o.table_slots, self._n_arm[i])
+        lay.add("margin", 1, 1)
+        self._lay = lay
+        self._build()
+
+    # -- construction ------------------------------------------------------------------
+    def _arm_spheres_sx(self, i: int, q: Any, p: Any) -> tuple[Any, Any, Any, Any]:
+        """Fine and coarse sphere centres ``(n, 3)`` and radii ``(n, 1)`` (held ones last)."""
+        arm = self.ctx.arm_names[i]
+        fk = self.ctx.fk[arm]
+        frames = joint_frames(q, fk.T_world_base)
+        held = self._lay.sym(p, f"held{i}")
+        tool0 = frames[5]
+        hc = (tool0[:3, :3] @ held[:, :3].T + ca.repmat(tool0[:3, 3], 1, held.shape[0])).T
+        C = ca.vertcat(sphere_centres(frames, fk.spheres), hc)
+        R = ca.vertcat(ca.DM(fk.spheres.radius), held[:, 3])
+        CC = ca.vertcat(sphere_centres(frames, fk.coarse), hc)
+        CR = ca.vertcat(ca.DM(fk.coarse.radius), held[:, 3])
+        return C, R, CC, CR
+
+    def _build(self) -> None:
+        o, lay, K = self.options, self._lay, self.options.knots
+        x = sx_sym("x", (K - 2) * 12)
+        p = sx_sym("p", lay.size)
+        q0, q1 = lay.sym(p, "q0").T, lay.sym(p, "q1").T
+        Q = [q0] + [x[12 * k : 12 * k + 12] for k in range(K - 2)] + [q1]
+        m = lay.sym(p, "margin")
+        cost = 0
+        for k in range(K - 1):
+            cost += o.w_length * ca.sumsqr(Q[k + 1] - Q[k])
+        for k in range(1, K - 1):
+            cost += ca.sumsqr(Q[k + 1] - 2 * Q[k] + Q[k - 1])
+        g: list[Any] = []
+        sel = {name: lay.sym(p, name) for name in lay.blocks if "sel" in name or "obs" in name}
+        for k in range(1, K - 1):
+            CR = [self._arm_spheres_sx(i, Q[k][6 * i : 6 * i + 6], p) for i in range(2)]
+            cl, cr = sel["aa_sel0"] @ CR[0][2], sel["aa_sel1"] @ CR[1][2]
+            rl, rr = sel["aa_sel0"] @ CR[0][3], sel["aa_sel1"] @ CR[1][3]
+            g.append(ca.sum2((cl - cr) ** 2) - (rl + rr + m) ** 2)
+            for i in range(2):
+                C, R = CR[i][0], CR[i][1]
+                obs = sel[f"ao_obs{i}"]
+                c, r = sel[f"ao_sel{i}"] @ C, sel[f"ao_sel{i}"] @ R
+                g.append(ca.sum2((c - obs[:, :3]) ** 2) - (r + obs[:, 3] + m) ** 2)
+            for i in range(2):
+                C, R = CR[i][0], CR[i][1]
+                g.append(sel[f"t_sel{i}"] @ C[:, 2] - sel[f"t_sel{i}"] @ R - m)
+        self._n_collision = sum(int(e.shape[0]) for e in g)
+        g.extend(Q[k + 1] - Q[k] for k in range(K - 1))
+        g.extend(Q[k + 1] - 2 * Q[k] + Q[k - 1] for k in range(1, K - 1))
+        nlp = {"x": x, "p": p, "f": cost, "g": ca.vertcat(*g)}
+        opts = {
+            "ipopt.print_level": 0,
+            "print_time": False,
+            "ipopt.sb": "yes",
+            "ipopt.max_iter": o.max_iter,
+            "ipopt.tol": o.tol,
+            "ipopt.acceptable_tol": 1e-2,
+            "ipopt.acceptable_iter": 3,
+            "ipopt.constr_viol_tol": 1e-4,
+            "ipopt.mu_strategy": "adaptive",
+            "expand": True,
+        }
+        self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", nlp, opts)
+        self._g_fn = ca.Function("g", [x, p], [nlp["g"]])
+        lo = np.concatenate([self.ctx.scene.arm(a).lower_array for a in self.ctx.arm_names])
+        hi = np.concatenate([self.ctx.scene.arm(a).upper_array for a in self.ctx.arm_names])
+        self._lbx, self._ubx = np.tile(lo, K - 2), np.tile(hi, K - 2)
+        v = np.concatenate([self.ctx.scene.arm(a).velocity_limit for a in self.ctx.arm_names])
+        acc = np.concatenate([self.ctx.scene.arm(a).acceleration_limit for a in self.ctx.arm_names])
+        self._vmax, self._amax = np.array(v), np.array(acc)
+
+    # -- solving -----------------------------------------------------------------------
+    def solve(self, query: TransferQuery, warm_start: FloatArray | None = None) -> TrajOptResult:
+        """Optimise the transfer; ``warm_start`` ``(K, 12)`` (default: the straight line)."""
+        t0 = time.perf_counter()
+        o, K = self.options, self.options.knots
+        q_a, q_b = np.asarray(query.q_start), np.asarray(query.q_goal)
+        straight = warm_start is None
+        if warm_start is None:
+            warm_start = straight_line(q_a, q_b, K)
+        path = np.array(warm_start, dtype=np.float64)
+        path[0], path[-1] = q_a, q_b
+        ends = path_spheres(self.ctx, np.stack([q_a, q_b]), query.held)
+        forced: _Selection | None = None
+        status, iters, rounds = "not solved", 0, 0
+        for rounds in range(1, o.active_set_rounds + 2):
+            dense = path_spheres(self.ctx, densify(path, 3), query.held)
+            selection = _select(dense, ends, query, o, forced)
+            p, lbg, ubg = self._parameters(query, selection)
+            lbx = np.minimum(self._lbx, path[1:-1].reshape(-1))
+            ubx = np.maximum(self._ubx, path[1:-1].reshape(-1))
+            for i, fixed in enumerate(query.fixed):
+                if fixed:
+                    hold = np.tile(q_a[6 * i : 6 * i + 6], (K - 2, 1))
+                    path[1:-1, 6 * i : 6 * i + 6] = hold
+                    lbx.reshape(K - 2, 12)[:, 6 * i : 6 * i + 6] = hold
+                    ubx.reshape(K - 2, 12)[:, 6 * i : 6 * i + 6] = hold
+            if straight and rounds == 1 and self._straight_is_optimal(path, p, lbg, ubg):
+                worst, violators = _violations(dense, ends, query, selection)
+                if not violators.any_left():
+                    return TrajOptResult(
+                        path, True, "straight line feasible", 0, time.perf_counter() - t0, 0, worst
+                    )
+            sol = self._solver(x0=path[1:-1].reshape(-1), p=p, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+            stats = self._solver.stats()
+            status, iters = str(stats["return_status"]), iters + int(stats["iter_count"])
+            path = path.copy()
+            path[1:-1] = to_array(sol["x"]).reshape(K - 2, 12)
+            g = to_array(self._g_fn(path[1:-1].reshape(-1), p)).reshape(-1)
+            feasible = bool(np.all(g >= lbg - 1e-4) and np.all(g <= ubg + 1e-4))
+            dense = path_spheres(self.ctx, densify(path, 3), query.held)
+            worst, violators = _violations(dense, ends, query, selection)
+            if feasible and not violators.any_left():
+                return TrajOptResult(
+                    path, True, status, iters, time.perf_counter() - t0, rounds, worst
+                )
+            _log.debug(
+                "round %d: %s, %d iterations, feasible %s, %s unslotted violators",
+                rounds, status, iters, feasible, violators,
+            )  # fmt: skip
+            forced = violators.merged(forced)
+        return TrajOptResult(path, False, status, iters, time.perf_counter() - t0, rounds)
+
+    def _straight_is_optimal(
+        self, path: FloatArray, p: FloatArray, lbg: FloatArray, ubg: FloatArray
+    ) -> bool:
+        """The evenly spaced straight line minimises the (convex quadratic) cost with no
+        constraints; when it also satisfies every constraint it is the NLP's optimum."""
+        g = to_array(self._g_fn(path[1:-1].reshape(-1), p)).reshape(-1)
+        return bool(np.all(g >= lbg) and np.all(g <= ubg))
+
+    def _parameters(
+        self, query: TransferQuery, s: _Selection
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        o, lay, K = self.options, self._lay, self.options.knots
+        p = np.zeros(lay.size)
+        lay.put(p, "q0", query.q_start)
+        lay.put(p, "q1", query.q_goal)
+        lay.put(p, "margin", np.array([o.margin]))
+        for i in range(2):
+            held = np.zeros((o.held_slots, 4))
+            h = query.held[i]
+            held[: len(h.radius), :3] = h.centre
+            held[: len(h.radius), 3] = h.radius
+            lay.put(p, f"held{i}", held)
+            lay.put(p, f"aa_sel{i}", _one_hot(s.aa[:, i], o.arm_arm_slots, self._n_coarse[i]))
+            lay.put(p, f"ao_sel{i}", _one_hot(s.ao[i][:, 0], o.obstacle_slots, self._n_arm[i]))
+            obs = np.zeros((o.obstacle_slots, 4))
+            idx = s.ao[i][:, 1]
+            obs[: len(idx), :3] = query.obstacles[0][idx]
+            obs[: len(idx), 3] = query.obstacles[1][idx]
+            lay.put(p, f"ao_obs{i}", obs)
+            lay.put(p, f"t_sel{i}", _one_hot(s.table[i], o.table_slots, self._n_arm[i]))
+        per_knot = np.concatenate(
+            [_slot_lb(s.aa_lb, o.arm_arm_slots)]
+            + [_slot_lb(s.ao_lb[i], o.obstacle_slots) for i in range(2)]
+            + [_slot_lb(s.table_lb[i], o.table_slots) for i in range(2)]
+        )
+        dt = query.duration / (K - 1)
+        lbg = np.concatenate(
+            [np.tile(per_knot, K - 2), np.tile(-self._vmax * dt, K - 1),
+             np.tile(-self._amax * dt * dt, K - 2)]
+        )  # fmt: skip
+        ubg = np.concatenate(
+            [np.full(self._n_collision, np.inf), np.tile(self._vmax * dt, K - 1),
+             np.tile(self._amax * dt * dt, K - 2)]
+        )  # fmt: skip
+        return p, lbg, ubg
+
+
+def straight_line(q_a: FloatArray, q_b: FloatArray, knots: int) -> FloatArray:
+    """``(knots, n)`` evenly spaced configurations from ``q_a`` to ``q_b``."""
+    s = np.linspace(0.0, 1.0, knots)[:, None]
+    return (1.0 - s) * np.asarray(q_a)[None] + s * np.asarray(q_b)[None]
+
+
+def densify(path: FloatArray, factor: int) -> FloatArray:
+    """The path with ``factor - 1`` evenly spaced points inserted in every segment."""
+    s = np.linspace(0.0, 1.0, factor + 1)[:-1]
+    seg = path[:-1, None] * (1.0 - s[None, :, None]) + path[1:, None] * s[None, :, None]
+    return np.concatenate([seg.reshape(-1, path.shape[1]), path[-1:]])
+
+
+def _one_hot(idx: FloatArray, slots: int, n: int) -> FloatArray:
+    out = np.zeros((slots, n))
+    out[np.arange(len(idx)), np.asarray(idx, dtype=np.int64)] = 1.0
+    return out
+
+
+def _slot_lb(lb: FloatArray, slots: int) -> FloatArray:
+    out = np.full(slots, -np.inf)
+    out[: len(lb)] = lb
+    return out
+
+
+@dataclass(frozen=True)
+class _Selection:
+    """Chosen pairs: ``aa`` ``(n, 2)`` sphere indices; ``ao[i]`` ``(n, 2)`` (arm sphere,
+    obstacle sphere); ``table[i]`` ``(n,)``; and each slot's constraint lower bound."""
+
+    aa: Any
+    ao: tuple[Any, Any]
+    table: tuple[Any, Any]
+    aa_lb: FloatArray
+    ao_lb: tuple[FloatArray, FloatArray]
+    table_lb: tuple[FloatArray, FloatArray]
+
+
+@dataclass(frozen=True)
+class _Violators:
+    aa: set[tuple[int, int]]
+    ao: tuple[set[tuple[int, int]], set[tuple[int, int]]]
+    table: tuple[set[int], set[int]]
+
+    def any_left(self) -> bool:
+        return bool(self.aa or self.ao[0] or self.ao[1] or self.table[0] or self.table[1])
+
+    def merged(self, other: _Selection | None) -> _Selection:
+        def pairs(base: Any, extra: set[tuple[int, int]]) -> Any:
+            have = {tuple(int(v) for v in r) for r in np.asarray(base).reshape(-1, 2)}
+            return np.array(sorted(have | extra), dtype=np.int64).reshape(-1, 2)
+
+        def singles(base: Any, extra: set[int]) -> Any:
+            return np.array(sorted({int(v) for v in np.asarray(base)} | extra), dtype=np.int64)
+
+        empty2 = np.zeros((0, 2), dtype=np.int64)
+        empty1 = np.zeros(0, dtype=np.int64)
+        nolb = np.zeros(0)
+        aa = pairs(other.aa if other else empty2, self.aa)
+        ao = tuple(pairs(other.ao[i] if other else empty2, self.ao[i]) for i in range(2))
+        tb = tuple(singles(other.table[i] if other else empty1, self.table[i]) for i in range(2))
+        return _Selection(aa, (ao[0], ao[1]), (tb[0], tb[1]), nolb, (nolb, nolb), (nolb, nolb))
+
+
+def _pick(clear: FloatArray, slots: int, limit: float, forced: Any) -> Any:
+    """Indices (rows of ``np.argwhere``) of the ``slots`` smallest entries below ``limit``,
+    forced ones first."""
+    flat = clear.reshape(-1)
+    forced_flat = (
+        np.ravel_multi_index(np.asarray(forced).T, clear.shape)
+        if forced is not None and np.asarray(forced).size
+        else np.zeros(0, dtype=np.int64)
+    )
+    order = [int(i) for i in np.argsort(flat) if flat[i] < limit and i not in set(forced_flat)]
+    chosen = (list(dict.fromkeys(int(i) for i in forced_flat)) + order)[:slots]
+    return np.stack(np.unravel_index(np.array(chosen, dtype=np.int64), clear.shape), axis=1)
+
+
+def _select(
+    dense: PathSpheres,
+    ends: PathSpheres,
+    query: TransferQuery,
+    o: TrajOptOptions,
+    forced: _Selection | None,
+) -> _Selection:
+    aa_c = arm_arm_clearance(dense).min(axis=0)
+    aa = _pick(aa_c, o.arm_arm_slots, o.select_distance, forced.aa if forced else None)
+    aa_end = arm_arm_clearance(ends)[:, aa[:, 0], aa[:, 1]]
+    rl, rr = ends.coarse_radii[0][aa[:, 0]], ends.coarse_radii[1][aa[:, 1]]
+    aa_lb = _lb_sq(aa_end, rl + rr, o.margin)
+    ao, ao_lb, tb, tb_lb = [], [], [], []
+    oc, orad = query.obstacles
+    for i in range(2):
+        if len(orad):
+            c = obstacle_clearance(dense, i, oc, orad).min(axis=0)
+            sel = _pick(c, o.obstacle_slots, o.select_distance, forced.ao[i] if forced else None)
+            end = obstacle_clearance(ends, i, oc, orad)[:, sel[:, 0], sel[:, 1]]
+            ao_lb.append(_lb_sq(end, ends.radii[i][sel[:, 0]] + orad[sel[:, 1]], o.margin))
+        else:
+            sel, _ = np.zeros((0, 2), dtype=np.int64), None
+            ao_lb.append(np.zeros(0))
+        ao.append(sel)
+        t = table_clearance(dense, i).min(axis=0)
+        tsel = _pick(
+            t, o.table_slots, o.select_distance, forced.table[i][:, None] if forced else None
+        )[:, 0]
+        tend = table_clearance(ends, i)[:, tsel].min(axis=0)
+        tb.append(tsel)
+        tb_lb.append(np.minimum(0.0, tend - o.margin) - 1e-6)
+    return _Selection(aa, (ao[0], ao[1]), (tb[0], tb[1]), aa_lb, (ao_lb[0], ao_lb[1]),
+                      (tb_lb[0], tb_lb[1]))  # fmt: skip
+
+
+def _lb_sq(end_clearance: FloatArray, rsum: FloatArray, margin: float) -> FloatArray:
+    """Lower bound of ``d^2 - (rsum + margin)^2`` from the end points' clearances ``(2, n)``."""
+    d = np.maximum(end_clearance.min(axis=0) + rsum, 0.0)
+    out: FloatArray = np.minimum(0.0, d**2 - (rsum + margin) ** 2) - 1e-6
+    return out
+
+
+def _violations(
+    dense: PathSpheres, ends: PathSpheres, query: TransferQuery, selection: _Selection
+) -> tuple[float, _Violators]:
+    """Pairs without a slot that come closer than zero clearance on the dense path (and
+    closer than at both end points). Pairs with a slot are the NLP's business."""
+    tol = -1e-3
+    aa = arm_arm_clearance(dense).min(axis=0)
+    aa_end = arm_arm_clearance(ends).min(axis=0)
+    bad_aa = {(int(a), int(b)) for a, b in np.argwhere(aa < np.minimum(0.0, aa_end) + tol)}
+    bad_aa -= {(int(a), int(b)) for a, b in selection.aa}
+    worst = float(aa.min())
+    ao: list[set[tuple[int, int]]] = []
+    tb: list[set[int]] = []
+    oc, orad = query.obstacles
+    for i in range(2):
+        if len(orad):
+            c = obstacle_clearance(dense, i, oc, orad).min(axis=0)
+            ce = obstacle_clearance(ends, i, oc, orad).min(axis=0)
+            bad = {(int(a), int(b)) for a, b in np.argwhere(c < np.minimum(0.0, ce) + tol)}
+            ao.append(bad - {(int(a), int(b)) for a, b in selection.ao[i]})
+            worst = min(worst, float(c.min()))
+        else:
+            ao.append(set())
+        t = table_clearance(dense, i).min(axis=0)
+        te = table_clearance(ends, i).min(axis=0)
+        bad_t = {int(a) for a in np.flatnonzero(t < np.minimum(0.0, te) + tol)}
+        tb.append(bad_t - {int(a) for a in selection.table[i]})
+        worst = min(worst, float(t.min()))
+    return worst, _Violators(bad_aa, (ao[0], ao[1]), (tb[0], tb[1]))

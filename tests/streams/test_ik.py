@@ -1,0 +1,72 @@
+import time
+
+import numpy as np
+
+from sdar_tamp.world.collision import ObjectBox
+from streams.context import WorldContext
+from streams.grasps import pregrasp_offset, sample_grasps
+from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
+
+
+def _requests(
+    ctx: WorldContext, objects: dict[str, ObjectBox], names: list[str]
+) -> list[IKRequest]:
+    grasps = sample_grasps(objects[names[0]].size, ctx.scene.gripper.max_graspable_width)
+    return [IKRequest(a, o, objects[o], grasps) for a in ctx.arm_names for o in names]
+
+
+def test_candidates_reproduce_the_grasp_pose_and_are_ranked(
+    ctx: WorldContext, objects: dict[str, ObjectBox]
+) -> None:
+    world = ctx.new_world()
+    names = list(objects)[:3]
+    home = {a: ctx.home(a) for a in ctx.arm_names}
+    cands = solve_ik_candidates(ctx, world, objects, _requests(ctx, objects, names), home)
+    assert cands
+    assert [c.cost for c in cands] == sorted(c.cost for c in cands)
+    for c in cands:
+        kin = ctx.kinematics[c.arm]
+        T = objects[c.obj].T_world_obj @ c.grasp.T_object_tcp
+        np.testing.assert_allclose(kin.fk_tcp(c.q), T, atol=1e-9)
+        np.testing.assert_allclose(kin.fk_tcp(c.q_pre), pregrasp_offset(T, 0.08), atol=1e-9)
+        lo, hi = kin.spec.lower_array, kin.spec.upper_array
+        assert np.all(c.q >= lo - 1e-12) and np.all(c.q <= hi + 1e-12)
+        # the pre-grasp never collides with anything
+        other = ctx.other(c.arm)
+        qs = {c.arm: c.q_pre, other: ctx.home(other)}
+        assert not world.in_collision(qs["left"], qs["right"])
+
+
+def test_ranking_time_for_two_arms_two_objects_six_grasps(
+    ctx: WorldContext, objects: dict[str, ObjectBox]
+) -> None:
+    world = ctx.new_world()
+    reqs = _requests(ctx, objects, list(objects)[:2])
+    home = {a: ctx.home(a) for a in ctx.arm_names}
+    solve_ik_candidates(ctx, world, objects, reqs, home)
+    times = []
+    for _ in range(5):
+        t = time.perf_counter()
+        solve_ik_candidates(ctx, world, objects, reqs, home)
+        times.append(time.perf_counter() - t)
+    assert np.median(times) < 0.05  # target 20 ms; loose bound for a busy CI machine
+
+
+def test_compatible_pairs_are_jointly_collision_free(
+    ctx: WorldContext, objects: dict[str, ObjectBox]
+) -> None:
+    world = ctx.new_world()
+    names = list(objects)
+    home = {a: ctx.home(a) for a in ctx.arm_names}
+    grasps = sample_grasps(objects[names[0]].size, ctx.scene.gripper.max_graspable_width)
+    left = solve_ik_candidates(
+        ctx, world, objects, [IKRequest("left", names[0], objects[names[0]], grasps)], home
+    )
+    right = solve_ik_candidates(
+        ctx, world, objects, [IKRequest("right", names[1], objects[names[1]], grasps)], home
+    )
+    pairs = compatible_pairs(ctx, world, objects, left, right, limit=3)
+    assert pairs
+    for a, b in pairs:
+        assert a.arm == "left" and b.arm == "right"
+        assert not world.in_collision(a.q_pre, b.q_pre)

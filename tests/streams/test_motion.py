@@ -1,0 +1,148 @@
+"""Synchronous motions: limits, exact collision freedom, fallbacks."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.world.collision import ObjectBox
+from streams.context import WorldContext
+from streams.grasps import sample_grasps
+from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
+from streams.motion import (
+    DualMotionPlanner,
+    MotionRequest,
+    SequentialStrategy,
+    TransferProblem,
+    UntangleStrategy,
+    default_strategies,
+    plan_dual_motion,
+)
+from streams.trajopt import TransferQuery, straight_line
+from streams.validate import configure_world, validate_trajectory
+
+# Two grasp configurations in M1 whose straight synchronous transfer is blocked (found by search).
+BLOCKED_START = np.array([-0.9597713794940521, -1.487539072672206, 2.2951842532166142,
+    -2.3784415073393053, -1.5707963267948966, 0.6482225313692203, -0.5339339743344569,
+    -0.675777200007472, 1.1304521182278542, -1.6688772479994611, -0.8550081079150917,
+    -0.5163163995987907])  # fmt: skip
+BLOCKED_GOAL = np.array([0.04376532233356345, -0.9655976891109983, 1.5288636436242042,
+    -2.1340622813081023, -1.5707963267948966, 1.221061045296719, 0.2352577772079112,
+    -1.4271827367975796, 2.22417797686042, -2.3677915668577363, -1.5707963267948966,
+    1.0782072680107593])  # fmt: skip
+
+
+def _pick_goal(ctx: WorldContext, objects: dict[str, ObjectBox], a: str, b: str) -> np.ndarray:
+    world = ctx.new_world()
+    home = {x: ctx.home(x) for x in ctx.arm_names}
+    g = sample_grasps(objects[a].size, ctx.scene.gripper.max_graspable_width)
+    left = solve_ik_candidates(ctx, world, objects, [IKRequest("left", a, objects[a], g)], home)
+    right = solve_ik_candidates(ctx, world, objects, [IKRequest("right", b, objects[b], g)], home)
+    pairs = compatible_pairs(ctx, world, objects, left, right)
+    assert pairs
+    return np.concatenate([pairs[0][0].q, pairs[0][1].q])
+
+
+def _check(
+    ctx: WorldContext, traj_t: np.ndarray, traj_q: np.ndarray, request: MotionRequest
+) -> None:
+    v = np.concatenate([ctx.scene.arm(a).velocity_limit for a in ctx.arm_names])
+    acc = np.concatenate([ctx.scene.arm(a).acceleration_limit for a in ctx.arm_names])
+    dt = np.diff(traj_t)
+    assert dt.max() <= 0.02 + 1e-12
+    vel = np.diff(traj_q, axis=0) / dt[:, None]
+    assert np.all(np.abs(vel) <= v * 1.001)
+    a = np.diff(vel, axis=0) / (0.5 * (dt[1:] + dt[:-1]))[:, None]
+    assert np.all(np.abs(a) <= acc * 1.05)
+    np.testing.assert_allclose(traj_q[0], request.q_start, atol=1e-9)
+    np.testing.assert_allclose(traj_q[-1], request.q_goal, atol=1e-9)
+    world = ctx.new_world()  # an independent world, finer resolution
+    configure_world(ctx, world, request.objects, request.held, request.q_start)
+    assert validate_trajectory(ctx, world, traj_q, max_tcp_step=0.005).ok
+
+
+def test_plain_pick_motion_is_valid(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    names = list(objects)
+    q_goal = _pick_goal(ctx, objects, names[0], names[5])
+    request = MotionRequest(_home12(ctx), q_goal, objects, approach=(True, True))
+    result = plan_dual_motion(planner, request)
+    assert result.success and result.level == "plain" and result.trajectory is not None
+    assert result.validation is not None and result.validation.ok
+    _check(ctx, result.trajectory.t, result.trajectory.q, request)
+
+
+@dataclass(frozen=True)
+class StraightLine:
+    """A user strategy: the straight joint-space line, not optimised."""
+
+    name: str = "straight"
+
+    def __call__(self, planner: DualMotionPlanner, problem: TransferProblem) -> list[np.ndarray]:
+        return [straight_line(problem.q_from, problem.q_to, 10)]
+
+
+def test_blocked_straight_line_is_detected_and_a_fallback_takes_over(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    request = MotionRequest(BLOCKED_START, BLOCKED_GOAL, objects, retreat=(True, True),
+                            approach=(True, True))  # fmt: skip
+    configure_world(ctx, planner.world, objects, {}, BLOCKED_START)
+    retreat, approach = planner.phases(request) or (None, None)
+    assert retreat is not None and approach is not None
+    straight = straight_line(retreat[-1], approach[0], 30)
+    assert not validate_trajectory(ctx, planner.world, straight).ok  # detected
+
+    only_straight = plan_dual_motion(planner, request, strategies=[StraightLine()])
+    assert not only_straight.success and only_straight.trajectory is None
+    assert only_straight.attempts == ("straight: validation failed (collision)",)
+    ladder = [StraightLine(), UntangleStrategy(), SequentialStrategy()]
+    result = plan_dual_motion(planner, request, strategies=ladder)
+    assert result.success and result.level in ("untangle", "sequential")
+    assert result.trajectory is not None
+    _check(ctx, result.trajectory.t, result.trajectory.q, request)
+    # the default ladder (optimised plain first) solves it too
+    assert plan_dual_motion(planner, request).success
+
+
+def test_sequential_only_moves_one_arm_at_a_time(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    names = list(objects)
+    q_goal = _pick_goal(ctx, objects, names[2], names[7])
+    request = MotionRequest(_home12(ctx), q_goal, objects)
+    result = plan_dual_motion(planner, request, sequential_only=True)
+    assert result.success and result.level == "sequential" and result.trajectory is not None
+    q = result.trajectory.q
+    moving = np.abs(np.diff(q, axis=0)) > 1e-9
+    assert not np.any(moving[:, :6].any(axis=1) & moving[:, 6:].any(axis=1))
+    _check(ctx, result.trajectory.t, q, request)
+
+
+def test_strategy_ladders() -> None:
+    assert [s.name for s in default_strategies()] == ["plain", "untangle", "sequential"]
+    assert [s.name for s in default_strategies(fallbacks=False)] == ["plain"]
+    assert [s.name for s in default_strategies(sequential_only=True)] == ["sequential"]
+
+
+def test_optimiser_is_reused_and_deterministic(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    names = list(objects)
+    q_goal = _pick_goal(ctx, objects, names[1], names[4])
+    problem = planner.transfer_problem(
+        MotionRequest(_home12(ctx), q_goal, objects), _home12(ctx), q_goal
+    )
+    query = TransferQuery(_home12(ctx), q_goal, problem.held, problem.obstacles, 3.0)
+    solver = planner.trajopt._solver
+    a = planner.trajopt.solve(query)
+    b = planner.trajopt.solve(query)
+    assert planner.trajopt._solver is solver
+    np.testing.assert_allclose(a.path, b.path)
+    lo = np.concatenate([ctx.scene.arm(x).lower_array for x in ctx.arm_names])
+    hi = np.concatenate([ctx.scene.arm(x).upper_array for x in ctx.arm_names])
+    assert a.success and np.all(a.path >= lo - 1e-9) and np.all(a.path <= hi + 1e-9)
+
+
+def _home12(ctx: WorldContext) -> np.ndarray:
+    return np.concatenate([ctx.home(a) for a in ctx.arm_names])

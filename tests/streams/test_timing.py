@@ -1,0 +1,51 @@
+import numpy as np
+import pytest
+
+from streams.timing import natural_spline, spline_eval, time_parameterize
+
+V = np.full(12, np.pi)
+A = np.full(12, 5.0)
+
+
+def _fd(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    dt = np.diff(t)
+    vel = np.diff(q, axis=0) / dt[:, None]
+    acc = np.diff(vel, axis=0) / (0.5 * (dt[1:] + dt[:-1]))[:, None]
+    return vel, acc
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_limits_endpoints_and_sampling(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    W = np.cumsum(rng.normal(0.0, 0.2, (8, 12)), axis=0)
+    traj = time_parameterize(W, V, A)
+    vel, acc = _fd(traj.t, traj.q)
+    assert np.abs(vel).max() <= np.pi
+    assert np.abs(acc).max() <= 5.0 * 1.01
+    assert np.diff(traj.t).max() <= 0.02 + 1e-12
+    np.testing.assert_allclose(traj.q[0], W[0])
+    np.testing.assert_allclose(traj.q[-1], W[-1])
+    assert np.abs(vel[0]).max() < 0.1 and np.abs(vel[-1]).max() < 0.1  # at rest
+
+
+def test_straight_line_is_a_synchronised_bang_bang_profile() -> None:
+    W = np.zeros((2, 12))
+    W[1, 0] = 2.0  # only joint 0 moves 2 rad
+    traj = time_parameterize(W, V, A, safety=1.0, grid_step=0.002, max_grid=2000)
+    # trapezoid: accelerate to pi at 5 rad/s^2 (0.987 rad), cruise, brake
+    t_acc = np.pi / 5.0
+    expected = 2 * t_acc + (2.0 - np.pi * t_acc) / np.pi
+    assert traj.duration == pytest.approx(expected, rel=0.02)
+
+
+def test_spline_interpolates_waypoints() -> None:
+    s = np.array([0.0, 1.0, 2.5, 3.0])
+    y = np.array([[0.0], [1.0], [0.5], [2.0]])
+    M = natural_spline(s, y)
+    val, _, _ = spline_eval(s, y, M, s)
+    np.testing.assert_allclose(val, y, atol=1e-12)
+
+
+def test_single_point_is_a_zero_length_trajectory() -> None:
+    traj = time_parameterize(np.ones((3, 12)), V, A)
+    assert traj.duration == 0.0 and traj.q.shape == (1, 12)

@@ -1,0 +1,139 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sdar_tamp.world.collision import CollisionWorld, ObjectBox
+from sdar_tamp.world.errors import CollisionModelError
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import pose_xyz_yaw, top_down_pose
+
+SIZE = (0.08, 0.04, 0.05)
+
+
+@pytest.fixture(scope="module")
+def kins(scene: Scene) -> dict[str, ArmKinematics]:
+    return {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+
+
+@pytest.fixture()
+def world(scene: Scene) -> CollisionWorld:
+    return CollisionWorld(scene)
+
+
+def _reach(kin: ArmKinematics, x: float, y: float, z: float, yaw: float = 0.0) -> np.ndarray:
+    q, ok = kin.ik_tcp(top_down_pose(x, y, z, yaw)[None]).closest(np.array(kin.spec.home))
+    assert ok[0]
+    return q[0]
+
+
+def _box(x: float, y: float, yaw: float = 0.0) -> ObjectBox:
+    return ObjectBox(pose_xyz_yaw(x, y, SIZE[2] / 2, yaw), SIZE)
+
+
+def test_home_configurations_are_free(world: CollisionWorld, scene: Scene) -> None:
+    home = np.array(scene.arms[0].home)
+    assert not world.in_collision(home, home)
+    assert world.report(home, home) == ()
+    assert world.min_distance(home, home).distance > 0.0
+
+
+def test_arms_driven_into_each_other_collide(world: CollisionWorld, kins: dict) -> None:
+    q_l = _reach(kins["left"], 0.0, 0.0, 0.15)
+    q_r = _reach(kins["right"], 0.0, 0.0, 0.15)
+    home = np.array(kins["right"].spec.home)
+    assert not world.in_collision(q_l, home)
+    assert world.in_collision(q_l, q_r)
+    pairs = world.report(q_l, q_r)
+    assert any(p.first.startswith("left_") and p.second.startswith("right_") for p in pairs)
+    assert world.min_distance(q_l, q_r).distance < 0.0
+
+
+def test_arm_into_the_table_collides(world: CollisionWorld, kins: dict) -> None:
+    home = np.array(kins["right"].spec.home)
+    q_l = _reach(kins["left"], 0.0, 0.0, 0.05)  # fingertips 0.017 m below the TCP: free
+    assert not world.in_collision(q_l, home)
+    q_l = _reach(kins["left"], 0.0, 0.0, 0.0)
+    assert world.in_collision(q_l, home)
+    assert any(p.second == "table" for p in world.report(q_l, home))
+
+
+def test_object_under_the_gripper_collides_until_held(world: CollisionWorld, kins: dict) -> None:
+    world.set_objects({"o0": _box(0.0, 0.1), "o1": _box(-0.1, -0.2)})
+    home = np.array(kins["right"].spec.home)
+    above = _reach(kins["left"], 0.0, 0.1, 0.2)
+    grasp = _reach(kins["left"], 0.0, 0.1, SIZE[2] / 2)  # fingers close along world y
+    off = _reach(kins["left"], 0.0, 0.13, SIZE[2] / 2)  # a finger lands in the object
+    assert not world.in_collision(above, home)
+    assert not world.in_collision(grasp, home)  # open fingers straddle the 0.04 m side
+    assert world.in_collision(off, home)
+    pairs = {(p.first, p.second) for p in world.report(off, home)}
+    assert ("left_gripper_left_finger_0", "object:o0") in pairs
+    # turned by 90 deg the 0.08 m side lies between the fingers: still free (0.085 m opening)
+    across = _reach(kins["left"], 0.0, 0.1, SIZE[2] / 2, yaw=np.pi / 2)
+    assert not world.in_collision(across, home)
+    world.attach("left", "o0", grasp)
+    assert world.held_by("left") == "o0"
+    assert not world.in_collision(grasp, home)  # the held object never hits its own gripper
+    lifted = _reach(kins["left"], 0.0, 0.1, 0.2)
+    assert not world.in_collision(lifted, home)
+    assert world.in_collision(off, home) is False  # held: moves with the gripper
+    placed = world.detach("left", grasp)
+    np.testing.assert_allclose(placed.T_world_obj, _box(0.0, 0.1).T_world_obj, atol=1e-9)
+    assert world.in_collision(off, home)
+
+
+def test_held_object_against_table_objects_and_other_held(
+    world: CollisionWorld, kins: dict
+) -> None:
+    world.set_objects({"a": _box(-0.1, 0.0), "b": _box(0.1, 0.0), "c": _box(0.0, 0.2)})
+    q_l = _reach(kins["left"], -0.1, 0.0, SIZE[2] / 2)
+    q_r = _reach(kins["right"], 0.1, 0.0, SIZE[2] / 2)
+    world.attach("left", "a", q_l)
+    world.attach("right", "b", q_r)
+    assert not world.in_collision(q_l, q_r)
+    # held object pushed into the table
+    low = _reach(kins["left"], -0.1, 0.0, 0.0)
+    assert ("held:a", "table") in {(p.first, p.second) for p in world.report(low, q_r)}
+    # held object lowered onto a resting one
+    onto = _reach(kins["left"], 0.0, 0.2, SIZE[2] / 2 + 0.03)
+    assert any({p.first, p.second} == {"held:a", "object:c"} for p in world.report(onto, q_r))
+    # both held objects brought together high above the table
+    q_l2 = _reach(kins["left"], -0.03, 0.0, 0.35)
+    q_r2 = _reach(kins["right"], 0.03, 0.0, 0.35)
+    assert any({p.first, p.second} == {"held:a", "held:b"} for p in world.report(q_l2, q_r2))
+
+
+def test_bad_requests_raise(world: CollisionWorld) -> None:
+    world.set_objects({"a": _box(0.0, 0.0)})
+    with pytest.raises(CollisionModelError, match="no resting object"):
+        world.attach("left", "zz")
+    with pytest.raises(CollisionModelError, match="unknown arm"):
+        world.attach("middle", "a")
+    with pytest.raises(CollisionModelError, match="holds nothing"):
+        world.detach("left")
+    world.attach("left", "a")
+    with pytest.raises(CollisionModelError, match="already holds"):
+        world.attach("left", "a")
+    with pytest.raises(CollisionModelError, match="held"):
+        world.set_objects({"a": _box(0.0, 0.0)})
+
+
+def test_configuration_is_stored(world: CollisionWorld, kins: dict) -> None:
+    q_l = _reach(kins["left"], 0.0, 0.0, 0.15)
+    q_r = _reach(kins["right"], 0.0, 0.0, 0.15)
+    world.set_configuration(q_l, q_r)
+    assert world.in_collision()
+    np.testing.assert_allclose(world.configuration[0], q_l)
+    np.testing.assert_allclose(world.tool0_pose("left"), kins["left"].fk_tool0(q_l), atol=1e-12)
+
+
+def test_coal_adapter_distance_between_boxes() -> None:
+    from sdar_tamp.world._coal import box, shape_distance
+
+    a, b = box(SIZE), box(SIZE)
+    d = shape_distance(a, _box(0.0, 0.0).T_world_obj, b, _box(0.18, 0.0).T_world_obj)
+    assert d == pytest.approx(0.10, abs=1e-9)
+    d = shape_distance(a, _box(0.0, 0.0).T_world_obj, b, _box(0.07, 0.0).T_world_obj)
+    assert d == pytest.approx(-0.01, abs=1e-6)

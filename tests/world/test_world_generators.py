@@ -1,0 +1,103 @@
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.world.commands import generate, generate_suite, show_instance
+from sdar_tamp.world.dependency import instance_dependency_graph
+from sdar_tamp.world.errors import GenerationError, SuiteError
+from sdar_tamp.world.generators import GeneratorOptions, generate_instance
+from sdar_tamp.world.instance import load_instance, validate_instance
+from sdar_tamp.world.scene import Workspace
+from sdar_tamp.world.suites import build_suite, load_suite, suite_members
+
+
+def test_same_seed_same_instance() -> None:
+    assert generate_instance("M", 12, 5) == generate_instance("M", 12, 5)
+    assert generate_instance("R", 8, 5) != generate_instance("R", 8, 6)
+
+
+@pytest.mark.parametrize("n", [4, 7, 12])
+def test_single_cycle(n: int) -> None:
+    for seed in range(3):
+        g = instance_dependency_graph(generate_instance("S", n, seed))
+        cycles = g.cycle_components()
+        assert len(cycles) == 1 and g.is_simple_cycle(cycles[0])
+
+
+@pytest.mark.parametrize("n", [4, 9, 12])
+def test_double_cycle(n: int) -> None:
+    for seed in range(3):
+        g = instance_dependency_graph(generate_instance("D", n, seed))
+        cycles = g.cycle_components()
+        assert len(cycles) == 2 and all(g.is_simple_cycle(c) for c in cycles)
+
+
+def test_mixed_has_all_three_kinds() -> None:
+    for seed in range(4):
+        inst = generate_instance("M", 12, seed)
+        s = instance_dependency_graph(inst).structure()
+        assert len(inst.objects) == 12 and s.independent and s.chains and s.cycles
+
+
+def test_random_is_feasible_and_uses_default_cuboid() -> None:
+    inst = generate_instance("R", 12, 0)
+    validate_instance(inst)
+    assert {o.size for o in inst.objects} == {(0.08, 0.04, 0.05)}
+
+
+def test_bad_arguments_and_impossible_requests() -> None:
+    with pytest.raises(ParameterError, match="family"):
+        generate_instance("Q", 5, 0)
+    with pytest.raises(ParameterError, match="at least 4"):
+        generate_instance("D", 3, 0)
+    tiny = GeneratorOptions(workspace=Workspace((0.0, 0.2), (0.0, 0.2)), attempts=3, samples=200)
+    with pytest.raises(GenerationError, match="after 3 attempts"):
+        generate_instance("S", 20, 0, tiny)
+
+
+def test_suite_members() -> None:
+    paper = suite_members("paper")
+    assert [m.name for m in paper][:3] == ["R4", "R5", "R6"]
+    assert len(paper) == 37 and paper[-1].name == "M10"
+    assert {m.n_objects for m in suite_members("stress")} == {16, 20, 24}
+    with pytest.raises(SuiteError, match="unknown suite"):
+        suite_members("huge")
+
+
+def test_shipped_paper_suite_is_current() -> None:
+    shipped = load_suite("paper")
+    assert len(shipped) == 37
+    members = suite_members("paper")
+    for k in (0, 13, 30):
+        m = members[k]
+        assert shipped[k] == generate_instance(m.family, m.n_objects, m.seed, name=m.name)
+
+
+def test_shipped_stress_suite_loads() -> None:
+    stress = load_suite("stress")
+    assert [len(i.objects) for i in stress[:3]] == [16, 20, 24]
+
+
+def test_commands(tmp_path: Path) -> None:
+    out = generate("D", 6, 3, tmp_path / "d6.yaml")
+    inst = load_instance(out)
+    assert inst.name == "D6" and inst.family == "D" and inst.seed == 3
+    png = show_instance(out, tmp_path / "d6.png")
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
+    with pytest.raises(SuiteError, match="missing instance files"):
+        load_suite("paper", tmp_path)
+
+
+def test_generate_suite_writes_loadable_files(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import sdar_tamp.world.suites as suites
+
+    few = suite_members("paper")[:2]
+    monkeypatch.setattr(suites, "suite_members", lambda name: few)
+    paths = generate_suite("paper", tmp_path)
+    assert [p.name for p in paths] == ["R4.yaml", "R5.yaml"]
+    assert load_suite("paper", tmp_path) == build_suite("paper")

@@ -1,0 +1,114 @@
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sdar_tamp.world.errors import InstanceError
+from sdar_tamp.world.instance import (
+    Instance,
+    ObjectSpec,
+    Pose2D,
+    dump_instance,
+    load_instance,
+    parse_instance,
+    save_instance,
+)
+from sdar_tamp.world.scene import Workspace
+
+HEAD = "name: T\nworkspace: {x: [-0.25, 0.25], y: [-0.3, 0.3]}\nobjects:\n"
+
+
+def _obj(name: str, start: str, goal: str, size: str = "[0.08, 0.04, 0.05]") -> str:
+    return f"  - {{name: {name}, size: {size}, start: {start}, goal: {goal}}}\n"
+
+
+def test_round_trip(tmp_path: Path) -> None:
+    inst = Instance(
+        "X3",
+        Workspace((-0.25, 0.25), (-0.3, 0.3)),
+        (
+            ObjectSpec("a", (0.08, 0.04, 0.05), Pose2D(0.1, 0.1 / 3, 0.3), Pose2D(-0.1, 0.0, -1.2)),
+            ObjectSpec("b", (0.06, 0.06, 0.05), Pose2D(-0.1, -0.2, 0.0), Pose2D(0.1, 0.2, 1e-17)),
+        ),
+        scene="scene.yaml",
+        family="R",
+        seed=3,
+    )
+    path = save_instance(inst, tmp_path / "sub" / "x3.yaml")
+    again = load_instance(path)
+    assert again == inst
+    assert dump_instance(again) == path.read_text()
+    assert again.scene_path(path) == tmp_path / "sub" / "scene.yaml"
+
+
+def test_valid_text_parses() -> None:
+    inst = parse_instance(HEAD + _obj("o0", "[0, 0, 0]", "[0.1, 0.1, 1.5]"))
+    assert inst.names == ("o0",) and inst.scene is None
+    assert inst.start_poses().shape == (1, 3)
+
+
+def test_touching_footprints_are_allowed() -> None:
+    parse_instance(
+        HEAD + _obj("a", "[0, 0, 0]", "[0, 0, 0]") + _obj("b", "[0.08, 0, 0]", "[0, 0.04, 0]")
+    )
+
+
+def test_overlap_at_start() -> None:
+    text = HEAD + _obj("a", "[0, 0, 0]", "[0, 0, 0]") + _obj("b", "[0.05, 0, 0]", "[0, 0.1, 0]")
+    with pytest.raises(InstanceError, match=r"object 'a': start footprint overlaps .* of 'b'"):
+        parse_instance(text, "inst.yaml")
+
+
+def test_overlap_at_goal() -> None:
+    text = (
+        HEAD + _obj("a", "[0, 0, 0]", "[0, 0.1, 0.4]") + _obj("b", "[0, 0.1, 0]", "[0.02, 0.1, 0]")
+    )
+    with pytest.raises(
+        InstanceError, match="'a': goal footprint overlaps the goal footprint of 'b'"
+    ):
+        parse_instance(text, "inst.yaml")
+
+
+def test_outside_workspace() -> None:
+    text = HEAD + _obj("a", "[0, 0, 0]", "[0.23, 0, 0]")
+    with pytest.raises(InstanceError, match=r"inst.yaml:4:5: object 'a': goal footprint leaves"):
+        parse_instance(text, "inst.yaml")
+
+
+def test_ungraspable_size() -> None:
+    text = HEAD + _obj("big", "[0, 0, 0]", "[0, 0, 0]", size="[0.1, 0.09, 0.05]")
+    with pytest.raises(InstanceError, match=r"object 'big': size .* cannot be grasped"):
+        parse_instance(text, "inst.yaml")
+
+
+def test_duplicate_names() -> None:
+    text = HEAD + _obj("a", "[0, 0, 0]", "[0, 0, 0]") + _obj("a", "[0, 0.2, 0]", "[0, 0.2, 0]")
+    with pytest.raises(InstanceError, match="object 'a': duplicate name"):
+        parse_instance(text, "inst.yaml")
+
+
+def test_bad_shape_names_file_and_key() -> None:
+    text = HEAD + "  - {name: a, size: [0.08, 0.04, 0.05], start: [0, 0], goal: [0, 0, 0]}\n"
+    with pytest.raises(
+        InstanceError, match=r"inst.yaml:4:\d+: objects\[0\]\.start: expected \[x, y, yaw\]"
+    ):
+        parse_instance(text, "inst.yaml")
+
+
+def test_missing_and_unknown_keys() -> None:
+    with pytest.raises(InstanceError, match="expected key 'objects'"):
+        parse_instance("name: T\nworkspace: {x: [0, 1], y: [0, 1]}\n", "inst.yaml")
+    with pytest.raises(InstanceError, match=r"objects\[0\]\.colour: unknown key"):
+        parse_instance(HEAD + "  - {name: a, colour: red}\n", "inst.yaml")
+
+
+def test_missing_file(tmp_path: Path) -> None:
+    with pytest.raises(InstanceError, match="cannot read file"):
+        load_instance(tmp_path / "none.yaml")
+
+
+def test_bad_object_name() -> None:
+    text = HEAD + _obj("'a b'", "[0, 0, 0]", "[0, 0, 0]")
+    with pytest.raises(InstanceError, match="object 'a b': expected a name of letters"):
+        parse_instance(text, "inst.yaml")
