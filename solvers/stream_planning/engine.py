@@ -27,16 +27,10 @@ from solvers.stream_planning.externals import (
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
 
 LOG = logging.getLogger(__name__)
-SUPPORTED_STREAM_OPTIONS = {
-    "eager",
-    "p_success",
-    "overhead",
-    "effort",
-    "negate",
-    "opt_gen_fn",
-    "verbose",
-}
-SUPPORTED_FUNCTION_OPTIONS = {"opt_fn", "verbose"}
+# Options the algorithms act on; any other option set to a non-default value is logged as
+# not implemented (eager, p_success, overhead, effort, negate, simultaneous, defer_fn, ...).
+SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn"}
+SUPPORTED_FUNCTION_OPTIONS = {"opt_fn"}
 RULE_PREFIX = "@rule"
 
 

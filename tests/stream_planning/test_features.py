@@ -333,10 +333,18 @@ def test_unimplemented_stream_info_options_log_a_warning(
 
 
 def test_supported_stream_info_logs_nothing(caplog: pytest.LogCaptureFixture) -> None:
-    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1)}
+    info = {"sample-pose": StreamInfo(opt_gen_fn="unique")}
     with caplog.at_level(logging.WARNING):
         assert solve(line_problem(counting()), stream_info=info, verbose=False).solved
     assert "not implemented" not in caplog.text
+
+
+def test_unused_cost_model_options_are_reported(caplog: pytest.LogCaptureFixture) -> None:
+    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True)}
+    with caplog.at_level(logging.WARNING):
+        assert solve(line_problem(counting()), stream_info=info, verbose=False).solved
+    for option in ("p_success", "overhead", "eager"):
+        assert f"stream_info['sample-pose'].{option}" in caplog.text
 
 
 def test_from_fn_stream_runs_once() -> None:
