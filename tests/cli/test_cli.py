@@ -92,8 +92,10 @@ def test_generate_needs_family_and_objects(
     assert "needs --family and --objects" in capsys.readouterr().err
 
 
-def test_generate_impossible_structure(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
-    assert (
-        main(["generate", "--family", "R", "--objects", "400", "-o", str(tmp_path / "x.yaml")]) == 2
-    )
-    assert "no instance with the promised structure" in capsys.readouterr().err
+def test_generate_rejects_a_bad_object_count(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    out = tmp_path / "x.yaml"
+    assert main(["generate", "--family", "S", "--objects", "1", "-o", str(out)]) == 2
+    assert "family S needs at least 2, got 1" in capsys.readouterr().err
+    assert not out.exists()
