@@ -5,35 +5,19 @@ Run: ``python examples/dual_arm_swap.py -a focused`` (``-a``: algorithm, ``-u``:
 
 from __future__ import annotations
 
-import logging
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a source checkout
 
 from domains.dual_arm_swap.samplers import make_problem
-from solvers.solution import Solution, print_solution
-from solvers.solve import create_parser, solve
+from solvers.solution import Solution
+from solvers.solve import solve_from_command_line
 
 
 def main(argv: list[str] | None = None) -> Solution:
     """Parse ``argv``, solve, print the plan; returns the solution (for tests)."""
-    parser = create_parser()
-    parser.add_argument("--seed", type=int, default=0, help="sampler seed (default: 0)")
-    parser.add_argument("--max-time", type=float, default=30, help="[s] (default: %(default)s)")
-    args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.WARNING)
-    problem = make_problem(seed=args.seed)
-    solution = solve(
-        problem,
-        algorithm=args.algorithm,
-        unit_costs=args.unit,
-        max_time=args.max_time,
-        seed=args.seed,
-        verbose=False,
-    )
-    print_solution(solution)
-    return solution
+    return solve_from_command_line(make_problem, argv, default_max_time=30)
 
 
 if __name__ == "__main__":

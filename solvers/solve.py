@@ -6,13 +6,13 @@ import argparse
 import logging
 import math
 import random
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.options import FunctionInfo, PlanConstraints, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
-from solvers.solution import Solution
+from solvers.solution import Solution, print_solution
 from solvers.stream_planning.algorithms import ALGORITHMS, StreamOptions, StreamSolver
 
 LOG = logging.getLogger(__name__)
@@ -124,3 +124,29 @@ def create_parser(default_algorithm: str = "adaptive") -> argparse.ArgumentParse
     )
     parser.add_argument("-u", "--unit", action="store_true", help="use unit action costs")
     return parser
+
+
+def solve_from_command_line(
+    make_problem: Callable[..., PDDLProblem],
+    argv: Sequence[str] | None = None,
+    default_max_time: float = 30.0,
+) -> Solution:
+    """An example's ``main``: parse ``-a/-u/--seed/--max-time``, build the problem with
+    ``make_problem(seed=...)``, solve it and print the solution (returned for tests)."""
+    parser = create_parser()
+    parser.add_argument("--seed", type=int, default=0, help="sampler seed (default: 0)")
+    parser.add_argument(
+        "--max-time", type=float, default=default_max_time, help="[s] (default: %(default)s)"
+    )
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.WARNING)
+    solution = solve(
+        make_problem(seed=args.seed),
+        algorithm=args.algorithm,
+        unit_costs=args.unit,
+        max_time=args.max_time,
+        seed=args.seed,
+        verbose=False,
+    )
+    print_solution(solution)
+    return solution
