@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sdar_tamp.world.transforms import BoolArray, FloatArray
+from sdar_tamp.world.transforms import BoolArray, FloatArray, inverse
 
 _EPS = 1e-9
 
@@ -109,8 +109,8 @@ def ur_ik(params: URParameters, T_dh0_flange: FloatArray) -> tuple[FloatArray, B
     rows = _rows(p)
     T01 = _dh(q1, *rows[0])  # (n, 2, 4, 4)
     T46 = _dh(q5, *rows[4]) @ _dh(q6, *rows[5])  # (n, 2, 2, 4, 4)
-    T10 = _inv(T01)
-    T14 = T10[:, :, None] @ T[:, None, None] @ _inv(T46)  # (n, 2, 2, 4, 4)
+    T10 = inverse(T01)
+    T14 = T10[:, :, None] @ T[:, None, None] @ inverse(T46)  # (n, 2, 2, 4, 4)
     x, y = T14[..., 0, 3], T14[..., 1, 3]
     c3 = (x * x + y * y - p.a2**2 - p.a3**2) / (2.0 * p.a2 * p.a3)
     ok3 = np.abs(c3) <= 1.0 + _EPS
@@ -132,15 +132,6 @@ def ur_ik(params: URParameters, T_dh0_flange: FloatArray) -> tuple[FloatArray, B
     ).reshape(n, 8, 6)
     valid = np.broadcast_to(ok1[:, None, None, None] & ok3[..., None], shape).reshape(n, 8)
     return wrap_pi(q), valid
-
-
-def _inv(T: FloatArray) -> FloatArray:
-    out = np.zeros_like(T)
-    rt = np.swapaxes(T[..., :3, :3], -1, -2)
-    out[..., :3, :3] = rt
-    out[..., :3, 3] = -np.einsum("...ij,...j->...i", rt, T[..., :3, 3])
-    out[..., 3, 3] = 1.0
-    return out
 
 
 def wrap_pi(q: FloatArray) -> FloatArray:
