@@ -88,6 +88,31 @@ def cmd_demo(args: argparse.Namespace) -> int:
     return cmd_plan(plan_args)
 
 
+def cmd_solve(args: argparse.Namespace) -> int:
+    """Plan a rearrangement instance with SDAR, validate the plan by independent replay and
+    write it (JSON, see the README). Exit status 0 only when solved and valid."""
+    from sdar_tamp.plan_file import save_plan
+    from sdar_tamp.solve_command import ProgressBar, format_summary, solve_instance
+
+    bar = ProgressBar(f"{args.instance.stem}") if not args.quiet else None
+    try:
+        outcome = solve_instance(
+            args.instance,
+            time_limit=args.time_limit,
+            seed=args.seed,
+            task_planner=args.task_planner,
+            motion_planner=args.motion_planner,
+            progress=bar,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    print(format_summary(outcome))
+    if outcome.plan is not None and args.output is not None:
+        print(f"wrote {save_plan(outcome.plan, args.output)}")
+    return 0 if outcome.success else 1
+
+
 def cmd_generate(args: argparse.Namespace) -> int:
     """Generate a rearrangement instance (one family) or a whole suite of instance files."""
     from sdar_tamp.world.commands import generate, generate_suite
@@ -104,11 +129,32 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 
 def cmd_show(args: argparse.Namespace) -> int:
-    """Draw an instance top-down: start and goal side by side with the dependency graph."""
-    from sdar_tamp.world.commands import show_instance
+    """Draw an instance, or a plan on it.
 
-    print(f"wrote {show_instance(args.instance, args.output)}")
+    Without a plan: .png (or another matplotlib format) draws start and goal top-down with the
+    dependency graph; .html is an interactive 3-D view of the start. With a plan: .html is an
+    interactive 3-D replay (plotly, works offline), .png a storyboard with one panel per step,
+    .gif a top-down animation."""
+    from sdar_tamp.viewer.commands import show
+
+    print(f"wrote {show(args.instance, args.plan, args.output, args.fps)}")
     return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    """Replay a plan file on an instance and check it independently of the planner."""
+    from sdar_tamp.replay import run_validate
+
+    return run_validate(args.instance, args.plan)
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """Run the paper's evaluation: every planner combination on every instance of a suite, in
+    worker processes. One CSV row per finished run (a rerun resumes), then plots and a report
+    in the output folder."""
+    from sdar_tamp.evaluation.runner import bench_command
+
+    return bench_command(args)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -153,10 +199,69 @@ def build_parser() -> argparse.ArgumentParser:
     )
     generate.set_defaults(func=cmd_generate)
 
-    show = sub.add_parser("show", help="draw an instance", description=cmd_show.__doc__)
+    solve = sub.add_parser(
+        "solve", help="plan a rearrangement instance with SDAR", description=cmd_solve.__doc__
+    )
+    solve.add_argument("instance", type=Path, help="instance YAML")
+    solve.add_argument("-o", "--output", type=Path, default=None, help="plan file (.json)")
+    solve.add_argument("--time-limit", type=float, default=60.0, help="seconds (default: 60)")
+    solve.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    solve.add_argument(
+        "--task-planner", choices=("sdar", "baseline"), default="sdar", help="(default: sdar)"
+    )
+    solve.add_argument(
+        "--motion-planner",
+        choices=("sdar", "plain", "sequential"),
+        default="sdar",
+        help="sdar: optimisation, untangling, one arm at a time; plain: optimisation only; "
+        "sequential: one arm at a time (default: sdar)",
+    )
+    solve.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    solve.set_defaults(func=cmd_solve)
+
+    show = sub.add_parser(
+        "show",
+        help="draw an instance, or replay a plan",
+        description=cmd_show.__doc__,
+    )
     show.add_argument("instance", type=Path, help="instance YAML")
-    show.add_argument("-o", "--output", type=Path, required=True, help="picture (.png)")
+    show.add_argument("plan", type=Path, nargs="?", default=None, help="plan JSON (optional)")
+    show.add_argument(
+        "-o", "--output", type=Path, required=True, help="picture: .png, .html or .gif"
+    )
+    show.add_argument(
+        "--fps",
+        type=float,
+        default=None,
+        help="animation frames per second of plan time (default: 10 for .html, 4 for .gif)",
+    )
     show.set_defaults(func=cmd_show)
+
+    validate = sub.add_parser(
+        "validate", help="check a plan file against an instance", description=cmd_validate.__doc__
+    )
+    validate.add_argument("instance", type=Path, help="instance YAML")
+    validate.add_argument("plan", type=Path, help="plan JSON")
+    validate.set_defaults(func=cmd_validate)
+
+    bench = sub.add_parser(
+        "bench", help="evaluate planner combinations on a suite", description=cmd_bench.__doc__
+    )
+    bench.add_argument("--suite", default="paper", help="paper, stress or a folder of instances")
+    bench.add_argument("--out", type=Path, required=True, help="output folder")
+    bench.add_argument(
+        "--combos",
+        default="all",
+        help="all, or some of sdar,baseline,baseline-tp+sdar-m,sdar-t+baseline-mp,"
+        "sdar-t+plain,baseline-tp+plain (default: all)",
+    )
+    bench.add_argument("--workers", type=int, default=1, help="processes (default: 1)")
+    bench.add_argument("--time-limit", type=float, default=60.0, help="s per run (default: 60)")
+    bench.add_argument("--only", default="", help="comma-separated instance names")
+    bench.add_argument("--max-objects", type=int, default=None, help="skip larger instances")
+    bench.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    bench.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    bench.set_defaults(func=cmd_bench)
 
     demo = sub.add_parser("demo", help="solve a built-in example", description=cmd_demo.__doc__)
     demo.add_argument("--time-limit", type=float, default=60.0, help="seconds (default: 60)")

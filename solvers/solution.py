@@ -52,6 +52,8 @@ class Solution:
         statistics: solver counters (search, grounding, iterations, times [s]).
         streams: per-stream statistics.
         diagnosis: when there is no plan, short sentences saying why.
+        trace: per-decision records of solvers that execute step by step (``sdar``).
+        partial_plan: the actions executed before a step-by-step solver stopped.
     """
 
     plan: list[Action] | None
@@ -61,6 +63,8 @@ class Solution:
     statistics: Mapping[str, float] = field(default_factory=dict)
     streams: Mapping[str, StreamStatistics] = field(default_factory=dict)
     diagnosis: Sequence[str] = ()
+    trace: Sequence[Mapping[str, Any]] = ()
+    partial_plan: Sequence[Action] = ()
 
     def __iter__(self) -> Iterator[Any]:
         return iter((self.plan, self.cost, self.certificate))

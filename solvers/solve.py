@@ -51,12 +51,15 @@ def solve(
     verbose: bool = True,
     seed: int | None = None,
     planner: str = "wastar-ff",
+    task_planner: str = "sdar",
     **unknown: Any,
 ) -> Solution:
     """Solve ``problem``; returns a :class:`Solution` (``plan, cost, certificate = solution``).
 
     Args:
-        algorithm: one of ``incremental``, ``focused``, ``binding``, ``adaptive``.
+        algorithm: one of ``incremental``, ``focused``, ``binding``, ``adaptive`` or ``sdar``
+            (rearrangement domains: dependency-driven steps grounded best first, see
+            :mod:`solvers.sdar.solver`).
         stream_info: per-stream :class:`StreamInfo` / :class:`FunctionInfo`, by stream name.
         unit_costs: every action costs 1 instead of its ``total-cost`` increase.
         success_cost: stop at the first plan of at most this cost (else keep improving until
@@ -64,6 +67,7 @@ def solve(
         max_time: wall-clock limit [s].
         planner: ``SEARCH-HEURISTIC`` of the classical planner, e.g. ``wastar-ff``,
             ``gbfs-ff``, ``astar-max``.
+        task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``.
         seed: seeds Python's ``random`` and NumPy's global generator before solving, so
             samplers that draw from them give the same plan for the same seed.
 
@@ -73,10 +77,14 @@ def solve(
     """
     if unknown:
         raise ParameterError(f"unknown solve() argument(s): {', '.join(sorted(unknown))}")
-    if algorithm not in ALGORITHMS:
-        raise ParameterError(f"algorithm must be one of {', '.join(ALGORITHMS)}; got {algorithm!r}")
+    if algorithm not in (*ALGORITHMS, "sdar"):
+        raise ParameterError(
+            f"algorithm must be one of {', '.join((*ALGORITHMS, 'sdar'))}; got {algorithm!r}"
+        )
     if not isinstance(problem, PDDLProblem):
         raise ParameterError(f"problem must be a PDDLProblem, got {type(problem).__name__}")
+    if algorithm == "sdar":
+        return _solve_sdar(problem, task_planner, max_time, stream_info, verbose, seed)
     search, _, heuristic = planner.partition("-")
     options = StreamOptions(
         algorithm=algorithm,
@@ -110,6 +118,25 @@ def solve(
         except ImportError:  # pragma: no cover - numpy is a dependency
             pass
     return StreamSolver(problem, options, stream_info).solve()
+
+
+def _solve_sdar(
+    problem: PDDLProblem,
+    task_planner: str,
+    max_time: float,
+    stream_info: Mapping[str, StreamInfo | FunctionInfo] | None,
+    verbose: bool,
+    seed: int | None,
+) -> Solution:
+    from solvers.sdar.planners import make_task_planner
+    from solvers.sdar.solver import SdarOptions, SdarSolver
+
+    planner = make_task_planner(task_planner)
+    logging.getLogger("solvers").setLevel(logging.INFO if verbose else logging.WARNING)
+    if seed is not None:
+        random.seed(seed)
+    options = SdarOptions(max_time=_positive("max_time", max_time))
+    return SdarSolver(problem, planner, options, stream_info).solve()
 
 
 def create_parser(default_algorithm: str = "adaptive") -> argparse.ArgumentParser:

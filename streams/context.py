@@ -44,9 +44,10 @@ class WorldContext:
     def home(self, arm: str) -> FloatArray:
         return np.array(self.scene.arm(arm).home, dtype=np.float64)
 
-    def new_world(self) -> CollisionWorld:
-        """A fresh collision world (mutable: each stream keeps its own)."""
-        return CollisionWorld(self.scene)
+    def new_world(self, margin: float = -1e-3) -> CollisionWorld:
+        """A fresh collision world (mutable: each stream keeps its own). Resting and held
+        objects are grown by ``margin`` [m] per face (the default shrinks them 1 mm)."""
+        return CollisionWorld(self.scene, tolerance=-margin)
 
     def split(self, q: FloatArray) -> dict[str, FloatArray]:
         """A dual-arm configuration ``(12,)`` as ``arm -> (6,)``."""

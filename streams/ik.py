@@ -3,8 +3,9 @@
 For many ``(arm, object pose, grasp)`` requests at once: the closed-form IK of the grasp pose
 and of its pre-grasp (``lift`` back along the approach) for every branch; a branch survives if
 both are real and within the joint limits, the pre-grasp lies on the same branch (joint
-distance below ``max_branch_jump``), and neither configuration collides with the table, the
-other resting objects, itself or the other arm (held at ``other_q``, default its home pose).
+distance below ``max_branch_jump``), and neither configuration, nor the straight approach
+between them (checked every 1.5 cm), collides with the table, the other resting objects,
+itself or the other arm (held at ``other_q``, default its home pose).
 The gripper may touch the object being grasped (the fingers close on it); every other
 contact counts. Survivors are ranked by the joint distance of their pre-grasp from the arm's
 current configuration. :func:`compatible_pairs` then pairs candidates of the two arms whose
@@ -22,6 +23,7 @@ import numpy as np
 
 from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.transforms import FloatArray
+from streams.cartesian import straight_tool_move
 from streams.context import WorldContext
 from streams.grasps import Grasp, pregrasp_offset
 
@@ -94,6 +96,11 @@ def solve_ik_candidates(
                 ctx, world, dual, arm, obj, q_pre[gi, b]
             ):
                 continue
+            sweep = straight_tool_move(kin, q[gi, b], -lift, step=SWEEP_STEP)
+            if sweep is None or any(
+                _collides(ctx, world, dual, arm, obj, qs) for qs in sweep[1:-1]
+            ):
+                continue  # the straight approach between them is blocked or unreachable
             cost = float(np.linalg.norm(q_pre[gi, b] - ref))
             out.append(
                 IKCandidate(
@@ -128,6 +135,8 @@ def _is_gripper_contact(a: str, b: str, arm: str, target: str) -> bool:
 
 
 _GRIPPER = "gripper"
+#: Spacing [m] of the checks along the straight approach between pre-grasp and grasp.
+SWEEP_STEP = 0.015
 
 
 def ensure_objects(world: CollisionWorld, objects: Mapping[str, ObjectBox]) -> None:

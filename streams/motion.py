@@ -44,6 +44,10 @@ from streams.timing import TimedTrajectory, time_parameterize
 from streams.trajopt import DualArmTrajOpt, TrajOptOptions, TransferQuery, straight_line
 from streams.validate import HeldObject, ValidationReport, configure_world, validate_trajectory
 
+#: Spheres per resting object in the optimiser's obstacle model (8: one per octant, tight
+#: enough that a pre-grasp beside a neighbour does not start inside its sphere).
+OBSTACLE_SPHERES = 8
+
 
 @dataclass(frozen=True)
 class MotionRequest:
@@ -211,7 +215,7 @@ class DualMotionPlanner:
                 held.append(HeldSpheres(c, r))
         cs, rs = [], []
         for box in request.objects.values():
-            c, r = object_spheres(box.size, box.T_world_obj, 2)
+            c, r = object_spheres(box.size, box.T_world_obj, OBSTACLE_SPHERES)
             cs.append(c)
             rs.append(r)
         obstacles = (
@@ -368,7 +372,11 @@ def plan_dual_motion(
             return MotionResult(True, strategy.name, traj, planner.optimisation_time,
                                 time.perf_counter() - t0, tuple(attempts), report,
                                 ipopt_solves=planner.ipopt_solves)  # fmt: skip
-        attempts.append(f"{strategy.name}: validation failed ({report.reason})")
+        attempts.append(
+            f"{strategy.name}: validation failed ({report.reason} at sample {report.index}"
+            + "".join(f", {p.first}-{p.second}" for p in report.pairs[:2])
+            + ")"
+        )
     return MotionResult(False, None, None, planner.optimisation_time, time.perf_counter() - t0,
                         tuple(attempts), report, reason="; ".join(attempts),
                         ipopt_solves=planner.ipopt_solves)  # fmt: skip

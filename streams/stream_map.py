@@ -2,9 +2,10 @@
 
 Generators (``sample-grasp``, ``inverse-kinematics``, ``sample-buffer``, ``combine-confs``,
 ``plan-dual-motion``) yield one output tuple per call of ``next``; tests (``test-overlap``,
-``test-cfree-conf-pose``) return a bool. :data:`STREAM_KINDS` says which is which, so the
-wiring layer can wrap them (e.g. ``from_gen_fn`` / ``from_test``). Replace any entry of the
-returned dict by another callable with the same signature to swap a stream.
+``test-cfree``) return a bool; the function ``Duration`` returns a number [s].
+:data:`STREAM_KINDS` says which is which, so the wiring layer can wrap them (e.g.
+``from_gen_fn`` / ``from_test`` / ``from_fn``). Replace any entry of the returned dict by
+another callable with the same signature to swap a stream.
 
 Values: objects are names (str); poses are :class:`sdar_tamp.world.instance.Pose2D`; grasps
 are :class:`streams.grasps.Grasp`; arm configurations :class:`ArmConf`; dual-arm
@@ -14,6 +15,7 @@ Fluent facts (``atpose ?o ?p``, ``holding ?a ?o ?g``) arrive as tuples in ``flue
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -21,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from sdar_tamp.world.collision import ObjectBox
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
@@ -32,9 +35,10 @@ from streams.ik import IKRequest, solve_ik_candidates
 from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
 from streams.validate import HeldObject
 
+LOG = logging.getLogger(__name__)
 Size = tuple[float, float, float]
 
-#: Kind of every stream of the file: "gen" (generator of output tuples) or "test".
+#: Kind of every stream of the file: "gen" (generator of output tuples), "test" or "function".
 STREAM_KINDS: Mapping[str, str] = MappingProxyType(
     {
         "sample-grasp": "gen",
@@ -43,7 +47,9 @@ STREAM_KINDS: Mapping[str, str] = MappingProxyType(
         "combine-confs": "gen",
         "plan-dual-motion": "gen",
         "test-overlap": "test",
-        "test-cfree-conf-pose": "test",
+        "test-cfree": "test",
+        "Duration": "function",
+        "Distance": "function",
     }
 )
 
@@ -69,8 +75,22 @@ class DualConf:
         return np.array(self.left.q + self.right.q)
 
 
+#: Collision worlds kept for IK queries, one per object arrangement.
+WORLD_CACHE = 8
+#: Clearance [m] IK asks of grasp, pre-grasp and approach configurations from the other
+#: objects (the timed trajectory may deviate slightly from the checked configurations).
+IK_MARGIN = 0.003
+
+#: Motion planners of ``plan-dual-motion``: SDAR-M's ladder, plain optimisation, one arm at a time.
+MOTION_PLANNERS = ("sdar", "plain", "sequential")
+
+
 class DualArmStreams:
-    """The streams of one problem: sizes of the objects, a seed, and a shared planner."""
+    """The streams of one problem: sizes of the objects, a seed, and a shared planner.
+
+    ``reserved``: object name -> pose whose footprint buffers must avoid (the goals), unless
+    no buffer can be found otherwise. ``motion``: one of :data:`MOTION_PLANNERS`.
+    """
 
     def __init__(
         self,
@@ -78,12 +98,22 @@ class DualArmStreams:
         sizes: Mapping[str, Size],
         seed: int = 0,
         planner: DualMotionPlanner | None = None,
+        reserved: Mapping[str, Pose2D] | None = None,
+        motion: str = "sdar",
     ) -> None:
+        if motion not in MOTION_PLANNERS:
+            raise ParameterError(
+                f"motion planner must be one of {', '.join(MOTION_PLANNERS)}; got {motion!r}"
+            )
         self.ctx = ctx
         self.sizes = dict(sizes)
         self.seed = seed
         self.world = ctx.new_world()
+        self._arms_only = ctx.new_world()  # no objects: arm-arm checks of combine-confs
+        self._worlds: dict[Any, CollisionWorld] = {}
         self._planner = planner
+        self.reserved = dict(reserved or {})
+        self.motion = motion
         self._grasps: dict[str, tuple[Grasp, ...]] = {}
         self._buffer_calls = 0
 
@@ -122,24 +152,52 @@ class DualArmStreams:
         objects[obj] = self.box(obj, p)
         request = IKRequest(arm, obj, objects[obj], (g,))
         home = {a: self.ctx.home(a) for a in self.ctx.arm_names}
-        for c in solve_ik_candidates(self.ctx, self.world, objects, [request], home):
+        world = self._world_for(fluents, obj, p, IK_MARGIN)
+        for c in solve_ik_candidates(self.ctx, world, objects, [request], home):
             yield (ArmConf(arm, tuple(map(float, c.q)), tuple(map(float, c.q_pre))),)
+
+    def _world_for(
+        self, fluents: Sequence[tuple[Any, ...]], obj: str, p: Pose2D, margin: float
+    ) -> CollisionWorld:
+        """A collision world already holding this object set (a few are kept: building the
+        geometry of a new set costs milliseconds, and IK queries alternate between sets)."""
+        key = (frozenset((f[1], f[2]) for f in fluents if f[0] == "atpose"), obj, p, margin)
+        world = self._worlds.pop(key, None)
+        if world is None:
+            if len(self._worlds) >= WORLD_CACHE:  # reuse the least recently used world
+                old_key = next(iter(self._worlds))
+                reused = self._worlds.pop(old_key)
+                world = reused if old_key[-1] == margin else self.ctx.new_world(margin=margin)
+            else:
+                world = self.ctx.new_world(margin=margin)
+        self._worlds[key] = world  # most recently used last
+        return world
 
     def sample_buffer(
         self, obj: str, fluents: Sequence[tuple[Any, ...]] = ()
     ) -> Iterator[tuple[Pose2D]]:
         size = self.size(obj)
-        taken = [
-            corners(np.array([f[2].as_tuple()]), np.array([self.size(f[1])[:2]]))
-            for f in fluents
-            if f[0] == "atpose" and f[1] != obj
-        ]
-        occupied = np.concatenate(taken) if taken else np.zeros((0, 4, 2))
+        resting = [(f[1], f[2]) for f in fluents if f[0] == "atpose" and f[1] != obj]
+        goals = [(o, p) for o, p in self.reserved.items() if o != obj]
         self._buffer_calls += 1
         seed = self.seed * 100_003 + self._buffer_calls
-        for arm in self.ctx.arm_names:
-            for p in sample_buffers(self.ctx, arm, size, occupied, 4, seed):
-                yield (p,)
+        found = False
+        for avoid in (resting + goals, resting):  # goals too if possible
+            occupied = self._footprints(avoid)
+            for arm in self.ctx.arm_names:
+                for p in sample_buffers(self.ctx, arm, size, occupied, 4, seed):
+                    found = True
+                    yield (p,)
+            if found:
+                return
+
+    def _footprints(self, poses: Sequence[tuple[str, Pose2D]]) -> FloatArray:
+        if not poses:
+            return np.zeros((0, 4, 2))
+        return corners(
+            np.array([p.as_tuple() for _, p in poses]),
+            np.array([self.size(o)[:2] for o, _ in poses]),
+        )
 
     def combine_confs(
         self, a1: str, q1: ArmConf, a2: str, q2: ArmConf
@@ -147,7 +205,9 @@ class DualArmStreams:
         left = self.ctx.arm_names[0]
         if a1 == a2:
             return
-        yield (DualConf(q1, q2) if a1 == left else DualConf(q2, q1),)
+        conf = DualConf(q1, q2) if a1 == left else DualConf(q2, q1)
+        if not self._arms_only.in_collision(np.array(conf.left.q), np.array(conf.right.q)):
+            yield (conf,)
 
     def plan_dual_motion(
         self, q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]] = ()
@@ -163,9 +223,16 @@ class DualArmStreams:
         retreat = (q1.left.pre is not None, q1.right.pre is not None)
         approach = (q2.left.pre is not None, q2.right.pre is not None)
         request = MotionRequest(q1.q, q2.q, objects, held, retreat, approach)
-        result = plan_dual_motion(self.planner, request)
+        result = plan_dual_motion(
+            self.planner,
+            request,
+            fallbacks=self.motion == "sdar",
+            sequential_only=self.motion == "sequential",
+        )
         if result.success:
             yield (result,)
+        else:
+            LOG.debug("plan-dual-motion failed: %s", result.reason)
 
     def test_overlap(self, o: str, p: Pose2D, o2: str, p2: Pose2D) -> bool:
         """Footprints of ``o`` at ``p`` and ``o2`` at ``p2`` overlap (dependency graph)."""
@@ -175,14 +242,30 @@ class DualArmStreams:
         b = corners(np.array([p2.as_tuple()]), np.array([self.size(o2)[:2]]))
         return bool(overlap_matrix(a, b)[0, 0])
 
-    def test_cfree_conf_pose(self, arm: str, q: ArmConf, o: str, p: Pose2D) -> bool:
-        """The arm at ``q`` (other arm at home) does not touch ``o`` resting at ``p``."""
-        world = self.world
-        world.set_objects({o: self.box(o, p)})
-        qs = {a: self.ctx.home(a) for a in self.ctx.arm_names}
-        qs[arm] = np.array(q.q)
-        left, right = self.ctx.arm_names
-        return not world.in_collision(qs[left], qs[right])
+    def test_cfree(self, o: str, p: Pose2D, o2: str, p2: Pose2D) -> bool:
+        """Footprints of ``o`` at ``p`` and ``o2`` at ``p2`` are clear of each other."""
+        return o != o2 and not self.test_overlap(o, p, o2, p2)
+
+    @staticmethod
+    def duration(t: MotionResult) -> float:
+        """Execution time [s] of a planned motion."""
+        assert t.trajectory is not None
+        return t.trajectory.duration
+
+    def distance(self, d1: DualConf, d2: DualConf) -> float:
+        """Estimated duration [s] of the synchronous motion ``d1 -> d2``: the slowest joint's
+        rest-to-rest time at its velocity and acceleration limits (no obstacles)."""
+        dq = np.abs(d2.q - d1.q)
+        v, a = self._limits
+        t = np.where(dq * a > v * v, dq / v + v / a, 2.0 * np.sqrt(dq / a))
+        return float(t.max())
+
+    @property
+    def _limits(self) -> tuple[FloatArray, FloatArray]:
+        arms = [self.ctx.scene.arm(a) for a in self.ctx.arm_names]
+        v = np.concatenate([np.asarray(s.velocity_limit) for s in arms])
+        a = np.concatenate([np.asarray(s.acceleration_limit) for s in arms])
+        return v, a
 
 
 def make_stream_map(
@@ -190,13 +273,17 @@ def make_stream_map(
     sizes: Mapping[str, Size] | None = None,
     seed: int = 0,
     planner: DualMotionPlanner | None = None,
+    reserved: Mapping[str, Pose2D] | None = None,
+    motion: str = "sdar",
 ) -> dict[str, Callable[..., Any]]:
     """Bind every stream of ``stream.pddl`` by name (see the module docstring).
 
     ``sizes``: object name -> (lx, ly, lz) [m] (default: the scene's object size);
-    ``planner``: a motion planner to share (default: one built on first use, about 3 s).
+    ``planner``: a motion planner to share (default: one built on first use, about 3 s);
+    ``reserved``: poses buffers keep clear of (the goals); ``motion``: ``sdar`` (optimisation,
+    untangling, one arm at a time), ``plain`` (optimisation only) or ``sequential``.
     """
-    s = DualArmStreams(world_context, sizes or {}, seed, planner)
+    s = DualArmStreams(world_context, sizes or {}, seed, planner, reserved, motion)
     return {
         "sample-grasp": s.sample_grasp,
         "inverse-kinematics": s.inverse_kinematics,
@@ -204,5 +291,7 @@ def make_stream_map(
         "combine-confs": s.combine_confs,
         "plan-dual-motion": s.plan_dual_motion,
         "test-overlap": s.test_overlap,
-        "test-cfree-conf-pose": s.test_cfree_conf_pose,
+        "test-cfree": s.test_cfree,
+        "Duration": s.duration,
+        "Distance": s.distance,
     }

@@ -1,35 +1,42 @@
 ; Streams of synchronous dual-arm rearrangement (bound in streams/stream_map.py).
-; Poses are planar object poses (x, y, yaw); configurations are per arm, combined into
-; dual-arm configurations between which synchronous motions are planned.
+; Poses are planar object poses (x, y, yaw); arm configurations are per arm, combined into
+; dual-arm configurations between which synchronous motions are planned. Type names used as
+; unary facts type the outputs (grasp, armconf, pose, dualconf, traj).
 (define (stream dual-arm-rearrangement)
   ; grasps of an object: top-down first, then growing tilt angles
   (:stream sample-grasp
     :inputs (?o) :domain (obj ?o)
-    :outputs (?g) :certified (grasp ?o ?g))
-  ; collision-free IK branches (with pre-grasp) for an arm grasping ?o at ?p with ?g
+    :outputs (?g) :certified (and (grasp ?g) (graspof ?o ?g)))
+  ; collision-free IK branches (with pre-grasp) for an arm grasping ?o at ?p with ?g,
+  ; among the objects resting in the state of the step (fluent atpose), best ranked first
   (:stream inverse-kinematics
-    :inputs (?a ?o ?p ?g) :domain (and (arm ?a) (objpose ?o ?p) (grasp ?o ?g))
+    :inputs (?a ?o ?p ?g) :domain (and (arm ?a) (objpose ?o ?p) (graspof ?o ?g))
     :fluents (atpose)
-    :outputs (?q) :certified (and (conf ?a ?q) (kin ?a ?o ?p ?g ?q)))
-  ; free, reachable temporary poses for ?o
+    :outputs (?q) :certified (and (armconf ?q) (confof ?a ?q) (kin ?a ?o ?p ?g ?q)))
+  ; free, reachable temporary poses for ?o (clear of resting objects and of goals)
   (:stream sample-buffer
     :inputs (?o) :domain (obj ?o)
     :fluents (atpose)
     :outputs (?p) :certified (and (pose ?p) (objpose ?o ?p) (buffer ?p)))
-  ; a dual-arm configuration from one configuration per arm
+  ; a dual-arm configuration from one configuration per arm (the two arms clear of each other)
   (:stream combine-confs
-    :inputs (?a1 ?q1 ?a2 ?q2) :domain (and (conf ?a1 ?q1) (conf ?a2 ?q2))
-    :outputs (?q) :certified (and (dualconf ?q) (combines ?q ?a1 ?q1 ?a2 ?q2)))
-  ; a synchronous, validated dual-arm motion (with its fallback level)
+    :inputs (?a1 ?q1 ?a2 ?q2) :domain (and (confof ?a1 ?q1) (confof ?a2 ?q2))
+    :outputs (?d) :certified (and (dualconf ?d) (confin ?d ?a1 ?q1) (confin ?d ?a2 ?q2)))
+  ; a synchronous, validated dual-arm motion among the resting and held objects of the step
+  ; (trajectory optimisation, then arm untangling, then one arm at a time)
   (:stream plan-dual-motion
-    :inputs (?q1 ?q2) :domain (and (dualconf ?q1) (dualconf ?q2))
+    :inputs (?d1 ?d2) :domain (and (dualconf ?d1) (dualconf ?d2))
     :fluents (atpose holding)
-    :outputs (?t) :certified (and (traj ?t) (motion ?q1 ?t ?q2)))
+    :outputs (?t) :certified (and (traj ?t) (motion ?d1 ?t ?d2)))
   ; footprint overlap of two object poses: the edges of the dependency graph
   (:stream test-overlap
     :inputs (?o ?p ?o2 ?p2) :domain (and (objpose ?o ?p) (objpose ?o2 ?p2))
     :certified (overlaps ?o ?p ?o2 ?p2))
-  ; an arm configuration clear of an object at a pose
-  (:stream test-cfree-conf-pose
-    :inputs (?a ?q ?o ?p) :domain (and (conf ?a ?q) (objpose ?o ?p))
-    :certified (cfree-conf-pose ?a ?q ?o ?p)))
+  ; the footprints of two object poses are clear of each other (placements)
+  (:stream test-cfree
+    :inputs (?o ?p ?o2 ?p2) :domain (and (objpose ?o ?p) (objpose ?o2 ?p2))
+    :certified (cfree ?o ?p ?o2 ?p2))
+  ; the execution time [s] of a motion
+  (:function (Duration ?t) (traj ?t))
+  ; an estimate [s] of the synchronous motion between two dual-arm configurations
+  (:function (Distance ?d1 ?d2) (and (dualconf ?d1) (dualconf ?d2))))

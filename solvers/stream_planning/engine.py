@@ -61,35 +61,8 @@ class Engine:
     ) -> None:
         self.problem = problem
         self.table: ObjectTable = problem.objects.copy()
-        info = {k.lower(): v for k, v in (stream_info or {}).items()}
-        _warn_unsupported(info)
-        debug = isinstance(problem.stream_map, str)
-        functions = problem.stream_functions
+        self.streams, self.functions = bind_externals(problem, stream_info)
         streams = problem.streams
-        self.streams = {
-            s.name: StreamExternal(
-                s,
-                debug_gen_fn(s) if debug else functions[s.name],
-                _as_stream_info(info.get(s.name)),
-            )
-            for s in streams.streams
-        }
-        self.functions: dict[str, FunctionExternal] = {}
-        declarations: list[StreamFunction | StreamPredicate] = [
-            *streams.functions,
-            *streams.predicates,
-        ]
-        for decl in declarations:
-            fn: Callable[..., Any]
-            if not debug:
-                fn = functions[decl.name]
-            elif isinstance(decl, StreamFunction):
-                fn = _debug_cost
-            else:
-                fn = _debug_predicate
-            self.functions[decl.name] = FunctionExternal(
-                decl, fn, info.get(decl.name) or FunctionInfo()
-            )
         self.rules = {f"{RULE_PREFIX}{i}": rule for i, rule in enumerate(streams.rules)}
         self.store = FactStore()
         self.numeric: dict[tuple[str, tuple[str, ...]], float] = dict(problem.facts.numeric)
@@ -171,6 +144,40 @@ class Engine:
 
     def instance(self, name: str, inputs: tuple[str, ...]) -> InstanceState | None:
         return self.instances.get((name, inputs))
+
+
+def bind_externals(
+    problem: PDDLProblem, stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None
+) -> tuple[dict[str, StreamExternal], dict[str, FunctionExternal]]:
+    """The problem's streams and functions bound to their callables (or the debug ones)."""
+    info = {k.lower(): v for k, v in (stream_info or {}).items()}
+    _warn_unsupported(info)
+    debug = isinstance(problem.stream_map, str)
+    functions = problem.stream_functions
+    streams = problem.streams
+    bound = {
+        s.name: StreamExternal(
+            s,
+            debug_gen_fn(s) if debug else functions[s.name],
+            _as_stream_info(info.get(s.name)),
+        )
+        for s in streams.streams
+    }
+    externals: dict[str, FunctionExternal] = {}
+    declarations: list[StreamFunction | StreamPredicate] = [
+        *streams.functions,
+        *streams.predicates,
+    ]
+    for decl in declarations:
+        fn: Callable[..., Any]
+        if not debug:
+            fn = functions[decl.name]
+        elif isinstance(decl, StreamFunction):
+            fn = _debug_cost
+        else:
+            fn = _debug_predicate
+        externals[decl.name] = FunctionExternal(decl, fn, info.get(decl.name) or FunctionInfo())
+    return bound, externals
 
 
 def _debug_cost(*_inputs: Any) -> float:

@@ -1,13 +1,15 @@
 from pathlib import Path
 
 import numpy as np
+import pytest
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.pddl import parse_domain
 from sdar_tamp.language.streams import parse_stream_file
 from sdar_tamp.world.instance import Instance, Pose2D
 from streams.context import WorldContext
 from streams.motion import DualMotionPlanner
-from streams.stream_map import STREAM_KINDS, ArmConf, make_stream_map
+from streams.stream_map import STREAM_KINDS, ArmConf, DualConf, make_stream_map
 
 DOMAIN = Path(__file__).resolve().parents[2] / "domains" / "dual_arm_rearrangement"
 
@@ -15,9 +17,9 @@ DOMAIN = Path(__file__).resolve().parents[2] / "domains" / "dual_arm_rearrangeme
 def test_stream_file_parses_and_every_stream_is_bound(ctx: WorldContext) -> None:
     domain = parse_domain((DOMAIN / "domain.pddl").read_text(encoding="utf-8"))
     streams = parse_stream_file((DOMAIN / "stream.pddl").read_text(encoding="utf-8"), domain)
-    names = {s.name for s in streams.streams}
+    names = {s.name for s in streams.streams} | {f.name for f in streams.functions}
     stream_map = make_stream_map(ctx)
-    assert names == set(stream_map) == set(STREAM_KINDS)
+    assert names == {n.lower() for n in stream_map} == {n.lower() for n in STREAM_KINDS}
     overlap = next(s for s in streams.streams if s.name == "test-overlap")
     assert overlap.outputs == ()
 
@@ -63,3 +65,55 @@ def test_motion_stream_plans_a_validated_place(
     np.testing.assert_allclose(q[0], q1.q, atol=1e-9)
     np.testing.assert_allclose(q[-1], q2.q, atol=1e-9)
     assert np.allclose(q[:, 6:], q1.q[6:])  # the right arm waits at home
+
+
+def test_cfree_is_the_complement_of_overlap(ctx: WorldContext, instance: Instance) -> None:
+    o = instance.objects[0]
+    sm = make_stream_map(ctx, {x.name: x.size for x in instance.objects})
+    near, far = Pose2D(o.start.x + 0.02, o.start.y, 0.0), Pose2D(o.start.x + 0.3, o.start.y, 0.0)
+    assert not sm["test-cfree"](o.name, o.start, "x", near)
+    assert sm["test-cfree"](o.name, o.start, "x", far)
+    assert not sm["test-cfree"](o.name, o.start, o.name, far)  # an object and itself
+
+
+def test_distance_estimates_a_rest_to_rest_time(ctx: WorldContext) -> None:
+    sm = make_stream_map(ctx)
+    home = {a: ArmConf(a, tuple(ctx.home(a))) for a in ctx.arm_names}
+    d0 = DualConf(home["left"], home["right"])
+    moved = list(home["left"].q)
+    moved[0] += 1.0
+    d1 = DualConf(ArmConf("left", tuple(moved)), home["right"])
+    assert sm["Distance"](d0, d0) == 0.0
+    t = sm["Distance"](d0, d1)
+    v = ctx.scene.arm("left").velocity_limit[0]
+    assert 1.0 / v < t < 1.0 / v + 2.0  # slower than the velocity limit allows, not absurd
+
+
+def test_combine_confs_rejects_arms_in_collision(ctx: WorldContext) -> None:
+    sm = make_stream_map(ctx)
+    home = {a: ArmConf(a, tuple(ctx.home(a))) for a in ctx.arm_names}
+    assert list(sm["combine-confs"]("left", home["left"], "right", home["right"]))
+    assert not list(sm["combine-confs"]("left", home["left"], "left", home["left"]))
+    # a left configuration whose gripper touches the right arm's gripper at home
+    crossing = ArmConf("left", (-2.781, -3.068, 0.89, 2.288, -0.423, 0.863))
+    pairs = ctx.new_world().report(np.array(crossing.q), ctx.home("right"))
+    assert any(p.first.startswith("left") and p.second.startswith("right") for p in pairs)
+    assert not list(sm["combine-confs"]("left", crossing, "right", home["right"]))
+
+
+def test_buffers_keep_clear_of_reserved_goals(ctx: WorldContext, instance: Instance) -> None:
+    sizes = {x.name: x.size for x in instance.objects}
+    goals = {x.name: x.goal for x in instance.objects}
+    sm = make_stream_map(ctx, sizes, reserved=goals)
+    o = instance.objects[0]
+    fluents = [("atpose", x.name, x.start) for x in instance.objects]
+    for (p,) in sm["sample-buffer"](o.name, fluents):
+        for x in instance.objects:
+            if x.name != o.name:
+                assert sm["test-cfree"](o.name, p, x.name, x.goal)
+                assert sm["test-cfree"](o.name, p, x.name, x.start)
+
+
+def test_unknown_motion_planner_is_refused(ctx: WorldContext) -> None:
+    with pytest.raises(ParameterError, match="motion planner must be one of sdar, plain"):
+        make_stream_map(ctx, motion="fast")

@@ -1,0 +1,147 @@
+"""Benchmark: SDAR end to end on a suite of rearrangement instances.
+
+Every instance is solved by ``sdar solve``'s code path (SDAR-T + SDAR-M, a time limit per
+instance), and every plan is checked by the independent replay (``sdar validate``); a plan
+that does not validate counts as a failure. Planning time per synchronous step is the paper's
+figure: a step is one synchronous dual-arm motion; its time is the motion's planning time plus
+an equal share of its task's selection time (IK, grasps, buffers, ranking). The motion
+planner's one-off set-up (building the optimiser) is excluded and printed separately.
+
+    python benchmarks/bench_sdar.py [--suite paper] [--max-objects 12] [--time-limit 60]
+                                    [--task-planner sdar] [--motion-planner sdar] [--only M1,R4]
+
+Prints one row per instance, a summary, then one JSON object on the last line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from pathlib import Path
+
+from sdar_tamp.resources import domain_file
+from sdar_tamp.solve_command import solve_instance
+from sdar_tamp.world.instance import load_instance
+
+
+def _suite_files(suite: str) -> list[Path]:
+    folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
+    return sorted(folder.glob("*.yaml"), key=lambda p: (p.stem[0], int(p.stem[1:])))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--suite", default="paper", choices=("paper", "stress"))
+    ap.add_argument("--max-objects", type=int, default=None)
+    ap.add_argument("--time-limit", type=float, default=60.0)
+    ap.add_argument("--task-planner", default="sdar", choices=("sdar", "baseline"))
+    ap.add_argument("--motion-planner", default="sdar", choices=("sdar", "plain", "sequential"))
+    ap.add_argument("--only", default="", help="comma-separated instance names")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+
+    shared: dict[str, object] = {}
+    rows = []
+    step_times: list[float] = []
+    step_selection: list[float] = []
+    step_motion: list[float] = []
+    wanted = {s for s in args.only.split(",") if s}
+    start = time.perf_counter()
+    print(f"{'instance':>9} {'n':>3} {'ok':>3} {'actions':>7} {'steps':>5} {'exec s':>7} "
+          f"{'plan s':>7} {'step med':>8} {'levels'}")  # fmt: skip
+    for path in _suite_files(args.suite):
+        if wanted and path.stem not in wanted:
+            continue
+        if args.max_objects is not None and len(load_instance(path).objects) > args.max_objects:
+            continue
+        outcome = solve_instance(
+            path,
+            time_limit=args.time_limit,
+            seed=args.seed,
+            task_planner=args.task_planner,
+            motion_planner=args.motion_planner,
+            shared=shared,
+        )
+        n = len(outcome.instance.objects)
+        f = outcome.figures
+        row = {
+            "instance": outcome.instance.name,
+            "objects": n,
+            "status": outcome.status,
+            "valid": outcome.valid,
+            "success": outcome.success,
+            "planning_time": f.get("planning_time", 0.0),
+            "selection_time": f.get("selection_time", 0.0),
+            "motion_time": f.get("motion_time", 0.0),
+        }
+        if outcome.plan is not None:
+            m = outcome.plan.metrics
+            row.update(
+                actions=m["actions"],
+                steps=m["steps"],
+                dual_arm_steps=m["dual_arm_steps"],
+                execution_time=m["execution_time"],
+                step_time_median=f["step_time_median"],
+                levels=f["levels"],
+                buffer_moves=f["buffer_moves"],
+            )
+        rows.append(row)
+        print(
+            f"{row['instance']:>9} {n:>3} {'yes' if row['success'] else 'NO':>3} "
+            f"{row.get('actions', '-'):>7} {row.get('steps', '-'):>5} "
+            f"{float(row.get('execution_time', 0.0)):>7.1f} {row['planning_time']:>7.2f} "
+            f"{float(row.get('step_time_median', 0.0)):>8.3f} {row.get('levels', '')}"
+            + ("" if row["success"] else f"  {outcome.violation or outcome.diagnosis}"),
+            flush=True,
+        )
+        for record in _steps(outcome):
+            step_selection.append(record[0])
+            step_motion.append(record[1])
+            step_times.append(record[0] + record[1])
+    solved = [r for r in rows if r["success"]]
+    summary = {
+        "benchmark": "sdar",
+        "suite": args.suite,
+        "task_planner": args.task_planner,
+        "motion_planner": args.motion_planner,
+        "time_limit": args.time_limit,
+        "instances": len(rows),
+        "success": len(solved),
+        "success_rate": len(solved) / len(rows) if rows else 0.0,
+        "steps": len(step_times),
+        "step_time_median": statistics.median(step_times) if step_times else None,
+        "step_time_p90": _quantile(step_times, 0.9),
+        "step_selection_median": statistics.median(step_selection) if step_selection else None,
+        "step_motion_median": statistics.median(step_motion) if step_motion else None,
+        "planning_time_total": sum(r["planning_time"] for r in rows),
+        "wall_time": time.perf_counter() - start,
+        "failures": [r["instance"] for r in rows if not r["success"]],
+    }
+    print(
+        f"success {summary['success']}/{summary['instances']}; step planning time median "
+        f"{_fmt(summary['step_time_median'])} s (selection {_fmt(summary['step_selection_median'])}"
+        f" s, motion {_fmt(summary['step_motion_median'])} s), p90 "
+        f"{_fmt(summary['step_time_p90'])} s over {summary['steps']} steps"
+    )
+    print(json.dumps(summary))
+
+
+def _steps(outcome: object) -> list[tuple[float, float]]:
+    return list(getattr(outcome, "figures", {}).get("step_times", []))
+
+
+def _quantile(values: list[float], q: float) -> float | None:
+    if not values:
+        return None
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+
+
+def _fmt(value: object) -> str:
+    return "-" if value is None else f"{float(str(value)):.3f}"
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,395 @@
+"""Independent validation of a plan file by replaying it against an instance.
+
+Shares no code with the planner (``streams/``): it uses only the world model (scene,
+kinematics, the coal collision world, footprints). The replay walks the timeline once, in time
+order, and returns the FIRST violation. Rules and tolerances:
+
+* ``scene`` (t = 0): arm names and order, base poses and TCP offsets equal the scene's (1e-6).
+* ``instance`` (t = 0): the plan's instance name, and the objects of ``final_poses`` and of
+  every event, are those of the instance.
+* ``joint limit``: every sample within the scene's limits (1e-9 rad).
+* ``velocity``: finite differences ``dq/dt`` per sample interval within the limit + 2 %.
+* ``acceleration`` (optional, ``acceleration_tolerance=None`` disables it): second finite
+  differences within the limit + 25 %. The tolerance is loose on purpose: a 50 Hz sampling of
+  a rest-to-rest spline overestimates the true acceleration where speed profiles switch.
+* ``collision``: samples are linearly interpolated in joint space so that no tool centre point
+  moves more than ``max_tcp_step`` [m] between checks (refined until true); each check is a
+  :class:`CollisionWorld` query: arm-arm, self, arm-table, arm-objects, held objects against
+  everything except their own wrist and gripper (objects shrunk by 1 mm). At an event instant
+  the configuration is checked before and after the gripper changes. Contact rule: the
+  gripper of an arm may touch the object of its grasp or release only while that arm stands
+  exactly at its configuration of the event (the event sample and the dwell around it);
+  once the arm moves, every contact counts.
+* ``grasp``: by an empty gripper, of a resting object, with ``T_world_tcp @ T_tcp_object``
+  equal to the object's resting pose within 1 mm and 1 degree (modulo the cuboid's symmetry).
+  The object is then held rigidly where it really was relative to the tool.
+* ``release``: by the arm holding the object, ``T_tcp_object`` as held (1 mm, 1 degree); the
+  object must rest flat (z = lz/2 within 1 mm, its z axis vertical within 1 degree), with its
+  footprint inside the instance workspace (1 mm) and not overlapping any resting object's
+  footprint (the released footprint is shrunk by 1 mm per side).
+* at the end: ``held`` (nothing in hand), ``goal`` (every object at its goal within 1 mm and
+  1 degree, yaw modulo pi), ``final poses`` (equal to the plan's ``final_poses``, same
+  tolerances).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sdar_tamp.plan_file import PlanEvent, PlanFile, load_plan
+from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
+from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
+from sdar_tamp.world.instance import Instance, load_instance
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.scene import JOINT_KEYS, Scene, load_scene
+from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
+
+POS_TOL = 1e-3  #: [m]
+ANGLE_TOL = math.radians(1.0)  #: [rad]
+#: Rotations mapping a cuboid onto itself (pi about x, y or z).
+_SYMMETRY = [np.diag(d) for d in ((1.0, 1, 1), (1.0, -1, -1), (-1.0, 1, -1), (-1.0, -1, 1))]
+
+
+@dataclass(frozen=True)
+class Violation:
+    """The first broken rule: time [s], kind (see the module docstring) and a message."""
+
+    t: float
+    kind: str
+    message: str
+
+
+@dataclass(frozen=True)
+class ReplayReport:
+    """``ok`` or the first violation; ``checks`` counts the collision queries made."""
+
+    ok: bool
+    violation: Violation | None
+    checks: int
+
+
+def validate_plan(
+    instance: Instance,
+    plan: PlanFile,
+    scene: Scene | None = None,
+    max_tcp_step: float = 0.005,
+    *,
+    velocity_tolerance: float = 0.02,
+    acceleration_tolerance: float | None = 0.25,
+) -> ReplayReport:
+    """Replay ``plan`` on ``instance`` (default scene: the instance's, else the shipped one)."""
+    scene = scene if scene is not None else load_scene(instance.scene_path())
+    first = _static(instance, plan, scene)
+    if first is not None:
+        return ReplayReport(False, first, 0)
+    limit = _limits(plan, scene, velocity_tolerance, acceleration_tolerance)
+    replay = _Replay(instance, plan, scene, max_tcp_step)
+    found = replay.walk(limit.t if limit is not None else math.inf)
+    violation = found if found is not None else limit
+    return ReplayReport(violation is None, violation, replay.checks)
+
+
+def run_validate(instance_path: Path, plan_path: Path) -> int:
+    """``sdar validate``: print the verdict; 0 when valid, 1 when not. Bad files raise."""
+    instance = load_instance(instance_path)
+    plan = load_plan(plan_path)
+    scene = load_scene(instance.scene_path(Path(instance_path)))
+    report = validate_plan(instance, plan, scene)
+    if report.violation is None:
+        print(
+            f"valid: {len(plan.events)} gripper events, {report.checks} collision checks, "
+            f"duration {plan.duration:.2f} s"
+        )
+        return 0
+    v = report.violation
+    print(f"invalid at t={v.t:.3f}s: {v.kind}: {v.message}")
+    return 1
+
+
+def _static(instance: Instance, plan: PlanFile, scene: Scene) -> Violation | None:
+    for info, spec in zip(plan.arms, scene.arms, strict=True):
+        if info.name != spec.name:
+            return Violation(
+                0.0,
+                "scene",
+                f"arms {list(plan.arm_names)} differ from the "
+                f"scene's {list(scene.arm_names)} (names and order)",
+            )
+        tcp = np.eye(4)
+        tcp[2, 3] = scene.gripper.tcp_offset
+        for label, T, ref in (
+            ("base", info.T_world_base, spec.T_world_base),
+            ("T_tool0_tcp", info.T_tool0_tcp, tcp),
+        ):
+            if not np.allclose(T, ref, atol=1e-6):
+                return Violation(0.0, "scene", f"arm {spec.name}: {label} differs from the scene")
+    if plan.instance != instance.name:
+        return Violation(0.0, "instance", f"plan for {plan.instance!r}, not {instance.name!r}")
+    named = set(plan.final_poses) | {e.object for e in plan.events}
+    if named != set(instance.names):
+        return Violation(
+            0.0,
+            "instance",
+            f"the plan's objects {sorted(named)} differ from the "
+            f"instance's {sorted(instance.names)}",
+        )
+    return None
+
+
+def _limits(plan: PlanFile, scene: Scene, v_tol: float, a_tol: float | None) -> Violation | None:
+    """The earliest joint-limit, velocity or acceleration violation (that order on ties)."""
+    lo = np.concatenate([a.lower for a in scene.arms])
+    hi = np.concatenate([a.upper for a in scene.arms])
+    v_max = np.concatenate([a.velocity_limit for a in scene.arms])
+    a_max = np.concatenate([a.acceleration_limit for a in scene.arms])
+    t, q = plan.t, plan.q
+    found: list[tuple[float, int, Violation]] = []
+
+    def joint(j: int) -> str:
+        return f"{scene.arms[j // 6].name} {JOINT_KEYS[j % 6]}"
+
+    bad = (q < lo - 1e-9) | (q > hi + 1e-9)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        msg = f"{joint(j)} = {q[i, j]:.4f} rad outside [{lo[j]:.4f}, {hi[j]:.4f}]"
+        found.append((float(t[i]), 0, Violation(float(t[i]), "joint limit", msg)))
+    dt = np.diff(t)
+    vel = np.diff(q, axis=0) / dt[:, None]
+    bad = np.abs(vel) > v_max * (1.0 + v_tol)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        msg = (
+            f"{joint(j)} moves at {abs(vel[i, j]):.3f} rad/s from t = {t[i]:.3f} to "
+            f"{t[i + 1]:.3f} s; limit {v_max[j]:.3f} rad/s + {v_tol:.0%}"
+        )
+        found.append((float(t[i]), 1, Violation(float(t[i]), "velocity", msg)))
+    if a_tol is not None and len(t) > 2:
+        acc = np.diff(vel, axis=0) / (0.5 * (dt[1:] + dt[:-1]))[:, None]
+        bad = np.abs(acc) > a_max * (1.0 + a_tol)
+        if bad.any():
+            i, j = np.argwhere(bad)[0]
+            msg = (
+                f"{joint(j)} accelerates at {abs(acc[i, j]):.2f} rad/s^2; limit "
+                f"{a_max[j]:.2f} rad/s^2 + {a_tol:.0%}"
+            )
+            found.append((float(t[i + 1]), 2, Violation(float(t[i + 1]), "acceleration", msg)))
+    return min(found, key=lambda f: (f[0], f[1]))[2] if found else None
+
+
+def _pose_error(T_a: FloatArray, T_b: FloatArray) -> tuple[float, float]:
+    """Distance [m] and rotation angle [rad] between two cuboid poses, modulo symmetry."""
+    R = T_a[:3, :3].T @ T_b[:3, :3]
+    trace = max(float(np.trace(R @ S)) for S in _SYMMETRY)
+    angle = math.acos(min(1.0, max(-1.0, (trace - 1.0) / 2.0)))
+    return float(np.linalg.norm(T_a[:3, 3] - T_b[:3, 3])), angle
+
+
+def _planar_error(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float]:
+    """Distance [m] and yaw difference modulo pi [rad] of two ``(x, y, yaw)`` poses."""
+    d = (a[2] - b[2]) % math.pi
+    return math.hypot(a[0] - b[0], a[1] - b[1]), min(d, math.pi - d)
+
+
+class _Replay:
+    """The state of the world along the timeline: resting and held objects."""
+
+    def __init__(self, instance: Instance, plan: PlanFile, scene: Scene, step: float) -> None:
+        self.instance, self.plan, self.scene, self.step = instance, plan, scene, step
+        self.kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+        self.sizes = {o.name: o.size for o in instance.objects}
+        self.rest = {o.name: o.start.as_tuple() for o in instance.objects}
+        self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
+        self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
+        self.world = CollisionWorld(scene)
+        self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
+        self.checks = 0
+
+    def box(self, name: str, pose: tuple[float, ...]) -> ObjectBox:
+        size = self.sizes[name]
+        return ObjectBox(pose_xyz_yaw(pose[0], pose[1], size[2] / 2.0, pose[2]), size)
+
+    def arm_q(self, arm: str, q: FloatArray) -> FloatArray:
+        i = self.scene.arm_names.index(arm)
+        return q[6 * i : 6 * i + 6]
+
+    def tcp(self, arm: str, q: FloatArray) -> FloatArray:
+        return self.kins[arm].fk_tcp(self.arm_q(arm, q))
+
+    # -- collisions -----------------------------------------------------------------------------
+    def collide(self, q: FloatArray, t: float) -> Violation | None:
+        self.checks += 1
+        for arm, (_, q_event) in list(self.exempt.items()):
+            if np.abs(self.arm_q(arm, q) - q_event).max() > 1e-9:
+                del self.exempt[arm]  # the arm has moved: contact counts again
+        if not self.world.in_collision(q[:6], q[6:]):
+            return None
+        pairs = [p for p in self.world.report(q[:6], q[6:]) if not self.allowed(p)]
+        if not pairs:
+            return None
+        text = ", ".join(f"{p.first} with {p.second}" for p in pairs[:3])
+        return Violation(t, "collision", text + (" ..." if len(pairs) > 3 else ""))
+
+    def allowed(self, p: CollisionPair) -> bool:
+        for arm, (obj, _) in self.exempt.items():
+            target = f"object:{obj}"
+            other = p.second if p.first == target else p.first if p.second == target else ""
+            if other.startswith(f"{arm}_gripper"):
+                return True
+        return False
+
+    def tcp_positions(self, q: FloatArray) -> FloatArray:
+        """Both TCP positions ``(m, 2, 3)`` [m] for ``q`` ``(m, 12)`` (closed-form FK)."""
+        out = []
+        for i, arm in enumerate(self.scene.arm_names):
+            kin = self.kins[arm]
+            out.append((kin.fk_batch(q[:, 6 * i : 6 * i + 6]) @ kin.T_tool0_tcp)[:, :3, 3])
+        return np.stack(out, axis=1)
+
+    def subdivisions(self, q: FloatArray) -> NDArray[np.int_]:
+        """Per interval of ``q`` ``(K, 12)``: the number of linear steps after which no TCP
+        has moved more than ``self.step`` [m] (refined until it holds)."""
+        chord = np.linalg.norm(np.diff(self.tcp_positions(q), axis=0), axis=2).max(axis=1)
+        n: NDArray[np.int_] = np.maximum(1, np.ceil(chord / self.step)).astype(int)
+        for _ in range(30):
+            off = np.cumsum(n + 1) - (n + 1)  # first dense point of every interval
+            idx = np.repeat(np.arange(len(n)), n + 1)
+            frac = (np.arange(len(idx)) - np.repeat(off, n + 1)) / np.repeat(n, n + 1)
+            dense = q[idx] + frac[:, None] * (q[idx + 1] - q[idx])
+            d = np.linalg.norm(np.diff(self.tcp_positions(dense), axis=0), axis=2).max(axis=1)
+            d[off[1:] - 1] = 0.0  # steps across intervals
+            worst = np.maximum.reduceat(np.append(d, 0.0), off)
+            bad = worst > self.step
+            if not bad.any():
+                break
+            n[bad] = np.maximum(n[bad] + 1, np.ceil(1.1 * n[bad] * worst[bad] / self.step))
+        return n
+
+    # -- the walk -------------------------------------------------------------------------------
+    def walk(self, t_stop: float) -> Violation | None:
+        """Replay until ``t_stop`` [s] (exclusive); the first violation, or None."""
+        plan = self.plan
+        knot_t = np.union1d(plan.t, [e.t for e in plan.events])
+        knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in range(12)], axis=1)
+        counts = self.subdivisions(knot_q) if len(knot_t) > 1 else np.zeros(0, dtype=int)
+        pending = list(plan.events)
+        for k, tk in enumerate(knot_t):
+            if tk >= t_stop:
+                return None
+            group = [e for e in pending if e.t <= tk]
+            pending = pending[len(group) :]
+            for e in group:
+                self.exempt[e.arm] = (e.object, self.arm_q(e.arm, knot_q[k]).copy())
+            found = self.collide(knot_q[k], float(tk))
+            for e in group:
+                found = found or self.apply(e, knot_q[k], float(tk))
+            if group and found is None:
+                found = self.collide(knot_q[k], float(tk))
+            if found is not None:
+                return found
+            if k + 1 < len(knot_t):
+                n = int(counts[k])
+                for s in range(1, n):
+                    t = float(tk + (knot_t[k + 1] - tk) * s / n)
+                    if t >= t_stop:
+                        return None
+                    q = knot_q[k] + (knot_q[k + 1] - knot_q[k]) * (s / n)
+                    found = self.collide(q, t)
+                    if found is not None:
+                        return found
+        return self.final(float(knot_t[-1]))
+
+    def apply(self, e: PlanEvent, q: FloatArray, t: float) -> Violation | None:
+        """Check and perform one gripper event at configuration ``q`` ``(12,)``."""
+        T_world_tcp = self.tcp(e.arm, q)
+        if e.type == "grasp":
+            if e.arm in self.held:
+                return Violation(
+                    t, "grasp", f"{e.arm} grasps {e.object} while holding {self.held[e.arm][0]}"
+                )
+            if e.object not in self.rest:
+                return Violation(t, "grasp", f"{e.arm} grasps {e.object}, which is not resting")
+            T_obj = self.box(e.object, self.rest[e.object]).T_world_obj
+            d, a = _pose_error(T_world_tcp @ e.T_tcp_object, T_obj)
+            if d > POS_TOL or a > ANGLE_TOL:
+                return Violation(
+                    t,
+                    "grasp",
+                    f"{e.arm} grasps {e.object} with the tool "
+                    f"{d * 1e3:.1f} mm / {math.degrees(a):.1f} deg away from it "
+                    "(tolerance 1 mm / 1 deg)",
+                )
+            del self.rest[e.object]
+            self.held[e.arm] = (e.object, inverse(T_world_tcp) @ T_obj)
+            self.world.attach(e.arm, e.object, self.arm_q(e.arm, q))
+            return None
+        holding = self.held.get(e.arm)
+        if holding is None or holding[0] != e.object:
+            what = holding[0] if holding else "nothing"
+            return Violation(t, "release", f"{e.arm} releases {e.object} but holds {what}")
+        d, a = _pose_error(holding[1], e.T_tcp_object)
+        if d > POS_TOL or a > ANGLE_TOL:
+            return Violation(
+                t,
+                "release",
+                f"{e.arm} releases {e.object} with T_tcp_object "
+                f"{d * 1e3:.1f} mm / {math.degrees(a):.1f} deg off the grasp",
+            )
+        T = T_world_tcp @ holding[1]
+        lz = self.sizes[e.object][2]
+        tilt = math.acos(min(1.0, abs(float(T[2, 2]))))
+        if abs(T[2, 3] - lz / 2.0) > POS_TOL or tilt > ANGLE_TOL:
+            return Violation(
+                t,
+                "release",
+                f"{e.object} released at z = {T[2, 3]:.4f} m tilted "
+                f"{math.degrees(tilt):.1f} deg; it must rest flat on the table "
+                f"(z = {lz / 2:.4f} m)",
+            )
+        pose = (float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0]))
+        size = np.array(self.sizes[e.object][:2])
+        ws = self.instance.workspace
+        rect = corners(np.array([pose]), size)
+        if not inside_rectangle(
+            rect, (ws.x[0] - POS_TOL, ws.x[1] + POS_TOL), (ws.y[0] - POS_TOL, ws.y[1] + POS_TOL)
+        )[0]:
+            return Violation(
+                t,
+                "release",
+                f"{e.object} released at ({pose[0]:.3f}, {pose[1]:.3f}) m leaves the workspace",
+            )
+        shrunk = corners(np.array([pose]), size - 2.0 * POS_TOL)
+        for other, p in self.rest.items():
+            rect_o = corners(np.array([p]), np.array(self.sizes[other][:2]))
+            if overlap_matrix(shrunk, rect_o)[0, 0]:
+                return Violation(t, "release", f"{e.object} released onto {other}")
+        del self.held[e.arm]
+        self.world.detach(e.arm, self.arm_q(e.arm, q))
+        self.world.set_object(e.object, self.box(e.object, pose))
+        self.rest[e.object] = pose
+        return None
+
+    def final(self, t: float) -> Violation | None:
+        if self.held:
+            what = ", ".join(f"{a} holds {o}" for a, (o, _) in self.held.items())
+            return Violation(t, "held", f"the plan ends with {what}")
+        for o in self.instance.objects:
+            for kind, ref in (
+                ("goal", o.goal.as_tuple()),
+                ("final poses", self.plan.final_poses[o.name]),
+            ):
+                d, a = _planar_error(self.rest[o.name], ref)
+                if d > POS_TOL or a > ANGLE_TOL:
+                    x, y, yaw = self.rest[o.name]
+                    return Violation(
+                        t,
+                        kind,
+                        f"{o.name} ends at ({x:.4f}, {y:.4f}, {yaw:.4f}), "
+                        f"{d * 1e3:.1f} mm / {math.degrees(a):.1f} deg from "
+                        f"{kind} {tuple(round(v, 4) for v in ref)}",
+                    )
+        return None

@@ -1,0 +1,191 @@
+"""SDAR-T: dependency-driven dual-arm task planning (paper, section IV-A, Alg. 1).
+
+Alg. 1 returns a task list; here it is a ranked list of :class:`~solvers.sdar.tasks.Step`
+candidates which SDAR-M grounds best first, falling back down the list. ``B(x)`` are the objects
+whose current poses block the goal of ``x``. Rank classes (lower is better):
+
+0. ``last``: one object left: it goes to its goal.
+1. ``pair`` / ``chain`` / ``swap``: two objects both to their goals, each blocked only by the
+   other (``B(i) <= {j}``, ``B(j) <= {i}``): two independent objects, the terminal pair of a
+   chain (``i -> j``, ``j`` a leaf) or a 2-cycle swapped by the two arms. Pairs that free more
+   objects, then remove more edges, come first, so chains are consumed from the leaf.
+2. ``cycle``: cycle breaking: ``x`` of a component of three or more objects goes to a buffer
+   and an object ``i`` with ``B(i) = {x}`` (adjacent in the cycle) to its goal.
+3. ``cycle``: ``x`` to a buffer paired with an object whose goal is free anyway.
+4. ``cycle``: when no step of classes 1-3 exists, two objects ``x``, ``y`` to buffers, if one
+   minimum buffer set holds both (``x`` among the three best optimal objects).
+5. ``cycle``: ``x`` alone, when no object can go to its goal in the same step.
+6. ``single``: one object to its free goal (the one-arm-at-a-time fallback).
+7. ``cycle``: as 2-3, for an ``x`` known to cost an extra buffer move (a detour).
+8. ``buffer``: one object to a buffer; objects already on a buffer only if nothing else is
+   possible (no ping-pong).
+
+Choosing ``x``: the objects that belong to a minimum *buffer set* of the current graph (the
+fewest objects whose removal leaves components of at most two objects, see
+:mod:`solvers.sdar.feedback`) are the optimal ones; goal moves never add to it, so taking the
+first candidate always uses ``n + |minimum buffer set|`` actions, never more than a single arm
+optimum (``n + |minimum FVS|``). Among them (or all of them, greedily, when the exact search
+exceeds ``node_budget``, which sets :attr:`SdarTaskPlanner.exact` to ``False``), objects that
+free more objects and have more predecessors come first. Ties break by object order, so the
+list is a function of the view. Steps of two moves are capped at ``max_candidates``; one-move
+steps are always kept. :meth:`~SdarTaskPlanner.commit` does nothing: SDAR-T replans from the
+view at every step.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.graph import DependencyGraph
+from solvers.sdar.feedback import extending_minimum, optimal_choices
+from solvers.sdar.tasks import Move, Step, TaskView
+
+_Edges = tuple[tuple[int, int], ...]
+_DOUBLE_FIRSTS = 3  # double buffer moves are sought for the best three first objects
+LAST, GOAL_PAIR, CYCLE, CYCLE_FREE, CYCLE_DOUBLE, CYCLE_ALONE, SINGLE, DETOUR, BUFFER = range(9)
+
+_Key = tuple[int, ...]
+_Ranked = list[tuple[_Key, Step]]
+
+
+class _Scene:
+    """The view's blockers and predecessors by name, and how much a lift frees."""
+
+    def __init__(self, view: TaskView) -> None:
+        self.names = view.remaining
+        self.order = {x: k for k, x in enumerate(self.names)}
+        self.blockers = {x: view.blockers(x) for x in self.names}
+        self.preds = {x: sum(1 for y in self.names if x in self.blockers[y]) for x in self.names}
+
+    def frees(self, lifted: frozenset[str]) -> tuple[int, int]:
+        """Objects whose goals become free, and edges removed, when ``lifted`` move."""
+        others = [y for y in self.names if y not in lifted]
+        freed = sum(1 for y in others if self.blockers[y] and self.blockers[y] <= lifted)
+        return freed, sum(1 for y in others for x in lifted if x in self.blockers[y])
+
+
+class SdarTaskPlanner:
+    """The SDAR-T task planner (see the module docstring for its rules)."""
+
+    def __init__(self, max_candidates: int = 24, node_budget: int | None = 50_000) -> None:
+        if max_candidates < 1:
+            raise ParameterError(f"max_candidates must be >= 1, got {max_candidates}")
+        if node_budget is not None and node_budget < 1:
+            raise ParameterError(f"node_budget must be None or >= 1, got {node_budget}")
+        self.max_candidates = max_candidates
+        self.node_budget = node_budget
+        self.exact = True
+        """``False`` once a cycle was broken by the greedy score (exact search over budget)."""
+        self._choices: dict[tuple[tuple[str, ...], _Edges], frozenset[str]] = {}
+
+    @property
+    def name(self) -> str:
+        return "sdar"
+
+    def commit(self, step: Step, view: TaskView) -> None:
+        """Nothing to do: the next candidates are computed from the next view."""
+
+    def candidates(self, view: TaskView) -> list[Step]:
+        names = view.remaining
+        if len(names) <= 1:
+            return [Step((Move(x, bool(view.blockers(x))),), "last", LAST) for x in names]
+        scene = _Scene(view)
+        goal_pairs = self._goal_pairs(scene)
+        ranked = goal_pairs + self._cycle_breaks(scene, view, bool(goal_pairs))
+        ranked.sort(key=lambda item: item[0])
+        kept = [item for item in ranked if len(item[1].moves) == 2][: self.max_candidates]
+        kept += [item for item in ranked if len(item[1].moves) == 1]
+        for x in names:
+            if not scene.blockers[x]:
+                key: _Key = (SINGLE, -scene.preds[x], scene.order[x])
+                kept.append((key, Step((Move(x),), "single", SINGLE)))
+        movable = [x for x in names if x not in view.in_buffer]
+        if not movable and not kept:
+            movable = list(names)  # nothing else is possible: allow a buffer-to-buffer move
+        proposed = {step.moves for _, step in kept}
+        for x in movable:
+            if (Move(x, to_buffer=True),) not in proposed:
+                key = (BUFFER, scene.order[x])
+                kept.append((key, Step((Move(x, to_buffer=True),), "buffer", BUFFER)))
+        kept.sort(key=lambda item: item[0])
+        return [step for _, step in kept]
+
+    def _goal_pairs(self, scene: _Scene) -> _Ranked:
+        """Class 1: both objects to their goals."""
+        out: _Ranked = []
+        for i, j in combinations(scene.names, 2):
+            bi, bj = scene.blockers[i], scene.blockers[j]
+            if bi <= {j} and bj <= {i}:
+                kind = "swap" if bi and bj else "chain" if bi or bj else "pair"
+                freed, removed = scene.frees(frozenset((i, j)))
+                key = (GOAL_PAIR, -freed, -removed, scene.order[i], scene.order[j])
+                out.append((key, Step((Move(i), Move(j)), kind, GOAL_PAIR)))
+        return out
+
+    def _cycle_breaks(self, scene: _Scene, view: TaskView, goal_pairs: bool) -> _Ranked:
+        """Classes 2-5 and 7: an object of a large component goes to a buffer."""
+        optimal, breakable = self._break_choices(view)
+        out: _Ranked = []
+        x_keys: dict[str, _Key] = {}
+        for x in breakable:
+            freed, removed = scene.frees(frozenset((x,)))
+            x_key = x_keys[x] = (-freed, -scene.preds[x], -removed, scene.order[x])
+            partners = [i for i in scene.names if i != x and scene.blockers[i] <= {x}]
+            for i in partners:
+                linked = bool(scene.blockers[i])
+                rank = (CYCLE if linked else CYCLE_FREE) if x in optimal else DETOUR
+                key: _Key = (rank, int(not linked), *x_key, -scene.preds[i], scene.order[i])
+                out.append((key, Step((Move(i), Move(x, to_buffer=True)), "cycle", rank)))
+            if not partners and x in optimal:
+                key = (CYCLE_ALONE, *x_key)
+                out.append((key, Step((Move(x, to_buffer=True),), "cycle", CYCLE_ALONE)))
+        if all(key[0] >= CYCLE_ALONE for key, _ in out) and not goal_pairs:
+            firsts = sorted((x for x in breakable if x in optimal), key=x_keys.__getitem__)
+            for x, y in self._double_buffers(view, firsts[:_DOUBLE_FIRSTS], firsts):
+                key = (CYCLE_DOUBLE, *x_keys[x], *x_keys[y])
+                moves = (Move(x, to_buffer=True), Move(y, to_buffer=True))
+                out.append((key, Step(moves, "cycle", CYCLE_DOUBLE)))
+        return out
+
+    def _break_choices(self, view: TaskView) -> tuple[frozenset[str], list[str]]:
+        """Objects whose buffering is optimal, and all objects of components above two."""
+        graph = view.graph
+        optimal: set[str] = set()
+        breakable: list[str] = []
+        for comp in graph.components():
+            if len(comp) < 3:
+                continue
+            local = {v: k for k, v in enumerate(comp)}
+            sub = DependencyGraph(
+                tuple(graph.names[v] for v in comp),
+                tuple((local[i], local[j]) for i, j in graph.edges if i in local and j in local),
+            )
+            breakable.extend(sub.names)
+            if (sub.names, sub.edges) not in self._choices:
+                found = optimal_choices(sub, allow_swaps=True, node_budget=self.node_budget)
+                if found is None:
+                    self.exact = False
+                    found = frozenset(sub.names)
+                self._choices[sub.names, sub.edges] = found
+            optimal |= self._choices[sub.names, sub.edges]
+        return frozenset(optimal), breakable
+
+    def _double_buffers(
+        self, view: TaskView, firsts: list[str], optimal: list[str]
+    ) -> list[tuple[str, str]]:
+        """Pairs ``(x, y)``, ``x`` in ``firsts``, that one minimum buffer set holds together."""
+        options: dict[frozenset[str], tuple[str, str]] = {}
+        for x in firsts:
+            for y in optimal:
+                if y != x:
+                    options.setdefault(frozenset((x, y)), (x, y))
+        if not options:
+            return []
+        found = extending_minimum(
+            view.graph, list(options), allow_swaps=True, node_budget=self.node_budget
+        )
+        if found is None:
+            self.exact = False
+            return list(options.values())
+        return [options[k] for k in found]

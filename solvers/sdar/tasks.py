@@ -1,0 +1,101 @@
+"""The vocabulary shared by rearrangement task planners (SDAR-T and the baseline) and SDAR-M.
+
+A task planner looks at a :class:`TaskView` of the current arrangement (the dependency graph of
+the objects not yet at their goals, and which objects sit in buffers) and proposes ranked
+:class:`Step` candidates: one or two object moves done in one synchronous dual-arm step (both
+arms pick, both place). SDAR-M assigns arms, grounds the candidates through the streams, picks
+one and reports it back with :meth:`TaskPlanner.commit`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+from sdar_tamp.graph import DependencyGraph
+
+
+@dataclass(frozen=True)
+class Move:
+    """Move ``obj`` to its goal, or to a buffer (a free temporary pose SDAR-M samples)."""
+
+    obj: str
+    to_buffer: bool = False
+
+
+@dataclass(frozen=True)
+class Step:
+    """One synchronous step: one or two moves of distinct objects, arms not yet assigned.
+
+    ``kind`` names the rule that proposed it (``pair``, ``chain``, ``swap``, ``cycle``,
+    ``single``, ``buffer``, ``last``, ``plan``); ``rank`` orders candidates (lower is better).
+    """
+
+    moves: tuple[Move, ...]
+    kind: str
+    rank: int = 0
+
+    def __post_init__(self) -> None:
+        if not 1 <= len(self.moves) <= 2:
+            raise ValueError(f"a step has one or two moves, got {len(self.moves)}")
+        if len({m.obj for m in self.moves}) != len(self.moves):
+            raise ValueError(f"a step moves distinct objects, got {self.moves}")
+
+    @property
+    def objects(self) -> tuple[str, ...]:
+        return tuple(m.obj for m in self.moves)
+
+    @property
+    def progress(self) -> int:
+        """Objects this step brings to their goals."""
+        return sum(1 for m in self.moves if not m.to_buffer)
+
+
+@dataclass(frozen=True)
+class TaskView:
+    """The current arrangement as a task planner sees it.
+
+    ``graph`` is the dependency graph over the objects not at their goals (``i -> j``: the goal
+    of ``i`` overlaps the current pose of ``j``); ``done`` are the objects at their goals;
+    ``in_buffer`` the objects resting on a buffer.
+    """
+
+    graph: DependencyGraph
+    done: frozenset[str]
+    in_buffer: frozenset[str]
+
+    @property
+    def remaining(self) -> tuple[str, ...]:
+        return self.graph.names
+
+    def blockers(self, obj: str) -> frozenset[str]:
+        """The objects whose current poses overlap the goal of ``obj``."""
+        i = self.graph.names.index(obj)
+        return frozenset(self.graph.names[j] for j in self.graph.successors(i))
+
+    def goal_free_after(self, obj: str, lifted: frozenset[str]) -> bool:
+        """The goal of ``obj`` is free once the objects in ``lifted`` are picked up."""
+        return self.blockers(obj) <= lifted
+
+
+class TaskPlanner(Protocol):
+    """Proposes the next synchronous steps; SDAR-M tells it which one was executed."""
+
+    @property
+    def name(self) -> str: ...
+
+    def candidates(self, view: TaskView) -> list[Step]:
+        """Ranked candidates (best first); empty only when every object is at its goal."""
+        ...
+
+    def commit(self, step: Step, view: TaskView) -> None:
+        """``step`` was executed from ``view`` (a planner with a fixed plan advances)."""
+        ...
+
+
+def step_is_valid(step: Step, view: TaskView) -> bool:
+    """Every goal move of ``step`` lands on a free goal once the step's objects are lifted."""
+    lifted = frozenset(step.objects)
+    return all(m.obj in view.graph.names for m in step.moves) and all(
+        m.to_buffer or view.goal_free_after(m.obj, lifted) for m in step.moves
+    )
