@@ -10,8 +10,8 @@ from pathlib import Path
 from sdar_tamp import __version__
 from sdar_tamp.errors import SdarError
 
-DEMO_DOMAIN = "blocksworld"
-DEMO_PROBLEM = "problems/reverse4.pddl"
+DEMO_DOMAIN = "dual_arm_rearrangement"
+DEMO_INSTANCE = "suites/paper/M1.yaml"
 
 
 def _read(path: Path) -> str:
@@ -72,20 +72,33 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    """Solve a shipped teaching problem and print the plan."""
-    from sdar_tamp.resources import domain_file
+    """Solve the shipped 12-object mixed instance M1 with SDAR, validate the plan by replay,
+    and write the plan file, the 3-D page and the storyboard (default: a folder in the
+    system's temporary directory; nothing is written to the working directory)."""
+    import tempfile
 
-    plan_args = argparse.Namespace(
-        domain=domain_file(DEMO_DOMAIN),
-        problem=domain_file(DEMO_DOMAIN, DEMO_PROBLEM),
-        search="gbfs",
-        heuristic="ff",
-        weight=2.0,
-        time_limit=args.time_limit,
-        unit=False,
-    )
-    print(f"Solving the shipped {DEMO_DOMAIN} problem {DEMO_PROBLEM}:")
-    return cmd_plan(plan_args)
+    from sdar_tamp.plan_file import save_plan
+    from sdar_tamp.resources import domain_file
+    from sdar_tamp.solve_command import ProgressBar, format_summary, solve_instance
+    from sdar_tamp.viewer import write_html, write_storyboard
+
+    instance = domain_file(DEMO_DOMAIN, DEMO_INSTANCE)
+    out = args.out or Path(tempfile.gettempdir()) / "sdar-demo"
+    out.mkdir(parents=True, exist_ok=True)
+    print(f"Solving the shipped mixed instance {DEMO_INSTANCE} (12 objects) with SDAR:")
+    bar = ProgressBar(instance.stem)
+    try:
+        outcome = solve_instance(instance, time_limit=args.time_limit, progress=bar)
+    finally:
+        bar.close()
+    print(format_summary(outcome))
+    if outcome.plan is None:
+        return 1
+    print(f"wrote {save_plan(outcome.plan, out / 'plan.json')}")
+    print(f"wrote {write_html(outcome.instance, outcome.plan, out / 'plan.html')}")
+    print(f"wrote {write_storyboard(outcome.instance, outcome.plan, out / 'storyboard.png')}")
+    print(f"check it again with: sdar validate {instance} {out / 'plan.json'}")
+    return 0 if outcome.success else 1
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
@@ -265,6 +278,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     demo = sub.add_parser("demo", help="solve a built-in example", description=cmd_demo.__doc__)
     demo.add_argument("--time-limit", type=float, default=60.0, help="seconds (default: 60)")
+    demo.add_argument("--out", type=Path, default=None, help="output folder (default: temp)")
     demo.set_defaults(func=cmd_demo)
     return parser
 

@@ -123,15 +123,28 @@ def solve_rearrangement(
     return SdarSolver(rearrangement.problem, planner, options).solve()
 
 
-def timeline(plan: Sequence[Action]) -> list[MotionSegment | GripperEvent]:
-    """The plan's motions and gripper events in order (both events of a ``*-both`` action)."""
+def timeline(
+    plan: Sequence[Action], trace: Sequence[Mapping[str, Any]] = ()
+) -> list[MotionSegment | GripperEvent]:
+    """The plan's motions and gripper events in order (both events of a ``*-both`` action).
+
+    ``trace``: the solver's per-task records (kind, objects, number of motions), used to label
+    the motions."""
+    labels = [
+        (str(r["kind"]), tuple(str(o) for o in r["objects"]))
+        for r in trace
+        for _ in range(int(r["motions"]))
+    ]
     items: list[MotionSegment | GripperEvent] = []
+    motions = 0
     for action in plan:
         if action.name == "move":
             result = action.args[1]
             assert isinstance(result, MotionResult) and result.trajectory is not None
             traj = result.trajectory
-            items.append(MotionSegment(traj.t, traj.q, result.level or ""))
+            kind, objects = labels[motions] if motions < len(labels) else ("", ())
+            items.append(MotionSegment(traj.t, traj.q, result.level or "", objects, kind))
+            motions += 1
             continue
         kind = "grasp" if action.name.startswith("pick") else "release"
         args = action.args
@@ -174,7 +187,7 @@ def plan_file_from_solution(
         instance.name,
         {o.name: o.start.as_tuple() for o in instance.objects},
         {o.name: o.size for o in instance.objects},
-        timeline(solution.plan),
+        timeline(solution.plan, solution.trace),
         figures,
         gripper_time=gripper_time,
         q_start=rearrangement.home.q,

@@ -30,8 +30,9 @@ from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.transforms import FloatArray
 
-#: Default largest graspable side: 0.085 m opening minus 0.01 m margin (as the shipped scene).
-DEFAULT_MAX_GRASP_WIDTH = 0.075
+#: Default largest graspable side: 0.060 m pre-grasp opening minus 0.01 m margin (as the
+#: shipped scene).
+DEFAULT_MAX_GRASP_WIDTH = 0.05
 _NAME = re.compile(r"[A-Za-z0-9_.\-]+")
 
 

@@ -450,34 +450,43 @@ class SdarSolver:
         return self._step(view, [s for s in candidates if s.progress == 0])
 
     def _evictions(self, view: TaskView) -> list[Step]:
-        """Dead-end recovery: objects at their goals whose absence would let a remaining
-        object be grasped at its goal (found by asking the IK stream without each of them),
+        """Dead-end recovery: objects at their goals whose absence would let a remaining object
+        be grasped where it rests or at its goal (found by asking the IK stream without them),
         moved to a buffer, together with the object they unblock when possible."""
         steps: list[Step] = []
+        current = self._current_poses()
         for obj in view.remaining:
-            if view.blockers(obj) or self._goal_reachable(obj, frozenset((obj,))):
-                continue  # blocked by the dependency graph, or not blocked at all
+            if not self._reachable(obj, current[obj], frozenset()):
+                pose, unblocks_goal = current[obj], False  # crowded where it rests
+            elif not view.blockers(obj) and not self._reachable(
+                obj, self.goals[obj], frozenset((obj,))
+            ):
+                pose, unblocks_goal = self.goals[obj], True  # crowded at its goal
+            else:
+                continue
+            lifted = frozenset((obj,)) if unblocks_goal else frozenset()
             done = sorted(view.done)
-            singles = [o for o in done if self._goal_reachable(obj, frozenset((o, obj)))]
+            singles = [o for o in done if self._reachable(obj, pose, lifted | {o})]
             for other in singles:
                 self.deferred[other] = obj
-                steps.append(Step((Move(obj), Move(other, True)), "evict", 0))
+                if unblocks_goal:
+                    steps.append(Step((Move(obj), Move(other, True)), "evict", 0))
                 steps.append(Step((Move(other, True),), "evict", 1))
             if singles:
                 continue
             for i, a in enumerate(done):  # boxed in from two sides: two objects make room
                 for b in done[i + 1 :]:
-                    if self._goal_reachable(obj, frozenset((a, b, obj))):
+                    if self._reachable(obj, pose, lifted | {a, b}):
                         self.deferred[a] = self.deferred[b] = obj
                         steps.append(Step((Move(a, True), Move(b, True)), "evict", 2))
         return steps
 
-    def _goal_reachable(self, obj: str, lifted: frozenset[str]) -> bool:
-        """Some arm grasps ``obj`` at its goal with some grasp while ``lifted`` are away."""
+    def _reachable(self, obj: str, pose: str, lifted: frozenset[str]) -> bool:
+        """Some arm grasps ``obj`` at ``pose`` with some grasp while ``lifted`` are away."""
         voc = self.voc
         fluents = self._fluents(voc.atpose, without=lifted)
         return any(
-            self._outputs(voc.ik, (arm, obj, self.goals[obj], g), 1, fluents)
+            self._outputs(voc.ik, (arm, obj, pose, g), 1, fluents)
             for arm in self.home
             for (g,) in self._outputs(voc.grasp, (obj,), self.options.grasps)
         )

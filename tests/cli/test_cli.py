@@ -1,7 +1,9 @@
 """The ``sdar`` command line: help, version, demo, plan, check and error paths."""
 
+import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sdar_tamp import __version__
@@ -26,10 +28,44 @@ def test_every_subcommand_has_help(capsys: pytest.CaptureFixture[str]) -> None:
         assert "usage: sdar" in capsys.readouterr().out
 
 
-def test_demo_solves_and_prints_a_plan(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["demo"]) == 0
+def test_demo_solves_validates_and_draws_the_mixed_instance(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    assert main(["demo", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "status: solved" in out and "1) (" in out
+    assert "M1: solved, plan valid" in out and "per step: median" in out
+    for name in ("plan.json", "plan.html", "storyboard.png"):
+        assert (tmp_path / name).stat().st_size > 1000
+    assert main(["validate", str(domain_file("dual_arm_rearrangement", "suites/paper/M1.yaml")),
+                 str(tmp_path / "plan.json")]) == 0  # fmt: skip
+
+
+def test_solve_writes_a_plan_that_validates(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    instance = domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml")
+    plan = tmp_path / "S4.json"
+    assert main(["solve", str(instance), "-o", str(plan), "-q", "--seed", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "S4: solved, plan valid" in out and "synchronous steps" in out
+    assert main(["validate", str(instance), str(plan)]) == 0
+    data = json.loads(plan.read_text())
+    assert data["format"] == "sdar-plan" and data["metrics"]["task_planner"] == "sdar"
+    assert max(np.diff(data["trajectory"]["t"])) <= 0.02 + 1e-9
+
+
+def test_solve_reports_failure_with_exit_status_1(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    instance = domain_file("dual_arm_rearrangement", "suites/paper/M2.yaml")
+    assert main(["solve", str(instance), "-q", "--time-limit", "0.01"]) == 1
+    assert "M2: timeout" in capsys.readouterr().out
+
+
+def test_solve_rejects_a_bad_time_limit(capsys: pytest.CaptureFixture[str]) -> None:
+    instance = domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml")
+    assert main(["solve", str(instance), "--time-limit", "-1"]) == 2
+    assert "time limit must be > 0" in capsys.readouterr().err
 
 
 def test_plan_on_shipped_files(capsys: pytest.CaptureFixture[str]) -> None:

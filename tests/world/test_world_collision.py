@@ -70,9 +70,10 @@ def test_object_under_the_gripper_collides_until_held(world: CollisionWorld, kin
     assert world.in_collision(off, home)
     pairs = {(p.first, p.second) for p in world.report(off, home)}
     assert ("left_gripper_left_finger_0", "object:o0") in pairs
-    # turned by 90 deg the 0.08 m side lies between the fingers: still free (0.085 m opening)
+    # turned by 90 deg the 0.08 m side would lie between the fingers: wider than the 0.060 m
+    # pre-grasp opening, so a finger lands in the object
     across = _reach(kins["left"], 0.0, 0.1, SIZE[2] / 2, yaw=np.pi / 2)
-    assert not world.in_collision(across, home)
+    assert world.in_collision(across, home)
     world.attach("left", "o0", grasp)
     assert world.held_by("left") == "o0"
     assert not world.in_collision(grasp, home)  # the held object never hits its own gripper

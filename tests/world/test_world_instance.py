@@ -29,7 +29,7 @@ def test_round_trip(tmp_path: Path) -> None:
         Workspace((-0.25, 0.25), (-0.3, 0.3)),
         (
             ObjectSpec("a", (0.08, 0.04, 0.05), Pose2D(0.1, 0.1 / 3, 0.3), Pose2D(-0.1, 0.0, -1.2)),
-            ObjectSpec("b", (0.06, 0.06, 0.05), Pose2D(-0.1, -0.2, 0.0), Pose2D(0.1, 0.2, 1e-17)),
+            ObjectSpec("b", (0.05, 0.05, 0.05), Pose2D(-0.1, -0.2, 0.0), Pose2D(0.1, 0.2, 1e-17)),
         ),
         scene="scene.yaml",
         family="R",

@@ -23,7 +23,7 @@ def test_shipped_scene_matches_the_paper_setup() -> None:
     assert left.velocity_limit == (pytest.approx(np.pi),) * 6
     assert left.acceleration_limit == (5.0,) * 6
     assert scene.object_size == (0.08, 0.04, 0.05)
-    assert scene.gripper.max_opening == 0.085 and scene.gripper.tcp_offset == 0.178
+    assert scene.gripper.max_opening == 0.060 and scene.gripper.tcp_offset == 0.178
     assert scene.robot_urdf.is_file()
     assert default_scene_path() == domain_path("scene.yaml")
 
