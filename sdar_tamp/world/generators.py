@@ -40,7 +40,11 @@ class GeneratorOptions:
 
     size: tuple[float, float, float] = DEFAULT_SIZE
     workspace: Workspace = DEFAULT_WORKSPACE
-    gap: float = 0.01  # minimum clearance between footprints of one arrangement [m]
+    # minimum clearance between footprints of one arrangement [m]: room for a finger of the
+    # 60 mm pre-grasp opening (1 cm from the pad to the object, 1.2 cm finger, 3 mm margin)
+    # beside every side of every object, so each object can be grasped in the start and in
+    # the goal arrangement
+    gap: float = 0.026
     attempts: int = 200  # whole-instance retries
     samples: int = 4000  # candidate poses drawn per placement
 

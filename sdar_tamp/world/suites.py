@@ -16,11 +16,12 @@ from importlib.resources import files
 from pathlib import Path
 
 from sdar_tamp.world.errors import SuiteError
-from sdar_tamp.world.generators import generate_instance
+from sdar_tamp.world.generators import GeneratorOptions, generate_instance
 from sdar_tamp.world.instance import Instance, load_instance, save_instance
 
 SUITES = ("paper", "stress")
 _FAMILY_SEED = {"R": 1000, "S": 2000, "D": 3000, "M": 4000}
+STRESS_GAP = 0.01  # [m]
 
 
 @dataclass(frozen=True)
@@ -31,6 +32,7 @@ class SuiteMember:
     family: str
     n_objects: int
     seed: int
+    gap: float | None = None  # footprint clearance [m]; None: the generator's default
 
 
 def suite_members(suite: str) -> tuple[SuiteMember, ...]:
@@ -42,11 +44,16 @@ def suite_members(suite: str) -> tuple[SuiteMember, ...]:
         members += [SuiteMember(f"M{k}", "M", 12, _FAMILY_SEED["M"] + k) for k in range(1, 11)]
         return tuple(members)
     if suite == "stress":
+        # 24 objects do not fit with the default (grasp) clearance: the stress suite keeps
+        # 1 cm, so some of its objects may be boxed in where they rest or at their goals
         members = [
-            SuiteMember(f"{f}{n}", f, n, _FAMILY_SEED[f] + n) for f in "RSD" for n in (16, 20, 24)
+            SuiteMember(f"{f}{n}", f, n, _FAMILY_SEED[f] + n, STRESS_GAP)
+            for f in "RSD"
+            for n in (16, 20, 24)
         ]
         members += [
-            SuiteMember(f"Mn{n}", "M", n, _FAMILY_SEED["M"] + 100 + n) for n in (16, 20, 24)
+            SuiteMember(f"Mn{n}", "M", n, _FAMILY_SEED["M"] + 100 + n, STRESS_GAP)
+            for n in (16, 20, 24)
         ]
         return tuple(members)
     raise SuiteError(f"unknown suite {suite!r}; expected one of {list(SUITES)}")
@@ -55,7 +62,14 @@ def suite_members(suite: str) -> tuple[SuiteMember, ...]:
 def build_suite(suite: str) -> tuple[Instance, ...]:
     """Generate every instance of a suite in memory."""
     return tuple(
-        generate_instance(m.family, m.n_objects, m.seed, name=m.name) for m in suite_members(suite)
+        generate_instance(
+            m.family,
+            m.n_objects,
+            m.seed,
+            GeneratorOptions() if m.gap is None else GeneratorOptions(gap=m.gap),
+            name=m.name,
+        )
+        for m in suite_members(suite)
     )
 
 

@@ -82,7 +82,6 @@ class _TaskRecord:
     motion_time: float = 0.0
     motions: int = 0
     tried: int = 0
-    placed_back: bool = False
     motion_times: list[float] = field(default_factory=list)  # [s] per motion planned
 
 
@@ -325,10 +324,11 @@ class SdarSolver:
         return found
 
     # -- execution ---------------------------------------------------------------------------
-    def _motion(self, d1: str, d2: str, record: _TaskRecord) -> str | None:
-        voc = self.voc
+    def _motion(
+        self, d1: str, d2: str, record: _TaskRecord, fluents: tuple[Atom, ...]
+    ) -> str | None:
         start = time.perf_counter()
-        out = self._outputs(voc.motion, (d1, d2), 1, self._fluents(voc.atpose, voc.holding))
+        out = self._outputs(self.voc.motion, (d1, d2), 1, fluents)
         elapsed = time.perf_counter() - start
         self.motion_time += elapsed
         if out:
@@ -365,40 +365,55 @@ class SdarSolver:
             self._test(self.voc.cfree, (*placed[0], *placed[1]))
 
     def _execute(self, g: _Grounding, record: _TaskRecord) -> bool:
+        """Plan the transfer (in the state after the pick), then the approach; apply both
+        only when both exist, so a failed candidate leaves nothing in the plan."""
+        voc = self.voc
         start_poses = [self._current_poses()[o] for o in g.step.objects]
+        targets = [o.target for o in g.options]
+        self._certify_placements(g, targets)
+        if not self._placeable(g, targets):
+            self._why(g.step, g.arms, "a target is not clear of the resting objects")
+            return False
+        held = [
+            Atom(voc.holding, (arm, move.obj, option.grasp))
+            for arm, move, option in zip(g.arms, g.step.moves, g.options, strict=True)
+        ]
+        lifted = frozenset(g.step.objects)
+        after_pick = tuple(sorted((*self._fluents(voc.atpose, without=lifted), *held), key=str))
+        t2 = self._motion(g.d_pick, g.d_place, record, after_pick)
+        if t2 is None:
+            self._why(g.step, g.arms, "no motion to the targets")
+            return False
         d0 = self._current_dualconf()
+        t1 = None
         if d0 != g.d_pick:
-            t1 = self._motion(d0, g.d_pick, record)
+            t1 = self._motion(d0, g.d_pick, record, self._fluents(voc.atpose, voc.holding))
             if t1 is None:
                 self._why(g.step, g.arms, "no motion to the objects")
                 return False
-            self._apply(self.voc.move, d0, t1, g.d_pick)
+            self._apply(voc.move, d0, t1, g.d_pick)
             record.motions += 1
         self._gripper("pick", g, start_poses, [o.pick for o in g.options], g.d_pick)
-        targets = [o.target for o in g.options]
-        self._certify_placements(g, targets)
-        t2 = self._motion(g.d_pick, g.d_place, record)
-        if t2 is not None and self._placeable(g, targets):
-            self._apply(self.voc.move, g.d_pick, t2, g.d_place)
-            record.motions += 1
-            self._gripper("place", g, targets, [o.place for o in g.options], g.d_place)
-            return True
-        self._why(g.step, g.arms, "no motion to the targets: objects put back")
-        # the transfer failed: put the objects back where they were (no progress, no deadlock)
-        self._certify_placements(g, start_poses)
-        self._gripper("place", g, start_poses, [o.pick for o in g.options], g.d_pick)
-        record.placed_back = True
-        return False
+        self._apply(voc.move, g.d_pick, t2, g.d_place)
+        record.motions += 1
+        self._gripper("place", g, targets, [o.place for o in g.options], g.d_place)
+        return True
 
     def _placeable(self, g: _Grounding, targets: Sequence[str]) -> bool:
-        unsafe = [
-            (obj, t)
-            for obj, t in zip(g.step.objects, targets, strict=True)
-            if self.state.holds(Atom(self.voc.unsafe, (obj, t)), {})
-        ]
-        if unsafe:
-            LOG.warning("sdar: targets not free for %s", unsafe)
-        return not unsafe
+        """Every target is certified clear of the objects resting after the pick (and of the
+        other target)."""
+        lifted = set(g.step.objects)
+        resting = {o: p for o, p in self._current_poses().items() if o not in lifted}
+        placed = list(zip(g.step.objects, targets, strict=True))
+        cfree = self.streams[self.voc.cfree].declaration.certified[0].predicate
+        clear = all(
+            self.state.has(cfree, obj, t, other, p)
+            for obj, t in placed
+            for other, p in resting.items()
+        )
+        if len(placed) == 2:
+            clear = clear and self.state.has(cfree, *placed[0], *placed[1])
+        return clear
 
     # -- the loop ----------------------------------------------------------------------------
     def solve(self) -> Solution:
@@ -527,9 +542,6 @@ class SdarSolver:
                     self.planner.commit(g.step, view)
                 return True
             self.tabu.add(key)
-            if record.placed_back:  # its actions are in the plan: account for them
-                self.records.append(record)
-                task_start, motion_before = time.perf_counter(), self.motion_time
         return False
 
     def _solution(self, status: Status, diagnosis: list[str], elapsed: float) -> Solution:
@@ -568,7 +580,6 @@ class SdarSolver:
                 "motion_time": r.motion_time,
                 "motions": r.motions,
                 "tried": r.tried,
-                "placed_back": r.placed_back,
                 "motion_times": tuple(r.motion_times),
             }
             for r in self.records

@@ -14,7 +14,19 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from sdar_tamp.language.model import Atom, Rule, StreamFunction, StreamPredicate
+from sdar_tamp.language.model import (
+    AndEffect,
+    Atom,
+    Domain,
+    Effect,
+    ForAllEffect,
+    FunctionTerm,
+    IncreaseCost,
+    Rule,
+    StreamFunction,
+    StreamPredicate,
+    When,
+)
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo, unsupported_options
 from sdar_tamp.language.problem import PDDLProblem
@@ -61,7 +73,12 @@ class Engine:
     ) -> None:
         self.problem = problem
         self.table: ObjectTable = problem.objects.copy()
-        self.streams, self.functions = bind_externals(problem, stream_info)
+        self.streams, functions = bind_externals(problem, stream_info)
+        used = cost_functions(problem.domain)
+        # a :function no action's cost mentions cannot change a plan: it is never evaluated
+        self.functions = {
+            name: f for name, f in functions.items() if f.is_predicate or name in used
+        }
         streams = problem.streams
         self.rules = {f"{RULE_PREFIX}{i}": rule for i, rule in enumerate(streams.rules)}
         self.store = FactStore()
@@ -144,6 +161,25 @@ class Engine:
 
     def instance(self, name: str, inputs: tuple[str, ...]) -> InstanceState | None:
         return self.instances.get((name, inputs))
+
+
+def cost_functions(domain: Domain) -> frozenset[str]:
+    """Names of the functions that appear in some action's cost increase."""
+    found: set[str] = set()
+
+    def visit(effect: Effect) -> None:
+        if isinstance(effect, IncreaseCost):
+            if isinstance(effect.amount, FunctionTerm):
+                found.add(effect.amount.name)
+        elif isinstance(effect, AndEffect):
+            for part in effect.parts:
+                visit(part)
+        elif isinstance(effect, ForAllEffect | When):
+            visit(effect.effect)
+
+    for action in domain.actions:
+        visit(action.effect)
+    return frozenset(found)
 
 
 def bind_externals(

@@ -2,12 +2,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.commands import generate, generate_suite, show_instance
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError, SuiteError
+from sdar_tamp.world.footprint import corners, inflate, overlap_matrix
 from sdar_tamp.world.generators import GeneratorOptions, generate_instance
 from sdar_tamp.world.instance import load_instance, validate_instance
 from sdar_tamp.world.scene import Workspace
@@ -76,9 +78,25 @@ def test_shipped_paper_suite_is_current() -> None:
         assert shipped[k] == generate_instance(m.family, m.n_objects, m.seed, name=m.name)
 
 
-def test_shipped_stress_suite_loads() -> None:
+def test_shipped_stress_suite_loads_and_is_current() -> None:
     stress = load_suite("stress")
     assert [len(i.objects) for i in stress[:3]] == [16, 20, 24]
+    m = suite_members("stress")[0]
+    assert m.gap == 0.01
+    assert stress[0] == generate_instance(
+        m.family, m.n_objects, m.seed, GeneratorOptions(gap=m.gap), name=m.name
+    )
+
+
+def test_paper_suite_leaves_room_for_the_fingers() -> None:
+    gap = GeneratorOptions().gap
+    for inst in load_suite("paper"):
+        for which in ("start", "goal"):
+            poses = np.array([getattr(o, which).as_tuple() for o in inst.objects])
+            sizes = inflate(np.array([o.size[:2] for o in inst.objects]), gap / 2 - 1e-6)
+            over = overlap_matrix(corners(poses, sizes), corners(poses, sizes))
+            np.fill_diagonal(over, False)
+            assert not over.any(), (inst.name, which)
 
 
 def test_commands(tmp_path: Path) -> None:

@@ -1,0 +1,377 @@
+"""Run every (instance, planner combination) of a suite in worker processes, one CSV row each.
+
+Output folder:
+
+- ``results.csv``: one row per finished run (:data:`COLUMNS`), appended and flushed as soon
+  as the run ends. A rerun skips every (instance, combination) pair already in the file, so an
+  interrupted benchmark resumes where it stopped (delete a row to run that pair again).
+- ``steps.csv``: planning time [s] of every synchronous step of every solved run, split into
+  plan selection (IK, grasps, buffers, ranking) and motion generation (:data:`STEP_COLUMNS`).
+
+A run succeeds when it is solved *and* its plan passes the independent replay. Each row also
+holds the task planner's geometry-free action count (:func:`solvers.sdar.abstract.run_abstract`
+on the instance's dependency graph), which compares SDAR-T with the baseline independently of
+motion failures. Every worker process keeps one ``shared`` cache, so it builds the motion
+planner once. Parallel runs share the cores: compare planning times only between runs made with
+the same ``workers``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import functools
+import logging
+import multiprocessing
+import re
+import sys
+import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sdar_tamp.errors import ParameterError, SdarError
+
+log = logging.getLogger(__name__)
+
+RESULTS = "results.csv"
+STEPS = "steps.csv"
+COLUMNS = (
+    "instance", "family", "objects", "combination", "task_planner", "motion_planner", "seed",
+    "time_limit_s", "success", "status", "valid", "actions", "steps", "dual_arm_steps",
+    "buffer_moves", "execution_time_s", "planning_time_s", "selection_time_s", "motion_time_s",
+    "step_time_median_s", "setup_time_s", "wall_time_s", "abstract_actions",
+    "abstract_buffer_moves", "abstract_steps", "violation", "diagnosis",
+)  # fmt: skip
+STEP_COLUMNS = ("instance", "combination", "step", "selection_s", "motion_s")
+FAMILY_ORDER = "RSDM"
+
+
+@dataclass(frozen=True)
+class Combination:
+    """A task planner paired with a motion planner (the paper's six, :data:`COMBINATIONS`)."""
+
+    id: str
+    label: str
+    task_planner: str  # sdar | baseline
+    motion_planner: str  # sdar | plain | sequential
+
+
+COMBINATIONS = (
+    Combination("sdar", "SDAR", "sdar", "sdar"),
+    Combination("baseline", "Baseline", "baseline", "sequential"),
+    Combination("baseline-tp+sdar-m", "Baseline TP + SDAR-M", "baseline", "sdar"),
+    Combination("sdar-t+baseline-mp", "SDAR-T + Baseline MP", "sdar", "sequential"),
+    Combination("sdar-t+plain", "SDAR-T + plain TO", "sdar", "plain"),
+    Combination("baseline-tp+plain", "Baseline TP + plain TO", "baseline", "plain"),
+)
+
+
+def parse_combos(spec: str | Sequence[str]) -> tuple[Combination, ...]:
+    """``"all"`` or comma-separated ids (or a list of ids), returned in :data:`COMBINATIONS`
+    order. Raises :class:`ParameterError` for an unknown, empty or repeated id."""
+    names = [s.strip() for s in (spec.split(",") if isinstance(spec, str) else spec)]
+    if names == ["all"]:
+        return COMBINATIONS
+    choices = f"'all' or a comma-separated list of {', '.join(c.id for c in COMBINATIONS)}"
+    unknown = [n for n in names if n not in {c.id for c in COMBINATIONS}]
+    if unknown:
+        raise ParameterError(f"combos must be {choices}; unknown: {', '.join(map(repr, unknown))}")
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise ParameterError(f"combos: {', '.join(repeated)} given more than once")
+    return tuple(c for c in COMBINATIONS if c.id in names)
+
+
+def instance_sort_key(name: str) -> tuple[int, int, str]:
+    """R, S, D, M (then others), by the number in the name: R4 < R10 < S4 < M1."""
+    family = FAMILY_ORDER.find(name[:1]) if name[:1] else -1
+    digits = re.search(r"\d+", name)
+    return (
+        family if family >= 0 else len(FAMILY_ORDER),
+        int(digits.group()) if digits else 0,
+        name,
+    )
+
+
+@dataclass(frozen=True)
+class SuiteEntry:
+    """One instance file of a suite."""
+
+    path: Path
+    name: str
+    family: str
+    objects: int
+
+
+def suite_entries(
+    suite: str | Path, only: Sequence[str] | None = None, max_objects: int | None = None
+) -> list[SuiteEntry]:
+    """The instances of ``suite`` (a shipped suite name or a folder of instance YAML files),
+    keeping the names in ``only`` (instance or file names) and at most ``max_objects``."""
+    from sdar_tamp.resources import domain_file
+    from sdar_tamp.world.instance import load_instance
+
+    folder = Path(suite)
+    if not folder.is_dir():
+        shipped = domain_file("dual_arm_rearrangement").parent / "suites"
+        names = sorted(p.name for p in shipped.iterdir() if p.is_dir() and p.name[0] != "_")
+        if str(suite) not in names:
+            raise ParameterError(
+                f"suite must be a folder or one of {', '.join(names)}; got {suite!r}"
+            )
+        folder = shipped / str(suite)
+    entries = []
+    for path in sorted(folder.glob("*.yaml")):
+        inst = load_instance(path)
+        family = inst.family or re.sub(r"\d.*", "", inst.name)
+        entries.append(SuiteEntry(path, inst.name, family, len(inst.objects)))
+    names_seen = [e.name for e in entries]
+    if len(set(names_seen)) < len(names_seen):
+        raise SdarError(f"{folder}: two instance files share an instance name")
+    if only:
+        known = {e.name for e in entries} | {e.path.stem for e in entries}
+        missing = [n for n in only if n not in known]
+        if missing:
+            raise ParameterError(f"only: no instance {', '.join(missing)} in {folder}")
+        entries = [e for e in entries if e.name in only or e.path.stem in only]
+    if max_objects is not None:
+        entries = [e for e in entries if e.objects <= max_objects]
+    if not entries:
+        raise ParameterError(f"no instance of {folder} is selected")
+    return sorted(entries, key=lambda e: (e.objects, instance_sort_key(e.name)))
+
+
+@dataclass(frozen=True)
+class _Task:
+    entry: SuiteEntry
+    combo: Combination
+    time_limit: float
+    seed: int
+
+
+@functools.cache
+def _worker_cache() -> dict[str, dict[Any, Any]]:
+    """Per worker process: ``solve`` is the ``shared`` dict of :func:`solve_instance`,
+    ``abstract`` the geometry-free runs by (instance file, task planner)."""
+    return {"solve": {}, "abstract": {}}
+
+
+def _abstract_figures(path: Path, task_planner: str) -> dict[str, int | None]:
+    from sdar_tamp.world.dependency import instance_dependency_graph
+    from sdar_tamp.world.instance import load_instance
+    from solvers.sdar.abstract import AbstractRunError, run_abstract
+    from solvers.sdar.planners import make_task_planner
+
+    cache = _worker_cache()["abstract"]
+    key = (str(path), task_planner)
+    if key not in cache:
+        graph = instance_dependency_graph(load_instance(path))
+        try:
+            run = run_abstract(make_task_planner(task_planner), graph)
+            cache[key] = (run.actions, run.buffer_moves, len(run.steps))
+        except AbstractRunError as error:
+            log.warning("%s: abstract %s run failed: %s", path.stem, task_planner, error)
+            cache[key] = (None, None, None)
+    actions, buffers, steps = cache[key]
+    return {"abstract_actions": actions, "abstract_buffer_moves": buffers, "abstract_steps": steps}
+
+
+def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
+    """One solve in a worker process: the CSV row and the per-step planning times."""
+    from sdar_tamp.solve_command import solve_instance
+
+    e, c = task.entry, task.combo
+    row: dict[str, Any] = dict(
+        instance=e.name, family=e.family, objects=e.objects, combination=c.id,
+        task_planner=c.task_planner, motion_planner=c.motion_planner, seed=task.seed,
+        time_limit_s=task.time_limit,
+    )  # fmt: skip
+    row.update(_abstract_figures(e.path, c.task_planner))
+    start = time.perf_counter()
+    try:
+        outcome = solve_instance(
+            e.path, time_limit=task.time_limit, seed=task.seed, task_planner=c.task_planner,
+            motion_planner=c.motion_planner, shared=_worker_cache()["solve"],
+        )  # fmt: skip
+    except Exception as error:  # one broken run is recorded as such, not the end of the bench
+        log.exception("%s with %s raised", e.name, c.id)
+        row.update(status="error", success=False, valid=False, diagnosis=repr(error))
+        row["wall_time_s"] = time.perf_counter() - start
+        return row, []
+    f = outcome.figures
+    row.update(
+        status=outcome.status, success=outcome.success, valid=outcome.valid,
+        violation=outcome.violation, diagnosis=outcome.diagnosis[0] if outcome.diagnosis else "",
+        planning_time_s=f.get("planning_time"), selection_time_s=f.get("selection_time"),
+        motion_time_s=f.get("motion_time"), setup_time_s=f.get("setup_time"),
+        wall_time_s=time.perf_counter() - start,
+    )  # fmt: skip
+    if outcome.plan is None:
+        return row, []
+    m = outcome.plan.metrics
+    row.update(
+        actions=m["actions"], steps=m["steps"], dual_arm_steps=m["dual_arm_steps"],
+        execution_time_s=m["execution_time"], buffer_moves=f.get("buffer_moves"),
+        step_time_median_s=f.get("step_time_median"),
+    )  # fmt: skip
+    return row, [(float(s), float(t)) for s, t in f.get("step_times", [])]
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return str(int(value))
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return " ".join(str(value).split())  # one line per row, whatever a message holds
+
+
+def append_rows(path: Path, columns: Sequence[str], rows: Iterable[Mapping[str, Any]]) -> None:
+    """Append ``rows`` to the CSV file ``path`` (header first if new) and flush."""
+    new = not path.exists() or path.stat().st_size == 0
+    with path.open("a", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        if new:
+            writer.writerow(columns)
+        writer.writerows([_cell(r.get(c)) for c in columns] for r in rows)
+        fh.flush()
+
+
+def read_rows(path: Path, columns: Sequence[str]) -> list[dict[str, str]]:
+    """The complete rows of a CSV file written by :func:`append_rows` (a last line cut short
+    by an interruption is dropped). Raises :class:`SdarError` if the header is not ``columns``."""
+    if not path.exists():
+        return []
+    text = path.read_text(encoding="utf-8")
+    lines = text.splitlines(keepends=True)
+    if lines and not lines[-1].endswith("\n"):
+        lines.pop()
+    reader = csv.reader(lines)
+    header = next(reader, None)
+    if header is not None and tuple(header) != tuple(columns):
+        raise SdarError(
+            f"{path}: unexpected columns (written by another version?); use a new folder"
+        )
+    return [dict(zip(columns, r, strict=True)) for r in reader if len(r) == len(columns)]
+
+
+def load_results(out_dir: Path) -> list[dict[str, str]]:
+    return read_rows(Path(out_dir) / RESULTS, COLUMNS)
+
+
+def load_steps(out_dir: Path) -> list[dict[str, str]]:
+    return read_rows(Path(out_dir) / STEPS, STEP_COLUMNS)
+
+
+def finished_pairs(out_dir: Path) -> set[tuple[str, str]]:
+    """(instance, combination) pairs already in ``results.csv``; repairs both files after an
+    interruption (a cut-short last row, steps of a run whose row was never written)."""
+    out = Path(out_dir)
+    results = _repaired(out / RESULTS, COLUMNS, lambda r: True)
+    done = {(r["instance"], r["combination"]) for r in results}
+    _repaired(out / STEPS, STEP_COLUMNS, lambda r: (r["instance"], r["combination"]) in done)
+    return done
+
+
+def _repaired(
+    path: Path, columns: Sequence[str], keep: Callable[[dict[str, str]], bool]
+) -> list[dict[str, str]]:
+    """The complete rows of ``path`` that ``keep`` accepts; the file is rewritten with only
+    those if it holds anything else."""
+    rows = read_rows(path, columns)
+    kept = [r for r in rows if keep(r)]
+    text = path.read_text(encoding="utf-8") if path.exists() else "\n"
+    if not text.endswith("\n") or text.count("\n") != len(kept) + 1:
+        path.unlink(missing_ok=True)
+        append_rows(path, columns, kept)
+    return kept
+
+
+def run_bench(
+    suite: str | Path,
+    out_dir: str | Path,
+    combos: str | Sequence[str] = "all",
+    *,
+    workers: int = 1,
+    time_limit: float = 60.0,
+    instances: Sequence[str] | None = None,
+    max_objects: int | None = None,
+    seed: int = 0,
+    progress: bool = True,
+) -> Path:
+    """Solve every (instance, combination) of ``suite`` not yet in ``out_dir/results.csv``
+    with ``workers`` processes and ``time_limit`` [s] per run; returns the results file."""
+    from tqdm import tqdm
+
+    chosen = parse_combos(combos)
+    if workers < 1:
+        raise ParameterError(f"workers must be >= 1, got {workers}")
+    if time_limit <= 0:
+        raise ParameterError(f"time limit must be > 0 [s], got {time_limit}")
+    entries = suite_entries(suite, instances, max_objects)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    done = finished_pairs(out)
+    tasks = [
+        _Task(e, c, time_limit, seed) for e in entries for c in chosen if (e.name, c.id) not in done
+    ]
+    if not tasks:
+        return out / RESULTS
+    context = multiprocessing.get_context("spawn")
+    bar = tqdm(total=len(tasks), desc="bench", unit="run", file=sys.stderr, disable=not progress)
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=context)
+    try:
+        futures = [pool.submit(_run_task, t) for t in tasks]
+        for future in as_completed(futures):
+            row, steps = future.result()
+            step_rows = [
+                dict(instance=row["instance"], combination=row["combination"], step=i,
+                     selection_s=s, motion_s=m)
+                for i, (s, m) in enumerate(steps)
+            ]  # fmt: skip
+            append_rows(out / STEPS, STEP_COLUMNS, step_rows)
+            append_rows(out / RESULTS, COLUMNS, [row])
+            bar.set_postfix_str(f"{row['instance']} {row['combination']}: {row['status']}")
+            bar.update(1)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+        bar.close()
+    return out / RESULTS
+
+
+def bench_command_line(args: argparse.Namespace) -> str:
+    """The ``sdar bench`` command that reproduces ``args`` (rerun: resumes, then redraws)."""
+    parts = [
+        f"sdar bench --suite {args.suite} --out {args.out} --combos {args.combos}",
+        f"--workers {args.workers} --time-limit {args.time_limit:g} --seed {args.seed}",
+    ]
+    if args.only:
+        parts.append(f"--only {args.only}")
+    if args.max_objects is not None:
+        parts.append(f"--max-objects {args.max_objects}")
+    return " ".join(parts)
+
+
+def bench_command(args: argparse.Namespace) -> int:
+    """``sdar bench``: run (or resume) the benchmark, then write the plots and the report."""
+    from sdar_tamp.evaluation.report import success_lines, write_report
+
+    only = [s.strip() for s in args.only.split(",") if s.strip()] if args.only else None
+    results = run_bench(
+        args.suite, args.out, args.combos, workers=args.workers, time_limit=args.time_limit,
+        instances=only, max_objects=args.max_objects, seed=args.seed, progress=not args.quiet,
+    )  # fmt: skip
+    print(f"results: {results}")
+    try:
+        from sdar_tamp.evaluation.plots import write_plots
+    except ImportError as error:  # matplotlib is an optional dependency (extra "viz")
+        print(f"no plots: {error} (pip install 'sdar-tamp[viz]')", file=sys.stderr)
+    else:
+        print(f"plots: {', '.join(p.name for p in write_plots(results.parent))}")
+    print(f"report: {write_report(results.parent, bench_command_line(args))}")
+    print("\n".join(success_lines(load_results(results.parent))))
+    return 0

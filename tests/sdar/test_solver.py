@@ -1,0 +1,207 @@
+"""SDAR-M end to end on small rearrangements: plans of the domain, statuses, diagnoses."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.rearrangement import (
+    plan_file_from_solution,
+    rearrangement_problem,
+    solve_rearrangement,
+)
+from sdar_tamp.replay import validate_plan
+from sdar_tamp.resources import domain_file
+from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
+from sdar_tamp.world.scene import Workspace
+from solvers.sdar.state import LiftedState
+from solvers.solution import Status
+from solvers.solve import solve
+from streams.context import WorldContext
+from streams.motion import DualMotionPlanner
+from streams.stream_map import make_stream_map
+
+SIZE = (0.08, 0.04, 0.05)
+WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
+
+
+@pytest.fixture(scope="module")
+def ctx() -> WorldContext:
+    return WorldContext.load()
+
+
+@pytest.fixture(scope="module")
+def planner(ctx: WorldContext) -> DualMotionPlanner:
+    return DualMotionPlanner(ctx)
+
+
+def _swap() -> Instance:
+    """Two objects whose goals are each other's starts (a 2-cycle: one dual-arm swap)."""
+    a, b = Pose2D(-0.1, 0.1, 0.0), Pose2D(0.1, -0.1, 0.5)
+    return Instance("swap", WORKSPACE, (ObjectSpec("a", SIZE, a, b), ObjectSpec("b", SIZE, b, a)))
+
+
+def _three() -> Instance:
+    """A chain c -> b (c's goal is b's start) and an independent object a."""
+    return Instance(
+        "three",
+        WORKSPACE,
+        (
+            ObjectSpec("a", SIZE, Pose2D(-0.15, 0.2, 0.0), Pose2D(-0.15, -0.2, 0.0)),
+            ObjectSpec("b", SIZE, Pose2D(0.1, 0.0, 0.0), Pose2D(0.1, 0.2, 1.0)),
+            ObjectSpec("c", SIZE, Pose2D(0.1, -0.2, 0.3), Pose2D(0.1, 0.0, 0.0)),
+        ),
+    )
+
+
+def test_swap_is_one_synchronous_dual_arm_step(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    r = rearrangement_problem(_swap(), ctx, planner=planner)
+    solution = solve_rearrangement(r, "sdar", 60.0)
+    assert solution.status is Status.SOLVED
+    names = [a.name for a in solution.plan or []]
+    assert names == ["move", "pick-both", "move", "place-both"]
+    assert [t["kind"] for t in solution.trace] == ["swap"]
+    plan = plan_file_from_solution(r, solution)
+    assert plan.metrics["actions"] == 2 and plan.metrics["dual_arm_steps"] == 2
+    report = validate_plan(r.instance, plan, ctx.scene)
+    assert report.ok, report.violation
+
+
+def test_plan_is_a_plan_of_the_domain(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+    r = rearrangement_problem(_three(), ctx, planner=planner)
+    solution = solve_rearrangement(r, "sdar", 60.0)
+    assert solution.status is Status.SOLVED and solution.plan is not None
+    # replay with an independent lifted state built from the certificate's facts
+    problem = r.problem
+    table = problem.objects.copy()
+    facts = {(f[0], tuple(table.name(v) for v in f[1:])) for f in solution.certificate.all_facts}
+    from sdar_tamp.language.model import Atom, FunctionTerm
+    from sdar_tamp.language.problem import type_facts
+
+    init = set(problem.facts.init) | type_facts(problem.facts.objects, problem.domain.types)
+    static = [Atom(p, args) for p, args in facts]
+    costs = {"gripper-time": 0.5}
+
+    def cost(term: FunctionTerm) -> float:
+        if term.name == "duration":
+            traj = table.value(term.args[0])
+            return float(traj.trajectory.duration)
+        return costs[term.name]
+
+    state = LiftedState(problem.domain, static, init, lambda t: [], cost)
+    total = sum(state.apply(a.name, tuple(table.name(v) for v in a.args)) for a in solution.plan)
+    assert total == pytest.approx(solution.cost)
+    for o in r.instance.objects:
+        assert state.has("atpose", table.name(o.name), table.name(o.goal))
+    # c waits for b (chain): b is placed no later than c
+    placed = [a.args for a in solution.plan if a.name.startswith("place")]
+    order = [x for args in placed for x in args if x in ("a", "b", "c")]
+    assert order.index("b") <= order.index("c")
+
+
+def test_baseline_task_planner_solves_too(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+    r = rearrangement_problem(_swap(), ctx, planner=planner)
+    solution = solve_rearrangement(r, "baseline", 60.0)
+    assert solution.status is Status.SOLVED
+    # the baseline has no dual-arm swap: one object goes through a buffer
+    assert sum(sum(t["to_buffer"]) for t in solution.trace) == 1
+
+
+def test_solve_entry_point_runs_sdar(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+    r = rearrangement_problem(_swap(), ctx, planner=planner)
+    plan, cost, _ = solve(r.problem, algorithm="sdar", max_time=60, verbose=False)
+    assert plan is not None and cost > 0
+
+
+def test_no_ik_gives_infeasible_with_a_diagnosis(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    def no_ik(*_args: Any, **_kwargs: Any) -> Iterator[Any]:
+        return iter(())
+
+    r = rearrangement_problem(
+        _swap(), ctx, planner=planner, overrides={"inverse-kinematics": no_ik}
+    )
+    solution = solve_rearrangement(r, "sdar", 60.0)
+    assert solution.status is Status.INFEASIBLE and solution.plan is None
+    assert "no candidate step could be grounded" in solution.diagnosis[0]
+    assert any("no grasp with IK" in d for d in solution.diagnosis)
+
+
+def test_time_limit_gives_timeout(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+    r = rearrangement_problem(_three(), ctx, planner=planner)
+    solution = solve_rearrangement(r, "sdar", 1e-6)
+    assert solution.status is Status.TIMEOUT
+    assert "max_time" in solution.diagnosis[0]
+
+
+def test_crowded_goal_is_unblocked_by_an_eviction(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    """a cannot be picked while b rests at its start, and a cannot be placed while b rests at
+    its goal: b must go to its goal first, then make room for a (an eviction), then return."""
+    inst = Instance(
+        "crowded",
+        WORKSPACE,
+        (
+            ObjectSpec("a", SIZE, Pose2D(-0.15, 0.2, 0.0), Pose2D(-0.15, -0.2, 0.0)),
+            ObjectSpec("b", SIZE, Pose2D(0.15, 0.2, 0.0), Pose2D(0.15, -0.2, 0.0)),
+        ),
+    )
+    real = make_stream_map(ctx, {o.name: o.size for o in inst.objects})["inverse-kinematics"]
+    b_start, b_goal = inst.objects[1].start, inst.objects[1].goal
+    a_goal = inst.objects[0].goal
+
+    def crowded_ik(arm: str, o: str, p: Pose2D, g: Any, fluents: Any = ()) -> Iterator[Any]:
+        resting = {(f[1], f[2]) for f in fluents if f[0] == "atpose"}
+        if o == "a" and p != a_goal and ("b", b_start) in resting:
+            return iter(())
+        if o == "a" and p == a_goal and ("b", b_goal) in resting:
+            return iter(())
+        return real(arm, o, p, g, fluents)
+
+    r = rearrangement_problem(
+        inst, ctx, planner=planner, overrides={"inverse-kinematics": crowded_ik}
+    )
+    solution = solve_rearrangement(r, "sdar", 60.0)
+    assert solution.status is Status.SOLVED, solution.diagnosis
+    kinds = [t["kind"] for t in solution.trace]
+    assert "evict" in kinds
+
+
+def test_sdar_refuses_a_domain_without_the_rearrangement_roles() -> None:
+    from domains.kitchen.samplers import make_problem
+
+    with pytest.raises(ParameterError, match="needs a rearrangement domain; missing: stream"):
+        solve(make_problem(), algorithm="sdar")
+
+
+def test_sdar_needs_a_goal_of_object_poses(ctx: WorldContext) -> None:
+    r = rearrangement_problem(_swap(), ctx)
+    p = r.problem
+    other = PDDLProblem(
+        domain_file("dual_arm_rearrangement").read_text(encoding="utf-8"),
+        {},
+        p.stream_pddl,
+        p.stream_map,
+        p.init,
+        ("empty", "left"),
+    )
+    with pytest.raises(ParameterError, match="conjunction of"):
+        solve(other, algorithm="sdar")
+
+
+def test_unknown_task_planner_and_override_are_refused(ctx: WorldContext) -> None:
+    r = rearrangement_problem(_swap(), ctx)
+    with pytest.raises(ParameterError, match="task_planner must be one of sdar, baseline"):
+        solve(r.problem, algorithm="sdar", task_planner="greedy")
+    with pytest.raises(ParameterError, match="overrides: unknown streams"):
+        rearrangement_problem(_swap(), ctx, overrides={"sample-pose": print})
+    with pytest.raises(ParameterError, match="motion planner must be one of"):
+        rearrangement_problem(_swap(), ctx, motion="fast")
