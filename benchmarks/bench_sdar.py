@@ -40,7 +40,15 @@ def main() -> None:
     ap.add_argument("--motion-planner", default="sdar", choices=("sdar", "plain", "sequential"))
     ap.add_argument("--only", default="", help="comma-separated instance names")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument(
+        "--compare-adaptive",
+        action="store_true",
+        help="instead: the generic adaptive algorithm against sdar on a one-object instance",
+    )
     args = ap.parse_args()
+    if args.compare_adaptive:
+        compare_adaptive(args.time_limit)
+        return
 
     shared: dict[str, object] = {}
     rows = []
@@ -126,6 +134,35 @@ def main() -> None:
         f"{_fmt(summary['step_time_p90'])} s over {summary['steps']} steps"
     )
     print(json.dumps(summary))
+
+
+def compare_adaptive(time_limit: float) -> None:
+    """The same PDDL domain solved by the generic ``adaptive`` algorithm and by ``sdar``."""
+    from sdar_tamp.rearrangement import rearrangement_problem
+    from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
+    from sdar_tamp.world.scene import Workspace
+    from solvers.solve import solve
+    from streams.context import WorldContext
+    from streams.motion import DualMotionPlanner
+
+    ctx = WorldContext.load()
+    planner = DualMotionPlanner(ctx)
+    size = (0.08, 0.04, 0.05)
+    one = Instance(
+        "one",
+        Workspace((-0.25, 0.25), (-0.30, 0.30)),
+        (ObjectSpec("a", size, Pose2D(-0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.3)),),
+    )
+    results = {}
+    for algorithm in ("sdar", "adaptive"):
+        problem = rearrangement_problem(one, ctx, planner=planner).problem
+        start = time.perf_counter()
+        solution = solve(problem, algorithm=algorithm, max_time=time_limit, verbose=False)
+        elapsed = time.perf_counter() - start
+        actions = [a.name for a in solution.plan or []]
+        results[algorithm] = {"status": solution.status.value, "time": elapsed, "plan": actions}
+        print(f"{algorithm:>9}: {solution.status.value} in {elapsed:.2f} s, plan {actions}")
+    print(json.dumps({"benchmark": "sdar-vs-adaptive", "objects": 1, **results}))
 
 
 def _steps(outcome: object) -> list[tuple[float, float]]:

@@ -1,7 +1,7 @@
 """Exact validation of a dual-arm trajectory with the world's coal collision checker.
 
 Between consecutive samples the configuration is interpolated linearly in joint space so that
-neither tool centre point moves more than ``max_tcp_step`` [m] (default 1 cm) between two
+neither tool centre point moves more than ``max_tcp_step`` [m] (default 5 mm) between two
 checks; every check is a full :meth:`CollisionWorld.in_collision` query (arm-arm, self,
 table, resting objects, held objects). Joint limits are checked on every sample, and, when
 times are given, the finite-difference velocity and acceleration limits (with a relative
@@ -82,7 +82,7 @@ def validate_trajectory(
     world: CollisionWorld,
     q: FloatArray,
     t: FloatArray | None = None,
-    max_tcp_step: float = 0.01,
+    max_tcp_step: float = 0.005,
     limit_tolerance: float = 1e-3,
 ) -> ValidationReport:
     """Check samples ``q`` ``(m, 12)`` (at times ``t`` ``(m,)`` [s] if given) against the

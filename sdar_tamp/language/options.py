@@ -26,7 +26,8 @@ class StreamInfo:
     """How a solver should treat one stream.
 
     Attributes:
-        eager: evaluate the stream as soon as its inputs exist (like an incremental stream).
+        eager: call each new instance once as soon as its inputs exist (before planning), as
+            an incremental stream would; at most 10,000 eager calls per solve.
         p_success: prior probability that one call succeeds, in (0, 1].
         overhead: expected cost of one call [s], >= 0.
         effort: fixed effort used in place of the one derived from p_success and overhead.

@@ -40,8 +40,11 @@ from solvers.stream_planning.facts import FactStore, Instantiator, Query
 
 LOG = logging.getLogger(__name__)
 # Options the algorithms act on; any other option set to a non-default value is logged as
-# not implemented (eager, p_success, overhead, effort, negate, simultaneous, defer_fn, ...).
-SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn"}
+# not implemented (p_success, overhead, effort, negate, simultaneous, defer_fn, ...).
+SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn", "eager"}
+#: Calls of eager stream instances one engine makes at most (a generator feeding its own
+#: inputs would otherwise never stop).
+EAGER_BUDGET = 10_000
 SUPPORTED_FUNCTION_OPTIONS = {"opt_fn"}
 RULE_PREFIX = "@rule"
 
@@ -73,6 +76,9 @@ class Engine:
     ) -> None:
         self.problem = problem
         self.table: ObjectTable = problem.objects.copy()
+        self._eager: list[InstanceState] = []  # eager instances not called yet
+        self._draining = False
+        self.eager_calls = 0
         self.streams, functions = bind_externals(problem, stream_info)
         used = cost_functions(problem.domain)
         # a :function no action's cost mentions cannot change a plan: it is never evaluated
@@ -102,7 +108,8 @@ class Engine:
     # --- adding facts ---------------------------------------------------------------------
 
     def add_facts(self, atoms: Iterable[Atom], level: int) -> list[Atom]:
-        """Add real facts and everything that follows at once (instances, rules, functions)."""
+        """Add real facts and everything that follows at once (instances, rules, functions,
+        and one call of every new instance of an ``eager`` stream)."""
         new: list[Atom] = []
         pending = list(atoms)
         while pending:
@@ -110,6 +117,14 @@ class Engine:
             if self.store.add(atom, level):
                 new.append(atom)
                 pending.extend(self._instantiate(self.instantiator.new_fact(atom)))
+        if not self._draining:
+            self._draining = True
+            try:
+                while self._eager and self.eager_calls < EAGER_BUDGET:
+                    self.eager_calls += 1
+                    self.sample(self._eager.pop(0))
+            finally:
+                self._draining = False
         return new
 
     def _instantiate(self, found: Iterable[tuple[Query, tuple[str, ...], int]]) -> list[Atom]:
@@ -118,7 +133,10 @@ class Engine:
             if query.name in self.streams:
                 stream = self.streams[query.name]
                 instance = StreamInstance(stream, inputs, self._fluents(stream))
-                self.instances[(query.name, inputs)] = InstanceState(instance, level)
+                state = InstanceState(instance, level)
+                self.instances[(query.name, inputs)] = state
+                if stream.info.eager:
+                    self._eager.append(state)
             elif query.name in self.functions:
                 external = self.functions[query.name]
                 value = external.evaluate(inputs, self.table)

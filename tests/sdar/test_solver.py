@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
 import pytest
 
 from sdar_tamp.errors import ParameterError
@@ -205,3 +206,16 @@ def test_unknown_task_planner_and_override_are_refused(ctx: WorldContext) -> Non
         rearrangement_problem(_swap(), ctx, overrides={"sample-pose": print})
     with pytest.raises(ParameterError, match="motion planner must be one of"):
         rearrangement_problem(_swap(), ctx, motion="fast")
+
+
+def test_same_seed_gives_the_same_plan(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+    plans = []
+    for _ in range(2):
+        r = rearrangement_problem(_three(), ctx, planner=planner, seed=7)
+        solution = solve_rearrangement(r, "sdar", 60.0)
+        plans.append(plan_file_from_solution(r, solution))
+    a, b = plans
+    assert np.array_equal(a.q, b.q) and np.array_equal(a.t, b.t)
+    assert [(e.t, e.arm, e.type, e.object) for e in a.events] == [
+        (e.t, e.arm, e.type, e.object) for e in b.events
+    ]

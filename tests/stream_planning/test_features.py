@@ -343,8 +343,32 @@ def test_unused_cost_model_options_are_reported(caplog: pytest.LogCaptureFixture
     info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True)}
     with caplog.at_level(logging.WARNING):
         assert solve(line_problem(counting()), stream_info=info, verbose=False).solved
-    for option in ("p_success", "overhead", "eager"):
+    for option in ("p_success", "overhead"):
         assert f"stream_info['sample-pose'].{option}" in caplog.text
+    assert "stream_info['sample-pose'].eager" not in caplog.text
+
+
+EAGER_TEST = SAMPLE.rstrip()[:-1] + """
+  (:stream test-free :inputs (?b ?p) :domain (pose ?b ?p) :certified (free ?p)))
+"""
+
+
+@pytest.mark.parametrize("algorithm", ["focused", "adaptive"])
+def test_eager_stream_is_called_as_soon_as_its_inputs_exist(algorithm: str) -> None:
+    seen: list[float] = []
+
+    def free(b: str, p: float) -> bool:
+        seen.append(p)
+        return True
+
+    problem = line_problem(counting(), EAGER_TEST, **{"test-free": from_test(free)})
+    lazy = solve(problem, algorithm=algorithm, verbose=False)
+    assert lazy.solved and seen == []  # the plan never needs (free ?p): never called
+    problem = line_problem(counting(), EAGER_TEST, **{"test-free": from_test(free)})
+    info = {"test-free": StreamInfo(eager=True)}
+    eager = solve(problem, algorithm=algorithm, stream_info=info, verbose=False)
+    assert eager.solved and 0.0 in seen  # the initial pose, before any planning
+    assert eager.streams["test-free"].calls == len(seen) >= 2  # sampled poses too
 
 
 def test_from_fn_stream_runs_once() -> None:
