@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import statistics
 import time
 from pathlib import Path
@@ -28,7 +29,12 @@ from sdar_tamp.world.instance import load_instance
 
 def _suite_files(suite: str) -> list[Path]:
     folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
-    return sorted(folder.glob("*.yaml"), key=lambda p: (p.stem[0], int(p.stem[1:])))
+
+    def key(p: Path) -> tuple[str, int]:
+        digits = re.sub(r"\D", "", p.stem)
+        return (p.stem[0], int(digits) if digits else 0)
+
+    return sorted(folder.glob("*.yaml"), key=key)
 
 
 def main() -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import logging
 import math
 import random
@@ -14,6 +15,7 @@ from sdar_tamp.language.options import FunctionInfo, PlanConstraints, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Solution, print_solution
 from solvers.stream_planning.algorithms import ALGORITHMS, StreamOptions, StreamSolver
+from solvers.stream_planning.constraints import compile_constraints
 
 LOG = logging.getLogger(__name__)
 INF = math.inf
@@ -61,6 +63,9 @@ def solve(
             (rearrangement domains: dependency-driven steps grounded best first, see
             :mod:`solvers.sdar.solver`).
         stream_info: per-stream :class:`StreamInfo` / :class:`FunctionInfo`, by stream name.
+        constraints: :class:`PlanConstraints`: plan skeletons (values, ``WILD``, ``"?x"``
+            variables; ``exact``) and ``max_cost`` (see
+            :mod:`solvers.stream_planning.constraints`).
         unit_costs: every action costs 1 instead of its ``total-cost`` increase.
         success_cost: stop at the first plan of at most this cost (else keep improving until
             ``max_time``).
@@ -101,8 +106,11 @@ def solve(
         search=search,
         heuristic=heuristic or "ff",
     )
+    if constraints is not None and not isinstance(constraints, PlanConstraints):
+        raise ParameterError(
+            f"constraints must be a PlanConstraints, got {type(constraints).__name__}"
+        )
     for name, value, default in (
-        ("constraints", constraints, None),
         ("unit_efforts", unit_efforts, False),
         ("effort_weight", effort_weight, None),
     ):
@@ -117,6 +125,9 @@ def solve(
             numpy.random.seed(seed % 2**32)
         except ImportError:  # pragma: no cover - numpy is a dependency
             pass
+    if constraints is not None:
+        options = dataclasses.replace(options, max_cost=constraints.max_cost)
+        problem = compile_constraints(problem, constraints)
     return StreamSolver(problem, options, stream_info).solve()
 
 

@@ -28,6 +28,7 @@ from sdar_tamp.language.problem import PDDLProblem, infer_object_types
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
+from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.costs import guard_costs, has_costs
 from solvers.stream_planning.diagnosis import diagnose
 from solvers.stream_planning.engine import Engine
@@ -63,6 +64,7 @@ class StreamOptions:
     search: str = "wastar"
     heuristic: str = "ff"
     weight: float = 2.0
+    max_cost: float = math.inf  # plans above it are not returned (PlanConstraints.max_cost)
 
 
 @dataclass(order=True)
@@ -181,6 +183,8 @@ class StreamSolver:
     def _record(self, actions: PlanSteps, needed: frozenset[Atom]) -> bool:
         """Keep a real plan if it is the best so far; True when it is good enough to stop."""
         cost = plan_cost(self.problem.domain, actions, self.engine.numeric, self.options.unit_costs)
+        if cost > self.options.max_cost:
+            return False
         if self.best is None or cost < self.best[0]:
             self.best = (cost, actions, needed)
         return self.best[0] <= self.options.success_cost
@@ -401,7 +405,10 @@ class StreamSolver:
                 diagnose(self, status),
             )
         cost, actions, needed = self.best
-        plan = [Action(name, tuple(table.value(a) for a in args)) for name, args in actions]
+        plan = [
+            Action(original_name(name), tuple(table.value(a) for a in args))
+            for name, args in actions
+        ]
         certificate = Certificate(
             tuple(fact(a) for a in real),
             tuple(fact(a) for a in sorted(needed, key=str) if not a.predicate.startswith("@")),

@@ -348,9 +348,12 @@ def test_unused_cost_model_options_are_reported(caplog: pytest.LogCaptureFixture
     assert "stream_info['sample-pose'].eager" not in caplog.text
 
 
-EAGER_TEST = SAMPLE.rstrip()[:-1] + """
+EAGER_TEST = (
+    SAMPLE.rstrip()[:-1]
+    + """
   (:stream test-free :inputs (?b ?p) :domain (pose ?b ?p) :certified (free ?p)))
 """
+)
 
 
 @pytest.mark.parametrize("algorithm", ["focused", "adaptive"])
