@@ -3,7 +3,9 @@
 Each instance whose next result stays within the complexity limit contributes placeholder
 outputs (``#o<k>``). By default a placeholder belongs to its instance (``unique``); with
 ``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output.
-Functions on placeholders take their optimistic value (``FunctionInfo.opt_fn``, default 1);
+Functions on placeholders take their optimistic value (``FunctionInfo.opt_fn``, default 1,
+called with the Python values of real inputs and an :class:`OptimisticValue` for each
+placeholder);
 predicates on placeholders are optimistically true unless the domain uses them negated.
 """
 
@@ -31,6 +33,18 @@ PLACEHOLDER = "#o"
 
 def is_placeholder(name: str) -> bool:
     return name.startswith(PLACEHOLDER)
+
+
+@dataclass(frozen=True)
+class OptimisticValue:
+    """What ``FunctionInfo.opt_fn`` receives for an input not sampled yet: the placeholder's
+    name and the stream that will produce it."""
+
+    name: str
+    stream: str
+
+    def __repr__(self) -> str:
+        return f"{self.name}({self.stream})"
 
 
 @dataclass(frozen=True)
@@ -111,12 +125,14 @@ class OptimisticBuilder:
         self.engine = engine
         self.negated = negated
         self._placeholders: dict[tuple[object, ...], str] = {}
+        self.producers: dict[str, str] = {}  # placeholder -> the stream that makes it
 
     def placeholder(self, key: tuple[object, ...]) -> str:
         name = self._placeholders.get(key)
         if name is None:
             name = f"{PLACEHOLDER}{len(self._placeholders)}"
             self._placeholders[key] = name
+            self.producers[name] = str(key[0])
         return name
 
     def build(self, limit: int) -> OptimisticWorld:
@@ -204,6 +220,13 @@ class OptimisticBuilder:
         )
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
 
+    def _values(self, inputs: tuple[str, ...]) -> tuple[object, ...]:
+        return tuple(
+            OptimisticValue(n, self.producers.get(n, "?")) if is_placeholder(n)
+            else self.engine.table.value(n)
+            for n in inputs
+        )  # fmt: skip
+
     def _function(
         self,
         function: FunctionExternal,
@@ -227,7 +250,7 @@ class OptimisticBuilder:
                 )
             ]
         opt_fn = getattr(function.info, "opt_fn", None)
-        value = float(opt_fn(*inputs)) if opt_fn is not None else 1.0
+        value = float(opt_fn(*self._values(inputs))) if opt_fn is not None else 1.0
         world.numeric[(function.name, inputs)] = value
         return [
             OptResult(

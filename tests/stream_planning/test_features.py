@@ -389,3 +389,23 @@ def test_from_fn_stream_runs_once() -> None:
 def test_from_test_adapter_is_usable_as_a_filter() -> None:
     assert list(from_test(lambda x: x > 0)(1)) == [[()]]
     assert list(from_test(lambda x: x > 0)(-1)) == [[]]
+
+
+def test_opt_fn_receives_values_and_optimistic_values() -> None:
+    from domains.kitchen.samplers import make_problem
+    from sdar_tamp.language.options import FunctionInfo
+    from solvers.stream_planning.optimistic import OptimisticValue
+
+    seen: list[tuple[Any, ...]] = []
+
+    def optimistic(q1: Any, q2: Any) -> float:
+        seen.append((q1, q2))
+        return 0.0
+
+    info = {"distance": FunctionInfo(opt_fn=optimistic)}
+    solution = solve(make_problem(), algorithm="adaptive", stream_info=info, verbose=False)
+    assert solution.solved
+    args = [a for pair in seen for a in pair]
+    placeholders = [a for a in args if isinstance(a, OptimisticValue)]
+    assert placeholders and all(p.stream == "sample-conf" for p in placeholders)
+    assert any(isinstance(a, tuple) for a in args)  # the robot's real start configuration
