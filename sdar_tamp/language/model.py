@@ -344,17 +344,23 @@ def iter_atoms(formula: Formula) -> Iterator[Atom]:
             stack.append(node.body)
 
 
-def iter_effect_literals(effect: Effect) -> Iterator[Literal]:
-    """Every add/delete literal inside ``effect``, including conditional and universal ones."""
+def iter_effects(effect: Effect) -> Iterator[Literal | IncreaseCost]:
+    """Every leaf of ``effect`` (literals and cost increases), in order, including those
+    inside conditional and universal effects."""
     stack: list[Effect] = [effect]
     while stack:
         node = stack.pop()
-        if isinstance(node, Literal):
+        if isinstance(node, Literal | IncreaseCost):
             yield node
         elif isinstance(node, AndEffect):
-            stack.extend(node.parts)
-        elif isinstance(node, ForAllEffect | When):
+            stack.extend(reversed(node.parts))
+        else:
             stack.append(node.effect)
+
+
+def iter_effect_literals(effect: Effect) -> Iterator[Literal]:
+    """Every add/delete literal inside ``effect``, including conditional and universal ones."""
+    return (e for e in iter_effects(effect) if isinstance(e, Literal))
 
 
 def substitute(formula: Formula, mapping: Mapping[str, str]) -> Formula:

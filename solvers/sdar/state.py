@@ -32,6 +32,7 @@ from sdar_tamp.language.model import (
     Or,
     Parameter,
     When,
+    iter_effect_literals,
 )
 
 Binding = Mapping[str, str]
@@ -43,20 +44,11 @@ class ActionError(Exception):
 
 def fluent_predicates(domain: Domain) -> frozenset[str]:
     """Predicates some action adds or deletes."""
-    found: set[str] = set()
-
-    def visit(effect: Effect) -> None:
-        if isinstance(effect, Literal):
-            found.add(effect.atom.predicate)
-        elif isinstance(effect, AndEffect):
-            for part in effect.parts:
-                visit(part)
-        elif isinstance(effect, ForAllEffect | When):
-            visit(effect.effect)
-
-    for action in domain.actions:
-        visit(action.effect)
-    return frozenset(found)
+    return frozenset(
+        literal.atom.predicate
+        for action in domain.actions
+        for literal in iter_effect_literals(action.effect)
+    )
 
 
 class LiftedState:

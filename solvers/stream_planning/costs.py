@@ -16,12 +16,11 @@ from sdar_tamp.language.model import (
     Atom,
     Domain,
     Effect,
-    ForAllEffect,
     FunctionTerm,
     IncreaseCost,
     Parameter,
     Predicate,
-    When,
+    iter_effects,
 )
 from solvers.stream_planning.engine import function_guard
 
@@ -39,16 +38,8 @@ def has_costs(domain: Domain) -> bool:
     return any(
         isinstance(effect, IncreaseCost)
         for action in domain.actions
-        for effect in _walk(action.effect)
+        for effect in iter_effects(action.effect)
     )
-
-
-def _walk(effect: Effect) -> list[Effect]:
-    if isinstance(effect, AndEffect):
-        return [e for part in effect.parts for e in _walk(part)]
-    if isinstance(effect, ForAllEffect | When):
-        return _walk(effect.effect)
-    return [effect]
 
 
 def guard_costs(domain: Domain) -> Domain:

@@ -15,17 +15,14 @@ from dataclasses import dataclass
 from typing import Any
 
 from sdar_tamp.language.model import (
-    AndEffect,
     Atom,
     Domain,
-    Effect,
-    ForAllEffect,
     FunctionTerm,
     IncreaseCost,
     Rule,
     StreamFunction,
     StreamPredicate,
-    When,
+    iter_effects,
 )
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo, unsupported_options
@@ -183,21 +180,12 @@ class Engine:
 
 def cost_functions(domain: Domain) -> frozenset[str]:
     """Names of the functions that appear in some action's cost increase."""
-    found: set[str] = set()
-
-    def visit(effect: Effect) -> None:
-        if isinstance(effect, IncreaseCost):
-            if isinstance(effect.amount, FunctionTerm):
-                found.add(effect.amount.name)
-        elif isinstance(effect, AndEffect):
-            for part in effect.parts:
-                visit(part)
-        elif isinstance(effect, ForAllEffect | When):
-            visit(effect.effect)
-
-    for action in domain.actions:
-        visit(action.effect)
-    return frozenset(found)
+    return frozenset(
+        e.amount.name
+        for action in domain.actions
+        for e in iter_effects(action.effect)
+        if isinstance(e, IncreaseCost) and isinstance(e.amount, FunctionTerm)
+    )
 
 
 def bind_externals(
