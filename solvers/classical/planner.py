@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import time
 
 from sdar_tamp.errors import ParameterError
@@ -41,6 +42,7 @@ def plan(
     preferred_operators: bool = True,
     lazy: bool = False,
     time_limit: float | None = None,
+    cost_bound: float = math.inf,
 ) -> SearchResult:
     """Find a plan for ``task``.
 
@@ -53,7 +55,8 @@ def plan(
     cost never rises); A* plans are returned as found. Greedy search adds 1 to every action
     cost inside the heuristic (so zero-cost actions still count as steps); plan costs are always
     the true costs.
-    ``time_limit`` [s] covers grounding and search.
+    ``time_limit`` [s] covers grounding and search. ``cost_bound``: only plans cheaper than it
+    (states whose cost so far reaches it are pruned; the initial state is never pruned).
     """
     _check("search", search, SEARCHES)
     _check("heuristic", heuristic, HEURISTICS)
@@ -71,7 +74,9 @@ def plan(
             PlanStatus.TIMEOUT, None, 0.0, SearchStatistics(0, 0, 0, 0, 0, 0, elapsed, 0.0)
         )
     grounded = time.perf_counter()
-    outcome = _search(ground_task, search, heuristic, weight, preferred_operators, lazy, deadline)
+    outcome = _search(
+        ground_task, search, heuristic, weight, preferred_operators, lazy, deadline, cost_bound
+    )
     searched = time.perf_counter()
     statistics = SearchStatistics(
         expanded=outcome.expanded,
@@ -101,6 +106,7 @@ def _search(
     preferred: bool,
     lazy: bool,
     deadline: float | None,
+    cost_bound: float = math.inf,
 ) -> SearchOutcome:
     if not ground_task.goal_reachable:
         logger.info("goal not relaxed-reachable: unsolvable")
@@ -120,6 +126,7 @@ def _search(
         lazy=lazy,
         reopen=search != "gbfs",
         deadline=deadline,
+        cost_bound=cost_bound,
     )
     if outcome.status == "solved" and search != "astar":
         shorter = eliminate_redundant_actions(compiled, list(outcome.operators), deadline)

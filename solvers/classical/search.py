@@ -80,10 +80,12 @@ def best_first_search(
     lazy: bool,
     reopen: bool,
     deadline: float | None,
+    cost_bound: float = inf,
 ) -> SearchOutcome:
-    """Search from ``compiled.init``; ``reopen`` re-expands states reached more cheaply."""
+    """Search from ``compiled.init``; ``reopen`` re-expands states reached more cheaply.
+    States whose cost so far reaches ``cost_bound`` are pruned (only cheaper plans)."""
     run = _lazy if lazy else _eager
-    return run(compiled, heuristic, g_weight, h_weight, preferred, reopen, deadline)
+    return run(compiled, heuristic, g_weight, h_weight, preferred, reopen, deadline, cost_bound)
 
 
 def _eager(
@@ -94,6 +96,7 @@ def _eager(
     preferred: bool,
     reopen: bool,
     deadline: float | None,
+    cost_bound: float,
 ) -> SearchOutcome:
     costs = compiled.costs
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
@@ -125,6 +128,8 @@ def _eager(
         for op in applicable(state):
             succ = successor(state, op)
             new_g = g + costs[op]
+            if new_g >= cost_bound:
+                continue
             known = best_g.get(succ)
             if known is not None and (not reopen or new_g >= known):
                 continue
@@ -152,6 +157,7 @@ def _lazy(
     preferred: bool,
     reopen: bool,
     deadline: float | None,
+    cost_bound: float,
 ) -> SearchOutcome:
     costs = compiled.costs
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
@@ -187,6 +193,8 @@ def _lazy(
         expanded += 1
         for succ_op in applicable(state):
             new_g = g + costs[succ_op]
+            if new_g >= cost_bound:
+                continue
             generated += 1
             key = g_weight * new_g + h_weight * h
             queues.push(

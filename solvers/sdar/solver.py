@@ -312,6 +312,8 @@ class SdarSolver:
         """Feasible groundings, best first: task-planner rank, then estimated motion time."""
         found: list[_Grounding] = []
         for index, step in enumerate(candidates):
+            if time.perf_counter() > self.deadline:
+                break
             if found and (
                 step.rank > found[0].step.rank
                 or (index >= self.options.candidates and len(found) >= 1)
@@ -490,6 +492,8 @@ class SdarSolver:
             if singles:
                 continue
             for i, a in enumerate(done):  # boxed in from two sides: two objects make room
+                if time.perf_counter() > self.deadline:
+                    return steps
                 for b in done[i + 1 :]:
                     if self._reachable(obj, pose, lifted | {a, b}):
                         self.deferred[a] = self.deferred[b] = obj

@@ -156,6 +156,8 @@ class StreamSolver:
             heuristic=self.options.heuristic,
             weight=self.options.weight,
             time_limit=limit,
+            # anytime: once a plan is known, only cheaper optimistic plans are of interest
+            cost_bound=self.best[0] if self.best is not None else math.inf,
         )
         self.stats["search_time"] += time.perf_counter() - start
         if result.status is PlanStatus.TIMEOUT:

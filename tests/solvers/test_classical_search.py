@@ -167,3 +167,13 @@ def test_goal_true_initially_gives_the_empty_plan() -> None:
     for search in SEARCHES:
         result = plan(trivial, search=search)
         assert result.status is PlanStatus.SOLVED and result.plan == () and result.cost == 0.0
+
+
+@pytest.mark.parametrize("search", ["gbfs", "wastar", "astar"])
+@pytest.mark.parametrize("lazy", [False, True])
+def test_cost_bound_keeps_only_cheaper_plans(search: str, lazy: bool) -> None:
+    task = load("delivery_costs", "detour")
+    at_bound = plan(task, search=search, heuristic="max", lazy=lazy, cost_bound=11.0)
+    assert at_bound.status is PlanStatus.UNSOLVABLE  # 11 is the optimum: nothing cheaper
+    above = plan(task, search=search, heuristic="max", lazy=lazy, cost_bound=11.5)
+    assert above.status is PlanStatus.SOLVED and above.cost == 11.0

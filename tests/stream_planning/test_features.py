@@ -409,3 +409,16 @@ def test_opt_fn_receives_values_and_optimistic_values() -> None:
     placeholders = [a for a in args if isinstance(a, OptimisticValue)]
     assert placeholders and all(p.stream == "sample-conf" for p in placeholders)
     assert any(isinstance(a, tuple) for a in args)  # the robot's real start configuration
+
+
+@pytest.mark.parametrize("algorithm", ["incremental", "adaptive"])
+def test_anytime_improvement_stops_when_no_cheaper_plan_exists(algorithm: str) -> None:
+    from domains.kitchen.samplers import make_problem
+
+    first = solve(make_problem(), algorithm=algorithm, max_time=60, verbose=False)
+    start = time.perf_counter()
+    best = solve(make_problem(), algorithm=algorithm, max_time=60, success_cost=0, verbose=False)
+    elapsed = time.perf_counter() - start
+    assert best.solved and best.cost < first.cost
+    assert best.cost < 41  # the sink next to the stove (the other gives 48 and more)
+    assert elapsed < 40  # ended by the cost bound, not by max_time
