@@ -67,6 +67,9 @@ def solve(
             variables; ``exact``) and ``max_cost`` (see
             :mod:`solvers.stream_planning.constraints`).
         unit_costs: every action costs 1 instead of its ``total-cost`` increase.
+        effort_weight: when set, optimistic plans are tried in the order of cost plus this
+            weight times their stream effort (``StreamInfo.effort``, or ``overhead /
+            p_success``; 1 per call with ``unit_efforts``).
         success_cost: stop at the first plan of at most this cost (else keep improving until
             ``max_time``).
         max_time: wall-clock limit [s].
@@ -110,12 +113,11 @@ def solve(
         raise ParameterError(
             f"constraints must be a PlanConstraints, got {type(constraints).__name__}"
         )
-    for name, value, default in (
-        ("unit_efforts", unit_efforts, False),
-        ("effort_weight", effort_weight, None),
-    ):
-        if value != default:
-            LOG.warning("solve(%s=...) is accepted but not implemented; it has no effect", name)
+    if effort_weight is not None:
+        _positive("effort_weight", effort_weight, allow_zero=True)
+    options = dataclasses.replace(
+        options, effort_weight=effort_weight, unit_efforts=bool(unit_efforts)
+    )
     logging.getLogger("solvers").setLevel(logging.INFO if verbose else logging.WARNING)
     if seed is not None:
         random.seed(seed)

@@ -24,6 +24,7 @@ from typing import Any
 
 from sdar_tamp.language.model import AndEffect, Atom, Domain, FunctionTerm, IncreaseCost
 from sdar_tamp.language.objects import ObjectTable
+from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
@@ -65,6 +66,8 @@ class StreamOptions:
     heuristic: str = "ff"
     weight: float = 2.0
     max_cost: float = math.inf  # plans above it are not returned (PlanConstraints.max_cost)
+    effort_weight: float | None = None  # skeletons ordered by cost + weight * stream effort
+    unit_efforts: bool = False  # every stream call has effort 1
 
 
 @dataclass(order=True)
@@ -277,7 +280,12 @@ class StreamSolver:
                     level += options.complexity_step
                 continue
             self.stats["skeletons"] += 1
-            skeleton = Skeleton((0, cost, self._order), actions, stream_plan)
+            priority = cost
+            if options.effort_weight is not None:
+                efforts = {n: e.info for n, e in self.engine.streams.items()}
+                effort = stream_plan_effort(stream_plan, efforts, options.unit_efforts)
+                priority += options.effort_weight * effort
+            skeleton = Skeleton((0, priority, self._order), actions, stream_plan)
             self._order += 1
             if options.algorithm == "focused":
                 self._sample_first_layer(stream_plan)
@@ -416,6 +424,26 @@ class StreamSolver:
             tuple(fact(a) for a in sorted(needed, key=str) if not a.predicate.startswith("@")),
         )
         return Solution(plan, cost, certificate, Status.SOLVED, dict(self.stats), streams)
+
+
+def stream_plan_effort(
+    stream_plan: Sequence[OptResult], info: Mapping[str, StreamInfo], unit_efforts: bool = False
+) -> float:
+    """Expected effort of making a stream plan real: per stream call ``StreamInfo.effort`` if
+    set, else 1 with ``unit_efforts``, else ``overhead / p_success`` (defaults 1 and 1)."""
+    total = 0.0
+    for result in stream_plan:
+        if result.kind != "stream":
+            continue
+        options = info[result.external]
+        if options.effort is not None:
+            total += options.effort
+        elif unit_efforts:
+            total += 1.0
+        else:
+            overhead = 1.0 if options.overhead is None else options.overhead
+            total += overhead / (1.0 if options.p_success is None else options.p_success)
+    return total
 
 
 def extract_stream_plan(needed: Iterable[Atom], world: OptimisticWorld) -> list[OptResult]:

@@ -37,8 +37,9 @@ from solvers.stream_planning.facts import FactStore, Instantiator, Query
 
 LOG = logging.getLogger(__name__)
 # Options the algorithms act on; any other option set to a non-default value is logged as
-# not implemented (p_success, overhead, effort, negate, simultaneous, defer_fn, ...).
-SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn", "eager"}
+# not implemented (negate, simultaneous, defer_fn, ...). p_success, overhead and effort act
+# through solve(effort_weight=...).
+SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn", "eager", "p_success", "overhead", "effort"}
 #: Calls of eager stream instances one engine makes at most (a generator feeding its own
 #: inputs would otherwise never stop).
 EAGER_BUDGET = 10_000

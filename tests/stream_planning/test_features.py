@@ -339,39 +339,49 @@ def test_supported_stream_info_logs_nothing(caplog: pytest.LogCaptureFixture) ->
     assert "not implemented" not in caplog.text
 
 
-def test_unused_cost_model_options_are_reported(caplog: pytest.LogCaptureFixture) -> None:
-    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True)}
+def test_cost_model_options_are_accepted(caplog: pytest.LogCaptureFixture) -> None:
+    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True, negate=True)}
     with caplog.at_level(logging.WARNING):
         assert solve(line_problem(counting()), stream_info=info, verbose=False).solved
-    for option in ("p_success", "overhead"):
-        assert f"stream_info['sample-pose'].{option}" in caplog.text
-    assert "stream_info['sample-pose'].eager" not in caplog.text
+    for option in ("p_success", "overhead", "eager"):
+        assert f"stream_info['sample-pose'].{option}" not in caplog.text
+    assert "stream_info['sample-pose'].negate" in caplog.text  # not acted on
 
 
-EAGER_TEST = (
+TWO_SAMPLERS = (
     SAMPLE.rstrip()[:-1]
     + """
-  (:stream test-free :inputs (?b ?p) :domain (pose ?b ?p) :certified (free ?p)))
+  (:stream sample-other :inputs (?b ?r) :domain (and (block ?b) (region ?r))
+    :outputs (?p) :certified (and (pose ?b ?p) (contained ?b ?p ?r))))
 """
 )
 
 
-@pytest.mark.parametrize("algorithm", ["focused", "adaptive"])
-def test_eager_stream_is_called_as_soon_as_its_inputs_exist(algorithm: str) -> None:
-    seen: list[float] = []
+def test_stream_plan_effort_follows_the_cost_model() -> None:
+    from solvers.stream_planning.algorithms import stream_plan_effort
+    from solvers.stream_planning.optimistic import OptResult
 
-    def free(b: str, p: float) -> bool:
-        seen.append(p)
-        return True
+    def result(name: str, kind: str = "stream") -> OptResult:
+        return OptResult(name, (), (), (), (), 0, kind)
 
-    problem = line_problem(counting(), EAGER_TEST, **{"test-free": from_test(free)})
-    lazy = solve(problem, algorithm=algorithm, verbose=False)
-    assert lazy.solved and seen == []  # the plan never needs (free ?p): never called
-    problem = line_problem(counting(), EAGER_TEST, **{"test-free": from_test(free)})
-    info = {"test-free": StreamInfo(eager=True)}
-    eager = solve(problem, algorithm=algorithm, stream_info=info, verbose=False)
-    assert eager.solved and 0.0 in seen  # the initial pose, before any planning
-    assert eager.streams["test-free"].calls == len(seen) >= 2  # sampled poses too
+    plan = [result("a"), result("b"), result("c"), result("f", "function")]
+    info = {
+        "a": StreamInfo(effort=5.0),
+        "b": StreamInfo(p_success=0.5, overhead=2.0),
+        "c": StreamInfo(),
+    }
+    assert stream_plan_effort(plan, info) == 5.0 + 4.0 + 1.0
+    assert stream_plan_effort(plan, info, unit_efforts=True) == 5.0 + 1.0 + 1.0
+
+
+def test_effort_weight_is_accepted_and_solves() -> None:
+    problem = line_problem(counting(), TWO_SAMPLERS, **{"sample-other": counting(7.0)})
+    info = {"sample-pose": StreamInfo(effort=100.0)}
+    solution = solve(problem, stream_info=info, effort_weight=1.0, unit_efforts=True,
+                     verbose=False)  # fmt: skip
+    assert solution.solved
+    with pytest.raises(ParameterError, match="effort_weight"):
+        solve(problem, effort_weight=-1.0, verbose=False)
 
 
 def test_from_fn_stream_runs_once() -> None:
