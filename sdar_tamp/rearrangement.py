@@ -40,6 +40,7 @@ class Rearrangement:
     ctx: WorldContext
     problem: PDDLProblem
     home: DualConf
+    motion: str = "sdar"  # the motion planner behind plan-dual-motion (MOTION_PLANNERS)
 
 
 def _wrap(kind: str, fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -103,7 +104,7 @@ def rearrangement_problem(
         init,
         goal,
     )
-    return Rearrangement(instance, ctx, problem, home)
+    return Rearrangement(instance, ctx, problem, home, motion)
 
 
 # -- solving, and from a solution to a plan file ---------------------------------------------
@@ -119,7 +120,9 @@ def solve_rearrangement(
     from solvers.sdar.solver import SdarOptions, SdarSolver
 
     planner = make_task_planner(task_planner)
-    options = SdarOptions(max_time=max_time, progress=progress)
+    # The baseline motion planner: one arm works while the other waits at its retract pose.
+    one_arm = rearrangement.motion == "sequential"
+    options = SdarOptions(max_time=max_time, progress=progress, one_arm_at_a_time=one_arm)
     return SdarSolver(rearrangement.problem, planner, options).solve()
 
 

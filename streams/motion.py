@@ -22,7 +22,9 @@ is returned as a success. Strategies, tried in order until one passes:
   its home pose, the second moves to its goal, then the first moves to its goal.
 
 ``plan_dual_motion(..., fallbacks=False)`` is the paper's "plain" planner (no fallbacks);
-``sequential_only=True`` is the baseline motion planner.
+``sequential_only=True`` is the baseline motion planner (:class:`OneArmStrategy`: the arms
+move one after the other; SDAR-M then also keeps the idle arm at home, so that one arm works
+while the other waits at its retract pose).
 """
 
 from __future__ import annotations
@@ -185,8 +187,12 @@ class DualMotionPlanner:
         return out
 
     # -- assembling ------------------------------------------------------------------------
-    def phases(self, request: MotionRequest) -> tuple[FloatArray, FloatArray] | None:
-        """Retreat and approach paths ``(n, 12)`` (synchronised, padded), or None."""
+    def phases(
+        self, request: MotionRequest, one_at_a_time: bool = False
+    ) -> tuple[list[FloatArray], list[FloatArray]] | None:
+        """Retreat and approach as lists of paths ``(n, 12)``: one synchronised (padded) path
+        each, or, with ``one_at_a_time``, the left arm's then the right arm's; None if a
+        straight tool move is unreachable."""
         ret, app = [], []
         for i, arm in enumerate(self.ctx.arm_names):
             kin = self.ctx.kinematics[arm]
@@ -199,7 +205,9 @@ class DualMotionPlanner:
                 return None
             ret.append(r)
             app.append(a[::-1])
-        return _sync(ret), _sync(app)
+        if one_at_a_time:
+            return _chain(ret), _chain(app)
+        return [_sync(ret)], [_sync(app)]
 
     def transfer_problem(
         self, request: MotionRequest, q_from: FloatArray, q_to: FloatArray
@@ -224,12 +232,16 @@ class DualMotionPlanner:
         return TransferProblem(q_from, q_to, (held[0], held[1]), obstacles)
 
     def assemble(
-        self, retreat: FloatArray, stages: Sequence[FloatArray], approach: FloatArray
+        self,
+        retreat: Sequence[FloatArray],
+        stages: Sequence[FloatArray],
+        approach: Sequence[FloatArray],
     ) -> TimedTrajectory:
-        traj = time_parameterize(retreat, self._v, self._a)
-        for stage in stages:
-            traj = traj.then(time_parameterize(stage, self._v, self._a))
-        return traj.then(time_parameterize(approach, self._v, self._a))
+        """The paths in order, each timed rest to rest."""
+        traj = time_parameterize(retreat[0], self._v, self._a)
+        for path in (*retreat[1:], *stages, *approach):
+            traj = traj.then(time_parameterize(path, self._v, self._a))
+        return traj
 
 
 def _sync(paths: list[FloatArray]) -> FloatArray:
@@ -237,6 +249,15 @@ def _sync(paths: list[FloatArray]) -> FloatArray:
     n = max(len(p) for p in paths)
     padded = [np.concatenate([p, np.repeat(p[-1:], n - len(p), axis=0)]) for p in paths]
     return np.concatenate(padded, axis=1)
+
+
+def _chain(paths: list[FloatArray]) -> list[FloatArray]:
+    """Two arm paths ``(n_i, 6)`` as two ``(n_i, 12)`` paths: the left arm moves while the
+    right waits at its start, then the right arm moves (each timed rest to rest)."""
+    left, right = paths
+    first = np.concatenate([left, np.repeat(right[:1], len(left), axis=0)], axis=1)
+    second = np.concatenate([np.repeat(left[-1:], len(right), axis=0), right], axis=1)
+    return [first, second]
 
 
 # -- strategies ---------------------------------------------------------------------------
@@ -325,12 +346,52 @@ class SequentialStrategy:
         return None
 
 
+@dataclass(frozen=True)
+class OneArmStrategy:
+    """The baseline motion planner's transfer: the arms move one after the other, each
+    straight to its goal while the other waits; an arm bound for its home pose moves first,
+    otherwise the arm reaching deeper into the other's half."""
+
+    name: str = "one-arm"
+
+    def __call__(
+        self, planner: DualMotionPlanner, problem: TransferProblem
+    ) -> list[FloatArray] | None:
+        ctx = planner.ctx
+        moving = [
+            i
+            for i in (0, 1)
+            if not np.allclose(problem.q_from[6 * i : 6 * i + 6], problem.q_to[6 * i : 6 * i + 6])
+        ]
+        depth = planner.depth(problem.q_from)
+        homeward = {
+            i: bool(np.allclose(problem.q_to[6 * i : 6 * i + 6], ctx.home(ctx.arm_names[i])))
+            for i in moving
+        }
+        moving.sort(key=lambda i: (not homeward[i], -depth[i]))
+        stages: list[FloatArray] = []
+        q = problem.q_from.copy()
+        for i in moving:
+            q_next = q.copy()
+            q_next[6 * i : 6 * i + 6] = problem.q_to[6 * i : 6 * i + 6]
+            fixed = (i != 0, i != 1)
+            path = planner.optimise(problem, q, q_next, fixed=fixed)
+            if path is None:
+                path = planner.optimise(problem, q, q_next, planner.lifted_via(q, q_next), fixed)
+            if path is None:
+                return None
+            stages.append(path)
+            q = q_next
+        return stages or [np.stack([problem.q_from, problem.q_to])]
+
+
 def default_strategies(
     fallbacks: bool = True, sequential_only: bool = False
 ) -> tuple[TransferStrategy, ...]:
-    """The ladder of Alg. 2: plain, untangle, sequential (or a part of it)."""
+    """The ladder of Alg. 2: plain, untangle, sequential (or a part of it).
+    ``sequential_only``: the baseline motion planner (:class:`OneArmStrategy`)."""
     if sequential_only:
-        return (SequentialStrategy(),)
+        return (OneArmStrategy(),)
     if not fallbacks:
         return (PlainStrategy(),)
     return (PlainStrategy(), UntangleStrategy(), SequentialStrategy())
@@ -352,12 +413,12 @@ def plan_dual_motion(
     ctx = planner.ctx
     q_start = np.asarray(request.q_start, dtype=np.float64)
     configure_world(ctx, planner.world, request.objects, request.held, q_start)
-    phases = planner.phases(request)
+    phases = planner.phases(request, one_at_a_time=sequential_only and strategies is None)
     if phases is None:
         return MotionResult(False, None, None, 0.0, time.perf_counter() - t0, (),
                             reason="approach or retreat unreachable")  # fmt: skip
     retreat, approach = phases
-    problem = planner.transfer_problem(request, retreat[-1], approach[0])
+    problem = planner.transfer_problem(request, retreat[-1][-1], approach[0][0])
     attempts: list[str] = []
     report: ValidationReport | None = None
     for strategy in ladder:

@@ -49,7 +49,10 @@ class SdarOptions:
     choose_among: int = 3  # feasible groundings compared by estimated motion time
     grasps: int = 6  # grasps tried per object
     options_per_move: int = 2  # (grasp, pick IK, place IK) options kept per arm and move
+    more_options: int = 6  # kept instead when every pair of the first ones makes the arms collide
+    expand_kinds: tuple[str, ...] = ("pair", "swap", "chain", "cycle")  # two-move steps
     buffers: int = 4  # buffer poses tried per buffer move
+    one_arm_at_a_time: bool = False  # the baseline motion planner (see _one_arm_sequence)
     progress: Callable[[int, int], None] | None = None  # (objects at goal, objects) per step
     vocabulary: SdarVocabulary = field(default_factory=SdarVocabulary)
 
@@ -63,6 +66,16 @@ class _Option:
 
 
 @dataclass(frozen=True)
+class _Event:
+    """One gripper action of a one-arm-at-a-time execution, at ``conf``: the acting arm at
+    its pick or place configuration, the other arm at home."""
+
+    index: int  # into the step's moves
+    pick: bool
+    conf: str  # dual-arm configuration
+
+
+@dataclass(frozen=True)
 class _Grounding:
     step: Step
     arms: tuple[str, ...]
@@ -70,6 +83,7 @@ class _Grounding:
     d_pick: str
     d_place: str
     estimate: float
+    sequence: tuple[_Event, ...] = ()  # one arm at a time only
 
 
 @dataclass
@@ -224,7 +238,9 @@ class SdarSolver:
         return TaskView(DependencyGraph(remaining, tuple(edges)), done, buffered)
 
     # -- grounding ---------------------------------------------------------------------------
-    def _move_options(self, arm: str, move: Move, lifted: frozenset[str]) -> list[_Option]:
+    def _move_options(
+        self, arm: str, move: Move, lifted: frozenset[str], limit: int
+    ) -> list[_Option]:
         voc, opt = self.voc, self.options
         current = self._current_poses()
         p = current[move.obj]
@@ -245,7 +261,7 @@ class SdarSolver:
                 if places:
                     found.append(_Option(g, picks[0][0], t, places[0][0]))
                     break
-            if len(found) >= opt.options_per_move:
+            if len(found) >= limit:
                 break
         return found
 
@@ -260,20 +276,48 @@ class SdarSolver:
         return float(self.functions[self.voc.distance].evaluate((d1, d2), self.table))
 
     def _ground(self, step: Step, arms: tuple[str, ...]) -> list[_Grounding]:
-        """Every grounding of ``step`` with ``arms`` not yet tried, cheapest estimate first."""
+        """Every grounding of ``step`` with ``arms`` not yet tried, cheapest estimate first:
+        from ``options_per_move`` options per move, or from ``more_options`` when none of
+        those combinations works (two arms reaching for neighbouring objects often collide
+        with the first grasps and not with tilted ones)."""
         lifted = frozenset(step.objects)
-        per_move = [self._move_options(a, m, lifted) for a, m in zip(arms, step.moves, strict=True)]
-        for a, m, options in zip(arms, step.moves, per_move, strict=True):
-            if not options:
-                target = "a buffer" if m.to_buffer else "its goal"
-                self._why(step, arms, f"no grasp with IK for {self._show(a)} at "
-                          f"{self._show(m.obj)} and at {target}")  # fmt: skip
-                return []
+        opt = self.options
+        limits = [opt.options_per_move]
+        if step.kind in opt.expand_kinds and opt.more_options > opt.options_per_move:
+            limits.append(opt.more_options)
+        for limit in limits:
+            per_move = [
+                self._move_options(a, m, lifted, limit)
+                for a, m in zip(arms, step.moves, strict=True)
+            ]
+            for a, m, options in zip(arms, step.moves, per_move, strict=True):
+                if not options:
+                    target = "a buffer" if m.to_buffer else "its goal"
+                    self._why(step, arms, f"no grasp with IK for {self._show(a)} at "
+                              f"{self._show(m.obj)} and at {target}")  # fmt: skip
+                    return []
+            found = self._combinations(step, arms, per_move)
+            if found or all(len(options) < limit for options in per_move):
+                break
+        if not found:
+            self._why(step, arms, "the arms' configurations collide (or were tried)")
+        return sorted(found, key=lambda g: g.estimate)
+
+    def _combinations(
+        self, step: Step, arms: tuple[str, ...], per_move: Sequence[Sequence[_Option]]
+    ) -> list[_Grounding]:
+        """The groundings of every combination of the moves' options not yet tried whose
+        dual-arm configurations are collision-free."""
         idle = [a for a in self.home if a not in arms]
         current = self._current_dualconf()
         found: list[_Grounding] = []
         for combo in _product(per_move):
             if self._tabu_key(step, arms, combo) in self.tabu:
+                continue
+            if self.options.one_arm_at_a_time:
+                one = self._ground_one_arm(step, arms, combo, current)
+                if one is not None:
+                    found.append(one)
                 continue
             pick = {a: o.pick for a, o in zip(arms, combo, strict=True)}
             place = {a: o.place for a, o in zip(arms, combo, strict=True)}
@@ -284,9 +328,45 @@ class SdarSolver:
                 continue
             estimate = self._distance(current, d_pick) + self._distance(d_pick, d_place)
             found.append(_Grounding(step, arms, combo, d_pick, d_place, estimate))
-        if not found:
-            self._why(step, arms, "the arms' configurations collide (or were tried)")
-        return sorted(found, key=lambda g: g.estimate)
+        return found
+
+    def _ground_one_arm(
+        self, step: Step, arms: tuple[str, ...], combo: tuple[_Option, ...], current: str
+    ) -> _Grounding | None:
+        """The baseline motion planner's grounding: every gripper action happens with the
+        acting arm at its configuration and the other arm at home (its retract pose)."""
+        sequence: list[_Event] = []
+        for index, pick in self._one_arm_order(step, [o.target for o in combo]):
+            arm = arms[index]
+            option = combo[index]
+            confs = {a: self.home[a] for a in self.home}
+            confs[arm] = option.pick if pick else option.place
+            d = self._combine(confs)
+            if d is None:
+                return None
+            sequence.append(_Event(index, pick, d))
+        estimate, d0 = 0.0, current
+        for event in sequence:
+            estimate += self._distance(d0, event.conf)
+            d0 = event.conf
+        first = sequence[0].conf
+        return _Grounding(step, arms, combo, first, sequence[-1].conf, estimate, tuple(sequence))
+
+    def _one_arm_order(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
+        """``(move index, pick?)`` in execution order. A move whose target is clear of every
+        other resting object goes first, alone, then the other; otherwise (a swap) the first
+        arm picks and waits at home holding its object while the second arm works."""
+        if len(step.moves) == 1:
+            return [(0, True), (0, False)]
+        current = self._current_poses()
+        for k, (obj, target) in enumerate(zip(step.objects, targets, strict=True)):
+            if all(
+                self._test(self.voc.cfree, (obj, target, other, pose))
+                for other, pose in current.items()
+                if other != obj
+            ):
+                return [(k, True), (k, False), (1 - k, True), (1 - k, False)]
+        return [(0, True), (1, True), (1, False), (0, False)]
 
     def _tabu_key(self, step: Step, arms: tuple[str, ...], combo: tuple[_Option, ...]) -> Any:
         return (self._fluents(self.voc.atpose), step.moves, arms, combo)
@@ -376,6 +456,8 @@ class SdarSolver:
         if not self._placeable(g, targets):
             self._why(g.step, g.arms, "a target is not clear of the resting objects")
             return False
+        if g.sequence:
+            return self._execute_one_arm(g, record)
         held = [
             Atom(voc.holding, (arm, move.obj, option.grasp))
             for arm, move, option in zip(g.arms, g.step.moves, g.options, strict=True)
@@ -399,6 +481,49 @@ class SdarSolver:
         self._apply(voc.move, g.d_pick, t2, g.d_place)
         record.motions += 1
         self._gripper("place", g, targets, [o.place for o in g.options], g.d_place)
+        return True
+
+    def _execute_one_arm(self, g: _Grounding, record: _TaskRecord) -> bool:
+        """Execute ``g.sequence``: before each gripper action one motion brings the acting arm
+        to its configuration and the other home, one arm at a time (the motion stream's
+        planner moves them in turn). Every motion is planned, in the state it starts from,
+        before any action is applied."""
+        voc = self.voc
+        poses = self._current_poses()
+        held: dict[str, tuple[str, str]] = {}  # arm -> (object, grasp)
+        d = self._current_dualconf()
+        actions: list[tuple[str, tuple[str, ...]]] = []
+        for event in g.sequence:
+            k = event.index
+            arm, move, option = g.arms[k], g.step.moves[k], g.options[k]
+            if d != event.conf:
+                fluents = tuple(sorted(
+                    [Atom(voc.atpose, (o, p)) for o, p in poses.items()]
+                    + [Atom(voc.holding, (a, o, grasp)) for a, (o, grasp) in held.items()],
+                    key=str,
+                ))  # fmt: skip
+                t = self._motion(d, event.conf, record, fluents)
+                if t is None:
+                    self._why(g.step, g.arms, f"no one-arm motion for {self._show(arm)}")
+                    return False
+                actions.append((voc.move, (d, t, event.conf)))
+                d = event.conf
+            if event.pick:
+                pose = poses.pop(move.obj)
+                held[arm] = (move.obj, option.grasp)
+                actions.append((voc.pick, (arm, move.obj, pose, option.grasp, option.pick, d)))
+            else:
+                for other, pose in poses.items():  # certify what the placement needs
+                    self._test(voc.cfree, (move.obj, option.target, other, pose))
+                poses[move.obj] = option.target
+                del held[arm]
+                actions.append(
+                    (voc.place, (arm, move.obj, option.target, option.grasp, option.place, d))
+                )
+        for name, args in actions:
+            self._apply(name, *args)
+            if name == voc.move:
+                record.motions += 1
         return True
 
     def _placeable(self, g: _Grounding, targets: Sequence[str]) -> bool:

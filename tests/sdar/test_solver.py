@@ -219,3 +219,54 @@ def test_same_seed_gives_the_same_plan(ctx: WorldContext, planner: DualMotionPla
     assert [(e.t, e.arm, e.type, e.object) for e in a.events] == [
         (e.t, e.arm, e.type, e.object) for e in b.events
     ]
+
+
+@pytest.mark.parametrize(("task_planner", "instance"), [("baseline", _three), ("sdar", _swap)])
+def test_baseline_motion_planner_works_one_arm_at_a_time(
+    ctx: WorldContext, planner: DualMotionPlanner, task_planner: str, instance: Any
+) -> None:
+    """The baseline motion planner: one arm moves at a time, and at every gripper action the
+    other arm waits at its retract (home) pose; a swap has one arm hold its object at home."""
+    r = rearrangement_problem(instance(), ctx, planner=planner, motion="sequential")
+    solution = solve_rearrangement(r, task_planner, 60.0)
+    assert solution.status is Status.SOLVED and solution.plan is not None
+    names = [a.name for a in solution.plan]
+    assert "pick-both" not in names and "place-both" not in names
+    plan = plan_file_from_solution(r, solution)
+    assert validate_plan(r.instance, plan, ctx.scene).ok
+    moving = np.abs(np.diff(plan.q, axis=0)) > 1e-9
+    assert not np.any(moving[:, :6].any(axis=1) & moving[:, 6:].any(axis=1))
+    home = [arm.home for arm in plan.arms]
+    for event in plan.events:
+        k = int(np.searchsorted(plan.t, event.t))
+        other = 1 if event.arm == plan.arms[0].name else 0
+        np.testing.assert_allclose(plan.q[k, 6 * other : 6 * other + 6], home[other], atol=1e-9)
+    if task_planner == "sdar":  # the swap: a picks, b picks, b is placed, then a
+        kinds = [(e.type, e.object) for e in plan.events]
+        first = kinds[0][1]
+        second = "b" if first == "a" else "a"
+        assert kinds == [("grasp", first), ("grasp", second), ("release", second),
+                         ("release", first)]  # fmt: skip
+
+
+def test_colliding_first_grasps_widen_the_options(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    """D5 is two 2-cycles and a free object. With the first two grasp options per arm, the
+    arms collide at every swap and SDAR-M falls back to buffers and single moves; with the
+    widened options both swaps are dual-arm steps."""
+    from sdar_tamp.world.instance import load_instance
+    from sdar_tamp.world.suites import shipped_suite_dir
+    from solvers.sdar.planners import make_task_planner
+    from solvers.sdar.solver import SdarOptions, SdarSolver
+
+    instance = load_instance(shipped_suite_dir("paper") / "D5.yaml")
+    kinds: dict[int, list[str]] = {}
+    for more in (2, 6):
+        r = rearrangement_problem(instance, ctx, planner=planner)
+        options = SdarOptions(max_time=60.0, more_options=more)
+        solution = SdarSolver(r.problem, make_task_planner("sdar"), options).solve()
+        assert solution.status is Status.SOLVED
+        kinds[more] = [t["kind"] for t in solution.trace]
+    assert "swap" not in kinds[2] and any(t.startswith("buffer") for t in kinds[2])
+    assert kinds[6].count("swap") == 2 and len(kinds[6]) < len(kinds[2])

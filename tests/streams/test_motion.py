@@ -90,7 +90,7 @@ def test_blocked_straight_line_is_detected_and_a_fallback_takes_over(
     configure_world(ctx, planner.world, objects, {}, BLOCKED_START)
     retreat, approach = planner.phases(request) or (None, None)
     assert retreat is not None and approach is not None
-    straight = straight_line(retreat[-1], approach[0], 30)
+    straight = straight_line(retreat[-1][-1], approach[0][0], 30)
     assert not validate_trajectory(ctx, planner.world, straight).ok  # detected
 
     only_straight = plan_dual_motion(planner, request, strategies=[StraightLine()])
@@ -113,17 +113,27 @@ def test_sequential_only_moves_one_arm_at_a_time(
     q_goal = _pick_goal(ctx, objects, names[2], names[7])
     request = MotionRequest(_home12(ctx), q_goal, objects)
     result = plan_dual_motion(planner, request, sequential_only=True)
-    assert result.success and result.level == "sequential" and result.trajectory is not None
+    assert result.success and result.level == "one-arm" and result.trajectory is not None
     q = result.trajectory.q
     moving = np.abs(np.diff(q, axis=0)) > 1e-9
     assert not np.any(moving[:, :6].any(axis=1) & moving[:, 6:].any(axis=1))
     _check(ctx, result.trajectory.t, q, request)
+    # back: both arms retreat from their picks and go home, still one at a time, the arm
+    # reaching deeper into the other's half first
+    back = MotionRequest(q_goal, _home12(ctx), objects, retreat=(True, True))
+    result = plan_dual_motion(planner, back, sequential_only=True)
+    assert result.success and result.trajectory is not None
+    q = result.trajectory.q
+    moving = np.abs(np.diff(q, axis=0)) > 1e-9
+    assert not np.any(moving[:, :6].any(axis=1) & moving[:, 6:].any(axis=1))
+    assert moving[:, :6].any() and moving[:, 6:].any()
+    _check(ctx, result.trajectory.t, q, back)
 
 
 def test_strategy_ladders() -> None:
     assert [s.name for s in default_strategies()] == ["plain", "untangle", "sequential"]
     assert [s.name for s in default_strategies(fallbacks=False)] == ["plain"]
-    assert [s.name for s in default_strategies(sequential_only=True)] == ["sequential"]
+    assert [s.name for s in default_strategies(sequential_only=True)] == ["one-arm"]
 
 
 def test_optimiser_is_reused_and_deterministic(
