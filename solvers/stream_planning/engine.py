@@ -3,8 +3,14 @@
 Real facts have complexity levels: init facts are level 0; a result of an instance whose domain
 facts reach level ``d`` and that was called ``k`` times before has level ``d + k + 1``.
 ``:function`` and ``:predicate`` instances are evaluated as soon as their domain holds (they are
-cheap, and negated predicates need their value); ``:rule`` facts are added at once. A
-``:fluents`` stream is called with ``fluents=`` the initial state's facts of those predicates.
+cheap, and negated predicates need their value); ``:rule`` facts are added at once.
+
+A ``:fluents`` stream has one instance per input tuple and fluent state. The instance made when
+its domain first holds sees the initial state's facts of its fluent predicates; the focused
+algorithms ask for more (:meth:`Engine.fluent_instance`) with the state of the plan step that
+uses the output. Their certified facts join the one global fact base, as in PDDLStream: they are
+about new output objects (a trajectory valid among the objects as they were at that step), so
+the stream's author must not certify facts about input objects that depend on the state.
 """
 
 from __future__ import annotations
@@ -88,6 +94,10 @@ class Engine:
         self.store = FactStore()
         self.numeric: dict[tuple[str, tuple[str, ...]], float] = dict(problem.facts.numeric)
         self.instances: dict[tuple[str, tuple[str, ...]], InstanceState] = {}
+        # fluent instances for states other than the initial one, and the calls made on all
+        # instances of a (fluent stream, inputs) pair: the pair's complexity counts them all
+        self.variants: dict[tuple[str, tuple[str, ...], tuple[Atom, ...]], InstanceState] = {}
+        self.fluent_calls: dict[tuple[str, tuple[str, ...]], int] = {}
         queries = [
             Query(s.name, s.declaration.inputs, s.declaration.domain) for s in self.streams.values()
         ]
@@ -154,11 +164,7 @@ class Engine:
         return derived  # rules and predicates take the level of the fact that completed them
 
     def _fluents(self, external: StreamExternal) -> tuple[Atom, ...]:
-        """The facts a fluent stream sees: the initial state's facts of its ``:fluents``.
-
-        (Instances are shared by every plan, so they see the initial state, not the state at
-        the plan step that uses their output.)
-        """
+        """The initial state's facts of a stream's ``:fluents`` (what its first instance sees)."""
         wanted = set(external.declaration.fluents)
         if not wanted:
             return ()
@@ -170,6 +176,10 @@ class Engine:
         """Call one instance once; True when it produced an output (or, for a test, passed)."""
         instance = state.instance
         level = state.next_level
+        if instance.external.declaration.fluents:
+            key = (instance.external.name, instance.inputs)
+            level = state.domain_level + self.fluent_calls.get(key, 0) + 1
+            self.fluent_calls[key] = self.fluent_calls.get(key, 0) + 1
         results, wild = instance.next(self.table)
         facts = [atom for result in results for atom in result.certified]
         self.add_facts([*facts, *wild], level)
@@ -177,6 +187,35 @@ class Engine:
 
     def instance(self, name: str, inputs: tuple[str, ...]) -> InstanceState | None:
         return self.instances.get((name, inputs))
+
+    def fluent_instance(
+        self, name: str, inputs: tuple[str, ...], fluents: tuple[Atom, ...]
+    ) -> InstanceState | None:
+        """The instance of a fluent stream on ``inputs`` that sees ``fluents`` (real facts of
+        its fluent predicates, sorted); None when its domain does not hold."""
+        base = self.instances.get((name, inputs))
+        if base is None or base.instance.fluents == fluents:
+            return base
+        key = (name, inputs, fluents)
+        state = self.variants.get(key)
+        if state is None:
+            instance = StreamInstance(base.instance.external, inputs, fluents)
+            state = self.variants[key] = InstanceState(instance, base.domain_level)
+        return state
+
+    def calls(self, state: InstanceState) -> int:
+        """Calls that count for an instance's complexity: for a fluent stream, those made in
+        every state."""
+        instance = state.instance
+        if not instance.external.declaration.fluents:
+            return instance.calls
+        return self.fluent_calls.get((instance.external.name, instance.inputs), 0)
+
+    def disable(self, state: InstanceState) -> None:
+        """Disable an instance until the complexity level rises; for a fluent instance, its
+        (stream, inputs) pair, which is what the optimistic world offers."""
+        base = self.instances.get((state.instance.external.name, state.instance.inputs), state)
+        base.instance.disabled = True
 
 
 def cost_functions(domain: Domain) -> frozenset[str]:
