@@ -38,6 +38,7 @@ from solvers.stream_planning.costs import guard_costs, has_costs
 from solvers.stream_planning.diagnosis import diagnose
 from solvers.stream_planning.engine import Engine, InstanceState
 from solvers.stream_planning.fluents import Fluents, fluent_plan
+from solvers.stream_planning.negation import check_negated_uses
 from solvers.stream_planning.optimistic import (
     OptimisticBuilder,
     OptimisticWorld,
@@ -103,10 +104,12 @@ class StreamSolver:
         self.problem = problem
         self.options = options
         self.start = time.perf_counter()
-        self.engine = Engine(problem, stream_info)
         self.domain: Domain = guard_costs(problem.domain)
         self.goal = problem.facts.goal
-        self.builder = OptimisticBuilder(self.engine, negated_predicates(problem.domain, self.goal))
+        negated = negated_predicates(problem.domain, self.goal)
+        check_negated_uses(problem.streams.streams, stream_info, negated)
+        self.engine = Engine(problem, stream_info)
+        self.builder = OptimisticBuilder(self.engine, negated)
         self.stats: dict[str, float] = {
             "iterations": 0,
             "skeletons": 0,
@@ -429,7 +432,7 @@ class StreamSolver:
             name: StreamStatistics(c.calls, c.successes, c.outputs, c.time)
             for name, c in (
                 *((n, e.counters) for n, e in engine.streams.items()),
-                *((n, e.counters) for n, e in engine.functions.items()),
+                *((e.stream or n, e.counters) for n, e in engine.functions.items()),
             )
         }
         self.stats["time"] = time.perf_counter() - self.start

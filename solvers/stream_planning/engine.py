@@ -40,11 +40,12 @@ from solvers.stream_planning.externals import (
     debug_gen_fn,
 )
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
+from solvers.stream_planning.negation import split_negated
 
 LOG = logging.getLogger(__name__)
-# Options the algorithms act on; any other option set to a non-default value is logged as
-# not implemented (negate, simultaneous, defer_fn, ...). p_success, overhead and effort act
-# through solve(effort_weight=...).
+# Options every solver acts on; any other option set to a non-default value is logged as
+# not implemented (simultaneous, defer_fn, ...). p_success, overhead and effort act through
+# solve(effort_weight=...). The stream algorithms also act on negate (see negation.py).
 SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn", "eager", "p_success", "overhead", "effort"}
 #: Calls of eager stream instances one engine makes at most (a generator feeding its own
 #: inputs would otherwise never stop).
@@ -83,7 +84,12 @@ class Engine:
         self._eager: list[InstanceState] = []  # eager instances not called yet
         self._draining = False
         self.eager_calls = 0
-        self.streams, functions = bind_externals(problem, stream_info)
+        streams_bound, functions = bind_externals(
+            problem, stream_info, SUPPORTED_STREAM_OPTIONS | {"negate"}
+        )
+        debug = isinstance(problem.stream_map, str)
+        self.streams, negated = split_negated(streams_bound, functions, debug)
+        functions.update(negated)
         used = cost_functions(problem.domain)
         # a :function no action's cost mentions cannot change a plan: it is never evaluated
         self.functions = {
@@ -229,11 +235,14 @@ def cost_functions(domain: Domain) -> frozenset[str]:
 
 
 def bind_externals(
-    problem: PDDLProblem, stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None
+    problem: PDDLProblem,
+    stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None,
+    supported: set[str] = SUPPORTED_STREAM_OPTIONS,
 ) -> tuple[dict[str, StreamExternal], dict[str, FunctionExternal]]:
-    """The problem's streams and functions bound to their callables (or the debug ones)."""
+    """The problem's streams and functions bound to their callables (or the debug ones);
+    stream options outside ``supported`` are logged as not implemented."""
     info = {k.lower(): v for k, v in (stream_info or {}).items()}
-    _warn_unsupported(info)
+    _warn_unsupported(info, supported)
     debug = isinstance(problem.stream_map, str)
     functions = problem.stream_functions
     streams = problem.streams
@@ -274,12 +283,12 @@ def _as_stream_info(info: StreamInfo | FunctionInfo | None) -> StreamInfo:
     return info if isinstance(info, StreamInfo) else StreamInfo()
 
 
-def _warn_unsupported(info: Mapping[str, StreamInfo | FunctionInfo]) -> None:
+def _warn_unsupported(
+    info: Mapping[str, StreamInfo | FunctionInfo], stream_options: set[str]
+) -> None:
     for name, options in info.items():
         supported = (
-            SUPPORTED_STREAM_OPTIONS
-            if isinstance(options, StreamInfo)
-            else SUPPORTED_FUNCTION_OPTIONS
+            stream_options if isinstance(options, StreamInfo) else SUPPORTED_FUNCTION_OPTIONS
         )
         if isinstance(options, StreamInfo) and callable(options.opt_gen_fn):
             LOG.warning(

@@ -340,12 +340,11 @@ def test_supported_stream_info_logs_nothing(caplog: pytest.LogCaptureFixture) ->
 
 
 def test_cost_model_options_are_accepted(caplog: pytest.LogCaptureFixture) -> None:
-    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True, negate=True)}
+    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True)}
     with caplog.at_level(logging.WARNING):
         assert solve(line_problem(counting()), stream_info=info, verbose=False).solved
     for option in ("p_success", "overhead", "eager"):
         assert f"stream_info['sample-pose'].{option}" not in caplog.text
-    assert "stream_info['sample-pose'].negate" in caplog.text  # not acted on
 
 
 TWO_SAMPLERS = (
