@@ -33,7 +33,8 @@ class StreamInfo:
         effort: fixed effort used in place of the one derived from p_success and overhead.
         opt_gen_fn: placeholder outputs: ``"unique"`` (default, one per instance) or
             ``"shared"`` (one per stream); a callable is accepted but not used yet.
-        negate: for tests/predicates: the certified fact may be used negated.
+        negate: for a test stream certifying one fact over its inputs: the domain may use
+            that fact negated; ``(not (fact ...))`` holds where the test returns False.
         simultaneous: evaluate all instances of this stream together.
         verbose: log each call.
         defer_fn: decides whether the stream is evaluated only after a plan is found.

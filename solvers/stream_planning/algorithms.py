@@ -10,6 +10,10 @@
 - adaptive: binding with a queue of skeletons (optimistic plans) that are revisited; after each
   search, each queued skeleton is worked on about ``search_sample_ratio`` times. The balance is
   counted in visits, not measured in seconds, so a seeded run is reproducible.
+
+A ``:fluents`` stream is called, in focused, binding and adaptive, with the fluent facts of the
+state in which the optimistic plan first needs its certified facts (:mod:`.fluents`);
+incremental samples before it has a plan, so it calls them with the initial state's facts.
 """
 
 from __future__ import annotations
@@ -32,7 +36,9 @@ from solvers.solution import Action, Certificate, Solution, Status, StreamStatis
 from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.costs import guard_costs, has_costs
 from solvers.stream_planning.diagnosis import diagnose
-from solvers.stream_planning.engine import Engine
+from solvers.stream_planning.engine import Engine, InstanceState
+from solvers.stream_planning.fluents import Fluents, fluent_plan
+from solvers.stream_planning.negation import check_negated_uses
 from solvers.stream_planning.optimistic import (
     OptimisticBuilder,
     OptimisticWorld,
@@ -79,6 +85,7 @@ class Skeleton:
     stream_plan: list[OptResult] = field(compare=False)
     attempts: int = field(default=0, compare=False)
     chosen: dict[int, tuple[str, ...]] = field(default_factory=dict, compare=False)
+    fluents: dict[int, Fluents] = field(default_factory=dict, compare=False)
 
 
 class _Timeout(Exception):
@@ -97,10 +104,12 @@ class StreamSolver:
         self.problem = problem
         self.options = options
         self.start = time.perf_counter()
-        self.engine = Engine(problem, stream_info)
         self.domain: Domain = guard_costs(problem.domain)
         self.goal = problem.facts.goal
-        self.builder = OptimisticBuilder(self.engine, negated_predicates(problem.domain, self.goal))
+        negated = negated_predicates(problem.domain, self.goal)
+        check_negated_uses(problem.streams.streams, stream_info, negated)
+        self.engine = Engine(problem, stream_info)
+        self.builder = OptimisticBuilder(self.engine, negated)
         self.stats: dict[str, float] = {
             "iterations": 0,
             "skeletons": 0,
@@ -175,6 +184,9 @@ class StreamSolver:
         state = self.engine.instance(name, inputs)
         if state is None:
             return None
+        return self._sample_state(state)
+
+    def _sample_state(self, state: InstanceState) -> bool:
         start = time.perf_counter()
         produced = self.engine.sample(state)
         self.stats["sample_time"] += time.perf_counter() - start
@@ -268,7 +280,9 @@ class StreamSolver:
             check = simulate(
                 self.problem.domain, self._objects(world.facts), world.facts, actions, self.goal
             )
-            stream_plan = extract_stream_plan(check.needed, world)
+            declared = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
+            ordered = fluent_plan(extract_stream_plan(check.needed, world), check, declared)
+            stream_plan = ordered.stream_plan
             if not any(r.kind == "stream" for r in stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
             ):
@@ -285,10 +299,12 @@ class StreamSolver:
                 efforts = {n: e.info for n, e in self.engine.streams.items()}
                 effort = stream_plan_effort(stream_plan, efforts, options.unit_efforts)
                 priority += options.effort_weight * effort
-            skeleton = Skeleton((0, priority, self._order), actions, stream_plan)
+            skeleton = Skeleton(
+                (0, priority, self._order), actions, stream_plan, fluents=ordered.fluents
+            )
             self._order += 1
             if options.algorithm == "focused":
-                self._sample_first_layer(stream_plan)
+                self._sample_first_layer(skeleton)
             elif options.algorithm == "binding":
                 if self._process(skeleton) is True:
                     return Status.SOLVED
@@ -297,15 +313,37 @@ class StreamSolver:
                 if self._process_queue():
                     return Status.SOLVED
 
-    def _sample_first_layer(self, stream_plan: Sequence[OptResult]) -> None:
-        for result in stream_plan:
+    def _sample_first_layer(self, skeleton: Skeleton) -> None:
+        for index, result in enumerate(skeleton.stream_plan):
             if result.kind != "stream" or any(is_placeholder(n) for n in result.inputs):
                 continue
+            state = self._instance(skeleton, index, result.inputs, {})
+            if state is None:
+                continue
             self._check_time()
-            produced = self._sample(result.external, result.inputs)
-            state = self.engine.instance(result.external, result.inputs)
-            if produced is False and state is not None:
-                state.instance.disabled = True
+            if not self._sample_state(state):
+                self.engine.disable(state)
+
+    def _instance(
+        self, skeleton: Skeleton, index: int, inputs: tuple[str, ...], bindings: Mapping[str, str]
+    ) -> InstanceState | None:
+        """The real instance for stream step ``index`` on ``inputs``: for a fluent stream, the
+        one seeing that step's fluent facts. None when it does not exist (yet)."""
+        name = skeleton.stream_plan[index].external
+        if index not in skeleton.fluents:
+            return self.engine.instance(name, inputs)
+        fluents = tuple(
+            sorted(
+                (
+                    Atom(a.predicate, tuple(bindings.get(n, n) for n in a.args))
+                    for a in skeleton.fluents[index]
+                ),
+                key=str,
+            )
+        )
+        if any(is_placeholder(n) for a in fluents for n in a.args):
+            return None
+        return self.engine.fluent_instance(name, inputs, fluents)
 
     def _process_queue(self) -> bool:
         """Work on queued skeletons, ``search_sample_ratio`` visits each; True when solved."""
@@ -345,16 +383,16 @@ class StreamSolver:
             if result.kind in ("rule", "function"):
                 continue
             self._check_time()
-            state = self.engine.instance(result.external, inputs)
+            state = self._instance(skeleton, index, inputs, bindings)
             if state is None:
                 return None
             if index not in skeleton.chosen:
                 before = len(state.instance.results)
                 if not state.instance.exhausted:
-                    self._sample(result.external, inputs)
+                    self._sample_state(state)
                 if len(state.instance.results) == before:
                     if self.options.algorithm == "binding":
-                        state.instance.disabled = True
+                        self.engine.disable(state)
                     if not state.instance.exhausted:
                         return False
                     return self._upstream_retry(skeleton, index)
@@ -394,7 +432,7 @@ class StreamSolver:
             name: StreamStatistics(c.calls, c.successes, c.outputs, c.time)
             for name, c in (
                 *((n, e.counters) for n, e in engine.streams.items()),
-                *((n, e.counters) for n, e in engine.functions.items()),
+                *((e.stream or n, e.counters) for n, e in engine.functions.items()),
             )
         }
         self.stats["time"] = time.perf_counter() - self.start

@@ -21,6 +21,7 @@ def _produced_predicates(solver: StreamSolver) -> set[str]:
     produced |= {axiom.predicate for axiom in domain.axioms}
     for external in solver.engine.streams.values():
         produced |= {a.predicate for a in external.declaration.certified}
+    produced |= {f.name for f in solver.engine.functions.values() if f.is_predicate}
     produced |= set(domain.types.parents)
     produced.add("=")
     return produced

@@ -3,8 +3,14 @@
 Real facts have complexity levels: init facts are level 0; a result of an instance whose domain
 facts reach level ``d`` and that was called ``k`` times before has level ``d + k + 1``.
 ``:function`` and ``:predicate`` instances are evaluated as soon as their domain holds (they are
-cheap, and negated predicates need their value); ``:rule`` facts are added at once. A
-``:fluents`` stream is called with ``fluents=`` the initial state's facts of those predicates.
+cheap, and negated predicates need their value); ``:rule`` facts are added at once.
+
+A ``:fluents`` stream has one instance per input tuple and fluent state. The instance made when
+its domain first holds sees the initial state's facts of its fluent predicates; the focused
+algorithms ask for more (:meth:`Engine.fluent_instance`) with the state of the plan step that
+uses the output. Their certified facts join the one global fact base, as in PDDLStream: they are
+about new output objects (a trajectory valid among the objects as they were at that step), so
+the stream's author must not certify facts about input objects that depend on the state.
 """
 
 from __future__ import annotations
@@ -34,11 +40,12 @@ from solvers.stream_planning.externals import (
     debug_gen_fn,
 )
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
+from solvers.stream_planning.negation import split_negated
 
 LOG = logging.getLogger(__name__)
-# Options the algorithms act on; any other option set to a non-default value is logged as
-# not implemented (negate, simultaneous, defer_fn, ...). p_success, overhead and effort act
-# through solve(effort_weight=...).
+# Options every solver acts on; any other option set to a non-default value is logged as
+# not implemented (simultaneous, defer_fn, ...). p_success, overhead and effort act through
+# solve(effort_weight=...). The stream algorithms also act on negate (see negation.py).
 SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn", "eager", "p_success", "overhead", "effort"}
 #: Calls of eager stream instances one engine makes at most (a generator feeding its own
 #: inputs would otherwise never stop).
@@ -77,7 +84,12 @@ class Engine:
         self._eager: list[InstanceState] = []  # eager instances not called yet
         self._draining = False
         self.eager_calls = 0
-        self.streams, functions = bind_externals(problem, stream_info)
+        streams_bound, functions = bind_externals(
+            problem, stream_info, SUPPORTED_STREAM_OPTIONS | {"negate"}
+        )
+        debug = isinstance(problem.stream_map, str)
+        self.streams, negated = split_negated(streams_bound, functions, debug)
+        functions.update(negated)
         used = cost_functions(problem.domain)
         # a :function no action's cost mentions cannot change a plan: it is never evaluated
         self.functions = {
@@ -88,6 +100,10 @@ class Engine:
         self.store = FactStore()
         self.numeric: dict[tuple[str, tuple[str, ...]], float] = dict(problem.facts.numeric)
         self.instances: dict[tuple[str, tuple[str, ...]], InstanceState] = {}
+        # fluent instances for states other than the initial one, and the calls made on all
+        # instances of a (fluent stream, inputs) pair: the pair's complexity counts them all
+        self.variants: dict[tuple[str, tuple[str, ...], tuple[Atom, ...]], InstanceState] = {}
+        self.fluent_calls: dict[tuple[str, tuple[str, ...]], int] = {}
         queries = [
             Query(s.name, s.declaration.inputs, s.declaration.domain) for s in self.streams.values()
         ]
@@ -154,11 +170,7 @@ class Engine:
         return derived  # rules and predicates take the level of the fact that completed them
 
     def _fluents(self, external: StreamExternal) -> tuple[Atom, ...]:
-        """The facts a fluent stream sees: the initial state's facts of its ``:fluents``.
-
-        (Instances are shared by every plan, so they see the initial state, not the state at
-        the plan step that uses their output.)
-        """
+        """The initial state's facts of a stream's ``:fluents`` (what its first instance sees)."""
         wanted = set(external.declaration.fluents)
         if not wanted:
             return ()
@@ -170,6 +182,10 @@ class Engine:
         """Call one instance once; True when it produced an output (or, for a test, passed)."""
         instance = state.instance
         level = state.next_level
+        if instance.external.declaration.fluents:
+            key = (instance.external.name, instance.inputs)
+            level = state.domain_level + self.fluent_calls.get(key, 0) + 1
+            self.fluent_calls[key] = self.fluent_calls.get(key, 0) + 1
         results, wild = instance.next(self.table)
         facts = [atom for result in results for atom in result.certified]
         self.add_facts([*facts, *wild], level)
@@ -177,6 +193,35 @@ class Engine:
 
     def instance(self, name: str, inputs: tuple[str, ...]) -> InstanceState | None:
         return self.instances.get((name, inputs))
+
+    def fluent_instance(
+        self, name: str, inputs: tuple[str, ...], fluents: tuple[Atom, ...]
+    ) -> InstanceState | None:
+        """The instance of a fluent stream on ``inputs`` that sees ``fluents`` (real facts of
+        its fluent predicates, sorted); None when its domain does not hold."""
+        base = self.instances.get((name, inputs))
+        if base is None or base.instance.fluents == fluents:
+            return base
+        key = (name, inputs, fluents)
+        state = self.variants.get(key)
+        if state is None:
+            instance = StreamInstance(base.instance.external, inputs, fluents)
+            state = self.variants[key] = InstanceState(instance, base.domain_level)
+        return state
+
+    def calls(self, state: InstanceState) -> int:
+        """Calls that count for an instance's complexity: for a fluent stream, those made in
+        every state."""
+        instance = state.instance
+        if not instance.external.declaration.fluents:
+            return instance.calls
+        return self.fluent_calls.get((instance.external.name, instance.inputs), 0)
+
+    def disable(self, state: InstanceState) -> None:
+        """Disable an instance until the complexity level rises; for a fluent instance, its
+        (stream, inputs) pair, which is what the optimistic world offers."""
+        base = self.instances.get((state.instance.external.name, state.instance.inputs), state)
+        base.instance.disabled = True
 
 
 def cost_functions(domain: Domain) -> frozenset[str]:
@@ -190,11 +235,14 @@ def cost_functions(domain: Domain) -> frozenset[str]:
 
 
 def bind_externals(
-    problem: PDDLProblem, stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None
+    problem: PDDLProblem,
+    stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None,
+    supported: set[str] = SUPPORTED_STREAM_OPTIONS,
 ) -> tuple[dict[str, StreamExternal], dict[str, FunctionExternal]]:
-    """The problem's streams and functions bound to their callables (or the debug ones)."""
+    """The problem's streams and functions bound to their callables (or the debug ones);
+    stream options outside ``supported`` are logged as not implemented."""
     info = {k.lower(): v for k, v in (stream_info or {}).items()}
-    _warn_unsupported(info)
+    _warn_unsupported(info, supported)
     debug = isinstance(problem.stream_map, str)
     functions = problem.stream_functions
     streams = problem.streams
@@ -235,12 +283,12 @@ def _as_stream_info(info: StreamInfo | FunctionInfo | None) -> StreamInfo:
     return info if isinstance(info, StreamInfo) else StreamInfo()
 
 
-def _warn_unsupported(info: Mapping[str, StreamInfo | FunctionInfo]) -> None:
+def _warn_unsupported(
+    info: Mapping[str, StreamInfo | FunctionInfo], stream_options: set[str]
+) -> None:
     for name, options in info.items():
         supported = (
-            SUPPORTED_STREAM_OPTIONS
-            if isinstance(options, StreamInfo)
-            else SUPPORTED_FUNCTION_OPTIONS
+            stream_options if isinstance(options, StreamInfo) else SUPPORTED_FUNCTION_OPTIONS
         )
         if isinstance(options, StreamInfo) and callable(options.opt_gen_fn):
             LOG.warning(

@@ -205,6 +205,7 @@ class FunctionExternal:
     info: FunctionInfo | StreamInfo
     counters: Counters = field(default_factory=Counters)
     values: dict[tuple[str, ...], float | bool] = field(default_factory=dict)
+    stream: str | None = None  # the test stream with ``negate=True`` this predicate stands for
 
     @property
     def name(self) -> str:
@@ -223,10 +224,10 @@ class FunctionExternal:
         if inputs in self.values:
             return self.values[inputs]
         values = tuple(table.value(n) for n in inputs)
-        what = (
-            f"{'predicate' if self.is_predicate else 'function'} {self.name!r} on inputs "
-            f"({', '.join(repr(v) for v in values)})"
-        )
+        kind = "predicate" if self.is_predicate else "function"
+        if self.stream is not None:
+            kind = f"negated test stream {self.stream!r} for predicate"
+        what = f"{kind} {self.name!r} on inputs ({', '.join(repr(v) for v in values)})"
         start = time.perf_counter()
         try:
             raw = self.fn(*values)

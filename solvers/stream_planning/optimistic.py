@@ -178,12 +178,13 @@ class OptimisticBuilder:
             state = engine.instance(name, inputs) if real else None
             next_level = level + 1
             if state is not None:
-                if state.instance.exhausted:
+                # a fluent instance exhausted in one state may still produce in another
+                if state.instance.exhausted and not external.declaration.fluents:
                     return []
                 if state.instance.disabled:
                     world.complete = False
                     return []
-                next_level = level + state.instance.calls + 1
+                next_level = level + engine.calls(state) + 1
             if next_level > limit:
                 world.complete = False
                 return []

@@ -39,12 +39,19 @@ Support = frozenset[Atom]
 @dataclass(frozen=True)
 class PlanCheck:
     """The outcome of :func:`simulate`: ``valid``, the failing step (or -1 for the goal), the
-    initial facts the plan needs, and the final state."""
+    initial facts the plan needs, and the final state.
+
+    ``states[k]`` is the state before step ``k`` and ``supports[k]`` the facts step ``k``'s
+    precondition and effect conditions rely on in it (for the steps simulated; when the plan
+    is valid, one more entry each: the final state and the goal's support).
+    """
 
     valid: bool
     failed_step: int | None
     needed: frozenset[Atom]
     final_state: frozenset[Atom]
+    states: tuple[frozenset[Atom], ...] = ()
+    supports: tuple[frozenset[Atom], ...] = ()
 
 
 class _Evaluator:
@@ -285,6 +292,14 @@ def simulate(
     state = frozenset(init)
     added: set[Atom] = set()
     needed: set[Atom] = set()
+    states: list[frozenset[Atom]] = []
+    supports: list[frozenset[Atom]] = []
+
+    def failed(step: int) -> PlanCheck:
+        return PlanCheck(
+            False, step, frozenset(needed - added), state, tuple(states), tuple(supports)
+        )
+
     for step, (name, args) in enumerate(plan):
         action = domain.action(name)
         evaluator = _Evaluator(domain, objects, state)
@@ -292,12 +307,14 @@ def simulate(
         if any(
             not evaluator.has_type(a, p.type) for p, a in zip(action.parameters, args, strict=True)
         ):
-            return PlanCheck(False, step, frozenset(needed - added), state)
+            return failed(step)
         support = evaluator.support(action.precondition, binding)
         if support is None:
-            return PlanCheck(False, step, frozenset(needed - added), state)
+            return failed(step)
         step_needed: set[Atom] = set(support)
         changes = list(_effects(evaluator, action.effect, binding, step_needed))
+        states.append(state)
+        supports.append(frozenset(step_needed))
         needed |= step_needed - added
         deletes = {atom for atom, negated in changes if negated}
         adds = {atom for atom, negated in changes if not negated}
@@ -306,6 +323,8 @@ def simulate(
     evaluator = _Evaluator(domain, objects, state)
     support = evaluator.support(goal, {})
     if support is None:
-        return PlanCheck(False, -1, frozenset(needed - added), state)
+        return failed(-1)
     needed |= support - added
-    return PlanCheck(True, None, frozenset(needed), state)
+    states.append(state)
+    supports.append(support)
+    return PlanCheck(True, None, frozenset(needed), state, tuple(states), tuple(supports))

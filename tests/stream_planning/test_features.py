@@ -277,9 +277,15 @@ def test_wild_output_facts_are_added(algorithm: str) -> None:
 # --- limits and arguments -----------------------------------------------------------------
 
 
-@pytest.mark.parametrize("algorithm", ["incremental", "adaptive"])
+@pytest.mark.parametrize("algorithm", ["incremental", "focused", "binding", "adaptive"])
 def test_max_time_is_honoured_on_an_unsolvable_infinite_problem(algorithm: str) -> None:
-    never = from_sampler(lambda b, r: (-1.0,))  # infinite, and the test below always fails
+    """Within 10 % of max_time, plus 0.05 s: a solve overruns by the one unit of work it cannot
+    interrupt (a sampler call, an optimistic world, the end of a search step), measured at up
+    to 0.05 s with the other core busy; the slack absorbs scheduling jitter of a loaded
+    2-core machine, not solver work."""
+    values = itertools.count()
+    # infinite and always new, and the test below always fails
+    never = from_sampler(lambda b, r: (-1.0 - next(values),))
     stream = """
     (define (stream line)
       (:stream sample-pose :inputs (?b ?r) :domain (and (block ?b) (region ?r))
@@ -289,10 +295,10 @@ def test_max_time_is_honoured_on_an_unsolvable_infinite_problem(algorithm: str) 
     """
     problem = line_problem(never, stream, **{"test-inside": from_test(lambda b, p, r: False)})
     start = time.perf_counter()
-    solution = solve(problem, algorithm=algorithm, max_time=1.0, verbose=False)
+    solution = solve(problem, algorithm=algorithm, max_time=1.5, verbose=False)
     elapsed = time.perf_counter() - start
     assert solution.status is Status.TIMEOUT
-    assert 0.9 <= elapsed <= 1.1
+    assert 1.5 <= elapsed < 1.5 * 1.1 + 0.05
     assert any("time limit" in reason for reason in solution.diagnosis)
 
 
@@ -340,12 +346,11 @@ def test_supported_stream_info_logs_nothing(caplog: pytest.LogCaptureFixture) ->
 
 
 def test_cost_model_options_are_accepted(caplog: pytest.LogCaptureFixture) -> None:
-    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True, negate=True)}
+    info = {"sample-pose": StreamInfo(p_success=0.5, overhead=0.1, eager=True)}
     with caplog.at_level(logging.WARNING):
         assert solve(line_problem(counting()), stream_info=info, verbose=False).solved
     for option in ("p_success", "overhead", "eager"):
         assert f"stream_info['sample-pose'].{option}" not in caplog.text
-    assert "stream_info['sample-pose'].negate" in caplog.text  # not acted on
 
 
 TWO_SAMPLERS = (
