@@ -11,7 +11,10 @@ whose current poses block the goal of ``x``. Rank classes (lower is better):
    objects, then remove more edges, come first, so chains are consumed from the leaf.
 2. ``cycle``: cycle breaking: ``x`` of a component of three or more objects goes to a buffer
    and an object ``i`` with ``B(i) = {x}`` (adjacent in the cycle) to its goal.
-3. ``cycle``: ``x`` to a buffer paired with an object whose goal is free anyway.
+3. ``cycle``: ``x`` to a buffer paired with an object whose goal is free anyway; also ``x``
+   of a 2-cycle paired with any object whose goal it alone blocks or that is free, for when
+   the swap of class 1 is geometrically impossible (two grippers closing on two neighbouring
+   objects collide). Such a step costs one buffer move, as the single-arm optimum does.
 4. ``cycle``: when no step of classes 1-3 exists, two objects ``x``, ``y`` to buffers, if one
    minimum buffer set holds both (``x`` among the three best optimal objects).
 5. ``cycle``: ``x`` alone, when no object can go to its goal in the same step.
@@ -140,6 +143,12 @@ class SdarTaskPlanner:
             if not partners and x in optimal:
                 key = (CYCLE_ALONE, *x_key)
                 out.append((key, Step((Move(x, to_buffer=True),), "cycle", CYCLE_ALONE)))
+        for x in self._two_cycle_members(view):
+            freed, removed = scene.frees(frozenset((x,)))
+            x_key = (-freed, -scene.preds[x], -removed, scene.order[x])
+            for i in (i for i in scene.names if i != x and scene.blockers[i] <= {x}):
+                key = (CYCLE_FREE, 1, *x_key, -scene.preds[i], scene.order[i])
+                out.append((key, Step((Move(i), Move(x, to_buffer=True)), "cycle", CYCLE_FREE)))
         if all(key[0] >= CYCLE_ALONE for key, _ in out) and not goal_pairs:
             firsts = sorted((x for x in breakable if x in optimal), key=x_keys.__getitem__)
             for x, y in self._double_buffers(view, firsts[:_DOUBLE_FIRSTS], firsts):
@@ -170,6 +179,13 @@ class SdarTaskPlanner:
                 self._choices[sub.names, sub.edges] = found
             optimal |= self._choices[sub.names, sub.edges]
         return frozenset(optimal), breakable
+
+    @staticmethod
+    def _two_cycle_members(view: TaskView) -> list[str]:
+        """Objects of the 2-cycles (their swap comes first; these breaks are for when two
+        grippers cannot close on the two neighbouring objects at once)."""
+        graph = view.graph
+        return [graph.names[v] for comp in graph.components() if len(comp) == 2 for v in comp]
 
     def _double_buffers(
         self, view: TaskView, firsts: list[str], optimal: list[str]
