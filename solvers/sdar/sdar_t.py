@@ -12,9 +12,10 @@ whose current poses block the goal of ``x``. Rank classes (lower is better):
 2. ``cycle``: cycle breaking: ``x`` of a component of three or more objects goes to a buffer
    and an object ``i`` with ``B(i) = {x}`` (adjacent in the cycle) to its goal.
 3. ``cycle``: ``x`` to a buffer paired with an object whose goal is free anyway; also ``x``
-   of a 2-cycle paired with any object whose goal it alone blocks or that is free, for when
-   the swap of class 1 is geometrically impossible (two grippers closing on two neighbouring
-   objects collide). Such a step costs one buffer move, as the single-arm optimum does.
+   of a 2-cycle proposed as a swap, paired with any object whose goal it alone blocks or
+   that is free, for when the swap is geometrically impossible (two grippers closing on two
+   neighbouring objects collide). Such a step costs one buffer move, as the single-arm
+   optimum does for that cycle.
 4. ``cycle``: when no step of classes 1-3 exists, two objects ``x``, ``y`` to buffers, if one
    minimum buffer set holds both (``x`` among the three best optimal objects).
 5. ``cycle``: ``x`` alone, when no object can go to its goal in the same step.
@@ -143,7 +144,7 @@ class SdarTaskPlanner:
             if not partners and x in optimal:
                 key = (CYCLE_ALONE, *x_key)
                 out.append((key, Step((Move(x, to_buffer=True),), "cycle", CYCLE_ALONE)))
-        for x in self._two_cycle_members(view):
+        for x in self._swappable(scene, view):
             freed, removed = scene.frees(frozenset((x,)))
             x_key = (-freed, -scene.preds[x], -removed, scene.order[x])
             for i in (i for i in scene.names if i != x and scene.blockers[i] <= {x}):
@@ -181,11 +182,18 @@ class SdarTaskPlanner:
         return frozenset(optimal), breakable
 
     @staticmethod
-    def _two_cycle_members(view: TaskView) -> list[str]:
-        """Objects of the 2-cycles (their swap comes first; these breaks are for when two
-        grippers cannot close on the two neighbouring objects at once)."""
+    def _swappable(scene: _Scene, view: TaskView) -> list[str]:
+        """Objects of the 2-cycles proposed as swaps (blocked by nothing else). The swap comes
+        first; breaking the cycle is for when two grippers cannot close on the two
+        neighbouring objects at once, and then costs the buffer move any plan needs."""
         graph = view.graph
-        return [graph.names[v] for comp in graph.components() if len(comp) == 2 for v in comp]
+        out: list[str] = []
+        for comp in graph.components():
+            if len(comp) == 2:
+                i, j = (graph.names[v] for v in comp)
+                if scene.blockers[i] <= {j} and scene.blockers[j] <= {i}:
+                    out += [i, j]
+        return out
 
     def _double_buffers(
         self, view: TaskView, firsts: list[str], optimal: list[str]
