@@ -476,8 +476,8 @@ def build_plan_file(
             raise ParameterError(
                 f"items[{n}]: the segment starts {jump:.3g} rad away from where the timeline stands"
             )
-        moving = np.abs(q - q[0]).max(axis=0) > 1e-9
-        dual += bool(moving[:6].any() and moving[6:].any())
+        moving = np.abs(np.diff(q, axis=0)) > 1e-9  # both arms moving at once
+        dual += bool(np.any(moving[:, :6].any(axis=1) & moving[:, 6:].any(axis=1)))
         steps.append(StepRecord(now, now + float(t[-1]), item.level, item.objects, item.kind))
         ts.append(now + t[1:])
         qs.append(q[1:])

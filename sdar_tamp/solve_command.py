@@ -125,7 +125,7 @@ def format_summary(outcome: SolveOutcome) -> str:
     lines = [
         head + (", plan valid" if outcome.valid else f", plan INVALID ({outcome.violation})"),
         f"  actions {m['actions']} ({f['buffer_moves']} to buffers), synchronous steps "
-        f"{m['steps']} ({m['dual_arm_steps']} with both arms moving)",
+        f"{m['steps']} ({m['dual_arm_steps']} with both arms moving at once)",
         f"  execution time {float(m['execution_time']):.2f} s",
         f"  planning time {f['planning_time']:.2f} s: selection/IK {f['selection_time']:.2f} s, "
         f"motion {f['motion_time']:.2f} s (setup {f['setup_time']:.2f} s not counted)",

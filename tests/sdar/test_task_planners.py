@@ -273,3 +273,23 @@ def test_an_invalid_planner_is_reported() -> None:
     bad = _Scripted([Step((Move("o0"),), "single")])
     with pytest.raises(AbstractRunError):
         run_abstract(bad, graph(2, [(0, 1)]))
+
+
+def test_a_swappable_two_cycle_may_also_be_broken_beside_another_goal_move() -> None:
+    # o0 <-> o1 swap first; if the grippers cannot close on both, o0 or o1 goes to a buffer
+    # while the free o2 (or the other member of the cycle) goes to its goal
+    view = view_of(graph(3, ((0, 1), (1, 0))), frozenset(), frozenset())
+    steps = SdarTaskPlanner().candidates(view)
+    assert steps[0].kind == "swap" and steps[0].rank == 1
+    breaks = [s for s in steps if s.kind == "cycle"]
+    assert breaks and all(s.rank == 3 and step_is_valid(s, view) for s in breaks)
+    pairs = {(m.obj, m.to_buffer) for s in breaks for m in s.moves}
+    assert {("o2", False), ("o0", True), ("o1", True)} <= pairs
+    # a 2-cycle that is not a swap (o0 also waits for o2) gets no such break
+    view = view_of(graph(3, ((0, 1), (1, 0), (0, 2))), frozenset(), frozenset())
+    assert not any(
+        m.to_buffer and m.obj == "o1" and len(s.moves) == 2
+        for s in SdarTaskPlanner().candidates(view)
+        if s.rank == 3
+        for m in s.moves
+    )
