@@ -158,13 +158,15 @@ def timeline(
 
 
 def step_times(solution: Solution) -> list[tuple[float, float]]:
-    """``(selection, motion)`` planning time [s] of every synchronous step (motion): a task's
-    selection time is shared equally by its motions."""
+    """``(selection, motion)`` planning time [s] of every synchronous step (motion). A task's
+    selection time and the time of the motions it tried in vain are shared equally by the
+    motions it executed, so the steps add up to the time of the decisions."""
     out: list[tuple[float, float]] = []
     for record in solution.trace:
         motions = list(record["motion_times"])
+        wasted = float(record["motion_time"]) - sum(motions)
         for m in motions:
-            out.append((record["selection_time"] / len(motions), m))
+            out.append((record["selection_time"] / len(motions), m + wasted / len(motions)))
     return out
 
 

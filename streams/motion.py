@@ -397,6 +397,26 @@ def default_strategies(
     return (PlainStrategy(), UntangleStrategy(), SequentialStrategy())
 
 
+def _clear_phases(
+    planner: DualMotionPlanner, request: MotionRequest, one_at_a_time: bool
+) -> tuple[list[FloatArray], list[FloatArray]] | str:
+    """Retreat and approach that are collision-free on their own (every strategy shares
+    them): synchronised, else one arm after the other; or why there are none."""
+    reason = "approach or retreat unreachable"
+    for chained in dict.fromkeys((one_at_a_time, True)):
+        phases = planner.phases(request, one_at_a_time=chained)
+        if phases is None:
+            return reason
+        for label, paths in zip(("retreat", "approach"), phases, strict=True):
+            report = validate_trajectory(planner.ctx, planner.world, np.concatenate(paths))
+            if not report.ok:
+                reason = f"{label} collides ({report.reason})"
+                break
+        else:
+            return phases
+    return reason
+
+
 def plan_dual_motion(
     planner: DualMotionPlanner,
     request: MotionRequest,
@@ -413,10 +433,10 @@ def plan_dual_motion(
     ctx = planner.ctx
     q_start = np.asarray(request.q_start, dtype=np.float64)
     configure_world(ctx, planner.world, request.objects, request.held, q_start)
-    phases = planner.phases(request, one_at_a_time=sequential_only and strategies is None)
-    if phases is None:
+    phases = _clear_phases(planner, request, sequential_only and strategies is None)
+    if isinstance(phases, str):
         return MotionResult(False, None, None, 0.0, time.perf_counter() - t0, (),
-                            reason="approach or retreat unreachable")  # fmt: skip
+                            reason=phases)  # fmt: skip
     retreat, approach = phases
     problem = planner.transfer_problem(request, retreat[-1][-1], approach[0][0])
     attempts: list[str] = []

@@ -46,6 +46,7 @@ STREAM_KINDS: Mapping[str, str] = MappingProxyType(
         "sample-buffer": "gen",
         "combine-confs": "gen",
         "plan-dual-motion": "gen",
+        "plan-dual-motion-quick": "gen",
         "test-overlap": "test",
         "test-cfree": "test",
         "Duration": "function",
@@ -212,6 +213,20 @@ class DualArmStreams:
     def plan_dual_motion(
         self, q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]] = ()
     ) -> Iterator[tuple[MotionResult]]:
+        """The motion planner of this map (``motion``): SDAR-M's ladder, plain or one arm."""
+        return self._motion(q1, q2, fluents, quick=False)
+
+    def plan_dual_motion_quick(
+        self, q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]] = ()
+    ) -> Iterator[tuple[MotionResult]]:
+        """The same motion without the fallbacks of SDAR-M's ladder (trajectory optimisation
+        alone): cheap to try and to fail. With ``motion`` plain or sequential it is the same
+        planner as :meth:`plan_dual_motion`."""
+        return self._motion(q1, q2, fluents, quick=True)
+
+    def _motion(
+        self, q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]], quick: bool
+    ) -> Iterator[tuple[MotionResult]]:
         objects = self.resting(fluents)
         held: dict[str, HeldObject] = {}
         for f in fluents:
@@ -226,7 +241,7 @@ class DualArmStreams:
         result = plan_dual_motion(
             self.planner,
             request,
-            fallbacks=self.motion == "sdar",
+            fallbacks=self.motion == "sdar" and not quick,
             sequential_only=self.motion == "sequential",
         )
         if result.success:
@@ -290,6 +305,7 @@ def make_stream_map(
         "sample-buffer": s.sample_buffer,
         "combine-confs": s.combine_confs,
         "plan-dual-motion": s.plan_dual_motion,
+        "plan-dual-motion-quick": s.plan_dual_motion_quick,
         "test-overlap": s.test_overlap,
         "test-cfree": s.test_cfree,
         "Duration": s.duration,

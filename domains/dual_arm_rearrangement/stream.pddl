@@ -28,6 +28,12 @@
     :inputs (?d1 ?d2) :domain (and (dualconf ?d1) (dualconf ?d2))
     :fluents (atpose holding)
     :outputs (?t) :certified (and (traj ?t) (motion ?d1 ?t ?d2)))
+  ; the same motion by trajectory optimisation alone (no fallbacks): cheap to try and to
+  ; fail, so SDAR-M asks it first for the best candidates before paying for the fallbacks
+  (:stream plan-dual-motion-quick
+    :inputs (?d1 ?d2) :domain (and (dualconf ?d1) (dualconf ?d2))
+    :fluents (atpose holding)
+    :outputs (?t) :certified (and (traj ?t) (motion ?d1 ?t ?d2)))
   ; footprint overlap of two object poses: the edges of the dependency graph
   (:stream test-overlap
     :inputs (?o ?p ?o2 ?p2) :domain (and (objpose ?o ?p) (objpose ?o2 ?p2))

@@ -52,7 +52,8 @@ class SdarOptions:
     more_options: int = 6  # kept instead when every pair of the first ones makes the arms collide
     expand_kinds: tuple[str, ...] = ("pair", "swap", "chain", "cycle")  # two-move steps
     buffers: int = 4  # buffer poses tried per buffer move
-    one_arm_at_a_time: bool = False  # the baseline motion planner (see _one_arm_sequence)
+    one_arm_at_a_time: bool = False  # the baseline motion planner (see _execute_one_arm)
+    quick_attempts: int = 6  # best-ranked groundings tried with the quick motion stream first
     progress: Callable[[int, int], None] | None = None  # (objects at goal, objects) per step
     vocabulary: SdarVocabulary = field(default_factory=SdarVocabulary)
 
@@ -77,6 +78,9 @@ class _Event:
 
 @dataclass(frozen=True)
 class _Grounding:
+    """A step with arms and options; ``d_pick`` / ``d_place``: the dual-arm configurations of
+    the first and of the last gripper action."""
+
     step: Step
     arms: tuple[str, ...]
     options: tuple[_Option, ...]
@@ -130,6 +134,9 @@ class SdarSolver:
         self.cost = 0.0
         self.records: list[_TaskRecord] = []
         self.tabu: set[tuple[Any, ...]] = set()
+        self.quick_tabu: set[tuple[Any, ...]] = set()  # failed with the quick motion stream
+        self._quick = False  # motions come from the quick motion stream
+        self._decision = (0.0, 0.0)  # (start [s], motion_time then) of the current decision
         self.failures: list[str] = []  # why candidates of the current decision failed
         self.evictions = 0
         self.deadline = math.inf
@@ -312,7 +319,8 @@ class SdarSolver:
         current = self._current_dualconf()
         found: list[_Grounding] = []
         for combo in _product(per_move):
-            if self._tabu_key(step, arms, combo) in self.tabu:
+            key = self._tabu_key(step, arms, combo)
+            if key in self.tabu or (self._quick and key in self.quick_tabu):
                 continue
             if self.options.one_arm_at_a_time:
                 one = self._ground_one_arm(step, arms, combo, current)
@@ -349,8 +357,8 @@ class SdarSolver:
         for event in sequence:
             estimate += self._distance(d0, event.conf)
             d0 = event.conf
-        first = sequence[0].conf
-        return _Grounding(step, arms, combo, first, sequence[-1].conf, estimate, tuple(sequence))
+        first, last = sequence[0].conf, sequence[-1].conf
+        return _Grounding(step, arms, combo, first, last, estimate, tuple(sequence))
 
     def _one_arm_order(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
         """``(move index, pick?)`` in execution order. A move whose target is clear of every
@@ -410,7 +418,8 @@ class SdarSolver:
         self, d1: str, d2: str, record: _TaskRecord, fluents: tuple[Atom, ...]
     ) -> str | None:
         start = time.perf_counter()
-        out = self._outputs(self.voc.motion, (d1, d2), 1, fluents)
+        stream = self.voc.quick_motion if self._quick else self.voc.motion
+        out = self._outputs(stream, (d1, d2), 1, fluents)
         elapsed = time.perf_counter() - start
         self.motion_time += elapsed
         if out:
@@ -549,6 +558,8 @@ class SdarSolver:
         status = Status.SOLVED
         diagnosis: list[str] = []
         while True:
+            # a decision's time, failed attempts included, is booked on the task it executes
+            self._decision = (time.perf_counter(), self.motion_time)
             view = self.view()
             if not view.remaining:
                 break
@@ -648,11 +659,29 @@ class SdarSolver:
         ] or list(candidates)
 
     def _step(self, view: TaskView, candidates: Sequence[Step], commit: bool = True) -> bool:
-        task_start = time.perf_counter()
-        motion_before = self.motion_time
+        """Execute the best grounding whose motions exist. With a quick motion stream, up to
+        ``quick_attempts`` groundings of the best rank are tried with it first (a cheap
+        motion for another grounding beats the fallbacks of the motion planner for the
+        first one); then every grounding with the full motion planner."""
+        try:
+            return self._try_groundings(view, candidates, commit)
+        finally:
+            self._quick = False
+
+    def _try_groundings(self, view: TaskView, candidates: Sequence[Step], commit: bool) -> bool:
+        task_start, motion_before = self._decision
         tried = 0
+        quick_left = self.options.quick_attempts if self.voc.quick_motion in self.streams else 0
+        best_rank: int | None = None
         while time.perf_counter() <= self.deadline:
+            self._quick = quick_left > 0
             groundings = self._select(candidates)
+            if self._quick:
+                if best_rank is None and groundings:
+                    best_rank = groundings[0].step.rank
+                if not groundings or groundings[0].step.rank != best_rank:
+                    quick_left = 0  # the best rank is used up: the full motion planner
+                    continue
             if not groundings:
                 return False
             g = groundings[0]
@@ -670,7 +699,11 @@ class SdarSolver:
                 if commit:
                     self.planner.commit(g.step, view)
                 return True
-            self.tabu.add(key)
+            if self._quick:
+                self.quick_tabu.add(key)
+                quick_left -= 1
+            else:
+                self.tabu.add(key)
         return False
 
     def _solution(self, status: Status, diagnosis: list[str], elapsed: float) -> Solution:

@@ -27,6 +27,7 @@ class SdarVocabulary:
     buffer: str = "sample-buffer"  # (?o) -> ?p, fluent atpose
     combine: str = "combine-confs"  # (?a1 ?q1 ?a2 ?q2) -> ?d
     motion: str = "plan-dual-motion"  # (?d1 ?d2) -> ?t, fluents atpose holding
+    quick_motion: str = "plan-dual-motion-quick"  # the same, cheaper and weaker (optional)
     distance: str = "distance"  # function (?d1 ?d2): estimated motion time (optional)
     # predicates and types
     atpose: str = "atpose"

@@ -273,3 +273,24 @@ def test_colliding_first_grasps_widen_the_options(
         buffered[more] = sum(sum(t["to_buffer"]) for t in solution.trace)
     assert "swap" not in kinds[2] and buffered[2] > 0  # the 2-cycles broken with buffers
     assert kinds[6].count("swap") == 2 and buffered[6] == 0
+
+
+def test_motions_come_from_the_quick_stream_first(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    """Where optimisation alone finds the motions, the full motion planner (with its
+    fallbacks) is never called; without quick attempts only the full planner is."""
+    from solvers.sdar.planners import make_task_planner
+    from solvers.sdar.solver import SdarOptions, SdarSolver
+
+    calls: dict[int, dict[str, int]] = {}
+    for quick in (6, 0):
+        r = rearrangement_problem(_three(), ctx, planner=planner)
+        options = SdarOptions(max_time=60.0, quick_attempts=quick)
+        solution = SdarSolver(r.problem, make_task_planner("sdar"), options).solve()
+        assert solution.status is Status.SOLVED
+        assert validate_plan(r.instance, plan_file_from_solution(r, solution), ctx.scene).ok
+        calls[quick] = {k: s.calls for k, s in solution.streams.items() if "motion" in k}
+    motions = calls[0]["plan-dual-motion"]
+    assert motions >= 3 and calls[0]["plan-dual-motion-quick"] == 0
+    assert calls[6] == {"plan-dual-motion": 0, "plan-dual-motion-quick": motions}

@@ -157,3 +157,22 @@ def test_optimiser_is_reused_and_deterministic(
 
 def _home12(ctx: WorldContext) -> np.ndarray:
     return np.concatenate([ctx.home(a) for a in ctx.arm_names])
+
+
+def test_a_colliding_retreat_fails_at_once_without_optimising(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    """Every strategy shares the straight retreat and approach: when they collide (here a
+    box right above the left tool) the motion fails before any optimisation."""
+    q_home = _home12(ctx)
+    tcp = ctx.kinematics["left"].fk_tcp(q_home[:6])
+    lid = np.eye(4)
+    lid[:3, :3] = tcp[:3, :3]
+    lid[:3, 3] = tcp[:3, 3] - 0.05 * tcp[:3, 2]  # 5 cm back along the tool axis
+    objects = {"lid": ObjectBox(lid, (0.12, 0.12, 0.01))}
+    q_goal = q_home.copy()
+    q_goal[6] += 0.3  # the right arm turns a little
+    request = MotionRequest(q_home, q_goal, objects, retreat=(True, False))
+    result = plan_dual_motion(planner, request)
+    assert not result.success and result.attempts == ()
+    assert result.reason.startswith("retreat collides") and result.optimisation_time == 0.0
