@@ -143,6 +143,19 @@ class DualMotionPlanner:
         self.ipopt_solves += int(result.rounds > 0)
         return result.path if result.success else None
 
+    def optimise_or_lift(
+        self,
+        problem: TransferProblem,
+        q_a: FloatArray,
+        q_b: FloatArray,
+        fixed: tuple[bool, bool] = (False, False),
+    ) -> FloatArray | None:
+        """:meth:`optimise` from the straight line, then from a lifted via-point."""
+        path = self.optimise(problem, q_a, q_b, fixed=fixed)
+        if path is None:
+            path = self.optimise(problem, q_a, q_b, self.lifted_via(q_a, q_b), fixed)
+        return path
+
     def lifted_via(self, q_a: FloatArray, q_b: FloatArray, height: float = 0.15) -> FloatArray:
         """A warm start ``(K, 12)`` through a via configuration whose TCPs are ``height`` [m]
         above the higher end, half-way between the two."""
@@ -298,11 +311,7 @@ class UntangleStrategy:
                 continue
             q_mid = problem.q_to.copy()
             q_mid[sl] = park
-            first = planner.optimise(problem, problem.q_from, q_mid)
-            if first is None:
-                first = planner.optimise(
-                    problem, problem.q_from, q_mid, planner.lifted_via(problem.q_from, q_mid)
-                )
+            first = planner.optimise_or_lift(problem, problem.q_from, q_mid)
             if first is None:
                 continue
             fixed = (y != 0, y != 1)
@@ -332,12 +341,7 @@ class SequentialStrategy:
             q2[ss] = problem.q_to[ss]
             stages = []
             for qa, qb, moving in ((problem.q_from, q1, f), (q1, q2, s), (q2, problem.q_to, f)):
-                fixed = (moving != 0, moving != 1)
-                path = planner.optimise(problem, qa, qb, fixed=fixed)
-                if path is None:
-                    path = planner.optimise(
-                        problem, qa, qb, planner.lifted_via(qa, qb), fixed=fixed
-                    )
+                path = planner.optimise_or_lift(problem, qa, qb, (moving != 0, moving != 1))
                 if path is None:
                     break
                 stages.append(path)
@@ -374,10 +378,7 @@ class OneArmStrategy:
         for i in moving:
             q_next = q.copy()
             q_next[6 * i : 6 * i + 6] = problem.q_to[6 * i : 6 * i + 6]
-            fixed = (i != 0, i != 1)
-            path = planner.optimise(problem, q, q_next, fixed=fixed)
-            if path is None:
-                path = planner.optimise(problem, q, q_next, planner.lifted_via(q, q_next), fixed)
+            path = planner.optimise_or_lift(problem, q, q_next, (i != 0, i != 1))
             if path is None:
                 return None
             stages.append(path)
