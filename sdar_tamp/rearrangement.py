@@ -121,8 +121,14 @@ def solve_rearrangement(
 
     planner = make_task_planner(task_planner)
     # The baseline motion planner: one arm works while the other waits at its retract pose.
-    one_arm = rearrangement.motion == "sequential"
-    options = SdarOptions(max_time=max_time, progress=progress, one_arm_at_a_time=one_arm)
+    # The quick motion stream differs from the full one only under SDAR-M's ladder.
+    motion = rearrangement.motion
+    options = SdarOptions(
+        max_time=max_time,
+        progress=progress,
+        one_arm_at_a_time=motion == "sequential",
+        quick_attempts=SdarOptions.quick_attempts if motion == "sdar" else 0,
+    )
     return SdarSolver(rearrangement.problem, planner, options).solve()
 
 
