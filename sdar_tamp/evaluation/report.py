@@ -296,7 +296,11 @@ def write_report(out_dir: Path, command: str | None = None) -> Path:
               "realised counts of SDAR and Baseline TP + SDAR-M beside them.", ""]  # fmt: skip
     lines += action_lines(rows)
     lines += ["## Planning time per synchronous step [s]", ""]
-    lines += ["Steps of successful runs; a task's selection time is shared by its steps.", ""]
+    lines += [
+        "Steps of successful runs; a decision's selection time and the motions it tried in "
+        "vain are shared by its steps, so the steps add up to the planning time.",
+        "",
+    ]
     lines += step_lines(rows, steps)
     lines += ["## Failures", "", *failure_lines(rows)]
     path = Path(out_dir) / REPORT
