@@ -110,6 +110,7 @@ class StreamSolver:
         check_negated_uses(problem.streams.streams, stream_info, negated)
         self.engine = Engine(problem, stream_info)
         self.builder = OptimisticBuilder(self.engine, negated)
+        self.fluent_streams = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
         self.stats: dict[str, float] = {
             "iterations": 0,
             "skeletons": 0,
@@ -280,8 +281,8 @@ class StreamSolver:
             check = simulate(
                 self.problem.domain, self._objects(world.facts), world.facts, actions, self.goal
             )
-            declared = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
-            ordered = fluent_plan(extract_stream_plan(check.needed, world), check, declared)
+            stream_plan = extract_stream_plan(check.needed, world)
+            ordered = fluent_plan(stream_plan, check, self.fluent_streams)
             stream_plan = ordered.stream_plan
             if not any(r.kind == "stream" for r in stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
