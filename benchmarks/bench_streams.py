@@ -2,21 +2,27 @@
 
 For every domain (pick_place_2d, kitchen, dual_arm_swap, infeasible) and every algorithm
 (incremental, focused, binding, adaptive): status, wall time [s], stream calls, plan cost and
-length. Each run builds a fresh problem from the same seed. Prints a table, then one JSON line.
+length. Each run builds a fresh problem from the same seed. Then, per algorithm, how far a run
+overshoots ``max_time`` on a problem that never ends by itself (an infinite sampler whose values
+a test always rejects): ``overrun`` = wall time / max_time - 1. Prints a table, then one JSON line.
 
     python benchmarks/bench_streams.py [--max-time 30] [--seed 0] [--domains kitchen ...]
+        [--limit-probe 1.5]
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import itertools
 import json
 import logging
 import math
 import time
 from typing import Any
 
+from sdar_tamp.language.generators import from_sampler, from_test
+from sdar_tamp.language.problem import PDDLProblem
 from solvers.solve import solve
 from solvers.stream_planning.algorithms import ALGORITHMS
 
@@ -43,6 +49,41 @@ def run(domain: str, algorithm: str, max_time: float, seed: int) -> dict[str, An
     }
 
 
+_ENDLESS_DOMAIN = """(define (domain endless) (:requirements :strips)
+  (:predicates (block ?b) (pose ?b ?p) (ok ?b ?p) (placed ?b))
+  (:action place :parameters (?b ?p) :precondition (and (pose ?b ?p) (ok ?b ?p))
+     :effect (placed ?b)))"""
+_ENDLESS_STREAMS = """(define (stream endless)
+  (:stream sample-pose :inputs (?b) :domain (block ?b) :outputs (?p) :certified (pose ?b ?p))
+  (:stream test-ok :inputs (?b ?p) :domain (pose ?b ?p) :certified (ok ?b ?p)))"""
+
+
+def limit_overrun(algorithm: str, max_time: float) -> dict[str, Any]:
+    """Solve a problem with an endless sampler and a test that always fails; time the run."""
+    values = itertools.count()
+    problem = PDDLProblem(
+        _ENDLESS_DOMAIN,
+        {},
+        _ENDLESS_STREAMS,
+        {
+            "sample-pose": from_sampler(lambda b: (float(next(values)),)),
+            "test-ok": from_test(lambda b, p: False),
+        },
+        init=[("block", "a")],
+        goal=("placed", "a"),
+    )
+    start = time.perf_counter()
+    solution = solve(problem, algorithm=algorithm, max_time=max_time, verbose=False)
+    elapsed = time.perf_counter() - start
+    return {
+        "algorithm": algorithm,
+        "status": solution.status.value,
+        "max_time": max_time,
+        "time": round(elapsed, 3),
+        "overrun": round(elapsed / max_time - 1.0, 4),
+    }
+
+
 def table(rows: list[dict[str, Any]]) -> str:
     header = (
         f"{'domain':<14} {'algorithm':<12} {'status':<11} {'time[s]':>8} {'calls':>7} "
@@ -66,6 +107,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--domains", nargs="+", choices=DOMAINS, default=list(DOMAINS))
     parser.add_argument("--algorithms", nargs="+", choices=ALGORITHMS, default=list(ALGORITHMS))
+    parser.add_argument(
+        "--limit-probe", type=float, default=1.5, help="[s] max_time of the overrun probe; 0: skip"
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     rows = [
@@ -74,12 +118,24 @@ def main(argv: list[str] | None = None) -> int:
         for algorithm in args.algorithms
     ]
     print(table(rows))
+    probes = (
+        [limit_overrun(algorithm, args.limit_probe) for algorithm in args.algorithms]
+        if args.limit_probe > 0
+        else []
+    )
+    for probe in probes:
+        print(
+            f"max_time {probe['max_time']:.2f} s, {probe['algorithm']:<12} {probe['status']:<9} "
+            f"ran {probe['time']:.3f} s (overrun {probe['overrun']:+.1%})"
+        )
     summary = {
         "benchmark": "stream_planning",
         "max_time": args.max_time,
         "seed": args.seed,
         "all_expected": all(r["status"] == r["expected"] for r in rows),
         "runs": rows,
+        "max_time_probes": probes,
+        "max_time_overrun_max": max((p["overrun"] for p in probes), default=None),
     }
     print(json.dumps(summary, separators=(",", ":")))
     return 0 if summary["all_expected"] else 1

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import itertools
 import random
-import time
 from collections.abc import Callable, Sequence
 
 import pytest
@@ -107,12 +106,10 @@ def test_optimal_choices_are_the_members_of_some_minimum_set() -> None:
         assert extending_minimum(g, pairs, allow_swaps=True) == expected
 
 
-def test_minimum_fvs_of_a_24_object_component_is_exact_and_quick() -> None:
+def test_minimum_fvs_of_a_24_object_component_is_exact() -> None:
     g = random_scc(24, 2, seed=3)
     assert len(g.cycle_components()) == 1
-    start = time.perf_counter()
     found = feedback_vertex_set(g)
-    assert time.perf_counter() - start < 10.0
     assert found.exact and breaks_cycles(g, found.members, False)
     size = len(found.members)
     smaller = itertools.combinations(g.names, size - 1)

@@ -51,7 +51,9 @@ def test_infeasible_is_proven_with_a_diagnosis(algorithm: str) -> None:
     solution = solve(_problem("infeasible"), algorithm=algorithm, max_time=20, verbose=False)
     assert solution.status is Status.INFEASIBLE and solution.plan is None
     assert solution.cost == float("inf")
-    assert solution.statistics["time"] < 5
+    # proven by exhausting the streams, not by running out of time (work, not seconds)
+    assert solution.statistics["iterations"] <= 20
+    assert sum(s.calls for s in solution.streams.values()) <= 1000
     assert any("'sample-pose' on inputs ('A', 'goal') ran dry" in r for r in solution.diagnosis)
 
 

@@ -1,5 +1,3 @@
-import time
-
 import numpy as np
 
 from sdar_tamp.world.collision import ObjectBox
@@ -37,19 +35,19 @@ def test_candidates_reproduce_the_grasp_pose_and_are_ranked(
         assert not world.in_collision(qs["left"], qs["right"])
 
 
-def test_ranking_time_for_two_arms_two_objects_six_grasps(
+def test_ranking_for_two_arms_two_objects_six_grasps_is_repeatable(
     ctx: WorldContext, objects: dict[str, ObjectBox]
 ) -> None:
+    # Its time is measured by benchmarks/bench_motion.py (ik_ranking_median_s).
     world = ctx.new_world()
     reqs = _requests(ctx, objects, list(objects)[:2])
     home = {a: ctx.home(a) for a in ctx.arm_names}
-    solve_ik_candidates(ctx, world, objects, reqs, home)
-    times = []
-    for _ in range(5):
-        t = time.perf_counter()
-        solve_ik_candidates(ctx, world, objects, reqs, home)
-        times.append(time.perf_counter() - t)
-    assert np.median(times) < 0.05  # target 20 ms; loose bound for a busy CI machine
+    first = solve_ik_candidates(ctx, world, objects, reqs, home)
+    again = solve_ik_candidates(ctx, world, objects, reqs, home)
+    assert first and len(first) == len(again)
+    for a, b in zip(first, again, strict=True):
+        assert (a.arm, a.obj, a.cost) == (b.arm, b.obj, b.cost)
+        np.testing.assert_array_equal(a.q, b.q)
 
 
 def test_compatible_pairs_are_jointly_collision_free(
