@@ -49,9 +49,17 @@ def test_valid_text_parses() -> None:
 
 
 def test_touching_footprints_are_allowed() -> None:
-    parse_instance(
+    inst = parse_instance(
         HEAD + _obj("a", "[0, 0, 0]", "[0, 0, 0]") + _obj("b", "[0.08, 0, 0]", "[0, 0.04, 0]")
     )
+    assert inst.names == ("a", "b")
+    assert inst.objects[1].start == Pose2D(0.08, 0.0, 0.0)
+    assert inst.objects[1].goal == Pose2D(0.0, 0.04, 0.0)
+    # one millimetre closer, the same two footprints overlap
+    with pytest.raises(InstanceError, match="overlaps"):
+        parse_instance(
+            HEAD + _obj("a", "[0, 0, 0]", "[0, 0, 0]") + _obj("b", "[0.079, 0, 0]", "[0, 0.04, 0]")
+        )
 
 
 def test_overlap_at_start() -> None:
