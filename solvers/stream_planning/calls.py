@@ -62,56 +62,39 @@ class CallTimeout(Exception):
 
 
 class _Worker:
-    """A daemon thread running one call at a time."""
+    """A daemon thread running one call at a time; the caller waits for each reply."""
 
     def __init__(self) -> None:
-        self.requests: queue.SimpleQueue[tuple[Callable[[], Any], _Reply] | None] = (
-            queue.SimpleQueue()
-        )
+        self.requests: queue.SimpleQueue[Callable[[], Any] | None] = queue.SimpleQueue()
+        # (True, value) or (False, exception) per call
+        self.replies: queue.SimpleQueue[tuple[bool, Any]] = queue.SimpleQueue()
+        self.abandoned: str | None = None  # set to the call's description when abandoned
         self.thread = threading.Thread(target=self._loop, name="stream-call", daemon=True)
         self.thread.start()
 
     def _loop(self) -> None:
         while True:
-            request = self.requests.get()
-            if request is None:
+            fn = self.requests.get()
+            if fn is None:
                 return
-            fn, reply = request
+            start = time.perf_counter()
             try:
-                reply.value = fn()
+                self.replies.put((True, fn()))
             except BaseException as error:  # handed to the caller, who re-raises it
-                reply.error = error
-            reply.done.set()
-            if reply.abandoned:
+                self.replies.put((False, error))
+            if self.abandoned is not None:
                 LOG.warning(
                     "abandoned call of %s returned after %.3g s",
-                    reply.what,
-                    time.perf_counter() - reply.start,
+                    self.abandoned,
+                    time.perf_counter() - start,
                 )
                 return  # the solve that abandoned it has ended; so does this thread
-
-    def submit(self, fn: Callable[[], Any]) -> _Reply:
-        reply = _Reply(time.perf_counter())
-        self.requests.put((fn, reply))
-        return reply
 
     def stop(self, wait: float = 0.0) -> None:
         """Ask the thread to exit after its current call; wait for that at most ``wait`` [s]."""
         self.requests.put(None)
         if wait > 0:
             self.thread.join(wait)
-
-
-class _Reply:
-    __slots__ = ("abandoned", "done", "error", "start", "value", "what")
-
-    def __init__(self, start: float) -> None:
-        self.start = start
-        self.done = threading.Event()
-        self.value: Any = None
-        self.error: BaseException | None = None
-        self.abandoned = False
-        self.what = ""  # set when abandoned
 
 
 class CallRunner:
@@ -144,22 +127,26 @@ class CallRunner:
         return value
 
     def _call_threaded(self, fn: Callable[[], T], what: Callable[[], str], start: float) -> T:
-        if self._worker is None:
-            self._worker = _Worker()
-        reply = self._worker.submit(fn)
-        wait = self.deadline + OVERRUN_TOLERANCE - start
-        if not reply.done.wait(wait):
-            description = what()
-            reply.what = description
-            reply.abandoned = True  # the worker exits once the call returns
-            worker, self._worker = self._worker, None
-            if not reply.done.is_set():
-                self._overrun(lambda: description, start, time.perf_counter(), abandoned=True)
-            worker.stop()  # the call ended just now (the worker may have exited already)
-        if reply.error is not None:
-            raise reply.error
-        value: T = reply.value
-        return value
+        worker = self._worker
+        if worker is None:
+            worker = self._worker = _Worker()
+        worker.requests.put(fn)
+        try:
+            ok, value = worker.replies.get(
+                timeout=max(0.0, self.deadline + OVERRUN_TOLERANCE - start)
+            )
+        except queue.Empty:
+            worker.abandoned = what()  # the worker exits once the call returns
+            self._worker = None
+            try:
+                ok, value = worker.replies.get_nowait()  # it may have returned just now
+            except queue.Empty:
+                self._overrun(lambda: str(worker.abandoned), start, time.perf_counter(), True)
+            worker.stop()  # in case it checked the flag before it was set
+        if not ok:
+            raise value
+        result: T = value
+        return result
 
     def _overrun(
         self, what: Callable[[], str], start: float, end: float, abandoned: bool
