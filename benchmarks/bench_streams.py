@@ -6,6 +6,10 @@ length. Each run builds a fresh problem from the same seed. Then, per algorithm,
 overshoots ``max_time`` on a problem that never ends by itself (an infinite sampler whose values
 a test always rejects): ``overrun`` = wall time / max_time - 1. Prints a table, then one JSON line.
 
+With ``--call-modes threaded inline`` every run is made once per way of calling user code
+(``solve(enforce_max_time=True/False)``), side by side, plus a micro-benchmark of one call's
+cost in each mode; ``cpu`` is the process time [s] of a run (all threads).
+
     python benchmarks/bench_streams.py [--max-time 30] [--seed 0] [--domains kitchen ...]
         [--limit-probe 1.5]
 """
@@ -25,20 +29,36 @@ from sdar_tamp.language.generators import from_sampler, from_test
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solve import solve
 from solvers.stream_planning.algorithms import ALGORITHMS
+from solvers.stream_planning.calls import CallRunner
 
 DOMAINS = ("pick_place_2d", "kitchen", "dual_arm_swap", "infeasible")
 EXPECTED = {"infeasible": "infeasible"}  # every other domain: solved
 
 
-def run(domain: str, algorithm: str, max_time: float, seed: int) -> dict[str, Any]:
+MODES = {"threaded": True, "inline": False}
+
+
+def run(
+    domain: str, algorithm: str, max_time: float, seed: int, mode: str = "threaded"
+) -> dict[str, Any]:
     make_problem = importlib.import_module(f"domains.{domain}.samplers").make_problem
     problem = make_problem(seed=seed)
     start = time.perf_counter()
-    solution = solve(problem, algorithm=algorithm, max_time=max_time, seed=seed, verbose=False)
+    cpu = time.process_time()
+    solution = solve(
+        problem,
+        algorithm=algorithm,
+        max_time=max_time,
+        seed=seed,
+        verbose=False,
+        enforce_max_time=MODES[mode],
+    )
     elapsed = time.perf_counter() - start
     return {
         "domain": domain,
         "algorithm": algorithm,
+        "calls_mode": mode,
+        "cpu": round(time.process_time() - cpu, 3),
         "status": solution.status.value,
         "expected": EXPECTED.get(domain, "solved"),
         "time": round(elapsed, 3),
@@ -84,10 +104,21 @@ def limit_overrun(algorithm: str, max_time: float) -> dict[str, Any]:
     }
 
 
+def call_overhead(mode: str, calls: int = 20_000) -> float:
+    """[us] the cost of one trivial user call through a :class:`CallRunner` in ``mode``."""
+    runner = CallRunner(time.perf_counter() + 3600, threaded=MODES[mode])
+    start = time.perf_counter()
+    for _ in range(calls):
+        runner.call(int, str)
+    elapsed = time.perf_counter() - start
+    runner.close()
+    return 1e6 * elapsed / calls
+
+
 def table(rows: list[dict[str, Any]]) -> str:
     header = (
-        f"{'domain':<14} {'algorithm':<12} {'status':<11} {'time[s]':>8} {'calls':>7} "
-        f"{'cost':>8} {'length':>6}  ok"
+        f"{'domain':<14} {'algorithm':<12} {'calls via':<9} {'status':<11} {'time[s]':>8} "
+        f"{'cpu[s]':>7} {'calls':>7} {'cost':>8} {'length':>6}  ok"
     )
     lines = [header, "-" * len(header)]
     for row in rows:
@@ -95,8 +126,9 @@ def table(rows: list[dict[str, Any]]) -> str:
         length = str(row["length"]) if row["length"] is not None else "-"
         ok = "yes" if row["status"] == row["expected"] else "NO"
         lines.append(
-            f"{row['domain']:<14} {row['algorithm']:<12} {row['status']:<11} "
-            f"{row['time']:>8.3f} {row['stream_calls']:>7d} {cost:>8} {length:>6}  {ok}"
+            f"{row['domain']:<14} {row['algorithm']:<12} {row['calls_mode']:<9} "
+            f"{row['status']:<11} {row['time']:>8.3f} {row['cpu']:>7.3f} "
+            f"{row['stream_calls']:>7d} {cost:>8} {length:>6}  {ok}"
         )
     return "\n".join(lines)
 
@@ -110,12 +142,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--limit-probe", type=float, default=1.5, help="[s] max_time of the overrun probe; 0: skip"
     )
+    parser.add_argument(
+        "--call-modes",
+        nargs="+",
+        choices=tuple(MODES),
+        default=["threaded"],
+        help="ways of calling user code to run side by side (default: %(default)s)",
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     rows = [
-        run(domain, algorithm, args.max_time, args.seed)
+        run(domain, algorithm, args.max_time, args.seed, mode)
         for domain in args.domains
         for algorithm in args.algorithms
+        for mode in args.call_modes
     ]
     print(table(rows))
     probes = (
@@ -128,10 +168,20 @@ def main(argv: list[str] | None = None) -> int:
             f"max_time {probe['max_time']:.2f} s, {probe['algorithm']:<12} {probe['status']:<9} "
             f"ran {probe['time']:.3f} s (overrun {probe['overrun']:+.1%})"
         )
+    overhead = {mode: round(call_overhead(mode), 2) for mode in args.call_modes}
+    if len(args.call_modes) > 1:
+        print("one trivial user call [us]: " + ", ".join(f"{m} {v}" for m, v in overhead.items()))
+        for mode in args.call_modes:
+            mine = [r for r in rows if r["calls_mode"] == mode]
+            print(
+                f"{mode}: total time {sum(r['time'] for r in mine):.3f} s, "
+                f"cpu {sum(r['cpu'] for r in mine):.3f} s"
+            )
     summary = {
         "benchmark": "stream_planning",
         "max_time": args.max_time,
         "seed": args.seed,
+        "call_overhead_us": overhead,
         "all_expected": all(r["status"] == r["expected"] for r in rows),
         "runs": rows,
         "max_time_probes": probes,

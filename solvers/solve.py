@@ -50,6 +50,7 @@ def solve(
     unit_efforts: bool = False,
     effort_weight: float | None = None,
     max_planner_time: float = INF,
+    enforce_max_time: bool = True,
     verbose: bool = True,
     seed: int | None = None,
     planner: str = "wastar-ff",
@@ -73,6 +74,12 @@ def solve(
         success_cost: stop at the first plan of at most this cost (else keep improving until
             ``max_time``).
         max_time: wall-clock limit [s].
+        enforce_max_time: (stream algorithms, finite ``max_time``) run user samplers, tests and
+            functions one at a time in a worker thread, so that one that blocks cannot hold
+            the solve past ``max_time``: the call is abandoned (it finishes in the
+            background), a warning names it and the solve returns ``TIMEOUT``. With False they
+            run in the calling thread (for code tied to it) and the deadline is checked after
+            each call, so a blocking call delays the ``TIMEOUT`` until it returns.
         planner: ``SEARCH-HEURISTIC`` of the classical planner, e.g. ``wastar-ff``,
             ``gbfs-ff``, ``astar-max``.
         task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``.
@@ -116,7 +123,10 @@ def solve(
     if effort_weight is not None:
         _positive("effort_weight", effort_weight, allow_zero=True)
     options = dataclasses.replace(
-        options, effort_weight=effort_weight, unit_efforts=bool(unit_efforts)
+        options,
+        effort_weight=effort_weight,
+        unit_efforts=bool(unit_efforts),
+        enforce_max_time=bool(enforce_max_time),
     )
     logging.getLogger("solvers").setLevel(logging.INFO if verbose else logging.WARNING)
     if seed is not None:

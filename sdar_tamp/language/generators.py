@@ -10,7 +10,8 @@ adapters below wrap the usual shapes of samplers into that form (PDDLStream's na
 - ``from_sampler(s)``: ``s(*inputs)`` returns one output tuple (or None), called forever;
 - ``from_fn(f)``: ``f(*inputs)`` returns one tuple or None, called once;
 - ``from_list_fn(f)``: ``f(*inputs)`` returns a list of tuples, called once;
-- ``from_test(t)``: ``t(*inputs)`` returns a truth value, called once (no outputs);
+- ``from_test(t)``: ``t(*inputs)`` returns a bool, called once (no outputs); see
+  :func:`truth_value` for what counts as one;
 - ``from_constant(c)``: always the tuple ``c``, once; ``fn_from_constant(c)``: a function
   (for ``:function``/``:predicate``) that always returns ``c``.
 """
@@ -20,6 +21,8 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
+
+from sdar_tamp.errors import SdarError
 
 Outputs = list[tuple[Any, ...]]
 ListGenFn = Callable[..., Iterator["Outputs | WildOutput"]]
@@ -90,9 +93,32 @@ def from_fn(fn: Callable[..., Any]) -> ListGenFn:
     return stream
 
 
+class TruthValueError(SdarError, TypeError):
+    """A test returned something other than a truth value (the solver names the stream)."""
+
+    def __init__(self, value: Any) -> None:
+        super().__init__(
+            "a test must return a bool (True/False or numpy.bool_; None counts as False), got "
+            f"{type(value).__name__}: {value!r}"
+        )
+        self.value = value
+
+
+def truth_value(value: Any) -> bool:
+    """A test's answer: ``bool`` or ``numpy.bool_``; ``None`` counts as False (a PDDLStream
+    test that falls off its end). Anything else (``"no"``, ``1``, a list) raises
+    :class:`TruthValueError` rather than being judged by its truthiness."""
+    if value is None:
+        return False
+    kind = type(value)
+    if kind is bool or (kind.__module__ == "numpy" and kind.__name__ in ("bool", "bool_")):
+        return bool(value)
+    raise TruthValueError(value)
+
+
 def from_test(test: Callable[..., Any]) -> ListGenFn:
     def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
-        yield [()] if test(*inputs, **kwargs) else []
+        yield [()] if truth_value(test(*inputs, **kwargs)) else []
 
     return stream
 
@@ -106,4 +132,4 @@ def fn_from_constant(constant: Any) -> Callable[..., Any]:
 
 
 def negate_test(test: Callable[..., Any]) -> Callable[..., bool]:
-    return lambda *inputs: not test(*inputs)
+    return lambda *inputs: not truth_value(test(*inputs))

@@ -33,6 +33,7 @@ from sdar_tamp.language.problem import PDDLProblem, infer_object_types
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
+from solvers.stream_planning.calls import CallRunner, CallTimeout
 from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.costs import guard_costs, has_costs
 from solvers.stream_planning.diagnosis import diagnose
@@ -74,6 +75,7 @@ class StreamOptions:
     max_cost: float = math.inf  # plans above it are not returned (PlanConstraints.max_cost)
     effort_weight: float | None = None  # skeletons ordered by cost + weight * stream effort
     unit_efforts: bool = False  # every stream call has effort 1
+    enforce_max_time: bool = True  # user calls in a worker thread, abandoned at max_time
 
 
 @dataclass(order=True)
@@ -108,7 +110,8 @@ class StreamSolver:
         self.goal = problem.facts.goal
         negated = negated_predicates(problem.domain, self.goal)
         check_negated_uses(problem.streams.streams, stream_info, negated)
-        self.engine = Engine(problem, stream_info)
+        self.runner = CallRunner(self.start + options.max_time, options.enforce_max_time)
+        self.engine = Engine(problem, stream_info, self.runner)
         self.builder = OptimisticBuilder(self.engine, negated)
         self.fluent_streams = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
         self.stats: dict[str, float] = {
@@ -211,12 +214,15 @@ class StreamSolver:
 
     def solve(self) -> Solution:
         try:
+            self.engine.start()
             if self.options.algorithm == "incremental":
                 status = self._incremental()
             else:
                 status = self._focused()
-        except _Timeout:
+        except (_Timeout, CallTimeout):
             status = Status.TIMEOUT
+        finally:
+            self.runner.close()
         if self.best is not None:
             status = Status.SOLVED
         return self._solution(status)

@@ -35,6 +35,7 @@ def diagnose(solver: StreamSolver, status: Status) -> list[str]:
             f"the time limit ({solver.options.max_time:g} s) or the iteration limit "
             "ended the search"
         )
+        reasons.extend(overrun.describe() for overrun in solver.runner.overruns)
     produced = _produced_predicates(solver)
     table = solver.engine.table
     for atom in iter_atoms(solver.goal):

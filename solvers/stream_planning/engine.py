@@ -11,6 +11,9 @@ algorithms ask for more (:meth:`Engine.fluent_instance`) with the state of the p
 uses the output. Their certified facts join the one global fact base, as in PDDLStream: they are
 about new output objects (a trajectory valid among the objects as they were at that step), so
 the stream's author must not certify facts about input objects that depend on the state.
+
+Every user call goes through the engine's :class:`CallRunner` (the solve's deadline); the
+initial facts, which may call user code, are added by :meth:`Engine.start`.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from sdar_tamp.language.model import (
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo, unsupported_options
 from sdar_tamp.language.problem import PDDLProblem
+from solvers.stream_planning.calls import CallRunner
 from solvers.stream_planning.externals import (
     FunctionExternal,
     StreamExternal,
@@ -72,14 +76,16 @@ class InstanceState:
 
 
 class Engine:
-    """Real facts and stream instances of one solve."""
+    """Real facts and stream instances of one solve (call :meth:`start` before using it)."""
 
     def __init__(
         self,
         problem: PDDLProblem,
         stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None,
+        runner: CallRunner | None = None,
     ) -> None:
         self.problem = problem
+        self.runner = runner if runner is not None else CallRunner()
         self.table: ObjectTable = problem.objects.copy()
         self._eager: list[InstanceState] = []  # eager instances not called yet
         self._draining = False
@@ -117,6 +123,10 @@ class Engine:
             self.store.add(atom, 0)
         for key in self.numeric:
             self.store.add(Atom(function_guard(key[0]), key[1]), 0)
+
+    def start(self) -> None:
+        """Instantiate what the initial facts allow: evaluates functions and predicates and
+        calls eager streams (user code: may raise :class:`CallTimeout`)."""
         self.add_facts(self._instantiate(self.instantiator.initial()), 0)
 
     # --- adding facts ---------------------------------------------------------------------
@@ -153,7 +163,7 @@ class Engine:
                     self._eager.append(state)
             elif query.name in self.functions:
                 external = self.functions[query.name]
-                value = external.evaluate(inputs, self.table)
+                value = external.evaluate(inputs, self.table, self.runner)
                 if external.is_predicate:
                     if value:
                         derived.append(Atom(query.name, inputs))
@@ -186,7 +196,7 @@ class Engine:
             key = (instance.external.name, instance.inputs)
             level = state.domain_level + self.fluent_calls.get(key, 0) + 1
             self.fluent_calls[key] = self.fluent_calls.get(key, 0) + 1
-        results, wild = instance.next(self.table)
+        results, wild = instance.next(self.table, self.runner)
         facts = [atom for result in results for atom in result.certified]
         self.add_facts([*facts, *wild], level)
         return bool(results)

@@ -2,7 +2,9 @@
 
 A sampler is called with the Python values behind the object names; what it returns is checked
 for shape, and its outputs get object names from the problem's :class:`ObjectTable`. A sampler
-that raises stops the solve with a :class:`StreamError` naming the stream and its inputs.
+that raises stops the solve with a :class:`StreamError` naming the stream and its inputs; a test
+or ``:predicate`` must answer with a bool (:func:`truth_value`). Calls go through the solve's
+:class:`CallRunner` when one is given (deadline, optional worker thread).
 """
 
 from __future__ import annotations
@@ -15,10 +17,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sdar_tamp.errors import SdarError
-from sdar_tamp.language.generators import ListGenFn, WildOutput
+from sdar_tamp.language.generators import ListGenFn, TruthValueError, WildOutput, truth_value
 from sdar_tamp.language.model import Atom, Stream, StreamFunction, StreamPredicate
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
+from solvers.stream_planning.calls import CallRunner, CallTimeout
 
 LOG = logging.getLogger(__name__)
 
@@ -128,27 +131,43 @@ class StreamInstance:
         values = ", ".join(repr(table.value(n)) for n in self.inputs)
         return f"stream {self.external.name!r} on inputs ({values})"
 
-    def next(self, table: ObjectTable) -> tuple[list[StreamResult], list[Atom]]:
-        """Call the sampler once; returns the new results and any wild facts."""
+    def next(
+        self, table: ObjectTable, runner: CallRunner | None = None
+    ) -> tuple[list[StreamResult], list[Atom]]:
+        """Call the sampler once; returns the new results and any wild facts.
+
+        Raises:
+            CallTimeout: (with ``runner``) the deadline passed before or during the call.
+        """
         if self.exhausted:
             return [], []
         external = self.external
         values = tuple(table.value(n) for n in self.inputs)
-        start = time.perf_counter()
-        try:
+        fluent_values = (
+            [(a.predicate, *(table.value(n) for n in a.args)) for a in self.fluents]
+            if self._iterator is None
+            else []
+        )
+
+        def call() -> Any:
             if self._iterator is None:
                 if external.declaration.fluents:
-                    fluent_values = [
-                        (a.predicate, *(table.value(n) for n in a.args)) for a in self.fluents
-                    ]
                     self._iterator = iter(external.gen_fn(*values, fluents=fluent_values))
                 else:
                     self._iterator = iter(external.gen_fn(*values))
-            produced = next(self._iterator)
+            return next(self._iterator)
+
+        if runner is not None:
+            runner.check()
+        start = time.perf_counter()
+        try:
+            produced = call() if runner is None else runner.call(call, lambda: self.describe(table))
         except StopIteration:
             self.exhausted = True
             produced = []
-        except SdarError:
+        except TruthValueError as error:
+            raise StreamOutputError(f"{self.describe(table)} is a test: {error}") from error
+        except (SdarError, CallTimeout):
             raise
         except Exception as error:
             raise StreamError(
@@ -220,30 +239,50 @@ class FunctionExternal:
             self.declaration.domain, dict(zip(self.declaration.inputs, inputs, strict=True))
         )
 
-    def evaluate(self, inputs: tuple[str, ...], table: ObjectTable) -> float | bool:
+    def evaluate(
+        self, inputs: tuple[str, ...], table: ObjectTable, runner: CallRunner | None = None
+    ) -> float | bool:
+        """The value on ``inputs`` (cached). Raises :class:`CallTimeout` as
+        :meth:`StreamInstance.next` does."""
         if inputs in self.values:
             return self.values[inputs]
         values = tuple(table.value(n) for n in inputs)
-        kind = "predicate" if self.is_predicate else "function"
-        if self.stream is not None:
-            kind = f"negated test stream {self.stream!r} for predicate"
-        what = f"{kind} {self.name!r} on inputs ({', '.join(repr(v) for v in values)})"
+
+        def describe() -> str:
+            kind = "predicate" if self.is_predicate else "function"
+            if self.stream is not None:
+                kind = f"negated test stream {self.stream!r} for predicate"
+            return f"{kind} {self.name!r} on inputs ({', '.join(repr(v) for v in values)})"
+
+        if runner is not None:
+            runner.check()
         start = time.perf_counter()
         try:
-            raw = self.fn(*values)
+            raw = (
+                self.fn(*values)
+                if runner is None
+                else runner.call(lambda: self.fn(*values), describe)
+            )
+        except CallTimeout:
+            raise
+        except TruthValueError as error:  # a negated test stream's test answered wrongly
+            raise StreamOutputError(f"{describe()}: {error}") from error
         except Exception as error:
-            raise StreamError(f"{what} raised {type(error).__name__}: {error}") from error
+            raise StreamError(f"{describe()} raised {type(error).__name__}: {error}") from error
         finally:
             self.counters.time += time.perf_counter() - start
             self.counters.calls += 1
         result: float | bool
         if self.is_predicate:
-            result = bool(raw)
+            try:
+                result = truth_value(raw)
+            except TruthValueError as error:
+                raise StreamOutputError(f"{describe()}: {error}") from error
         else:
             if isinstance(raw, bool) or not isinstance(raw, int | float):
-                raise StreamOutputError(f"{what} must return a number, got {raw!r}")
+                raise StreamOutputError(f"{describe()} must return a number, got {raw!r}")
             if raw < 0:
-                raise StreamOutputError(f"{what} must return a non-negative cost, got {raw}")
+                raise StreamOutputError(f"{describe()} must return a non-negative cost, got {raw}")
             result = float(raw)
         self.counters.successes += 1
         self.counters.outputs += 1

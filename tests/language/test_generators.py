@@ -2,9 +2,11 @@
 
 import itertools
 
+import numpy as np
 import pytest
 
 from sdar_tamp.language.generators import (
+    TruthValueError,
     WildOutput,
     fn_from_constant,
     from_constant,
@@ -15,6 +17,7 @@ from sdar_tamp.language.generators import (
     from_sampler,
     from_test,
     negate_test,
+    truth_value,
 )
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import WILD, StreamInfo
@@ -71,3 +74,23 @@ def test_stream_info_validates_values() -> None:
     with pytest.raises(ValueError, match="opt_gen_fn"):
         StreamInfo(opt_gen_fn="sometimes")
     assert repr(WILD) == "WILD"
+
+
+def test_truth_values_are_bools_numpy_bools_or_none() -> None:
+    assert truth_value(True) is True and truth_value(False) is False
+    assert truth_value(np.True_) is True and truth_value(np.float64(1.0) < 0) is False
+    assert truth_value(None) is False  # a test that falls off its end
+    for value in ("no", 1, 0, 1.0, [True], (), np.array([True])):
+        with pytest.raises(TruthValueError) as info:
+            truth_value(value)
+        assert info.value.value is value and repr(value) in str(info.value)
+
+
+def test_from_test_and_negate_test_check_the_answer() -> None:
+    assert list(from_test(lambda: np.True_)()) == [[()]]
+    assert list(from_test(lambda: None)()) == [[]]
+    with pytest.raises(TruthValueError, match="str: 'no'"):
+        list(from_test(lambda: "no")())
+    assert negate_test(lambda: None)() is True
+    with pytest.raises(TruthValueError, match="int: 1"):
+        negate_test(lambda: 1)()
