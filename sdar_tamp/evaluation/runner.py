@@ -36,6 +36,7 @@ import re
 import shlex
 import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -477,7 +478,9 @@ def bench_command(args: argparse.Namespace) -> int:
 
     SIGINT (Ctrl-C) and SIGTERM stop it with one line on stderr and exit status 128 + the
     signal number (130, 143); the workers are killed and the finished rows stay."""
-    handled = (signal.SIGINT, signal.SIGTERM)
+    handled: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)
+    if threading.current_thread() is not threading.main_thread():
+        handled = ()  # only the main thread may set handlers: plain KeyboardInterrupt then
     previous = {s: signal.getsignal(s) for s in handled}
     for s in handled:
         signal.signal(s, _interrupt)

@@ -75,12 +75,20 @@ def _follow_parent(parent_pid: int) -> None:
     threading.Thread(target=watch, name="watch-parent", daemon=True).start()
 
 
+def _block(signals: set[int], how: str = "block") -> set[int]:
+    """Block, unblock or set (``how``) the calling thread's blocked ``signals``; returns the
+    previous set (empty where the platform has no ``pthread_sigmask``)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        return set()
+    flag = {"block": signal.SIG_BLOCK, "unblock": signal.SIG_UNBLOCK, "set": signal.SIG_SETMASK}
+    return {int(s) for s in signal.pthread_sigmask(flag[how], signals)}
+
+
 def _serve(fn: Callable[[Any], Any], conn: Connection, parent_pid: int) -> None:
     """A worker's loop: receive a task, send ``("ok", answer)`` or ``("error", text)``."""
     _follow_parent(parent_pid)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if hasattr(signal, "pthread_sigmask"):  # blocked by the parent while it started us
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _block({signal.SIGINT, signal.SIGTERM}, how="unblock")  # blocked by the parent at start
     while True:
         try:
             task = conn.recv()
@@ -174,19 +182,17 @@ class WorkerPool(Generic[T, R]):
         process = self._context.Process(
             target=_serve, args=(self.fn, theirs, os.getpid()), name="sdar-worker", daemon=True
         )
-        # The new process inherits the blocked SIGINT and ignores it before unblocking it: a
-        # Ctrl-C while it starts up reaches the parent only (delayed until the line below).
-        blocking = hasattr(signal, "pthread_sigmask")
-        if blocking:
-            mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        # The new process inherits SIGINT and SIGTERM blocked, and ignores SIGINT before it
+        # unblocks them: a Ctrl-C while it starts up reaches the parent only, and a signal to
+        # the parent waits until the new worker is on the list that close() kills.
+        blocked = _block({signal.SIGINT, signal.SIGTERM})
         try:
             process.start()
+            worker = _Worker(process, mine)
+            self._live.append(worker)
         finally:
-            if blocking:
-                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            _block(blocked, how="set")
         theirs.close()
-        worker = _Worker(process, mine)
-        self._live.append(worker)
         return worker
 
     def _discard(self, worker: _Worker, kill: bool) -> None:
