@@ -163,8 +163,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     """Run the paper's evaluation: every planner combination on every instance of a suite, in
-    worker processes. One CSV row per finished run (a rerun resumes), then plots and a report
-    in the output folder."""
+    worker processes. One CSV row per finished run, then plots and a report in the output
+    folder. A rerun with the same settings resumes (Ctrl-C keeps the finished runs); one with
+    another seed, time limit, worker count or suite is refused unless --restart is given."""
     from sdar_tamp.evaluation.runner import bench_command
 
     return bench_command(args)
@@ -274,6 +275,12 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--max-objects", type=int, default=None, help="skip larger instances")
     bench.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
     bench.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    bench.add_argument(
+        "--restart",
+        action="store_true",
+        help="discard the runs already in --out (needed to change seed, time limit, workers "
+        "or suite there; without it such a rerun is refused)",
+    )
     bench.set_defaults(func=cmd_bench)
 
     demo = sub.add_parser("demo", help="solve a built-in example", description=cmd_demo.__doc__)

@@ -274,8 +274,12 @@ def failure_lines(rows: Sequence[Row]) -> list[str]:
     return _table(["instance", "combination", "status", "why"], body) if body else ["none", ""]
 
 
-def write_report(out_dir: Path, command: str | None = None) -> Path:
-    """Write ``out_dir/report.md`` from the CSV files there; returns its path."""
+def write_report(
+    out_dir: Path, command: str | Sequence[str] | None = None, version: str | None = None
+) -> Path:
+    """Write ``out_dir/report.md`` from the CSV files there; returns its path. ``command``:
+    the ``sdar bench`` command(s) that made the rows; ``version``: the package version that
+    did."""
     rows, steps = load_results(out_dir), load_steps(out_dir)
     names = instances_in(rows)
     limits = sorted({r["time_limit_s"] for r in rows})
@@ -286,9 +290,11 @@ def write_report(out_dir: Path, command: str | None = None) -> Path:
         "Success = solved and the plan passes the independent replay.",
         "",
     ]
-    if command:
-        lines += ["Regenerate (finished runs are skipped; plots and report are redrawn):", "",
-                  f"    {command}", ""]  # fmt: skip
+    commands = [command] if isinstance(command, str) else list(command or [])
+    if commands:
+        made = f" with sdar-tamp {version}" if version else ""
+        lines += [f"Made{made} by (rerun to resume: finished runs are skipped, plots and "
+                  "report are redrawn):", "", *(f"    {c}" for c in commands), ""]  # fmt: skip
     lines += ["## Success per combination", "", *success_lines(rows)]
     lines += ["## Execution time", "", *execution_lines(rows)]
     lines += ["## Actions: SDAR-T vs baseline task planner", ""]

@@ -3,10 +3,19 @@
 Output folder:
 
 - ``results.csv``: one row per finished run (:data:`COLUMNS`), appended and flushed as soon
-  as the run ends. A rerun skips every (instance, combination) pair already in the file, so an
-  interrupted benchmark resumes where it stopped (delete a row to run that pair again).
+  as the run ends, whole lines only. A rerun skips every (instance, combination) pair already
+  in the file, so an interrupted benchmark resumes where it stopped (delete a row to run that
+  pair again).
 - ``steps.csv``: planning time [s] of every synchronous step of every solved run, split into
   plan selection (IK, grasps, buffers, ranking) and motion generation (:data:`STEP_COLUMNS`).
+- ``settings.json``: what the rows depend on (seed, time limit, workers, suite, instance file
+  hashes, version; :mod:`sdar_tamp.evaluation.settings`). A rerun with other settings is
+  refused instead of mixing their rows; ``restart=True`` discards the old rows.
+
+Each run is solved in a worker process (:class:`~sdar_tamp.evaluation.workers.WorkerPool`):
+a run that overruns a hard limit (by default ``2 * time_limit + 120`` s: set-up, abstract run
+and replay come on top of the time limit) or whose worker crashes is recorded as an ``error``
+row, and no worker outlives the benchmark, even if it is killed.
 
 A run succeeds when it is solved *and* its plan passes the independent replay. Each row also
 holds the task planner's geometry-free action count (:func:`solvers.sdar.abstract.run_abstract`
@@ -21,18 +30,31 @@ from __future__ import annotations
 import argparse
 import csv
 import functools
+import io
 import logging
-import multiprocessing
 import re
+import shlex
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
+from sdar_tamp import __version__
 from sdar_tamp.errors import ParameterError, SdarError
+from sdar_tamp.evaluation.settings import (
+    SETTINGS,
+    BenchSettings,
+    file_digest,
+    read_settings,
+    reconcile,
+    write_settings,
+)
+from sdar_tamp.evaluation.workers import WorkerFailure, WorkerPool
 
 log = logging.getLogger(__name__)
 
@@ -144,6 +166,12 @@ def suite_entries(
     return sorted(entries, key=lambda e: (e.objects, instance_sort_key(e.name)))
 
 
+def suite_label(suite: str | Path) -> str:
+    """How the settings record names ``suite``: a folder by its resolved path, a shipped
+    suite by its name."""
+    return str(Path(suite).resolve()) if Path(suite).is_dir() else str(suite)
+
+
 @dataclass(frozen=True)
 class _Task:
     entry: SuiteEntry
@@ -179,16 +207,22 @@ def _abstract_figures(path: Path, task_planner: str) -> dict[str, int | None]:
     return {"abstract_actions": actions, "abstract_buffer_moves": buffers, "abstract_steps": steps}
 
 
+def _task_row(task: _Task) -> dict[str, Any]:
+    """The columns of a row known before the run."""
+    e, c = task.entry, task.combo
+    return dict(
+        instance=e.name, family=e.family, objects=e.objects, combination=c.id,
+        task_planner=c.task_planner, motion_planner=c.motion_planner, seed=task.seed,
+        time_limit_s=task.time_limit,
+    )  # fmt: skip
+
+
 def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
     """One solve in a worker process: the CSV row and the per-step planning times."""
     from sdar_tamp.solve_command import solve_instance
 
     e, c = task.entry, task.combo
-    row: dict[str, Any] = dict(
-        instance=e.name, family=e.family, objects=e.objects, combination=c.id,
-        task_planner=c.task_planner, motion_planner=c.motion_planner, seed=task.seed,
-        time_limit_s=task.time_limit,
-    )  # fmt: skip
+    row = _task_row(task)
     row.update(_abstract_figures(e.path, c.task_planner))
     start = time.perf_counter()
     try:
@@ -231,13 +265,16 @@ def _cell(value: Any) -> str:
 
 
 def append_rows(path: Path, columns: Sequence[str], rows: Iterable[Mapping[str, Any]]) -> None:
-    """Append ``rows`` to the CSV file ``path`` (header first if new) and flush."""
+    """Append ``rows`` to the CSV file ``path`` (header first if new) and flush. The text is
+    written in one call, so an interruption (``KeyboardInterrupt``) leaves whole lines."""
     new = not path.exists() or path.stat().st_size == 0
+    text = io.StringIO()
+    writer = csv.writer(text)
+    if new:
+        writer.writerow(columns)
+    writer.writerows([_cell(r.get(c)) for c in columns] for r in rows)
     with path.open("a", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        if new:
-            writer.writerow(columns)
-        writer.writerows([_cell(r.get(c)) for c in columns] for r in rows)
+        fh.write(text.getvalue())
         fh.flush()
 
 
@@ -291,6 +328,12 @@ def _repaired(
     return kept
 
 
+def default_hard_limit(time_limit: float) -> float:
+    """[s] a worker may spend on one run before it is killed: the planner's ``time_limit``
+    plus set-up (the motion planner, built once per worker), abstract run and replay."""
+    return 2.0 * time_limit + 120.0
+
+
 def run_bench(
     suite: str | Path,
     out_dir: str | Path,
@@ -302,9 +345,17 @@ def run_bench(
     max_objects: int | None = None,
     seed: int = 0,
     progress: bool = True,
+    restart: bool = False,
+    hard_limit: float | None = None,
 ) -> Path:
     """Solve every (instance, combination) of ``suite`` not yet in ``out_dir/results.csv``
-    with ``workers`` processes and ``time_limit`` [s] per run; returns the results file."""
+    with ``workers`` processes and ``time_limit`` [s] per run; returns the results file.
+
+    Rows already in the folder are reused only if they were made with the same settings
+    (:mod:`sdar_tamp.evaluation.settings`); otherwise :class:`SettingsMismatch` is raised
+    before anything runs, unless ``restart`` discards them first. ``hard_limit`` [s] (default
+    :func:`default_hard_limit`) bounds one run's worker. An exception (``KeyboardInterrupt``)
+    kills the workers and leaves every finished row in place."""
     from tqdm import tqdm
 
     chosen = parse_combos(combos)
@@ -312,58 +363,155 @@ def run_bench(
         raise ParameterError(f"workers must be >= 1, got {workers}")
     if time_limit <= 0:
         raise ParameterError(f"time limit must be > 0 [s], got {time_limit}")
+    if hard_limit is None:
+        hard_limit = default_hard_limit(time_limit)
     entries = suite_entries(suite, instances, max_objects)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    if restart:
+        for name in (RESULTS, STEPS, SETTINGS):
+            (out / name).unlink(missing_ok=True)
+    wanted = BenchSettings(
+        version=__version__, suite=suite_label(suite), seed=seed, time_limit_s=time_limit,
+        workers=workers, instances={e.name: file_digest(e.path) for e in entries},
+    )  # fmt: skip
+    write_settings(out, reconcile(out, wanted, load_results(out)))
     done = finished_pairs(out)
     tasks = [
         _Task(e, c, time_limit, seed) for e in entries for c in chosen if (e.name, c.id) not in done
     ]
     if not tasks:
         return out / RESULTS
-    context = multiprocessing.get_context("spawn")
     bar = tqdm(total=len(tasks), desc="bench", unit="run", file=sys.stderr, disable=not progress)
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=context)
+    pool = WorkerPool(_run_task, min(workers, len(tasks)), hard_limit=hard_limit)
     try:
-        futures = [pool.submit(_run_task, t) for t in tasks]
-        for future in as_completed(futures):
-            row, steps = future.result()
-            step_rows = [
-                dict(instance=row["instance"], combination=row["combination"], step=i,
-                     selection_s=s, motion_s=m)
-                for i, (s, m) in enumerate(steps)
-            ]  # fmt: skip
-            append_rows(out / STEPS, STEP_COLUMNS, step_rows)
-            append_rows(out / RESULTS, COLUMNS, [row])
-            bar.set_postfix_str(f"{row['instance']} {row['combination']}: {row['status']}")
-            bar.update(1)
+        with pool:
+            for task, answer in pool.run(tasks):
+                steps: list[tuple[float, float]]
+                if isinstance(answer, WorkerFailure):
+                    failed = _failed_row(task, answer)
+                    if failed is None:
+                        continue
+                    row, steps = failed, []
+                else:
+                    row, steps = answer
+                step_rows = [
+                    dict(instance=row["instance"], combination=row["combination"], step=i,
+                         selection_s=s, motion_s=m)
+                    for i, (s, m) in enumerate(steps)
+                ]  # fmt: skip
+                append_rows(out / STEPS, STEP_COLUMNS, step_rows)  # first: see finished_pairs
+                append_rows(out / RESULTS, COLUMNS, [row])
+                bar.set_postfix_str(f"{row['instance']} {row['combination']}: {row['status']}")
+                bar.update(1)
     finally:
-        pool.shutdown(wait=True, cancel_futures=True)
         bar.close()
     return out / RESULTS
 
 
-def bench_command_line(args: argparse.Namespace) -> str:
-    """The ``sdar bench`` command that reproduces ``args`` (rerun: resumes, then redraws)."""
-    parts = [
-        f"sdar bench --suite {args.suite} --out {args.out} --combos {args.combos}",
-        f"--workers {args.workers} --time-limit {args.time_limit:g} --seed {args.seed}",
-    ]
-    if args.only:
-        parts.append(f"--only {args.only}")
-    if args.max_objects is not None:
-        parts.append(f"--max-objects {args.max_objects}")
-    return " ".join(parts)
+def _failed_row(task: _Task, failure: WorkerFailure) -> dict[str, Any] | None:
+    """The ``error`` row of a run without an answer; ``None`` (no row: a rerun runs it again)
+    when its worker was terminated from outside."""
+    name = f"{task.entry.name} with {task.combo.id}"
+    if failure.external:
+        log.warning("%s not recorded: %s", name, failure.reason)
+        return None
+    log.error("%s: %s", name, failure.reason)
+    row = _task_row(task)
+    row.update(status="error", success=False, valid=False, diagnosis=failure.reason)
+    return row
+
+
+def bench_commands(
+    out: str | Path, settings: BenchSettings, rows: Sequence[Mapping[str, str]],
+    suite_names: Iterable[str],
+) -> list[str]:  # fmt: skip
+    """The ``sdar bench`` commands that made ``rows`` under ``settings`` (rerun: resumes, then
+    redraws): one per group of instances run with the same combinations."""
+    by_instance: dict[str, set[str]] = {}
+    objects: dict[str, int] = {}
+    for r in rows:
+        by_instance.setdefault(r["instance"], set()).add(r["combination"])
+        objects[r["instance"]] = int(r["objects"]) if r["objects"].isdigit() else 0
+    groups: dict[frozenset[str], list[str]] = {}
+    for name in sorted(by_instance, key=lambda n: (objects[n], instance_sort_key(n))):
+        groups.setdefault(frozenset(by_instance[name]), []).append(name)
+    base = (
+        f"sdar bench --suite {shlex.quote(settings.suite)} --out {shlex.quote(str(out))}",
+        f"--workers {settings.workers} --time-limit {_number(settings.time_limit_s)} "
+        f"--seed {settings.seed}",
+    )
+    everything = set(suite_names)
+    commands = []
+    for combos, names in groups.items():
+        ids = [c.id for c in COMBINATIONS if c.id in combos]
+        ids += sorted(combos - set(ids))  # ids of another version, kept as they are
+        combo_arg = "all" if ids == [c.id for c in COMBINATIONS] else ",".join(ids)
+        command = f"{base[0]} --combos {shlex.quote(combo_arg)} {base[1]}"
+        if len(groups) > 1 or set(names) != everything:
+            command += f" --only {shlex.quote(','.join(names))}"
+        commands.append(command)
+    return commands
+
+
+def _number(value: float) -> str:
+    short = f"{value:g}"
+    return short if float(short) == value else repr(value)
+
+
+class BenchInterrupted(KeyboardInterrupt):
+    """``sdar bench`` stopped by a signal (SIGINT or SIGTERM)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+def _interrupt(signum: int, frame: FrameType | None) -> None:
+    for name in ("SIGINT", "SIGTERM"):  # a second signal must not break the clean-up
+        signal.signal(getattr(signal, name), signal.SIG_IGN)
+    raise BenchInterrupted(signum)
 
 
 def bench_command(args: argparse.Namespace) -> int:
-    """``sdar bench``: run (or resume) the benchmark, then write the plots and the report."""
+    """``sdar bench``: run (or resume) the benchmark, then write the plots and the report.
+
+    SIGINT (Ctrl-C) and SIGTERM stop it with one line on stderr and exit status 128 + the
+    signal number (130, 143); the workers are killed and the finished rows stay."""
+    handled: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)
+    if threading.current_thread() is not threading.main_thread():
+        handled = ()  # only the main thread may set handlers: plain KeyboardInterrupt then
+    previous = {s: signal.getsignal(s) for s in handled}
+    for s in handled:
+        signal.signal(s, _interrupt)
+    try:
+        return _bench(args)
+    except KeyboardInterrupt as stop:
+        signum = stop.signum if isinstance(stop, BenchInterrupted) else signal.SIGINT
+        results = Path(args.out) / RESULTS
+        try:
+            kept = f"{len(load_results(args.out))} finished runs kept in {results}"
+        except (OSError, SdarError):
+            kept = f"the finished runs stay in {results}"
+        print(
+            f"sdar bench: interrupted ({signal.Signals(signum).name}); {kept}; "
+            "run the same command again to resume",
+            file=sys.stderr,
+        )
+        return 128 + signum
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+
+
+def _bench(args: argparse.Namespace) -> int:
     from sdar_tamp.evaluation.report import success_lines, write_report
 
     only = [s.strip() for s in args.only.split(",") if s.strip()] if args.only else None
     results = run_bench(
         args.suite, args.out, args.combos, workers=args.workers, time_limit=args.time_limit,
         instances=only, max_objects=args.max_objects, seed=args.seed, progress=not args.quiet,
+        restart=args.restart,
     )  # fmt: skip
     print(f"results: {results}")
     try:
@@ -372,6 +520,13 @@ def bench_command(args: argparse.Namespace) -> int:
         print(f"no plots: {error} (pip install 'sdar-tamp[viz]')", file=sys.stderr)
     else:
         print(f"plots: {', '.join(p.name for p in write_plots(results.parent))}")
-    print(f"report: {write_report(results.parent, bench_command_line(args))}")
-    print("\n".join(success_lines(load_results(results.parent))))
+    rows = load_results(results.parent)
+    settings = read_settings(results.parent)
+    commands: list[str] = []
+    if settings is not None and rows:
+        names = [e.name for e in suite_entries(args.suite)]
+        commands = bench_commands(args.out, settings, rows, names)
+    version = settings.version if settings is not None else None
+    print(f"report: {write_report(results.parent, commands, version)}")
+    print("\n".join(success_lines(rows)))
     return 0

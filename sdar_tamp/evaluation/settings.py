@@ -1,0 +1,149 @@
+"""The settings record of a benchmark folder (``settings.json``): what its rows depend on.
+
+A row of ``results.csv`` is the outcome of one (instance, combination) pair *under* a seed, a
+time limit, a number of parallel workers (they share the cores, so planning times and even
+successes within the time limit depend on it), the instance file's content and the package
+version. The first run writes these to ``settings.json``; a rerun reuses rows only when its
+own settings are the same, and otherwise stops with one line naming every difference (rather
+than silently mixing outcomes of different settings). Instances added by a later run are
+added to the record; an instance file whose content changed is a difference.
+
+A folder written before the record existed is checked against the seed and time limit its
+rows hold, then gets a record.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from sdar_tamp.errors import SdarError
+
+SETTINGS = "settings.json"
+FORMAT = 1
+
+
+class SettingsMismatch(SdarError):
+    """A rerun's settings differ from those that made the rows already in the folder."""
+
+
+@dataclass(frozen=True)
+class BenchSettings:
+    """Everything a benchmark row depends on besides its (instance, combination) pair.
+
+    ``suite``: a shipped suite name or the resolved path of a folder; ``time_limit_s`` [s];
+    ``instances``: instance name -> SHA-256 of its file."""
+
+    version: str
+    suite: str
+    seed: int
+    time_limit_s: float
+    workers: int
+    instances: Mapping[str, str] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return dict(
+            format=FORMAT, version=self.version, suite=self.suite, seed=self.seed,
+            time_limit_s=self.time_limit_s, workers=self.workers,
+            instances=dict(sorted(self.instances.items())),
+        )  # fmt: skip
+
+
+def file_digest(path: Path) -> str:
+    """SHA-256 of a file's bytes (hex)."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def read_settings(out_dir: Path) -> BenchSettings | None:
+    """The record in ``out_dir``, ``None`` if there is none. Raises :class:`SdarError` for a
+    file that is not a record of this format."""
+    path = Path(out_dir) / SETTINGS
+    if not path.exists():
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        if data.get("format") != FORMAT:
+            raise ValueError(f"format {data.get('format')!r}")
+        return BenchSettings(
+            version=str(data["version"]), suite=str(data["suite"]), seed=int(data["seed"]),
+            time_limit_s=float(data["time_limit_s"]), workers=int(data["workers"]),
+            instances={str(k): str(v) for k, v in dict(data["instances"]).items()},
+        )  # fmt: skip
+    except (ValueError, KeyError, TypeError, AttributeError) as error:
+        raise SdarError(
+            f"{path}: not a settings record of format {FORMAT} ({error}); "
+            "delete it only if the rows beside it were made with the current settings"
+        ) from None
+
+
+def write_settings(out_dir: Path, settings: BenchSettings) -> Path:
+    """Write the record (atomically: a reader sees the old or the new one)."""
+    path = Path(out_dir) / SETTINGS
+    partial = path.with_name(f".{SETTINGS}.partial")
+    partial.write_text(json.dumps(settings.to_json(), indent=1) + "\n", encoding="utf-8")
+    os.replace(partial, path)
+    return path
+
+
+def _limit(value: float) -> str:
+    return f"{value:g} s"
+
+
+def _differences(old: BenchSettings, new: BenchSettings) -> list[str]:
+    pairs = [
+        ("version", old.version, new.version),
+        ("suite", old.suite, new.suite),
+        ("seed", str(old.seed), str(new.seed)),
+        ("time limit", _limit(old.time_limit_s), _limit(new.time_limit_s)),
+        ("workers", str(old.workers), str(new.workers)),
+    ]
+    found = [f"{name} {now} (the rows: {then})" for name, then, now in pairs if then != now]
+    found += [
+        f"instance {name} (file changed since its rows)"
+        for name, digest in new.instances.items()
+        if old.instances.get(name, digest) != digest
+    ]
+    return found
+
+
+def _row_differences(rows: Sequence[Mapping[str, str]], new: BenchSettings) -> list[str]:
+    """Seed and time limit of rows written without a record (older versions)."""
+    found = []
+    seeds = sorted({r["seed"] for r in rows}, key=lambda s: (len(s), s))
+    if seeds != [str(new.seed)]:
+        found.append(f"seed {new.seed} (the rows: {', '.join(seeds)})")
+    limits = sorted({float(r["time_limit_s"]) for r in rows})
+    if limits != [float(f"{new.time_limit_s:.6g}")]:  # the rows hold 6 significant digits
+        found.append(
+            f"time limit {_limit(new.time_limit_s)} (the rows: {', '.join(map(_limit, limits))})"
+        )
+    return found
+
+
+def reconcile(
+    out_dir: Path, new: BenchSettings, rows: Iterable[Mapping[str, str]]
+) -> BenchSettings:
+    """The record to keep in ``out_dir`` for a run with settings ``new`` that finds ``rows``
+    there: ``new`` with every instance of the old record. Raises :class:`SettingsMismatch`
+    (one line) if the rows were made with other settings."""
+    rows = list(rows)
+    if not rows:  # nothing to protect: a fresh start
+        return new
+    old = read_settings(out_dir)
+    if old is None:
+        found = _row_differences(rows, new)
+        merged = new
+    else:
+        found = _differences(old, new)
+        merged = replace(new, instances={**old.instances, **new.instances})
+    if found:
+        raise SettingsMismatch(
+            f"{out_dir} holds runs made with other settings: {'; '.join(found)}. Rerun with "
+            "the settings of the rows, pass --restart to discard them, or use another --out"
+        )
+    return merged
