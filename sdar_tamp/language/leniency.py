@@ -25,7 +25,7 @@ at info level.
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from sdar_tamp.errors import SourceLocation
@@ -95,9 +95,6 @@ class LeniencyLog:
 
     def add(self, kind: str, message: str, location: SourceLocation | None) -> None:
         self._items.append(Leniency(kind, message, location))
-
-    def __iter__(self) -> Iterator[Leniency]:
-        return iter(self._items)
 
     def finish(self) -> tuple[Leniency, ...]:
         """The leniencies in source order, each logged once.
