@@ -23,11 +23,21 @@ def _read(path: Path) -> str:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     """Classical planning on a PDDL domain and problem file."""
-    from sdar_tamp.language import parse_domain, parse_problem
+    from sdar_tamp.language import StrictModeError, parse_domain, parse_problem
     from solvers.classical import PlanStatus, plan, task_from_problem
 
-    domain = parse_domain(_read(args.domain), str(args.domain))
-    problem = parse_problem(_read(args.problem), domain, str(args.problem))
+    try:
+        domain = parse_domain(_read(args.domain), str(args.domain), strict=args.strict)
+        problem = parse_problem(_read(args.problem), domain, str(args.problem), strict=args.strict)
+    except StrictModeError as error:
+        for leniency in error.leniencies:
+            print(f"sdar: warning: {leniency}", file=sys.stderr)
+        print(
+            f"sdar: error: --strict: {len(error.leniencies)} warning(s); without --strict "
+            "these constructs are accepted",
+            file=sys.stderr,
+        )
+        return 2
     result = plan(
         task_from_problem(domain, problem, use_costs=False if args.unit else None),
         search=args.search,
@@ -189,6 +199,12 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--weight", type=float, default=2.0, help="weight of wastar (default: 2)")
     plan.add_argument("--time-limit", type=float, default=None, help="seconds (default: none)")
     plan.add_argument("--unit", action="store_true", help="ignore action costs")
+    plan.add_argument(
+        "--strict",
+        action="store_true",
+        help="reject what Fast Downward and VAL accept beyond standard PDDL (glued '?x', "
+        "undeclared or twice-declared predicates...): print each as a warning, exit 2",
+    )
     plan.set_defaults(func=cmd_plan)
 
     check = sub.add_parser(

@@ -13,17 +13,20 @@ from sdar_tamp.language.errors import (
     UnknownKeywordError,
     UnsupportedFeatureError,
 )
+from sdar_tamp.language.leniency import Leniency, StrictModeError
 from sdar_tamp.language.pddl import parse_domain, parse_problem
 from sdar_tamp.language.streams import parse_stream_file
 
 __all__ = [
     "ArityError",
     "DuplicateError",
+    "Leniency",
     "PddlError",
     "PddlSyntaxError",
     "ProblemDefinitionError",
     "StreamDefinitionError",
     "StreamMapError",
+    "StrictModeError",
     "UnboundVariableError",
     "UndeclaredError",
     "UnknownKeywordError",

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -68,12 +70,17 @@ def parse_name_header(node: SExpr, keyword: str) -> str:
 
 
 def parse_typed_list(
-    items: Sequence[SExpr], what: str, types: frozenset[str] | None, variables: bool
+    items: Sequence[SExpr],
+    what: str,
+    types: frozenset[str] | None,
+    variables: bool,
+    repeats: list[tuple[str, SourceLocation]] | None = None,
 ) -> list[tuple[str, str, SourceLocation]]:
     """Parse ``a b - t c`` into ``[(a, t), (b, t), (c, object)]`` with locations.
 
     ``types`` None means the caller does not check types (type declarations themselves).
-    ``variables`` requires every name to start with ``?``; otherwise none may.
+    ``variables`` requires every name to start with ``?``; otherwise none may. A name that
+    appears twice is an error, unless ``repeats`` is given: then it is kept and noted there.
     """
     result: list[tuple[str, str, SourceLocation]] = []
     pending: list[Symbol] = []
@@ -107,9 +114,31 @@ def parse_typed_list(
     seen: set[str] = set()
     for name, _, location in result:
         if name in seen:
-            raise DuplicateError(f"{name!r} appears twice in {what}", location)
+            if repeats is None:
+                raise DuplicateError(f"{name!r} appears twice in {what}", location)
+            repeats.append((name, location))
         seen.add(name)
     return result
+
+
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+def parse_number(token: Symbol, what: str) -> float:
+    """A finite decimal number such as ``3``, ``-0.5`` or ``1e3`` (no ``nan``, ``inf``, ``1_0``).
+
+    Raises:
+        PddlSyntaxError: not a number, or one too large for a float (``1e309``).
+    """
+    if not _NUMBER.fullmatch(token.text):
+        raise PddlSyntaxError(f"expected {what}, found {token.text!r}", token.location)
+    value = float(token.text)
+    if not math.isfinite(value):
+        raise PddlSyntaxError(
+            f"expected {what}, found {token.text!r}, which is too large for a finite value",
+            token.location,
+        )
+    return value
 
 
 def check_type(node: Symbol, types: frozenset[str] | None) -> None:
@@ -130,6 +159,8 @@ class Vocabulary:
     derived: frozenset[str] = frozenset()
     allow_new_functions: bool = False
     filename: str | None = None
+    implicit_predicates: dict[str, SourceLocation] | None = None
+    """When not None, an undeclared predicate is declared at its first use (noted here)."""
 
 
 class FormulaReader:
@@ -165,6 +196,9 @@ class FormulaReader:
             expected = self.vocabulary.predicates[name]
         elif name in self.vocabulary.types:
             expected = 1
+        elif self.vocabulary.implicit_predicates is not None:
+            expected = self.vocabulary.predicates[name] = len(args)
+            self.vocabulary.implicit_predicates[name] = head.location
         else:
             raise UndeclaredError(f"undeclared predicate {name!r}", head.location)
         if len(args) != expected:
@@ -266,12 +300,7 @@ class FormulaReader:
 
     def numeric(self, node: SExpr, scope: Mapping[str, str]) -> NumericExpr:
         if isinstance(node, Symbol):
-            try:
-                value = float(node.text)
-            except ValueError:
-                raise PddlSyntaxError(
-                    f"expected a number or a function term, found {node.text!r}", node.location
-                ) from None
+            value = parse_number(node, "a finite number or a function term")
             if value < 0:
                 raise PddlSyntaxError(
                     f"action costs must be non-negative, got {value}", node.location

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import TypeAlias
 
 from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.leniency import Leniency
 
 OBJECT_TYPE = "object"
 EQUALITY = "="
@@ -216,6 +217,8 @@ class Domain:
     actions: tuple[Action, ...]
     axioms: tuple[Axiom, ...]
     source: str | None = field(default=None, compare=False)
+    leniencies: tuple[Leniency, ...] = field(default=(), compare=False)
+    """What was accepted although strict PDDL rejects it (see ``language.leniency``)."""
 
     @property
     def derived_predicates(self) -> frozenset[str]:
@@ -238,6 +241,8 @@ class Problem:
     goal: Formula
     minimize_cost: bool = False
     source: str | None = field(default=None, compare=False)
+    leniencies: tuple[Leniency, ...] = field(default=(), compare=False)
+    """What was accepted although strict PDDL rejects it (see ``language.leniency``)."""
 
 
 # --- stream files -----------------------------------------------------------------------------
@@ -312,6 +317,8 @@ class StreamFile:
     predicates: tuple[StreamPredicate, ...] = ()
     rules: tuple[Rule, ...] = ()
     source: str | None = field(default=None, compare=False)
+    leniencies: tuple[Leniency, ...] = field(default=(), compare=False)
+    """What was accepted although strict PDDL rejects it (see ``language.leniency``)."""
 
     def merged(self, other: StreamFile) -> StreamFile:
         return StreamFile(
@@ -321,6 +328,7 @@ class StreamFile:
             predicates=self.predicates + other.predicates,
             rules=self.rules + other.rules,
             source=self.source,
+            leniencies=self.leniencies + other.leniencies,
         )
 
 

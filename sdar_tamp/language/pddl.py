@@ -3,11 +3,16 @@
 Supported requirements: ``:strips :typing :negative-preconditions :disjunctive-preconditions
 :equality :existential-preconditions :universal-preconditions :quantified-preconditions
 :conditional-effects :derived-predicates :action-costs :adl``. Names are case-insensitive.
+
+What Fast Downward and VAL accept beyond the standard (``(aircraft?a)``, ``(in ?obj ?obj)``,
+predicates used only in ``:init`` or the goal...) is accepted and noted as a
+:class:`~sdar_tamp.language.leniency.Leniency`; ``strict=True`` rejects it instead.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import itertools
+from collections.abc import Iterable, Mapping
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.errors import (
@@ -24,7 +29,17 @@ from sdar_tamp.language.grammar import (
     expect_list,
     expect_symbol,
     parse_name_header,
+    parse_number,
     parse_typed_list,
+)
+from sdar_tamp.language.leniency import (
+    DUPLICATE_PREDICATE,
+    IMPLICIT_PREDICATE,
+    INIT_TYPE,
+    REPEATED_VARIABLE,
+    UNDECLARED_PARENT_TYPE,
+    LeniencyLog,
+    note_glued_variables,
 )
 from sdar_tamp.language.model import (
     OBJECT_TYPE,
@@ -89,13 +104,19 @@ def _sections(root: SList, kind: str, allowed: Iterable[str]) -> list[tuple[str,
     return result
 
 
-def parse_domain(text: str, filename: str | None = None) -> Domain:
+def parse_domain(text: str, filename: str | None = None, *, strict: bool = False) -> Domain:
     """Parse a PDDL domain.
+
+    Leniencies (see :mod:`sdar_tamp.language.leniency`) are kept in ``Domain.leniencies`` and
+    logged, or with ``strict=True`` rejected.
 
     Raises:
         PddlError: a subclass naming ``file:line:col`` and what was expected.
+        StrictModeError: ``strict=True`` and the domain needs a leniency.
     """
     root = read_sexpr(text, filename)
+    log = LeniencyLog(strict)
+    note_glued_variables(root, log)
     name = parse_name_header(root.items[1] if len(root.items) > 1 else root, "domain")
     requirements: set[str] = set()
     parents: dict[str, str] = {}
@@ -120,7 +141,7 @@ def parse_domain(text: str, filename: str | None = None) -> Domain:
                     )
                 requirements.add(symbol.text)
         elif keyword == ":types":
-            _declare_types(body, parents)
+            _declare_types(body, parents, log)
             vocabulary.types = frozenset({OBJECT_TYPE, *parents})
         elif keyword == ":constants":
             for const, type_name, location in parse_typed_list(
@@ -131,12 +152,26 @@ def parse_domain(text: str, filename: str | None = None) -> Domain:
                 constants[const] = type_name
         elif keyword == ":predicates":
             for node in body:
-                predicate = _declaration(node, reader, "a predicate declaration")
-                if predicate.name in predicates or predicate.name in vocabulary.types:
+                predicate = _declaration(node, reader, "a predicate declaration", log)
+                if predicate.name in vocabulary.types:
                     raise DuplicateError(
-                        f"predicate {predicate.name!r} is declared twice or clashes with a type",
+                        f"predicate {predicate.name!r} has the name of a type", node.location
+                    )
+                if predicate.name in predicates:
+                    first = predicates[predicate.name]
+                    if first.arity != predicate.arity:
+                        raise DuplicateError(
+                            f"predicate {predicate.name!r} is declared twice with different "
+                            f"arities ({first.arity} and {predicate.arity})",
+                            node.location,
+                        )
+                    log.add(
+                        DUPLICATE_PREDICATE,
+                        f"predicate {predicate.name!r} is declared twice; the first declaration "
+                        "is kept",
                         node.location,
                     )
+                    continue
                 predicates[predicate.name] = predicate
                 vocabulary.predicates[predicate.name] = predicate.arity
         elif keyword == ":functions":
@@ -170,6 +205,7 @@ def parse_domain(text: str, filename: str | None = None) -> Domain:
         actions=tuple(actions),
         axioms=tuple(axioms),
         source=filename,
+        leniencies=log.finish(),
     )
 
 
@@ -180,13 +216,30 @@ def _derived_name(section: SList) -> str:
     return expect_symbol(head.items[0] if head.items else head, "a predicate name").text
 
 
-def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str]) -> None:
+def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str], log: LeniencyLog) -> None:
     for child, parent, location in parse_typed_list(body, "the types", None, variables=False):
         if child == OBJECT_TYPE:
             continue
         if child in parents:
             raise DuplicateError(f"type {child!r} is declared twice", location)
         parents[child] = parent
+    noted: set[str] = set()
+    for dash, node in itertools.pairwise(body):
+        if (
+            isinstance(dash, Symbol)
+            and dash.text == "-"
+            and isinstance(node, Symbol)
+            and node.text not in parents
+            and node.text != OBJECT_TYPE
+            and node.text not in noted
+        ):
+            noted.add(node.text)
+            log.add(
+                UNDECLARED_PARENT_TYPE,
+                f"parent type {node.text!r} is not declared in :types; it is taken to be a "
+                "subtype of 'object'",
+                node.location,
+            )
     for child, parent in list(parents.items()):
         seen = {child}
         while parent != OBJECT_TYPE:
@@ -201,12 +254,27 @@ def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str]) -> None:
             parent = parents[parent]
 
 
-def _declaration(node: SExpr, reader: FormulaReader, what: str) -> Predicate:
+def _declaration(
+    node: SExpr, reader: FormulaReader, what: str, log: LeniencyLog | None = None
+) -> Predicate:
+    """``(name ?a - t ?b)``; with ``log``, a repeated variable name is noted, not an error."""
     lst = expect_list(node, what)
     head = expect_symbol(lst.items[0] if lst.items else lst, "a name")
+    repeats: list[tuple[str, SourceLocation]] = []
     params = parse_typed_list(
-        lst.items[1:], f"the parameters of {head.text!r}", reader.vocabulary.types, variables=True
+        lst.items[1:],
+        f"the parameters of {head.text!r}",
+        reader.vocabulary.types,
+        variables=True,
+        repeats=repeats if log is not None else None,
     )
+    if log is not None:
+        for variable, location in repeats:
+            log.add(
+                REPEATED_VARIABLE,
+                f"variable {variable} appears twice in the declaration of {head.text!r}",
+                location,
+            )
     return Predicate(head.text, tuple(Parameter(n, t) for n, t, _ in params))
 
 
@@ -283,13 +351,22 @@ def _axiom(section: SList, reader: FormulaReader, predicates: dict[str, Predicat
     return Axiom(declared.name, params, body, section.location)
 
 
-def parse_problem(text: str, domain: Domain, filename: str | None = None) -> Problem:
+def parse_problem(
+    text: str, domain: Domain, filename: str | None = None, *, strict: bool = False
+) -> Problem:
     """Parse a PDDL problem for ``domain``.
+
+    Each section may appear once and ``:goal`` is required. Predicates that the domain does not
+    declare may be used in ``:init`` and the goal (declared by their first use). Leniencies are
+    kept in ``Problem.leniencies`` and logged, or with ``strict=True`` rejected.
 
     Raises:
         PddlError: a subclass naming ``file:line:col`` and what was expected.
+        StrictModeError: ``strict=True`` and the problem needs a leniency.
     """
     root = read_sexpr(text, filename)
+    log = LeniencyLog(strict)
+    note_glued_variables(root, log)
     name = parse_name_header(root.items[1] if len(root.items) > 1 else root, "problem")
     types = frozenset(domain.types.types())
     objects: dict[str, str] = dict(domain.constants)
@@ -300,10 +377,19 @@ def parse_problem(text: str, domain: Domain, filename: str | None = None) -> Pro
         {f.name: len(f.parameters) for f in domain.functions.values()},
         derived=domain.derived_predicates,
         filename=filename,
+        implicit_predicates={},
     )
     reader = FormulaReader(vocabulary)
     domain_name = domain.name
     sections = _sections(root, "problem", PROBLEM_SECTIONS)
+    seen: dict[str, SList] = {}
+    for keyword, section in sections:
+        if keyword in seen:
+            raise DuplicateError(
+                f"section {keyword} appears twice (first at {seen[keyword].location})",
+                section.location,
+            )
+        seen[keyword] = section
     own: dict[str, str] = {}
     for keyword, section in sections:
         if keyword == ":domain":
@@ -327,25 +413,49 @@ def parse_problem(text: str, domain: Domain, filename: str | None = None) -> Pro
     numeric: dict[tuple[str, tuple[str, ...]], float] = {}
     goal = TRUE
     minimize = False
+    located: list[tuple[Atom, SourceLocation]] = []
     for keyword, section in sections:
         if keyword == ":init":
             for node in section.items[1:]:
-                _init_fact(node, reader, init, numeric)
+                atom = _init_fact(node, reader, numeric)
+                if atom is not None:
+                    located.append((atom, node.location))
+                    init.append(atom)
         elif keyword == ":goal":
             if len(section.items) != 2:
                 raise PddlSyntaxError("expected '(:goal formula)'", section.location)
             goal = reader.formula(section.items[1], {})
         elif keyword == ":metric":
             minimize = _metric(section)
-    return Problem(name, domain_name, dict(own), tuple(init), numeric, goal, minimize, filename)
+    if ":goal" not in seen:
+        raise PddlSyntaxError(
+            f"expected a '(:goal ...)' section in problem {name!r}", root.location
+        )
+    _check_init_types(located, domain, objects, log)
+    for predicate, location in (vocabulary.implicit_predicates or {}).items():
+        log.add(
+            IMPLICIT_PREDICATE,
+            f"predicate {predicate!r} is not declared in the domain; declared by this first use "
+            f"with {vocabulary.predicates[predicate]} argument(s)",
+            location,
+        )
+    return Problem(
+        name,
+        domain_name,
+        dict(own),
+        tuple(init),
+        numeric,
+        goal,
+        minimize,
+        filename,
+        leniencies=log.finish(),
+    )
 
 
 def _init_fact(
-    node: SExpr,
-    reader: FormulaReader,
-    init: list[Atom],
-    numeric: dict[tuple[str, tuple[str, ...]], float],
-) -> None:
+    node: SExpr, reader: FormulaReader, numeric: dict[tuple[str, tuple[str, ...]], float]
+) -> Atom | None:
+    """The atom of an initial fact, or None for a numeric one (stored in ``numeric``)."""
     lst = expect_list(node, "an initial fact")
     head = lst.items[0] if lst.items else lst
     if (
@@ -358,20 +468,56 @@ def _init_fact(
         fname = expect_symbol(term.items[0] if term.items else term, "a function name")
         args = tuple(reader.term(arg, {}) for arg in term.items[1:])
         reader.function_arity(fname, len(args), term.location)
-        value = expect_symbol(lst.items[2], "a number")
-        try:
-            numeric[(fname.text, args)] = float(value.text)
-        except ValueError:
+        value_node = expect_symbol(lst.items[2], "a number")
+        value = parse_number(value_node, "a finite number")
+        if fname.text == TOTAL_COST and value < 0:
             raise PddlSyntaxError(
-                f"expected a number, found {value.text!r}", value.location
-            ) from None
-        return
+                f"expected a non-negative initial total-cost, found {value_node.text!r}",
+                value_node.location,
+            )
+        numeric[(fname.text, args)] = value
+        return None
     atom = reader.atom(lst, {})
     if atom.predicate in reader.vocabulary.derived:
         raise PddlSyntaxError(
             f"derived predicate {atom.predicate!r} cannot be in :init", lst.location
         )
-    init.append(atom)
+    return atom
+
+
+def _check_init_types(
+    facts: Iterable[tuple[Atom, SourceLocation]],
+    domain: Domain,
+    objects: Mapping[str, str],
+    log: LeniencyLog,
+) -> None:
+    """Note an argument whose type is not the predicate's parameter type.
+
+    An object's type is its declared one, or a subtype given by a unary type fact in :init.
+    """
+    facts = list(facts)
+    hierarchy = domain.types
+    types = dict(objects)
+    for atom, _ in facts:
+        if atom.predicate in hierarchy.parents and len(atom.args) == 1:
+            current = types.get(atom.args[0], OBJECT_TYPE)
+            if hierarchy.is_subtype(atom.predicate, current):
+                types[atom.args[0]] = atom.predicate
+    for atom, location in facts:
+        declaration = domain.predicates.get(atom.predicate)
+        if declaration is None:
+            continue
+        for position, (arg, parameter) in enumerate(
+            zip(atom.args, declaration.parameters, strict=True), 1
+        ):
+            own = types.get(arg, OBJECT_TYPE)
+            if not hierarchy.is_subtype(own, parameter.type):
+                log.add(
+                    INIT_TYPE,
+                    f"argument {position} of {atom} is {arg!r} of type {own!r}, but "
+                    f"{atom.predicate!r} expects a {parameter.type!r}",
+                    location,
+                )
 
 
 def _metric(section: SList) -> bool:

@@ -5,10 +5,15 @@ meaning: the domain and stream files are given as text (or parsed models), ``con
 the domain's constants to Python values, ``stream_map`` maps stream and function names
 (case-insensitive) to callables, or is ``"debug"``, and ``init``/``goal`` are tuples whose
 arguments are arbitrary Python values. Building the object validates all of it.
+
+As in PDDLStream, ``init`` and ``goal`` may use predicates that neither the domain nor the stream
+files declare: each is declared by its first use (logged at info level and kept in
+``PDDLProblem.leniencies``); using it later with another arity is an error.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -20,9 +25,11 @@ from sdar_tamp.language.errors import (
     StreamMapError,
     UndeclaredError,
 )
+from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, Leniency, LeniencyLog
 from sdar_tamp.language.model import (
     EQUALITY,
     OBJECT_TYPE,
+    TOTAL_COST,
     And,
     Atom,
     Domain,
@@ -71,6 +78,7 @@ class PDDLProblem:
     streams: StreamFile = field(init=False)
     objects: ObjectTable = field(init=False)
     facts: GroundFacts = field(init=False)
+    leniencies: tuple[Leniency, ...] = field(init=False, default=())
 
     def __post_init__(self) -> None:
         self.domain = (
@@ -91,7 +99,7 @@ class PDDLProblem:
             )
         self.objects = ObjectTable(constants)
         self.stream_map = _check_stream_map(self.stream_map, self.streams)
-        self.facts = _ground(self)
+        self.facts, self.leniencies = _ground(self)
 
     def __iter__(self) -> Iterator[Any]:
         """Unpacks as PDDLStream's tuple: domain, constants, streams, stream map, init, goal."""
@@ -167,6 +175,7 @@ class _Grounder:
             self.arities.setdefault(atom.predicate, len(atom.args))
         self.types = set(domain.types.types())
         self.functions = {f.name: len(f.parameters) for f in domain.functions.values()}
+        self.log = LeniencyLog(strict=False)
 
     def term(self, value: Any, scope: frozenset[str], where: str) -> str:
         if isinstance(value, str) and value.startswith("?"):
@@ -189,7 +198,13 @@ class _Grounder:
         elif name in self.types:
             expected = 1
         else:
-            raise UndeclaredError(f"undeclared predicate {name!r} in {fact!r}", _where(where))
+            expected = self.arities[name] = len(args)
+            self.log.add(
+                IMPLICIT_PREDICATE,
+                f"predicate {name!r} is declared neither in the domain nor in the stream files; "
+                f"declared by this first use with {expected} argument(s)",
+                _where(where),
+            )
         if len(args) != expected:
             raise ArityError(
                 f"predicate {name!r} takes {expected} argument(s), got {len(args)} in {fact!r}",
@@ -230,7 +245,7 @@ def _stream_atoms(streams: StreamFile) -> Iterable[Atom]:
         yield predicate.head
 
 
-def _ground(problem: PDDLProblem) -> GroundFacts:
+def _ground(problem: PDDLProblem) -> tuple[GroundFacts, tuple[Leniency, ...]]:
     grounder = _Grounder(problem)
     init: set[Atom] = set()
     numeric: dict[tuple[str, tuple[str, ...]], float] = {}
@@ -248,17 +263,25 @@ def _ground(problem: PDDLProblem) -> GroundFacts:
                 raise UndeclaredError(f"undeclared function {name!r} in {fact!r}", _where(where))
             args = tuple(grounder.term(arg, frozenset(), where) for arg in head[1:])
             try:
-                numeric[(name, args)] = float(fact[2])
+                value = float(fact[2])
             except (TypeError, ValueError):
+                value = math.nan
+            if not math.isfinite(value):
                 raise ProblemDefinitionError(
-                    f"expected a number as the value of {head!r}, got {fact[2]!r}", _where(where)
-                ) from None
+                    f"expected a finite number as the value of {head!r}, got {fact[2]!r}",
+                    _where(where),
+                )
+            if name == TOTAL_COST and value < 0:
+                raise ProblemDefinitionError(
+                    f"expected a non-negative initial total-cost, got {fact[2]!r}", _where(where)
+                )
+            numeric[(name, args)] = value
             continue
         init.add(grounder.atom(fact, frozenset(), where))
     goal = grounder.formula(problem.goal, frozenset(), "goal")
     objects = _object_types(problem, init)
     init |= type_facts(objects, problem.domain.types)
-    return GroundFacts(objects, frozenset(init), numeric, goal)
+    return GroundFacts(objects, frozenset(init), numeric, goal), grounder.log.finish()
 
 
 def _object_types(problem: PDDLProblem, init: set[Atom]) -> dict[str, str]:

@@ -77,8 +77,9 @@ def read_sexpr(text: str, filename: str | None = None) -> SList:
                 result = node
             index, column = index + 1, column + 1
         else:
-            end = index
-            while end < length and text[end] not in " \t\r\n\f\v();":
+            # A '?' always starts a new token, as in Fast Downward and VAL: (at?x) is (at ?x).
+            end = index + 1
+            while end < length and text[end] not in " \t\r\n\f\v();?":
                 end += 1
             if not stack:
                 raise PddlSyntaxError(f"expected '(' but found {text[index:end]!r}", here)

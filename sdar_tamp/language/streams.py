@@ -5,7 +5,9 @@
 Well-formedness: domain and certified are conjunctions of atoms; parameters are unique; every domain
 parameter is an input; every certified parameter is an input or an output. Predicates must be
 declared in the domain, be type names, or be certified by some stream of the file (stream-only
-predicates, whose arity must then be consistent).
+predicates, whose arity must then be consistent). As in PDDLStream, a predicate used only in a
+``:domain`` (a fact the problem's init provides) is declared by its first use and noted as a
+leniency; ``strict=True`` rejects it.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from sdar_tamp.language.grammar import (
     expect_symbol,
     parse_name_header,
 )
+from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, LeniencyLog, note_glued_variables
 from sdar_tamp.language.model import Atom, Domain, FunctionTerm, Rule, Stream, StreamFile
 from sdar_tamp.language.model import StreamFunction as StreamFunctionDecl
 from sdar_tamp.language.model import StreamPredicate as StreamPredicateDecl
@@ -40,13 +43,18 @@ STREAM_OPTIONS = (":inputs", ":domain", ":fluents", ":outputs", ":certified")
 RULE_OPTIONS = (":inputs", ":parameters", ":domain", ":certified")
 
 
-def parse_stream_file(text: str, domain: Domain, filename: str | None = None) -> StreamFile:
+def parse_stream_file(
+    text: str, domain: Domain, filename: str | None = None, *, strict: bool = False
+) -> StreamFile:
     """Parse a stream file against ``domain`` (whose predicates, types and constants it may use).
 
     Raises:
         PddlError: a subclass naming ``file:line:col`` and what was expected.
+        StrictModeError: ``strict=True`` and the file needs a leniency.
     """
     root = read_sexpr(text, filename)
+    log = LeniencyLog(strict)
+    note_glued_variables(root, log)
     expect_head(root, "define", "a stream file '(define (stream NAME) ...)'")
     name = parse_name_header(root.items[1] if len(root.items) > 1 else root, "stream")
     sections: list[tuple[str, SList]] = []
@@ -67,6 +75,7 @@ def parse_stream_file(text: str, domain: Domain, filename: str | None = None) ->
 
     predicates = {p.name: p.arity for p in domain.predicates.values()}
     _declare_certified(sections, predicates, frozenset(domain.types.types()))
+    _declare_domain_only(sections, predicates, frozenset(domain.types.types()), log)
     vocabulary = Vocabulary(
         predicates,
         frozenset(domain.types.types()),
@@ -97,7 +106,13 @@ def parse_stream_file(text: str, domain: Domain, filename: str | None = None) ->
         else:
             rules.append(_rule(section, reader))
     return StreamFile(
-        name, tuple(streams), tuple(functions), tuple(external), tuple(rules), filename
+        name,
+        tuple(streams),
+        tuple(functions),
+        tuple(external),
+        tuple(rules),
+        filename,
+        leniencies=log.finish(),
     )
 
 
@@ -147,18 +162,56 @@ def _declare_certified(
                     _declare_atom(part, predicates, types)
 
 
-def _declare_atom(node: SExpr, predicates: dict[str, int], types: frozenset[str]) -> None:
+def _declare_domain_only(
+    sections: Iterable[tuple[str, SList]],
+    predicates: dict[str, int],
+    types: frozenset[str],
+    log: LeniencyLog,
+) -> None:
+    """Predicates used in a ``:domain`` that neither the domain nor the file declares."""
+    for keyword, section in sections:
+        if keyword in (":function", ":predicate"):
+            nodes = section.items[2:3]
+        else:
+            start = 2 if keyword == ":stream" else 1
+            items = section.items[start:]
+            nodes = tuple(
+                value
+                for key, value in zip(items[::2], items[1::2], strict=False)
+                if isinstance(key, Symbol) and key.text == ":domain"
+            )
+        for node in nodes:
+            if not isinstance(node, SList):
+                continue
+            for part in node.items[1:] if _is_and(node) else (node,):
+                head = _declare_atom(part, predicates, types)
+                if head is not None:
+                    log.add(
+                        IMPLICIT_PREDICATE,
+                        f"predicate {head.text!r} is declared neither in the domain nor by a "
+                        f"stream's :certified; declared by this first use with "
+                        f"{predicates[head.text]} argument(s)",
+                        head.location,
+                    )
+
+
+def _declare_atom(node: SExpr, predicates: dict[str, int], types: frozenset[str]) -> Symbol | None:
+    """Declare ``node``'s predicate unless known; return its head when it was new."""
     if not isinstance(node, SList) or not node.items:
-        return
+        return None
     head = node.items[0]
     if not isinstance(head, Symbol) or head.text in types or head.text == "=":
-        return
+        return None
     arity = len(node.items) - 1
+    if head.text in ("and", "or", "not", "imply", "exists", "forall"):
+        return None
+    new = head.text not in predicates
     if predicates.setdefault(head.text, arity) != arity:
         raise ArityError(
             f"predicate {head.text!r} takes {predicates[head.text]} argument(s), got {arity}",
             node.location,
         )
+    return head if new else None
 
 
 def _is_and(node: SList) -> bool:

@@ -7,6 +7,7 @@ are never reachable are trivially true and dropped too.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from operator import itemgetter
 
@@ -101,8 +102,8 @@ class _Instantiator:
                 term = "(" + " ".join((expr.name, *args)) + ")"
                 raise GroundingError(f"cost term {term} has no value in the numeric init")
             value = float(self.task.numeric_init[key])
-        if value < 0:
-            raise GroundingError(f"negative action cost {value}")
+        if not math.isfinite(value) or value < 0:
+            raise GroundingError(f"action costs must be finite and non-negative, got {value}")
         return value
 
     def templates(self, lits: tuple[Lit, ...], parameters: tuple[str, ...]) -> list[_Template]:

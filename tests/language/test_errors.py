@@ -224,8 +224,10 @@ def test_optimizer_is_refused_with_a_clear_message() -> None:
     assert "not supported" in str(error)
 
 
-def test_stream_undeclared_domain_predicate() -> None:
-    error = stream_error(" (:stream f :inputs (?x) :domain (Pose ?x) :outputs (?y))")
+def test_stream_undeclared_fluent_predicate() -> None:
+    error = stream_error(
+        " (:stream f :inputs (?x) :domain (clear ?x) :fluents (pose) :outputs (?y))"
+    )
     assert isinstance(error, UndeclaredError)
 
 

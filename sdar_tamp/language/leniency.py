@@ -1,0 +1,144 @@
+"""Constructs the parsers accept although strict PDDL rejects them, and the warnings about them.
+
+Real PDDL files and PDDLStream programs rely on what Fast Downward, VAL and PDDLStream accept, so
+the parsers accept it too, note each case as a :class:`Leniency` (kept on the parsed model and
+logged), and reject it only with ``strict=True`` (:class:`StrictModeError`). The kinds:
+
+``glued-variable``
+    ``(aircraft?a)`` reads as ``(aircraft ?a)``: a ``?`` always starts a new token.
+``repeated-variable``
+    ``(in ?obj ?obj)`` in a predicate declaration (the names there are placeholders).
+``implicit-predicate``
+    a predicate used in ``:init``, a goal or a stream's ``:domain`` but never declared; it is
+    declared with the arity of its first use (a later use with another arity is still an error).
+``duplicate-predicate``
+    a predicate declared twice with the same arity (the first declaration is kept).
+``undeclared-parent-type``
+    ``(:types a - b)`` where ``b`` is never declared: ``b`` becomes a subtype of ``object``.
+``init-type``
+    an initial fact whose argument's type is not the declared parameter type.
+
+The last two are more likely mistakes than dialect, so they are logged as warnings; the others
+at info level.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.errors import PddlError
+from sdar_tamp.language.sexpr import SList, Symbol
+
+LOGGER = logging.getLogger("sdar_tamp.language")
+
+GLUED_VARIABLE = "glued-variable"
+REPEATED_VARIABLE = "repeated-variable"
+IMPLICIT_PREDICATE = "implicit-predicate"
+DUPLICATE_PREDICATE = "duplicate-predicate"
+UNDECLARED_PARENT_TYPE = "undeclared-parent-type"
+INIT_TYPE = "init-type"
+
+KINDS = (
+    GLUED_VARIABLE,
+    REPEATED_VARIABLE,
+    IMPLICIT_PREDICATE,
+    DUPLICATE_PREDICATE,
+    UNDECLARED_PARENT_TYPE,
+    INIT_TYPE,
+)
+_WARNING_KINDS = frozenset({UNDECLARED_PARENT_TYPE, INIT_TYPE})
+
+
+@dataclass(frozen=True)
+class Leniency:
+    """One accepted construct that strict PDDL rejects (``kind`` is one of :data:`KINDS`)."""
+
+    kind: str
+    message: str
+    location: SourceLocation | None = None
+
+    @property
+    def level(self) -> int:
+        """The logging level it is reported at (warning for likely mistakes, else info)."""
+        return logging.WARNING if self.kind in _WARNING_KINDS else logging.INFO
+
+    def __str__(self) -> str:
+        where = f"{self.location}: " if self.location is not None else ""
+        return f"{where}{self.message} [{self.kind}]"
+
+
+class StrictModeError(PddlError):
+    """Raised by a parser called with ``strict=True`` when the source needs any leniency.
+
+    ``leniencies`` lists every one of them, in source order; the message has one per line.
+    """
+
+    def __init__(self, leniencies: Iterable[Leniency]) -> None:
+        self.leniencies = tuple(leniencies)
+        lines = "\n".join(f"  {item}" for item in self.leniencies)
+        first = self.leniencies[0].location if self.leniencies else None
+        super().__init__(
+            f"strict mode: {len(self.leniencies)} construct(s) that strict PDDL rejects:\n{lines}",
+            first,
+        )
+
+
+class LeniencyLog:
+    """Collects the leniencies of one parse; logs them (lenient mode) or raises (strict mode)."""
+
+    def __init__(self, strict: bool) -> None:
+        self.strict = strict
+        self._items: list[Leniency] = []
+
+    def add(self, kind: str, message: str, location: SourceLocation | None) -> None:
+        self._items.append(Leniency(kind, message, location))
+
+    def finish(self) -> tuple[Leniency, ...]:
+        """The leniencies in source order, each logged once.
+
+        Raises:
+            StrictModeError: in strict mode, when there is any.
+        """
+        items = tuple(sorted(self._items, key=_order))
+        if self.strict and items:
+            raise StrictModeError(items)
+        for item in items:
+            LOGGER.log(item.level, "%s", item)
+        return items
+
+
+def note_glued_variables(root: SList, log: LeniencyLog) -> None:
+    """Note every variable written right after the previous token, as in ``(aircraft?a)``.
+
+    The reader splits such tokens; this finds them again from the token positions.
+    """
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        previous: Symbol | None = None
+        for item in node.items:
+            if isinstance(item, SList):
+                stack.append(item)
+                previous = None
+                continue
+            if (
+                previous is not None
+                and item.text.startswith("?")
+                and item.location.line == previous.location.line
+                and item.location.column == previous.location.column + len(previous.text)
+            ):
+                log.add(
+                    GLUED_VARIABLE,
+                    f"{item.text!r} is glued to the token before it ({previous.text!r}); "
+                    "read as two tokens",
+                    item.location,
+                )
+            previous = item
+
+
+def _order(item: Leniency) -> tuple[int, int]:
+    location = item.location
+    return (location.line, location.column) if location is not None else (0, 0)
