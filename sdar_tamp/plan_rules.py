@@ -117,16 +117,21 @@ def check_scene(plan: PlanFile, scene: Scene, urdf_joints: tuple[str, ...]) -> V
     for i, (info, spec) in enumerate(zip(plan.arms, scene.arms, strict=True)):
         expected = plan_joint_names(spec.name, urdf_joints)
         if info.joints != expected:
+            if len(info.joints) != len(expected):
+                return Violation(
+                    0.0,
+                    "scene",
+                    f"arms[{i}].joints: expected the {len(expected)} joints of the scene's "
+                    f"robot {list(expected)}, got {len(info.joints)} names",
+                )
             k = next(
-                (k for k, (a, b) in enumerate(zip(info.joints, expected, strict=False)) if a != b),
-                min(len(info.joints), len(expected)),
+                k for k, (a, b) in enumerate(zip(info.joints, expected, strict=True)) if a != b
             )
-            got = repr(info.joints[k]) if k < len(info.joints) else "nothing"
             return Violation(
                 0.0,
                 "scene",
-                f"arms[{i}].joints[{k}]: expected {expected[k]!r}, got {got} (the joints of "
-                f"the scene's robot, in order: {list(expected)})",
+                f"arms[{i}].joints[{k}]: expected {expected[k]!r}, got {info.joints[k]!r} (the "
+                f"joints of the scene's robot, in order: {list(expected)})",
             )
         for label, T, ref in (
             ("T_world_base", info.T_world_base, spec.T_world_base),
@@ -262,7 +267,7 @@ def _dwell(plan: PlanFile, scene: Scene, dwell: float) -> Violation | None:
     t, q = plan.t, plan.q
     for t_e in sorted({e.t for e in plan.events}):
         what = ", ".join(f"{e.arm} {e.type} of {e.object}" for e in plan.events if e.t == t_e)
-        end = t_e + dwell - TIME_TOL
+        end = max(t_e, t_e + dwell - TIME_TOL)
         if end > t[-1]:
             return Violation(
                 t_e,

@@ -975,3 +975,56 @@ def test_the_dwell_is_the_format_s_and_a_shorter_one_can_be_asked(base: Base) ->
     assert report.violation.t == pytest.approx(_instants(base.plan)[0])
     assert f"still for {GRIPPER_DWELL} s" in report.violation.message
     assert validate_plan(base.instance, plan, base.ctx.scene, 0.05, dwell=0.3).ok
+
+
+def test_format_rules_for_plans_built_in_memory(base: Base) -> None:
+    plan = base.plan
+    left, right = plan.arms
+    e = plan.events[0]
+    cases: dict[str, tuple[PlanFile, str]] = {
+        "no samples": (
+            dataclasses.replace(plan, t=np.zeros(0), q=np.zeros((0, 12)), events=()),
+            "trajectory.t: expected a non-empty list",
+        ),
+        "q rows": (_with_q(plan, plan.q[:-1]), "trajectory.q: expected shape"),
+        "q columns": (_with_q(plan, plan.q[:, :11]), "trajectory.q: expected shape"),
+        "event arm": (
+            _events(plan, [dataclasses.replace(e, arm="middle"), *plan.events[1:]]),
+            "events[0]: expected an arm of ['left', 'right']",
+        ),
+        "event type": (
+            _events(plan, [dataclasses.replace(e, type="squeeze"), *plan.events[1:]]),
+            "and a type of ['grasp', 'release'], got 'left', 'squeeze'",
+        ),
+        "event transform": (
+            _events(plan, [dataclasses.replace(e, T_tcp_object=2.0 * np.eye(4))]),
+            "events[0].T_tcp_object: expected a finite rigid transform",
+        ),
+        "five joints": (
+            dataclasses.replace(
+                plan, arms=(left, dataclasses.replace(right, joints=right.joints[:5]))
+            ),
+            "arms[1].joints: expected the 6 joints of the scene's robot",
+        ),
+        "seven joints": (
+            dataclasses.replace(
+                plan, arms=(dataclasses.replace(left, joints=(*left.joints, "x")), right)
+            ),
+            "arms[0].joints: expected the 6 joints",
+        ),
+    }
+    for name, (mutant, text) in cases.items():
+        report = base.coarse.validate(base.instance, mutant)
+        assert report.violation is not None, name
+        assert report.violation.kind in ("format", "scene") and text in report.violation.message, (
+            name,
+            report.violation,
+        )
+        assert report.checks == 0
+
+
+def test_without_a_dwell_only_the_events_matter(base: Base) -> None:
+    """``dwell=0``: an event may come right before the robot moves on."""
+    plan = _remove(base.plan, _index(base.plan, _instants(base.plan)[0]) + 1, 25)
+    assert base.coarse.validate(base.instance, plan).violation.kind == "dwell"  # type: ignore[union-attr]
+    assert validate_plan(base.instance, plan, base.ctx.scene, 0.05, dwell=0.0).ok
