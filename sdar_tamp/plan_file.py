@@ -8,6 +8,7 @@ Layout (``version`` 1; every length in m, angle in rad, time in s)::
                "T_tool0_tcp" (4x4), "home" (6)}, ...two arms, scene order],
      "trajectory": {"t": [n times from 0, spacing <= 0.02], "q": [n rows of 12: arm 1, arm 2]},
      "events": [{"t", "arm", "type": "grasp" | "release", "object", "T_tcp_object" (4x4)}],
+                # after the events of one instant the robot stands still GRIPPER_DWELL (0.5 s)
      "final_poses": {"o1": [x, y, yaw]},
      "metrics": {"actions", "steps", "dual_arm_steps", "execution_time", "planning_time", ...},
      "steps": [{"t_start", "t_end", "level", "objects", "kind"}]}   # optional
@@ -39,6 +40,14 @@ VERSION = 1
 UNITS = {"length": "m", "angle": "rad", "time": "s"}
 MAX_DT = 0.02  #: largest spacing of trajectory samples [s]
 EVENT_TYPES = ("grasp", "release")
+#: After the gripper events of one instant the robot stands still this long [s] (the gripper
+#: closes or opens; the 2F-85 takes about half a second).
+GRIPPER_DWELL = 0.5
+
+
+def plan_joint_names(arm: str, robot_joints: Sequence[str]) -> tuple[str, ...]:
+    """The names in ``arms[].joints``: the arm's name, ``_``, the robot's (URDF) joint name."""
+    return tuple(f"{arm}_{j}" for j in robot_joints)
 
 
 class PlanFileError(SdarError):
@@ -405,7 +414,7 @@ def build_plan_file(
     sizes: Mapping[str, tuple[float, float, float]],
     items: Sequence[MotionSegment | GripperEvent],
     metrics: Mapping[str, float | int | str],
-    gripper_time: float = 0.5,
+    gripper_time: float = GRIPPER_DWELL,
     dt: float = MAX_DT,
     q_start: FloatArray | None = None,
 ) -> PlanFile:
@@ -494,7 +503,7 @@ def build_plan_file(
     arms = tuple(
         ArmInfo(
             a.name,
-            tuple(f"{a.name}_{j}" for j in kins[a.name].robot.joint_names),
+            plan_joint_names(a.name, kins[a.name].robot.joint_names),
             a.T_world_base,
             kins[a.name].T_tool0_tcp,
             np.array(a.home),

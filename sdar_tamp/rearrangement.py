@@ -17,7 +17,13 @@ from typing import Any
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.generators import from_gen_fn, from_test
 from sdar_tamp.language.problem import PDDLProblem
-from sdar_tamp.plan_file import GripperEvent, MotionSegment, PlanFile, build_plan_file
+from sdar_tamp.plan_file import (
+    GRIPPER_DWELL,
+    GripperEvent,
+    MotionSegment,
+    PlanFile,
+    build_plan_file,
+)
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.transforms import inverse
@@ -29,7 +35,7 @@ from streams.stream_map import STREAM_KINDS, ArmConf, DualConf, make_stream_map
 DOMAIN = "dual_arm_rearrangement"
 TASK_PLANNERS = ("sdar", "baseline")
 MOTION_PLANNERS = ("sdar", "plain", "sequential")
-GRIPPER_TIME = 0.5  # [s] one gripper action (both grippers at once take the same time)
+GRIPPER_TIME = GRIPPER_DWELL  # [s] one gripper action (both grippers at once take as long)
 
 
 @dataclass(frozen=True)

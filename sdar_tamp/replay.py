@@ -1,24 +1,18 @@
 """Independent validation of a plan file by replaying it against an instance.
 
 Shares no code with the planner (``streams/``): it uses only the world model (scene,
-kinematics, the coal collision world, footprints). The replay walks the timeline once, in time
-order, and returns the FIRST violation. Rules and tolerances:
+kinematics, the coal collision world, footprints) and the plan format. The rules that need no
+replay (format, scene, instance, joint limits, velocity, acceleration, dwell) are in
+:mod:`sdar_tamp.plan_rules`; the replay walks the timeline once, in time order, up to the
+earliest of those violations, and returns the FIRST violation. Replay rules:
 
-* ``scene`` (t = 0): arm names and order, base poses and TCP offsets equal the scene's (1e-6).
-* ``instance`` (t = 0): the plan's instance name, and the objects of ``final_poses`` and of
-  every event, are those of the instance.
-* ``joint limit``: every sample within the scene's limits (1e-9 rad).
-* ``velocity``: finite differences ``dq/dt`` per sample interval within the limit + 2 %.
-* ``acceleration`` (optional, ``acceleration_tolerance=None`` disables it): second finite
-  differences within the limit + 25 %. The tolerance is loose on purpose: a 50 Hz sampling of
-  a rest-to-rest spline overestimates the true acceleration where speed profiles switch.
 * ``collision``: samples are linearly interpolated in joint space so that no tool centre point
   moves more than ``max_tcp_step`` [m] between checks (refined until true); each check is a
   :class:`CollisionWorld` query: arm-arm, self, arm-table, arm-objects, held objects against
   everything except their own wrist and gripper (objects shrunk by 1 mm). At an event instant
   the configuration is checked before and after the gripper changes. Contact rule: the
   gripper of an arm may touch the object of its grasp or release only while that arm stands
-  exactly at its configuration of the event (the event sample and the dwell around it);
+  exactly at its configuration of the event (the event sample and the dwell after it);
   once the arm moves, every contact counts.
 * ``grasp``: by an empty gripper, of a resting object, with ``T_world_tcp @ T_tcp_object``
   equal to the object's resting pose within 1 mm and 1 degree (modulo the cuboid's symmetry).
@@ -30,6 +24,8 @@ order, and returns the FIRST violation. Rules and tolerances:
 * at the end: ``held`` (nothing in hand), ``goal`` (every object at its goal within 1 mm and
   1 degree, yaw modulo pi), ``final poses`` (equal to the plan's ``final_poses``, same
   tolerances).
+
+The README section "What `sdar validate` checks" lists every rule with its tolerance.
 """
 
 from __future__ import annotations
@@ -41,27 +37,30 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from sdar_tamp.plan_file import PlanEvent, PlanFile, load_plan
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.plan_file import GRIPPER_DWELL, PlanEvent, PlanFile, load_plan
+from sdar_tamp.plan_rules import (
+    LIMIT_RTOL,
+    STILL_TOL,
+    Violation,
+    check_format,
+    check_instance,
+    check_scene,
+    check_timeline,
+)
 from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
 from sdar_tamp.world.instance import Instance, load_instance
 from sdar_tamp.world.kinematics import ArmKinematics
-from sdar_tamp.world.scene import JOINT_KEYS, Scene, load_scene
+from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
+
+__all__ = ["PlanValidator", "ReplayReport", "Violation", "run_validate", "validate_plan"]
 
 POS_TOL = 1e-3  #: [m]
 ANGLE_TOL = math.radians(1.0)  #: [rad]
 #: Rotations mapping a cuboid onto itself (pi about x, y or z).
 _SYMMETRY = [np.diag(d) for d in ((1.0, 1, 1), (1.0, -1, -1), (-1.0, 1, -1), (-1.0, -1, 1))]
-
-
-@dataclass(frozen=True)
-class Violation:
-    """The first broken rule: time [s], kind (see the module docstring) and a message."""
-
-    t: float
-    kind: str
-    message: str
 
 
 @dataclass(frozen=True)
@@ -73,25 +72,82 @@ class ReplayReport:
     checks: int
 
 
+class PlanValidator:
+    """Validates plans against one scene; the kinematics and collision geometry are built
+    once (about 50 ms) and reused by every :meth:`validate` call.
+
+    ``max_tcp_step`` [m]: largest tool-centre-point travel between collision checks;
+    ``dwell`` [s]: still time after gripper events; ``velocity_tolerance`` and
+    ``acceleration_tolerance``: relative tolerances of the limits (numerical, 1e-6).
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        max_tcp_step: float = 0.005,
+        *,
+        dwell: float = GRIPPER_DWELL,
+        velocity_tolerance: float = LIMIT_RTOL,
+        acceleration_tolerance: float = LIMIT_RTOL,
+    ) -> None:
+        for name, value, ok in (
+            ("max_tcp_step", max_tcp_step, max_tcp_step > 0.0),
+            ("dwell", dwell, dwell >= 0.0),
+            ("velocity_tolerance", velocity_tolerance, velocity_tolerance >= 0.0),
+            ("acceleration_tolerance", acceleration_tolerance, acceleration_tolerance >= 0.0),
+        ):
+            if not (ok and math.isfinite(value)):
+                raise ParameterError(
+                    f"{name}: expected a finite number >= 0 (> 0 for max_tcp_step), got {value!r}"
+                )
+        self.scene, self.step, self.dwell = scene, max_tcp_step, dwell
+        self.v_tol, self.a_tol = velocity_tolerance, acceleration_tolerance
+        self.kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+        self.robot_joints = self.kins[scene.arm_names[0]].robot.joint_names
+        self.world = CollisionWorld(scene)
+
+    def validate(self, instance: Instance, plan: PlanFile) -> ReplayReport:
+        """Replay ``plan`` on ``instance``: ok, or the first violation in time."""
+        first = (
+            check_format(plan)
+            or check_scene(plan, self.scene, self.robot_joints)
+            or check_instance(plan, instance)
+        )
+        if first is not None:
+            return ReplayReport(False, first, 0)
+        limit = check_timeline(plan, self.scene, self.dwell, self.v_tol, self.a_tol)
+        if limit is not None and limit.t <= 0.0:
+            return ReplayReport(False, limit, 0)
+        for arm in self.scene.arm_names:  # a fresh world: nothing held
+            if self.world.held_by(arm) is not None:
+                self.world.detach(arm)
+        replay = _Replay(instance, plan, self.scene, self.step, self.kins, self.world)
+        found = replay.walk(limit.t if limit is not None else math.inf)
+        violation = found if found is not None else limit
+        return ReplayReport(violation is None, violation, replay.checks)
+
+
 def validate_plan(
     instance: Instance,
     plan: PlanFile,
     scene: Scene | None = None,
     max_tcp_step: float = 0.005,
     *,
-    velocity_tolerance: float = 0.02,
-    acceleration_tolerance: float | None = 0.25,
+    dwell: float = GRIPPER_DWELL,
+    velocity_tolerance: float = LIMIT_RTOL,
+    acceleration_tolerance: float = LIMIT_RTOL,
 ) -> ReplayReport:
-    """Replay ``plan`` on ``instance`` (default scene: the instance's, else the shipped one)."""
+    """Replay ``plan`` on ``instance`` (default scene: the instance's, else the shipped one);
+    see :class:`PlanValidator` for the parameters."""
     scene = scene if scene is not None else load_scene(instance.scene_path())
-    first = _static(instance, plan, scene)
-    if first is not None:
-        return ReplayReport(False, first, 0)
-    limit = _limits(plan, scene, velocity_tolerance, acceleration_tolerance)
-    replay = _Replay(instance, plan, scene, max_tcp_step)
-    found = replay.walk(limit.t if limit is not None else math.inf)
-    violation = found if found is not None else limit
-    return ReplayReport(violation is None, violation, replay.checks)
+    validator = PlanValidator(
+        scene,
+        max_tcp_step,
+        dwell=dwell,
+        velocity_tolerance=velocity_tolerance,
+        acceleration_tolerance=acceleration_tolerance,
+    )
+    return validator.validate(instance, plan)
 
 
 def run_validate(instance_path: Path, plan_path: Path) -> int:
@@ -111,76 +167,6 @@ def run_validate(instance_path: Path, plan_path: Path) -> int:
     return 1
 
 
-def _static(instance: Instance, plan: PlanFile, scene: Scene) -> Violation | None:
-    for info, spec in zip(plan.arms, scene.arms, strict=True):
-        if info.name != spec.name:
-            return Violation(
-                0.0,
-                "scene",
-                f"arms {list(plan.arm_names)} differ from the "
-                f"scene's {list(scene.arm_names)} (names and order)",
-            )
-        tcp = np.eye(4)
-        tcp[2, 3] = scene.gripper.tcp_offset
-        for label, T, ref in (
-            ("base", info.T_world_base, spec.T_world_base),
-            ("T_tool0_tcp", info.T_tool0_tcp, tcp),
-        ):
-            if not np.allclose(T, ref, atol=1e-6):
-                return Violation(0.0, "scene", f"arm {spec.name}: {label} differs from the scene")
-    if plan.instance != instance.name:
-        return Violation(0.0, "instance", f"plan for {plan.instance!r}, not {instance.name!r}")
-    named = set(plan.final_poses) | {e.object for e in plan.events}
-    if named != set(instance.names):
-        return Violation(
-            0.0,
-            "instance",
-            f"the plan's objects {sorted(named)} differ from the "
-            f"instance's {sorted(instance.names)}",
-        )
-    return None
-
-
-def _limits(plan: PlanFile, scene: Scene, v_tol: float, a_tol: float | None) -> Violation | None:
-    """The earliest joint-limit, velocity or acceleration violation (that order on ties)."""
-    lo = np.concatenate([a.lower for a in scene.arms])
-    hi = np.concatenate([a.upper for a in scene.arms])
-    v_max = np.concatenate([a.velocity_limit for a in scene.arms])
-    a_max = np.concatenate([a.acceleration_limit for a in scene.arms])
-    t, q = plan.t, plan.q
-    found: list[tuple[float, int, Violation]] = []
-
-    def joint(j: int) -> str:
-        return f"{scene.arms[j // 6].name} {JOINT_KEYS[j % 6]}"
-
-    bad = (q < lo - 1e-9) | (q > hi + 1e-9)
-    if bad.any():
-        i, j = np.argwhere(bad)[0]
-        msg = f"{joint(j)} = {q[i, j]:.4f} rad outside [{lo[j]:.4f}, {hi[j]:.4f}]"
-        found.append((float(t[i]), 0, Violation(float(t[i]), "joint limit", msg)))
-    dt = np.diff(t)
-    vel = np.diff(q, axis=0) / dt[:, None]
-    bad = np.abs(vel) > v_max * (1.0 + v_tol)
-    if bad.any():
-        i, j = np.argwhere(bad)[0]
-        msg = (
-            f"{joint(j)} moves at {abs(vel[i, j]):.3f} rad/s from t = {t[i]:.3f} to "
-            f"{t[i + 1]:.3f} s; limit {v_max[j]:.3f} rad/s + {v_tol:.0%}"
-        )
-        found.append((float(t[i]), 1, Violation(float(t[i]), "velocity", msg)))
-    if a_tol is not None and len(t) > 2:
-        acc = np.diff(vel, axis=0) / (0.5 * (dt[1:] + dt[:-1]))[:, None]
-        bad = np.abs(acc) > a_max * (1.0 + a_tol)
-        if bad.any():
-            i, j = np.argwhere(bad)[0]
-            msg = (
-                f"{joint(j)} accelerates at {abs(acc[i, j]):.2f} rad/s^2; limit "
-                f"{a_max[j]:.2f} rad/s^2 + {a_tol:.0%}"
-            )
-            found.append((float(t[i + 1]), 2, Violation(float(t[i + 1]), "acceleration", msg)))
-    return min(found, key=lambda f: (f[0], f[1]))[2] if found else None
-
-
 def _pose_error(T_a: FloatArray, T_b: FloatArray) -> tuple[float, float]:
     """Distance [m] and rotation angle [rad] between two cuboid poses, modulo symmetry."""
     R = T_a[:3, :3].T @ T_b[:3, :3]
@@ -198,16 +184,25 @@ def _planar_error(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, fl
 class _Replay:
     """The state of the world along the timeline: resting and held objects."""
 
-    def __init__(self, instance: Instance, plan: PlanFile, scene: Scene, step: float) -> None:
+    def __init__(
+        self,
+        instance: Instance,
+        plan: PlanFile,
+        scene: Scene,
+        step: float,
+        kins: dict[str, ArmKinematics],
+        world: CollisionWorld,
+    ) -> None:
         self.instance, self.plan, self.scene, self.step = instance, plan, scene, step
-        self.kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+        self.kins = kins
         self.sizes = {o.name: o.size for o in instance.objects}
         self.rest = {o.name: o.start.as_tuple() for o in instance.objects}
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
         self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
-        self.world = CollisionWorld(scene)
+        self.world = world
         self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
         self.checks = 0
+        self.free: FloatArray | None = None  # the last configuration found free
 
     def box(self, name: str, pose: tuple[float, ...]) -> ObjectBox:
         size = self.sizes[name]
@@ -222,11 +217,14 @@ class _Replay:
 
     # -- collisions -----------------------------------------------------------------------------
     def collide(self, q: FloatArray, t: float) -> Violation | None:
+        if self.free is not None and np.array_equal(q, self.free):
+            return None  # standing still in an unchanged world
         self.checks += 1
         for arm, (_, q_event) in list(self.exempt.items()):
-            if np.abs(self.arm_q(arm, q) - q_event).max() > 1e-9:
+            if np.abs(self.arm_q(arm, q) - q_event).max() > STILL_TOL:
                 del self.exempt[arm]  # the arm has moved: contact counts again
         if not self.world.in_collision(q[:6], q[6:]):
+            self.free = q.copy()
             return None
         pairs = [p for p in self.world.report(q[:6], q[6:]) if not self.allowed(p)]
         if not pairs:
@@ -274,6 +272,7 @@ class _Replay:
         """Replay until ``t_stop`` [s] (exclusive); the first violation, or None."""
         plan = self.plan
         knot_t = np.union1d(plan.t, [e.t for e in plan.events])
+        knot_t = knot_t[: int(np.searchsorted(knot_t, t_stop)) + 1]  # the last one: to t_stop
         knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in range(12)], axis=1)
         counts = self.subdivisions(knot_q) if len(knot_t) > 1 else np.zeros(0, dtype=int)
         pending = list(plan.events)
@@ -305,6 +304,7 @@ class _Replay:
 
     def apply(self, e: PlanEvent, q: FloatArray, t: float) -> Violation | None:
         """Check and perform one gripper event at configuration ``q`` ``(12,)``."""
+        self.free = None  # the world changes
         T_world_tcp = self.tcp(e.arm, q)
         if e.type == "grasp":
             if e.arm in self.held:

@@ -61,9 +61,8 @@ def _segment(result: MotionResult, kind: str) -> MotionSegment:
 
 
 @pytest.fixture(scope="module")
-def planned() -> Planned:
-    ctx = WorldContext.load()
-    planner = DualMotionPlanner(ctx)
+def planned(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Planned:
+    ctx, planner = world_ctx, motion_planner
     instance = parse_instance(INSTANCE, "t2.yaml")
     o1 = instance.objects[0]
     start = {o.name: _box(o, o.start) for o in instance.objects}
@@ -165,7 +164,8 @@ def test_joint_limit(planned: Planned) -> None:
 
 
 def test_a_faster_replay_breaks_the_dynamic_limits(planned: Planned) -> None:
-    plan = dataclasses.replace(planned.plan, t=planned.plan.t * 0.5)
+    events = tuple(dataclasses.replace(e, t=0.5 * e.t) for e in planned.plan.events)
+    plan = dataclasses.replace(planned.plan, t=planned.plan.t * 0.5, events=events)
     assert _kind(planned.instance, plan) in ("velocity", "acceleration")
 
 
@@ -213,7 +213,15 @@ def test_a_skipped_release(planned: Planned) -> None:
 def test_a_second_grasp_by_a_full_gripper(planned: Planned) -> None:
     grasp = planned.plan.events[0]
     events = (grasp, dataclasses.replace(grasp, object="o2"), *planned.plan.events[1:])
-    assert _kind(planned.instance, dataclasses.replace(planned.plan, events=events)) == "grasp"
+    report = validate_plan(planned.instance, dataclasses.replace(planned.plan, events=events))
+    assert report.violation is not None and report.violation.kind == "dwell"
+    assert "grasp of o2 comes 0.000 s after its grasp" in report.violation.message
+    # the second grasp after the dwell, the arm still standing: the gripper is full
+    plan = _standing(planned, planned.instance, [], second="o2")
+    report = validate_plan(planned.instance, plan)
+    assert report.violation is not None and report.violation.kind == "grasp"
+    assert "left grasps o2 while holding o1" in report.violation.message
+    assert report.violation.t == pytest.approx(0.5)
 
 
 def test_wrong_instance_object_set_and_name(planned: Planned) -> None:
@@ -242,12 +250,16 @@ def test_arms_must_match_the_scene(planned: Planned) -> None:
 
 
 # -- release rules, on plans that stand still at the grasp -------------------------------------
-def _standing(planned: Planned, instance: Instance, motion: list[MotionSegment]) -> PlanFile:
-    """Grasp o1 where it stands, optionally move, release."""
+def _standing(
+    planned: Planned, instance: Instance, motion: list[MotionSegment], second: str = "o1"
+) -> PlanFile:
+    """Grasp o1 where it stands, optionally move (else stand still through the dwell), then
+    release it (``second``: another object, grasped instead)."""
+    still = MotionSegment(np.zeros(1), planned.q_grasp[None])  # the dwell, nothing more
     items: list[MotionSegment | GripperEvent] = [
         GripperEvent("left", "grasp", "o1", planned.T_tcp_obj),
-        *motion,
-        GripperEvent("left", "release", "o1", planned.T_tcp_obj),
+        *(motion or [still]),
+        GripperEvent("left", "release" if second == "o1" else "grasp", second, planned.T_tcp_obj),
     ]
     return build_plan_file(
         planned.ctx.scene,
@@ -274,7 +286,10 @@ def test_grasp_and_release_in_place_is_valid(planned: Planned) -> None:
 def test_release_onto_another_object(planned: Planned) -> None:
     o1 = _only_o1(planned).objects[0]
     s = o1.start
-    near = Pose2D(s.x + 0.075 * np.cos(s.yaw), s.y + 0.075 * np.sin(s.yaw), s.yaw)  # 5 mm over
+    # 1.5 mm over: the footprints overlap (the released one is shrunk by 1 mm per side), the
+    # boxes do not collide (both shrunk by 1 mm per side)
+    d = 0.0785
+    near = Pose2D(s.x + d * np.cos(s.yaw), s.y + d * np.sin(s.yaw), s.yaw)
     o2 = ObjectSpec("o2", o1.size, near, near)
     instance = Instance("T1", planned.instance.workspace, (o1, o2))
     report = validate_plan(instance, _standing(planned, instance, []))

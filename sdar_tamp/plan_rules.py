@@ -1,0 +1,291 @@
+"""The rules of a plan that need no replay: format, scene, instance, limits and dwells.
+
+Every check returns the earliest :class:`Violation` it finds (or None); the replay
+(:mod:`sdar_tamp.replay`) combines them with the geometric rules. The rules and their
+tolerances are listed in the README (section "What `sdar validate` checks").
+
+Limits are checked on the plan's own samples, which are the trajectory (the executor streams
+them; between samples the motion is linear in joint space):
+
+* velocity of interval ``i``: ``(q[i+1] - q[i]) / (t[i+1] - t[i])``;
+* acceleration at sample ``i``: the second divided difference on the non-uniform grid,
+  ``(v[i] - v[i-1]) / ((t[i+1] - t[i-1]) / 2)``, with the robot at rest before ``t = 0`` and
+  after the last sample (``v[-1] = v[n-1] = 0``, the virtual neighbour one spacing away).
+
+Both are mean values of the derivative of any smooth motion through the samples (mean value
+theorem for divided differences), so they never exceed its true peak: a plan whose samples
+break a limit cannot be followed within it. Hence only a numerical tolerance (relative 1e-6).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.plan_file import EVENT_TYPES, GRIPPER_DWELL, MAX_DT, PlanFile, plan_joint_names
+from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.scene import JOINT_KEYS, Scene
+from sdar_tamp.world.transforms import FloatArray, translation
+
+LIMIT_RTOL = 1e-6  #: relative tolerance of the velocity and acceleration limits
+JOINT_TOL = 1e-9  #: [rad] tolerance of the joint limits
+STILL_TOL = 1e-9  #: [rad] "still": no joint moves more than this
+TIME_TOL = 1e-9  #: [s] tolerance of time comparisons (dwell length, event times)
+FRAME_TOL = 1e-6  #: tolerance of the arms' frames and home against the scene
+
+
+@dataclass(frozen=True)
+class Violation:
+    """The first broken rule: time [s], kind (see the README) and a message."""
+
+    t: float
+    kind: str
+    message: str
+
+
+def _finite(a: FloatArray) -> bool:
+    return bool(np.all(np.isfinite(a)))
+
+
+def _rigid(T: FloatArray) -> bool:
+    if T.shape != (4, 4) or not _finite(T):
+        return False
+    R = T[:3, :3]
+    bottom = np.allclose(T[3], [0.0, 0.0, 0.0, 1.0])
+    return bottom and np.allclose(R.T @ R, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0.0
+
+
+def check_format(plan: PlanFile) -> Violation | None:
+    """What :func:`~sdar_tamp.plan_file.load_plan` guarantees, for plans built in memory:
+    times from 0, increasing, at most ``MAX_DT`` apart; finite values; events sorted, within
+    the trajectory, of a known arm and type, with rigid transforms."""
+    t, q = plan.t, plan.q
+
+    def bad(key: str, detail: str) -> Violation:
+        return Violation(0.0, "format", f"{key}: {detail}")
+
+    if t.ndim != 1 or len(t) == 0:
+        return bad("trajectory.t", f"expected a non-empty list of times, got shape {t.shape}")
+    if q.shape != (len(t), 12):
+        return bad("trajectory.q", f"expected shape ({len(t)}, 12), got {q.shape}")
+    for name, values in (("trajectory.t", t[:, None]), ("trajectory.q", q)):
+        if not _finite(values):
+            i = int(np.argwhere(~np.isfinite(values))[0, 0])
+            return bad(f"{name}[{i}]", "expected finite numbers")
+    if t[0] != 0.0:
+        return bad("trajectory.t[0]", f"expected 0, got {t[0]!r}")
+    h = np.diff(t)
+    if np.any(h <= 0.0):
+        i = int(np.argmax(h <= 0.0)) + 1
+        return bad(f"trajectory.t[{i}]", f"expected a time > {t[i - 1]!r}, got {t[i]!r}")
+    if np.any(h > MAX_DT + TIME_TOL):
+        i = int(np.argmax(h > MAX_DT + TIME_TOL)) + 1
+        return bad(f"trajectory.t[{i}]", f"expected at most {MAX_DT} s after t[{i - 1}]")
+    for i, e in enumerate(plan.events):
+        key = f"events[{i}]"
+        if not (math.isfinite(e.t) and 0.0 <= e.t <= t[-1]):
+            return bad(f"{key}.t", f"expected a time within [0, {t[-1]}] s, got {e.t!r}")
+        if i and e.t < plan.events[i - 1].t:
+            return bad(f"{key}.t", "expected events sorted by time")
+        if e.arm not in plan.arm_names or e.type not in EVENT_TYPES:
+            return bad(
+                key,
+                f"expected an arm of {list(plan.arm_names)} and a type of "
+                f"{list(EVENT_TYPES)}, got {e.arm!r}, {e.type!r}",
+            )
+        if not _rigid(e.T_tcp_object):
+            return bad(f"{key}.T_tcp_object", "expected a finite rigid transform")
+    for name, pose in plan.final_poses.items():
+        if not all(math.isfinite(v) for v in pose):
+            return bad(f"final_poses.{name}", "expected finite numbers")
+    return None
+
+
+def check_scene(plan: PlanFile, scene: Scene, urdf_joints: tuple[str, ...]) -> Violation | None:
+    """Arm names and order, joint names (``urdf_joints``: the robot's joints, in order), base
+    poses, tool frames and home configurations equal the scene's."""
+    if plan.arm_names != scene.arm_names:
+        return Violation(
+            0.0,
+            "scene",
+            f"arms {list(plan.arm_names)} differ from the "
+            f"scene's {list(scene.arm_names)} (names and order)",
+        )
+    tcp = translation(0.0, 0.0, scene.gripper.tcp_offset)
+    for i, (info, spec) in enumerate(zip(plan.arms, scene.arms, strict=True)):
+        expected = plan_joint_names(spec.name, urdf_joints)
+        if info.joints != expected:
+            if len(info.joints) != len(expected):
+                return Violation(
+                    0.0,
+                    "scene",
+                    f"arms[{i}].joints: expected the {len(expected)} joints of the scene's "
+                    f"robot {list(expected)}, got {len(info.joints)} names",
+                )
+            k = next(
+                k for k, (a, b) in enumerate(zip(info.joints, expected, strict=True)) if a != b
+            )
+            return Violation(
+                0.0,
+                "scene",
+                f"arms[{i}].joints[{k}]: expected {expected[k]!r}, got {info.joints[k]!r} (the "
+                f"joints of the scene's robot, in order: {list(expected)})",
+            )
+        for label, T, ref in (
+            ("T_world_base", info.T_world_base, spec.T_world_base),
+            ("T_tool0_tcp", info.T_tool0_tcp, tcp),
+            ("home", info.home, np.array(spec.home)),
+        ):
+            if T.shape != ref.shape or not np.allclose(T, ref, atol=FRAME_TOL):
+                return Violation(
+                    0.0, "scene", f"arms[{i}].{label} of {spec.name} differs from the scene"
+                )
+    return None
+
+
+def check_instance(plan: PlanFile, instance: Instance) -> Violation | None:
+    """The plan's instance name and the objects it names are the instance's."""
+    if plan.instance != instance.name:
+        return Violation(0.0, "instance", f"plan for {plan.instance!r}, not {instance.name!r}")
+    named = set(plan.final_poses) | {e.object for e in plan.events}
+    if named != set(instance.names):
+        return Violation(
+            0.0,
+            "instance",
+            f"the plan's objects {sorted(named)} differ from the "
+            f"instance's {sorted(instance.names)}",
+        )
+    return None
+
+
+def check_timeline(
+    plan: PlanFile,
+    scene: Scene,
+    dwell: float = GRIPPER_DWELL,
+    v_tol: float = LIMIT_RTOL,
+    a_tol: float = LIMIT_RTOL,
+) -> Violation | None:
+    """The earliest joint-limit, velocity, acceleration or dwell violation (that order on
+    ties); see the module docstring for the measures."""
+    found = [
+        v
+        for v in (
+            _joint_limits(plan, scene),
+            _velocity(plan, scene, v_tol),
+            _acceleration(plan, scene, a_tol),
+            _dwell(plan, scene, dwell),
+        )
+        if v is not None
+    ]
+    return min(found, key=lambda v: v.t) if found else None  # min keeps the first on ties
+
+
+def _joint(scene: Scene, j: int) -> str:
+    return f"{scene.arms[j // 6].name} {JOINT_KEYS[j % 6]}"
+
+
+def _joint_limits(plan: PlanFile, scene: Scene) -> Violation | None:
+    lo = np.concatenate([a.lower for a in scene.arms])
+    hi = np.concatenate([a.upper for a in scene.arms])
+    t, q = plan.t, plan.q
+    bad = (q < lo - JOINT_TOL) | (q > hi + JOINT_TOL)
+    if not bad.any():
+        return None
+    i, j = np.argwhere(bad)[0]
+    msg = f"{_joint(scene, j)} = {q[i, j]:.6f} rad outside [{lo[j]:.6f}, {hi[j]:.6f}]"
+    return Violation(float(t[i]), "joint limit", msg)
+
+
+def _velocity(plan: PlanFile, scene: Scene, tol: float) -> Violation | None:
+    v_max = np.concatenate([a.velocity_limit for a in scene.arms])
+    t = plan.t
+    if len(t) < 2:
+        return None
+    vel = np.diff(plan.q, axis=0) / np.diff(t)[:, None]
+    bad = np.abs(vel) > v_max * (1.0 + tol)
+    if not bad.any():
+        return None
+    i, j = np.argwhere(bad)[0]
+    msg = (
+        f"{_joint(scene, j)} moves at {abs(vel[i, j]):.6g} rad/s from t = {t[i]:.3f} to "
+        f"{t[i + 1]:.3f} s, {abs(vel[i, j]) / v_max[j] - 1.0:.3%} over the limit "
+        f"{v_max[j]:.6g} rad/s"
+    )
+    return Violation(float(t[i]), "velocity", msg)
+
+
+def _acceleration(plan: PlanFile, scene: Scene, tol: float) -> Violation | None:
+    a_max = np.concatenate([a.acceleration_limit for a in scene.arms])
+    t = plan.t
+    if len(t) < 2:
+        return None
+    h = np.diff(t)
+    vel = np.diff(plan.q, axis=0) / h[:, None]
+    rest = np.zeros((1, vel.shape[1]))
+    v_ext = np.concatenate([rest, vel, rest])  # at rest before the start and after the end
+    h_ext = np.concatenate([h[:1], h, h[-1:]])  # the virtual neighbours: one spacing away
+    acc = np.diff(v_ext, axis=0) / (0.5 * (h_ext[1:] + h_ext[:-1]))[:, None]  # at every t[i]
+    bad = np.abs(acc) > a_max * (1.0 + tol)
+    if not bad.any():
+        return None
+    i, j = np.argwhere(bad)[0]
+    where = (
+        "when it starts, the robot being at rest before t = 0"
+        if i == 0
+        else "when the plan ends, the robot having to stop"
+        if i == len(t) - 1
+        else f"at t = {t[i]:.3f} s"
+    )
+    msg = (
+        f"{_joint(scene, j)} accelerates at {abs(acc[i, j]):.6g} rad/s^2 {where}, "
+        f"{abs(acc[i, j]) / a_max[j] - 1.0:.3%} over the limit {a_max[j]:.6g} rad/s^2"
+    )
+    return Violation(float(t[i]), "acceleration", msg)
+
+
+def _at(plan: PlanFile, t: float) -> FloatArray:
+    """Configuration ``(12,)`` at time ``t`` [s] (linear between samples)."""
+    return np.array([np.interp(t, plan.t, plan.q[:, j]) for j in range(plan.q.shape[1])])
+
+
+def _dwell(plan: PlanFile, scene: Scene, dwell: float) -> Violation | None:
+    """After the gripper events of one instant, the robot (both arms) stands still for
+    ``dwell`` [s]; an arm's gripper acts at most once per dwell."""
+    last: dict[str, tuple[float, str]] = {}
+    for e in plan.events:
+        prev = last.get(e.arm)
+        if prev is not None and e.t - prev[0] < dwell - TIME_TOL:
+            return Violation(
+                e.t,
+                "dwell",
+                f"the {e.arm} gripper's {e.type} of {e.object} comes {e.t - prev[0]:.3f} s "
+                f"after its {prev[1]} at t = {prev[0]:.3f} s; a gripper action takes {dwell} s",
+            )
+        last[e.arm] = (e.t, e.type)
+    t, q = plan.t, plan.q
+    for t_e in sorted({e.t for e in plan.events}):
+        what = ", ".join(f"{e.arm} {e.type} of {e.object}" for e in plan.events if e.t == t_e)
+        end = max(t_e, t_e + dwell - TIME_TOL)
+        if end > t[-1]:
+            return Violation(
+                t_e,
+                "dwell",
+                f"the plan ends {t[-1] - t_e:.3f} s after the {what}; the robot must stand "
+                f"still for {dwell} s after a gripper event",
+            )
+        q_e = _at(plan, t_e)
+        inside = (t > t_e) & (t < end)
+        times = np.concatenate([t[inside], [end]])
+        moved = np.abs(np.concatenate([q[inside], _at(plan, end)[None]]) - q_e)
+        if moved.max() > STILL_TOL:
+            k, j = np.argwhere(moved > STILL_TOL)[0]
+            return Violation(
+                t_e,
+                "dwell",
+                f"after the {what} at t = {t_e:.3f} s the robot must stand still for "
+                f"{dwell} s; {_joint(scene, j)} has moved {moved[k, j]:.3g} rad at "
+                f"t = {times[k]:.3f} s",
+            )
+    return None
