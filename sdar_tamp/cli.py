@@ -218,7 +218,10 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--search", default="gbfs", help="gbfs, astar or wastar (default: gbfs)")
     plan.add_argument("--heuristic", default="ff", help="ff, add, max or blind (default: ff)")
     plan.add_argument(
-        "--weight", type=SEARCH_WEIGHT.parse, default=2.0, help="weight of wastar, >= 1 (default: 2)"
+        "--weight",
+        type=SEARCH_WEIGHT.parse,
+        default=2.0,
+        help="weight of wastar, >= 1 (default: 2)",
     )
     plan.add_argument(
         "--time-limit", type=TIME_LIMIT.parse, default=None, help="seconds (default: none)"

@@ -191,7 +191,10 @@ def solve_from_command_line(
     parser = create_parser()
     parser.add_argument("--seed", type=SEED.parse, default=0, help="sampler seed (default: 0)")
     parser.add_argument(
-        "--max-time", type=TIME_LIMIT.parse, default=default_max_time, help="[s] (default: %(default)s)"
+        "--max-time",
+        type=TIME_LIMIT.parse,
+        default=default_max_time,
+        help="[s] (default: %(default)s)",
     )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)

@@ -25,6 +25,7 @@ import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -242,27 +243,30 @@ def _arrangement(
     placed = np.zeros((0, 3))
     for i in range(n):
         cand = _candidates(opts.samples, sizes[i], rng, opts)
-        first = _first(
-            len(cand), lambda s: _clear(cand[s], sizes[i], placed, sizes[: len(placed)], opts.gap)
+        clear = partial(
+            _clear, size=sizes[i], poses=placed, sizes=sizes[: len(placed)], gap=opts.gap
         )
+        first = _first(cand, clear)
         if first is None:
             return placed
         placed = np.vstack([placed, cand[first]])
     return placed
 
 
-def _first(count: int, test: Callable[[slice], BoolArray], chunk: int = 256) -> int | None:
-    """The first index in ``range(count)`` where ``test`` (a mask of a slice) holds, testing
-    chunk by chunk (the same answer as ``argmax`` over the whole mask, for less work)."""
-    for lo in range(0, count, chunk):
-        ok = test(slice(lo, min(lo + chunk, count)))
+def _first(
+    cand: FloatArray, test: Callable[[FloatArray], BoolArray], chunk: int = 256
+) -> int | None:
+    """The index of the first candidate pose that passes ``test`` (a mask of poses), testing
+    chunk by chunk: the same answer as ``argmax`` over the whole mask, for less work."""
+    for lo in range(0, len(cand), chunk):
+        ok = test(cand[lo : lo + chunk])
         if ok.any():
             return lo + int(np.argmax(ok))
     return None
 
 
 def _clear(
-    cand: FloatArray, size: FloatArray, poses: FloatArray, sizes: FloatArray, gap: float
+    cand: FloatArray, *, size: FloatArray, poses: FloatArray, sizes: FloatArray, gap: float
 ) -> BoolArray:
     """Mask of candidates at least ``gap`` away from every footprint at ``poses``."""
     if len(poses) == 0:
@@ -304,10 +308,17 @@ def _structured_goals(
             cand = _candidates(opts.samples, sizes[i], rng, opts)
             allowed = np.zeros(n, dtype=bool)
             allowed[i] = True
-        first = _first(
-            len(cand),
-            lambda s: _goal_ok(cand[s], i, succ.get(i), allowed, start_rect, goals, sizes, opts),
+        test = partial(
+            _goal_ok,
+            i=i,
+            successor=succ.get(i),
+            allowed=allowed,
+            start_rect=start_rect,
+            goals=goals,
+            sizes=sizes,
+            opts=opts,
         )
+        first = _first(cand, test)
         if first is None:
             return None
         goals[i] = cand[first]
@@ -316,6 +327,7 @@ def _structured_goals(
 
 def _goal_ok(
     cand: FloatArray,
+    *,
     i: int,
     successor: int | None,
     allowed: BoolArray,
@@ -331,5 +343,5 @@ def _goal_ok(
     if successor is not None:
         ok &= hits[:, successor]
     placed = ~np.isnan(goals[:, 0])
-    ok &= _clear(cand, sizes[i], goals[placed], sizes[placed], opts.gap)
+    ok &= _clear(cand, size=sizes[i], poses=goals[placed], sizes=sizes[placed], gap=opts.gap)
     return np.asarray(ok, dtype=np.bool_)

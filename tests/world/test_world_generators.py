@@ -58,7 +58,7 @@ def test_bad_arguments_and_impossible_requests() -> None:
     tiny = GeneratorOptions(workspace=Workspace((0.0, 0.2), (0.0, 0.2)), attempts=3, samples=200)
     with pytest.raises(GenerationError, match=r"after 3 attempts \(in 3 of them no room"):
         generate_instance("S", 6, 0, tiny)
-    with pytest.raises(ParameterError, match="at most 7 objects .* got 20"):
+    with pytest.raises(ParameterError, match=r"at most 7 objects .* got 20"):
         generate_instance("S", 20, 0, tiny)
 
 
