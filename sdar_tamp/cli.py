@@ -6,12 +6,23 @@ import argparse
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import NoReturn
 
 from sdar_tamp import __version__
+from sdar_tamp.arguments import (
+    COUNT,
+    FPS,
+    SEARCH_WEIGHT,
+    SEED,
+    TIME_LIMIT,
+    output_file,
+    output_folder,
+)
 from sdar_tamp.errors import SdarError
 
 DEMO_DOMAIN = "dual_arm_rearrangement"
 DEMO_INSTANCE = "suites/paper/M1.yaml"
+_FORCE = "replace output files that exist (default: refuse)"
 
 
 def _read(path: Path) -> str:
@@ -93,7 +104,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     from sdar_tamp.viewer import write_html, write_storyboard
 
     instance = domain_file(DEMO_DOMAIN, DEMO_INSTANCE)
-    out = args.out or Path(tempfile.gettempdir()) / "sdar-demo"
+    out = output_folder(args.out or Path(tempfile.gettempdir()) / "sdar-demo", name="--out")
     out.mkdir(parents=True, exist_ok=True)
     print(f"Solving the shipped mixed instance {DEMO_INSTANCE} (12 objects) with SDAR:")
     bar = ProgressBar(instance.stem)
@@ -117,6 +128,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from sdar_tamp.plan_file import save_plan
     from sdar_tamp.solve_command import ProgressBar, format_summary, solve_instance
 
+    if args.output is not None:
+        output_file(args.output, suffixes=(".json",), force=args.force)
     bar = ProgressBar(f"{args.instance.stem}") if not args.quiet else None
     try:
         outcome = solve_instance(
@@ -138,14 +151,24 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 def cmd_generate(args: argparse.Namespace) -> int:
     """Generate a rearrangement instance (one family) or a whole suite of instance files."""
-    from sdar_tamp.world.commands import generate, generate_suite
+    from sdar_tamp.world.commands import generate, generate_suite, suite_files
 
     if args.suite is not None:
+        if args.family is not None or args.objects is not None:
+            raise SdarError("sdar generate: --suite cannot be combined with --family/--objects")
+        output_folder(args.output)
+        taken = [p for p in suite_files(args.suite, args.output) if p.exists()]
+        if taken and not args.force:
+            raise SdarError(
+                f"--output: {len(taken)} instance file(s) of suite {args.suite!r} exist in "
+                f"{str(args.output)!r} (e.g. {taken[0].name}); pass --force to replace them"
+            )
         paths = generate_suite(args.suite, args.output)
         print(f"wrote {len(paths)} instances of suite {args.suite!r} to {args.output}")
         return 0
     if args.family is None or args.objects is None:
         raise SdarError("sdar generate needs --family and --objects, or --suite")
+    output_file(args.output, suffixes=(".yaml", ".yml"), force=args.force)
     path = generate(args.family, args.objects, args.seed, args.output)
     print(f"wrote {path}")
     return 0
@@ -158,8 +181,10 @@ def cmd_show(args: argparse.Namespace) -> int:
     dependency graph; .html is an interactive 3-D view of the start. With a plan: .html is an
     interactive 3-D replay (plotly, works offline), .png a storyboard with one panel per step,
     .gif a top-down animation."""
-    from sdar_tamp.viewer.commands import show
+    from sdar_tamp.viewer.commands import check_output, show
 
+    check_output(args.output, args.plan is not None)
+    output_file(args.output, force=args.force)
     print(f"wrote {show(args.instance, args.plan, args.output, args.fps)}")
     return 0
 
@@ -181,8 +206,15 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return bench_command(args)
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line: ``sdar solve: error: ... (see --help)``."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="sdar",
         description="Declarative task-and-motion planning with PDDL streams.",
     )
@@ -196,8 +228,15 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("problem", type=Path, help="problem.pddl")
     plan.add_argument("--search", default="gbfs", help="gbfs, astar or wastar (default: gbfs)")
     plan.add_argument("--heuristic", default="ff", help="ff, add, max or blind (default: ff)")
-    plan.add_argument("--weight", type=float, default=2.0, help="weight of wastar (default: 2)")
-    plan.add_argument("--time-limit", type=float, default=None, help="seconds (default: none)")
+    plan.add_argument(
+        "--weight",
+        type=SEARCH_WEIGHT.parse,
+        default=2.0,
+        help="weight of wastar, >= 1 (default: 2)",
+    )
+    plan.add_argument(
+        "--time-limit", type=TIME_LIMIT.parse, default=None, help="seconds (default: none)"
+    )
     plan.add_argument("--unit", action="store_true", help="ignore action costs")
     plan.add_argument(
         "--strict",
@@ -221,12 +260,17 @@ def build_parser() -> argparse.ArgumentParser:
         "generate", help="generate rearrangement instances", description=cmd_generate.__doc__
     )
     generate.add_argument("--family", choices=("R", "S", "D", "M"), help="instance family")
-    generate.add_argument("--objects", type=int, help="number of objects")
-    generate.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    generate.add_argument("--objects", type=COUNT.parse, help="number of objects")
+    generate.add_argument("--seed", type=SEED.parse, default=0, help="random seed (default: 0)")
     generate.add_argument("--suite", choices=("paper", "stress"), help="a whole suite")
     generate.add_argument(
-        "-o", "--output", type=Path, required=True, help="instance file (or folder with --suite)"
+        "-o",
+        "--output",
+        type=Path,
+        required=True,
+        help="instance file (.yaml), or folder with --suite",
     )
+    generate.add_argument("--force", action="store_true", help=_FORCE)
     generate.set_defaults(func=cmd_generate)
 
     solve = sub.add_parser(
@@ -234,8 +278,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     solve.add_argument("instance", type=Path, help="instance YAML")
     solve.add_argument("-o", "--output", type=Path, default=None, help="plan file (.json)")
-    solve.add_argument("--time-limit", type=float, default=60.0, help="seconds (default: 60)")
-    solve.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    solve.add_argument("--force", action="store_true", help=_FORCE)
+    solve.add_argument(
+        "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="seconds (default: 60)"
+    )
+    solve.add_argument("--seed", type=SEED.parse, default=0, help="random seed (default: 0)")
     solve.add_argument(
         "--task-planner", choices=("sdar", "baseline"), default="sdar", help="(default: sdar)"
     )
@@ -257,11 +304,16 @@ def build_parser() -> argparse.ArgumentParser:
     show.add_argument("instance", type=Path, help="instance YAML")
     show.add_argument("plan", type=Path, nargs="?", default=None, help="plan JSON (optional)")
     show.add_argument(
-        "-o", "--output", type=Path, required=True, help="picture: .png, .html or .gif"
+        "-o",
+        "--output",
+        type=Path,
+        required=True,
+        help="picture: .png or .html (also .pdf, .svg, .jpg without a plan, .gif with one)",
     )
+    show.add_argument("--force", action="store_true", help=_FORCE)
     show.add_argument(
         "--fps",
-        type=float,
+        type=FPS.parse,
         default=None,
         help="animation frames per second of plan time (default: 10 for .html, 4 for .gif)",
     )
@@ -285,11 +337,15 @@ def build_parser() -> argparse.ArgumentParser:
         help="all, or some of sdar,baseline,baseline-tp+sdar-m,sdar-t+baseline-mp,"
         "sdar-t+plain,baseline-tp+plain (default: all)",
     )
-    bench.add_argument("--workers", type=int, default=1, help="processes (default: 1)")
-    bench.add_argument("--time-limit", type=float, default=60.0, help="s per run (default: 60)")
+    bench.add_argument("--workers", type=COUNT.parse, default=1, help="processes (default: 1)")
+    bench.add_argument(
+        "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="s per run (default: 60)"
+    )
     bench.add_argument("--only", default="", help="comma-separated instance names")
-    bench.add_argument("--max-objects", type=int, default=None, help="skip larger instances")
-    bench.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    bench.add_argument(
+        "--max-objects", type=COUNT.parse, default=None, help="skip larger instances"
+    )
+    bench.add_argument("--seed", type=SEED.parse, default=0, help="random seed (default: 0)")
     bench.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     bench.add_argument(
         "--restart",
@@ -300,7 +356,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.set_defaults(func=cmd_bench)
 
     demo = sub.add_parser("demo", help="solve a built-in example", description=cmd_demo.__doc__)
-    demo.add_argument("--time-limit", type=float, default=60.0, help="seconds (default: 60)")
+    demo.add_argument(
+        "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="seconds (default: 60)"
+    )
     demo.add_argument("--out", type=Path, default=None, help="output folder (default: temp)")
     demo.set_defaults(func=cmd_demo)
     return parser
@@ -314,6 +372,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return func(args)
     except SdarError as error:
         print(f"sdar: error: {error}", file=sys.stderr)
+        return 2
+    except OSError as error:  # a file that could not be read or written after the checks
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"sdar: error: {where}{error.strerror or error}", file=sys.stderr)
         return 2
 
 

@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from sdar_tamp.arguments import MAX_TIME, SEED, Real
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.generators import from_gen_fn, from_test
 from sdar_tamp.language.problem import PDDLProblem
@@ -36,6 +37,7 @@ DOMAIN = "dual_arm_rearrangement"
 TASK_PLANNERS = ("sdar", "baseline")
 MOTION_PLANNERS = ("sdar", "plain", "sequential")
 GRIPPER_TIME = GRIPPER_DWELL  # [s] one gripper action (both grippers at once take as long)
+_DURATION = Real(0.0, closed=True, unit="s")  # gripper_time
 
 
 @dataclass(frozen=True)
@@ -80,6 +82,8 @@ def rearrangement_problem(
         raise ParameterError(
             f"motion planner must be one of {', '.join(MOTION_PLANNERS)}; got {motion!r}"
         )
+    seed = SEED.check("seed", seed)
+    gripper_time = _DURATION.check("gripper_time", gripper_time)
     ctx = ctx or WorldContext.load()
     sizes = {o.name: o.size for o in instance.objects}
     goals = {o.name: o.goal for o in instance.objects}
@@ -121,10 +125,16 @@ def solve_rearrangement(
     progress: Callable[[int, int], None] | None = None,
 ) -> Solution:
     """Solve with SDAR-M over ``task_planner`` (``sdar`` or ``baseline``) within ``max_time``
-    [s]; ``progress(done, total)`` is called before every step and at the end."""
+    [s] (> 0, ``inf`` for no limit, checked as by :func:`solvers.solve.solve`);
+    ``progress(done, total)`` is called before every step and at the end.
+
+    Raises:
+        ParameterError: ``max_time`` out of range or an unknown ``task_planner``.
+    """
     from solvers.sdar.planners import make_task_planner
     from solvers.sdar.solver import SdarOptions, SdarSolver
 
+    max_time = MAX_TIME.check("max_time", max_time)
     planner = make_task_planner(task_planner)
     # The baseline motion planner: one arm works while the other waits at its retract pose.
     # The quick motion stream differs from the full one only under SDAR-M's ladder.

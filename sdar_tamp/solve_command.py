@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
+from sdar_tamp.arguments import SEED, TIME_LIMIT
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.world.instance import Instance, load_instance
@@ -49,11 +50,15 @@ def solve_instance(
 ) -> SolveOutcome:
     """Solve the instance in ``instance_path`` and validate the plan.
 
+    ``time_limit`` [s]: finite and > 0; ``seed``: an integer >= 0 (else ParameterError).
+
     ``shared``: a dict in which the world and the motion planner are kept between calls with
     the same scene (building the optimiser takes a few seconds; it is reported as
     ``setup_time``, not as planning time).
     """
     from sdar_tamp.rearrangement import (
+        MOTION_PLANNERS,
+        TASK_PLANNERS,
         plan_file_from_solution,
         rearrangement_problem,
         solve_rearrangement,
@@ -63,8 +68,14 @@ def solve_instance(
     from streams.context import WorldContext
     from streams.motion import DualMotionPlanner
 
-    if time_limit <= 0:
-        raise ParameterError(f"time limit must be > 0 [s], got {time_limit}")
+    time_limit = TIME_LIMIT.check("time_limit", time_limit)
+    seed = SEED.check("seed", seed)
+    for name, value, choices in (
+        ("task_planner", task_planner, TASK_PLANNERS),
+        ("motion_planner", motion_planner, MOTION_PLANNERS),
+    ):
+        if value not in choices:
+            raise ParameterError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
     instance = load_instance(instance_path)
     cache = shared if shared is not None else {}
     scene_path = instance.scene_path(instance_path)

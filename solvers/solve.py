@@ -10,6 +10,16 @@ import random
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from sdar_tamp.arguments import (
+    COST_BOUND,
+    COUNT,
+    MAX_TIME,
+    SEED,
+    TIME_LIMIT,
+    Integer,
+    Real,
+    optional,
+)
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.options import FunctionInfo, PlanConstraints, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
@@ -19,18 +29,9 @@ from solvers.stream_planning.constraints import compile_constraints
 
 LOG = logging.getLogger(__name__)
 INF = math.inf
-
-
-def _positive(name: str, value: float, allow_zero: bool = False) -> float:
-    if (
-        not isinstance(value, int | float)
-        or math.isnan(value)
-        or value < 0
-        or (value == 0 and not allow_zero)
-    ):
-        rule = ">= 0" if allow_zero else "> 0"
-        raise ParameterError(f"{name} must be a number {rule}, got {value!r}")
-    return float(value)
+_LIMIT = Real(0.0, allow_inf=True)  # max_iterations, max_skeletons, search_sample_ratio
+_NATURAL = Integer(0)  # initial_complexity
+_WEIGHT = Real(0.0, closed=True)  # effort_weight
 
 
 def solve(
@@ -86,6 +87,11 @@ def solve(
         seed: seeds Python's ``random`` and NumPy's global generator before solving, so
             samplers that draw from them give the same plan for the same seed.
 
+    Every numeric argument is checked (with ``algorithm="sdar"`` too) by the rules of
+    :mod:`sdar_tamp.arguments`: NaN is refused everywhere; ``inf`` means "no limit" for the
+    budgets and bounds; ``seed``, ``initial_complexity`` are integers >= 0 and
+    ``complexity_step`` an integer >= 1.
+
     Raises:
         ParameterError: an argument out of range or unknown; the message names it.
         StreamError: a user sampler raised (chained) or returned the wrong shape.
@@ -98,21 +104,32 @@ def solve(
         )
     if not isinstance(problem, PDDLProblem):
         raise ParameterError(f"problem must be a PDDLProblem, got {type(problem).__name__}")
+    max_time = MAX_TIME.check("max_time", max_time)
+    success_cost = COST_BOUND.check("success_cost", success_cost)
+    max_complexity = COST_BOUND.check("max_complexity", max_complexity)
+    initial_complexity = _NATURAL.check("initial_complexity", initial_complexity)
+    complexity_step = COUNT.check("complexity_step", complexity_step)
+    effort_weight = optional(_WEIGHT, "effort_weight", effort_weight)
+    seed = None if seed is None else SEED.check("seed", seed)
+    max_iterations = _LIMIT.check("max_iterations", max_iterations)
+    max_skeletons = _LIMIT.check("max_skeletons", max_skeletons)
+    search_sample_ratio = _LIMIT.check("search_sample_ratio", search_sample_ratio)
+    max_planner_time = MAX_TIME.check("max_planner_time", max_planner_time)
     if algorithm == "sdar":
         return _solve_sdar(problem, task_planner, max_time, stream_info, verbose, seed)
     search, _, heuristic = planner.partition("-")
     options = StreamOptions(
         algorithm=algorithm,
         unit_costs=unit_costs,
-        success_cost=_positive("success_cost", success_cost, allow_zero=True),
-        max_time=_positive("max_time", max_time),
-        max_iterations=_positive("max_iterations", max_iterations),
-        max_skeletons=_positive("max_skeletons", max_skeletons),
-        search_sample_ratio=_positive("search_sample_ratio", search_sample_ratio),
-        initial_complexity=int(_positive("initial_complexity", initial_complexity, True)),
-        complexity_step=int(_positive("complexity_step", complexity_step)),
-        max_complexity=_positive("max_complexity", max_complexity, allow_zero=True),
-        max_planner_time=_positive("max_planner_time", max_planner_time),
+        success_cost=success_cost,
+        max_time=max_time,
+        max_iterations=max_iterations,
+        max_skeletons=max_skeletons,
+        search_sample_ratio=search_sample_ratio,
+        initial_complexity=initial_complexity,
+        complexity_step=complexity_step,
+        max_complexity=max_complexity,
+        max_planner_time=max_planner_time,
         search=search,
         heuristic=heuristic or "ff",
     )
@@ -120,8 +137,6 @@ def solve(
         raise ParameterError(
             f"constraints must be a PlanConstraints, got {type(constraints).__name__}"
         )
-    if effort_weight is not None:
-        _positive("effort_weight", effort_weight, allow_zero=True)
     options = dataclasses.replace(
         options,
         effort_weight=effort_weight,
@@ -158,7 +173,7 @@ def _solve_sdar(
     logging.getLogger("solvers").setLevel(logging.INFO if verbose else logging.WARNING)
     if seed is not None:
         random.seed(seed)
-    options = SdarOptions(max_time=_positive("max_time", max_time))
+    options = SdarOptions(max_time=max_time)
     return SdarSolver(problem, planner, options, stream_info).solve()
 
 
@@ -184,9 +199,12 @@ def solve_from_command_line(
     """An example's ``main``: parse ``-a/-u/--seed/--max-time``, build the problem with
     ``make_problem(seed=...)``, solve it and print the solution (returned for tests)."""
     parser = create_parser()
-    parser.add_argument("--seed", type=int, default=0, help="sampler seed (default: 0)")
+    parser.add_argument("--seed", type=SEED.parse, default=0, help="sampler seed (default: 0)")
     parser.add_argument(
-        "--max-time", type=float, default=default_max_time, help="[s] (default: %(default)s)"
+        "--max-time",
+        type=TIME_LIMIT.parse,
+        default=default_max_time,
+        help="[s] (default: %(default)s)",
     )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)

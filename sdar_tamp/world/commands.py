@@ -11,6 +11,7 @@ from sdar_tamp.world.draw import draw_instance
 from sdar_tamp.world.generators import generate_instance
 from sdar_tamp.world.instance import load_instance, save_instance
 from sdar_tamp.world.suites import generate_suite as _generate_suite
+from sdar_tamp.world.suites import suite_members
 
 
 def generate(family: str, objects: int, seed: int, out: Path) -> Path:
@@ -21,6 +22,11 @@ def generate(family: str, objects: int, seed: int, out: Path) -> Path:
 def generate_suite(suite: str, out_dir: Path) -> list[Path]:
     """Write the named suite (``paper`` or ``stress``) into ``out_dir``."""
     return _generate_suite(suite, Path(out_dir))
+
+
+def suite_files(suite: str, out_dir: Path) -> list[Path]:
+    """The files :func:`generate_suite` writes for ``suite`` into ``out_dir``."""
+    return [Path(out_dir) / f"{m.name}.yaml" for m in suite_members(suite)]
 
 
 def show_instance(instance_path: Path, out: Path) -> Path:

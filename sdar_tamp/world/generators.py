@@ -12,15 +12,24 @@ the dependency graph has exactly the edges ``i -> j``; objects without successor
 overlapping no other object's start. Each instance is verified with
 :mod:`sdar_tamp.world.dependency`; failures are retried with the same generator, bounded.
 Every random choice comes from ``numpy.random.default_rng(seed)``: same seed, same instance.
+
+Requests that cannot be met are refused early: :func:`max_objects` is a sound area bound (more
+objects than it allows cannot be placed with the clearance, whatever the placement), checked
+before any sampling; and the retries stop after ``GeneratorOptions.crowded_attempts``
+attempts in a row in which the random placement found no room for every object.
 """
 
 from __future__ import annotations
 
 import itertools
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
+from sdar_tamp.arguments import COUNT, SEED, Real
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError
@@ -32,6 +41,8 @@ from sdar_tamp.world.transforms import BoolArray, FloatArray
 FAMILIES = ("R", "S", "D", "M")
 DEFAULT_SIZE = (0.08, 0.04, 0.05)
 DEFAULT_WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
+_LENGTH = Real(0.0, closed=True, unit="m")
+_SIDE = Real(0.0, unit="m")
 
 
 @dataclass(frozen=True)
@@ -47,6 +58,26 @@ class GeneratorOptions:
     gap: float = 0.026
     attempts: int = 200  # whole-instance retries
     samples: int = 4000  # candidate poses drawn per placement
+    # give up after this many attempts in a row in which the random placement of the start
+    # (or, for R, the goal) arrangement found no room for every object: the table is too full
+    crowded_attempts: int = 5
+
+    def __post_init__(self) -> None:
+        for name in ("attempts", "samples", "crowded_attempts"):
+            COUNT.check(name, getattr(self, name))
+        _LENGTH.check("gap", self.gap)
+        for k, side in enumerate(self.size):
+            _SIDE.check(f"size[{k}]", side)
+
+
+def max_objects(options: GeneratorOptions | None = None) -> int:
+    """The most objects that can rest in the workspace at the clearance ``gap`` [m]: a sound
+    upper bound from areas. Every footprint grown by ``gap / 2`` on each side is disjoint
+    from the others' (that is how clearance is tested) and lies within the workspace grown by
+    ``gap / 2``; so ``n`` footprints need ``n (l + gap)(w + gap)`` of the grown workspace's
+    area. More objects than this can never be placed; fewer may still fail to be found."""
+    opts = options or GeneratorOptions()
+    return math.floor(_table_area(opts) / _grown_area(opts) + 1e-9)
 
 
 def generate_instance(
@@ -59,20 +90,62 @@ def generate_instance(
     """One instance of ``family`` with ``n_objects`` objects; deterministic in ``seed``."""
     if family not in FAMILIES:
         raise ParameterError(f"family: expected one of {list(FAMILIES)}, got {family!r}")
+    n_objects = COUNT.check("objects", n_objects)
+    seed = SEED.check("seed", seed)
     minimum = {"R": 1, "S": 2, "D": 4, "M": 5}[family]
     if n_objects < minimum:
         raise ParameterError(f"objects: family {family} needs at least {minimum}, got {n_objects}")
     opts = options or GeneratorOptions()
+    limit = max_objects(opts)
+    if n_objects > limit:
+        raise ParameterError(
+            f"objects: at most {limit} objects of {opts.size[0]:g} x {opts.size[1]:g} m with "
+            f"{opts.gap:g} m clearance fit on the {_extent(opts)} workspace (their grown "
+            f"footprints need {n_objects * _grown_area(opts):.3f} m^2 of "
+            f"{_table_area(opts):.3f} m^2); got {n_objects}"
+        )
     rng = np.random.default_rng(seed)
+    crowded = most = full = 0
     for _ in range(opts.attempts):
         inst = _attempt(family, n_objects, rng, opts, name or f"{family}{n_objects}", seed)
+        if isinstance(inst, int):
+            crowded, most, full = crowded + 1, max(most, inst), full + 1
+            if crowded >= opts.crowded_attempts:
+                raise GenerationError(
+                    f"family {family} with {n_objects} objects (seed {seed}): the table is "
+                    f"too full: random placement found room for at most {most} of them with "
+                    f"{opts.gap:g} m clearance in {crowded} attempts in a row; try fewer "
+                    "objects, a smaller clearance or a larger workspace"
+                )
+            continue
+        crowded = 0
         if inst is not None and _verified(family, inst):
             validate_instance(inst)
             return inst
+    crowding = (
+        f" (in {full} of them no room was found for more than {most} objects)" if full else ""
+    )
     raise GenerationError(
         f"family {family} with {n_objects} objects (seed {seed}): no instance with the promised "
-        f"structure after {opts.attempts} attempts; try fewer objects or a larger workspace"
+        f"structure after {opts.attempts} attempts{crowding}; try fewer objects or a larger "
+        "workspace"
     )
+
+
+def _extent(opts: GeneratorOptions) -> str:
+    ws = opts.workspace
+    return f"{ws.x[1] - ws.x[0]:g} x {ws.y[1] - ws.y[0]:g} m"
+
+
+def _grown_area(opts: GeneratorOptions) -> float:
+    """Area [m^2] of one footprint grown by half the clearance on every side."""
+    return (opts.size[0] + opts.gap) * (opts.size[1] + opts.gap)
+
+
+def _table_area(opts: GeneratorOptions) -> float:
+    """Area [m^2] of the workspace grown by half the clearance on every side."""
+    ws = opts.workspace
+    return (ws.x[1] - ws.x[0] + opts.gap) * (ws.y[1] - ws.y[0] + opts.gap)
 
 
 def _verified(family: str, inst: Instance) -> bool:
@@ -126,13 +199,17 @@ def _successors(family: str, n: int, rng: np.random.Generator) -> dict[int, int]
 
 def _attempt(
     family: str, n: int, rng: np.random.Generator, opts: GeneratorOptions, name: str, seed: int
-) -> Instance | None:
+) -> Instance | int | None:
+    """An instance; or the number of objects placed when a random arrangement found no
+    room for the next one; or ``None`` when the goals could not be pinned."""
     sizes = np.tile(np.array(opts.size[:2]), (n, 1))
     starts = _arrangement(n, sizes, rng, opts)
-    if starts is None:
-        return None
+    if len(starts) < n:
+        return len(starts)
     if family == "R":
-        goals = _arrangement(n, sizes, rng, opts)
+        goals: FloatArray | None = _arrangement(n, sizes, rng, opts)
+        if goals is not None and len(goals) < n:
+            return len(goals)
     else:
         goals = _structured_goals(_successors(family, n, rng), starts, sizes, rng, opts)
     if goals is None:
@@ -160,20 +237,36 @@ def _candidates(
 
 def _arrangement(
     n: int, sizes: FloatArray, rng: np.random.Generator, opts: GeneratorOptions
-) -> FloatArray | None:
-    """Random sequential placement of ``n`` footprints, pairwise at least ``gap`` apart."""
+) -> FloatArray:
+    """Random sequential placement of ``n`` footprints, pairwise at least ``gap`` apart; the
+    poses ``(k, 3)`` placed, ``k < n`` when no candidate had room for the next one."""
     placed = np.zeros((0, 3))
     for i in range(n):
         cand = _candidates(opts.samples, sizes[i], rng, opts)
-        ok = _clear(cand, sizes[i], placed, sizes[: len(placed)], opts.gap)
-        if not ok.any():
-            return None
-        placed = np.vstack([placed, cand[np.argmax(ok)]])
+        clear = partial(
+            _clear, size=sizes[i], poses=placed, sizes=sizes[: len(placed)], gap=opts.gap
+        )
+        first = _first(cand, clear)
+        if first is None:
+            return placed
+        placed = np.vstack([placed, cand[first]])
     return placed
 
 
+def _first(
+    cand: FloatArray, test: Callable[[FloatArray], BoolArray], chunk: int = 256
+) -> int | None:
+    """The index of the first candidate pose that passes ``test`` (a mask of poses), testing
+    chunk by chunk: the same answer as ``argmax`` over the whole mask, for less work."""
+    for lo in range(0, len(cand), chunk):
+        ok = test(cand[lo : lo + chunk])
+        if ok.any():
+            return lo + int(np.argmax(ok))
+    return None
+
+
 def _clear(
-    cand: FloatArray, size: FloatArray, poses: FloatArray, sizes: FloatArray, gap: float
+    cand: FloatArray, *, size: FloatArray, poses: FloatArray, sizes: FloatArray, gap: float
 ) -> BoolArray:
     """Mask of candidates at least ``gap`` away from every footprint at ``poses``."""
     if len(poses) == 0:
@@ -195,7 +288,6 @@ def _structured_goals(
     goals = np.full((n, 3), np.nan)
     # objects with a successor first (their goals are pinned near a start), then free goals
     for i in [*sorted(succ), *(i for i in range(n) if i not in succ)]:
-        placed = ~np.isnan(goals[:, 0])
         if i in succ:
             j = succ[i]
             jitter = np.column_stack(
@@ -216,14 +308,40 @@ def _structured_goals(
             cand = _candidates(opts.samples, sizes[i], rng, opts)
             allowed = np.zeros(n, dtype=bool)
             allowed[i] = True
-        if len(cand) == 0:
+        test = partial(
+            _goal_ok,
+            i=i,
+            successor=succ.get(i),
+            allowed=allowed,
+            start_rect=start_rect,
+            goals=goals,
+            sizes=sizes,
+            opts=opts,
+        )
+        first = _first(cand, test)
+        if first is None:
             return None
-        hits = overlap_matrix(corners(cand, np.tile(sizes[i], (len(cand), 1))), start_rect)
-        ok = ~hits[:, ~allowed].any(axis=1)
-        if i in succ:
-            ok &= hits[:, succ[i]]
-        ok &= _clear(cand, sizes[i], goals[placed], sizes[placed], opts.gap)
-        if not ok.any():
-            return None
-        goals[i] = cand[np.argmax(ok)]
+        goals[i] = cand[first]
     return goals
+
+
+def _goal_ok(
+    cand: FloatArray,
+    *,
+    i: int,
+    successor: int | None,
+    allowed: BoolArray,
+    start_rect: FloatArray,
+    goals: FloatArray,
+    sizes: FloatArray,
+    opts: GeneratorOptions,
+) -> BoolArray:
+    """Mask of goal candidates for object ``i``: overlapping no start but the ``allowed``
+    ones, the successor's start if any, and clear of the goals placed so far."""
+    hits = overlap_matrix(corners(cand, np.tile(sizes[i], (len(cand), 1))), start_rect)
+    ok = ~hits[:, ~allowed].any(axis=1)
+    if successor is not None:
+        ok &= hits[:, successor]
+    placed = ~np.isnan(goals[:, 0])
+    ok &= _clear(cand, size=sizes[i], poses=goals[placed], sizes=sizes[placed], gap=opts.gap)
+    return np.asarray(ok, dtype=np.bool_)

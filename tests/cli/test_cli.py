@@ -64,8 +64,10 @@ def test_solve_reports_failure_with_exit_status_1(
 
 def test_solve_rejects_a_bad_time_limit(capsys: pytest.CaptureFixture[str]) -> None:
     instance = domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml")
-    assert main(["solve", str(instance), "--time-limit", "-1"]) == 2
-    assert "time limit must be > 0" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as info:
+        main(["solve", str(instance), "--time-limit", "-1"])
+    assert info.value.code == 2
+    assert "--time-limit: expected a finite number > 0 [s], got '-1'" in capsys.readouterr().err
 
 
 def test_plan_on_shipped_files(capsys: pytest.CaptureFixture[str]) -> None:

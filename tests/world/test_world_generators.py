@@ -10,7 +10,7 @@ from sdar_tamp.world.commands import generate, generate_suite, show_instance
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError, SuiteError
 from sdar_tamp.world.footprint import corners, inflate, overlap_matrix
-from sdar_tamp.world.generators import GeneratorOptions, generate_instance
+from sdar_tamp.world.generators import GeneratorOptions, generate_instance, max_objects
 from sdar_tamp.world.instance import load_instance, validate_instance
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.suites import build_suite, load_suite, suite_members
@@ -56,8 +56,89 @@ def test_bad_arguments_and_impossible_requests() -> None:
     with pytest.raises(ParameterError, match="at least 4"):
         generate_instance("D", 3, 0)
     tiny = GeneratorOptions(workspace=Workspace((0.0, 0.2), (0.0, 0.2)), attempts=3, samples=200)
-    with pytest.raises(GenerationError, match="after 3 attempts"):
+    with pytest.raises(GenerationError, match=r"after 3 attempts \(in 3 of them no room"):
+        generate_instance("S", 6, 0, tiny)
+    with pytest.raises(ParameterError, match=r"at most 7 objects .* got 20"):
         generate_instance("S", 20, 0, tiny)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("R", 4, -5), "seed must be an integer >= 0, got -5"),
+        (("R", 2.5, 0), "objects must be an integer >= 1, got 2.5"),
+        (("R", True, 0), "objects must be an integer >= 1"),
+        (("R", 4, 1.0), "seed must be an integer >= 0"),
+    ],
+)
+def test_numeric_arguments_are_checked(args: tuple[str, int, int], message: str) -> None:
+    with pytest.raises(ParameterError, match=message):
+        generate_instance(*args)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"gap": -0.01}, "gap"),
+        ({"gap": float("nan")}, "gap"),
+        ({"attempts": 0}, "attempts"),
+        ({"samples": 0}, "samples"),
+        ({"crowded_attempts": 0}, "crowded_attempts"),
+        ({"size": (0.08, 0.0, 0.05)}, r"size\[1\]"),
+    ],
+)
+def test_generator_options_are_checked(kwargs: dict[str, object], name: str) -> None:
+    with pytest.raises(ParameterError, match=name):
+        GeneratorOptions(**kwargs)  # type: ignore[arg-type]
+
+
+def test_area_bound_refuses_what_cannot_fit_and_accepts_the_suites() -> None:
+    # grown footprints (0.08 + 0.026) x (0.04 + 0.026) in the grown 0.526 x 0.626 workspace
+    assert max_objects() == int(0.526 * 0.626 / (0.106 * 0.066)) == 47
+    assert max_objects(GeneratorOptions(gap=0.01)) == 69
+    assert max(m.n_objects for m in suite_members("paper")) <= max_objects()
+    stress = suite_members("stress")
+    assert all(m.gap is not None and m.n_objects <= max_objects(GeneratorOptions(gap=m.gap))
+               for m in stress)  # fmt: skip
+    with pytest.raises(ParameterError, match=r"objects: at most 47 objects .* got 48"):
+        generate_instance("R", 48, 0)
+    with pytest.raises(ParameterError, match="got 200"):
+        generate_instance("M", 200, 0)
+
+
+def test_area_bound_is_not_below_a_packing_that_exists() -> None:
+    # a grid of 35 turned objects that keeps the clearance: the bound must allow it
+    opts = GeneratorOptions()
+    ws, (length, width, _), gap = opts.workspace, opts.size, opts.gap
+    xs = ws.x[0] + width / 2 + np.arange(7) * (width + gap)
+    ys = ws.y[0] + length / 2 + np.arange(5) * (length + gap)
+    poses = np.array([(x, y, np.pi / 2) for x in xs for y in ys])
+    sizes = np.tile([length, width], (len(poses), 1))
+    assert (xs + width / 2 <= ws.x[1]).all() and (ys + length / 2 <= ws.y[1]).all()
+    grown = corners(poses, inflate(sizes, gap / 2 - 1e-9))
+    over = overlap_matrix(grown, grown)
+    np.fill_diagonal(over, False)
+    assert not over.any()
+    assert len(poses) == 35 <= max_objects(opts)
+
+
+def test_the_largest_accepted_count_fails_after_a_few_crowded_attempts(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import sdar_tamp.world.generators as generators
+
+    calls: list[object] = []
+    attempt = generators._attempt
+
+    def counted(*args: object) -> object:
+        calls.append(result := attempt(*args))  # type: ignore[arg-type]
+        return result
+
+    monkeypatch.setattr(generators, "_attempt", counted)
+    with pytest.raises(GenerationError, match=r"table is too full: .* at most \d+ of them"):
+        generate_instance("R", max_objects(), 0)
+    assert len(calls) == GeneratorOptions().crowded_attempts
+    assert all(isinstance(c, int) and c < max_objects() for c in calls)
 
 
 def test_suite_members() -> None:
