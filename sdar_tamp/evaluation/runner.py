@@ -45,6 +45,7 @@ from types import FrameType
 from typing import Any
 
 from sdar_tamp import __version__
+from sdar_tamp.arguments import COUNT, SEED, TIME_LIMIT
 from sdar_tamp.errors import ParameterError, SdarError
 from sdar_tamp.evaluation.settings import (
     SETTINGS,
@@ -359,12 +360,14 @@ def run_bench(
     from tqdm import tqdm
 
     chosen = parse_combos(combos)
-    if workers < 1:
-        raise ParameterError(f"workers must be >= 1, got {workers}")
-    if time_limit <= 0:
-        raise ParameterError(f"time limit must be > 0 [s], got {time_limit}")
+    workers = COUNT.check("workers", workers)
+    time_limit = TIME_LIMIT.check("time_limit", time_limit)
+    seed = SEED.check("seed", seed)
+    if max_objects is not None:
+        max_objects = COUNT.check("max_objects", max_objects)
     if hard_limit is None:
         hard_limit = default_hard_limit(time_limit)
+    hard_limit = TIME_LIMIT.check("hard_limit", hard_limit)
     entries = suite_entries(suite, instances, max_objects)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

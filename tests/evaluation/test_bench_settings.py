@@ -119,3 +119,19 @@ def test_restart_discards_the_old_rows(tmp_path: Path) -> None:
     assert json.loads((tmp_path / SETTINGS).read_text())["seed"] == 2
     text = (tmp_path / "report.md").read_text()
     assert "--combos sdar-t+plain --workers 1 --time-limit 30 --seed 2 --only R4" in text
+
+
+@pytest.mark.parametrize(
+    ("option", "value"),
+    [("time_limit", float("nan")), ("time_limit", -1.0), ("workers", 0), ("seed", -5)],
+)
+def test_run_bench_refuses_bad_numbers_before_writing(
+    tmp_path: Path, option: str, value: float
+) -> None:
+    from sdar_tamp.errors import ParameterError
+    from sdar_tamp.evaluation.runner import run_bench
+
+    out = tmp_path / "out"
+    with pytest.raises(ParameterError, match=option):
+        run_bench("paper", out, "sdar", progress=False, **{option: value})
+    assert not out.exists()
