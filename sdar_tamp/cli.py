@@ -9,16 +9,14 @@ from pathlib import Path
 
 from sdar_tamp import __version__
 from sdar_tamp.errors import SdarError
+from sdar_tamp.textfile import read_text
 
 DEMO_DOMAIN = "dual_arm_rearrangement"
 DEMO_INSTANCE = "suites/paper/M1.yaml"
 
 
 def _read(path: Path) -> str:
-    try:
-        return path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise SdarError(f"cannot read {path}: {error.strerror}") from None
+    return read_text(path)
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
