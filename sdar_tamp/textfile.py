@@ -10,6 +10,7 @@ dropped.
 
 from __future__ import annotations
 
+import codecs
 from pathlib import Path
 from typing import Protocol
 
@@ -63,13 +64,14 @@ def decode_text(data: bytes, file: str, error: ErrorFactory = TextFileError) -> 
     Raises:
         SdarError: what ``error`` builds when ``data`` is not UTF-8.
     """
+    skip = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0
     try:
-        return data.decode("utf-8-sig")
+        return data[skip:].decode("utf-8")
     except UnicodeDecodeError as exc:
-        offset = exc.start
-        line_start = data.rfind(b"\n", 0, offset) + 1
-        # The bytes before the first bad one decode (the BOM, if any, is not a character).
-        before = data[line_start:offset].decode("utf-8-sig" if line_start == 0 else "utf-8")
+        offset = skip + exc.start
+        line_start = max(data.rfind(b"\n", 0, offset) + 1, skip)
+        # The bytes before the first bad one decode; the mark is no character.
+        before = data[line_start:offset].decode("utf-8")
         location = SourceLocation(file, data.count(b"\n", 0, offset) + 1, len(before) + 1)
         detail = (
             f"not UTF-8 text: byte 0x{data[offset]:02x} at byte offset {offset} "

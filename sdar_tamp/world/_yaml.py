@@ -177,8 +177,9 @@ def read_yaml(path: Path, error_type: type[WorldFileError]) -> Node:
 
 def parse_yaml(text: str, name: str, error_type: type[WorldFileError]) -> Node:
     """Parse YAML text; ``name`` is the file name used in messages."""
-    loader = _Loader(text)
+    loader: _Loader | None = None
     try:
+        loader = _Loader(text)  # checks the characters
         ynode = loader.get_single_node()
         value = loader.construct_document(ynode) if ynode is not None else None
     except yaml.MarkedYAMLError as exc:
@@ -190,13 +191,15 @@ def parse_yaml(text: str, name: str, error_type: type[WorldFileError]) -> Node:
         breaks = list(_LINE_BREAK.finditer(text, 0, exc.position))
         line = len(breaks) + 1
         column = exc.position - (breaks[-1].end() if breaks else 0) + 1
+        code = exc.character if isinstance(exc.character, int) else ord(exc.character)
         raise error_type(
-            f"invalid YAML: character {exc.character!r} (#x{ord(exc.character):04x}) is not "
-            "allowed; special characters must be escaped in double-quoted strings",
+            f"invalid YAML: character #x{code:04x} is not allowed; special characters must be "
+            "escaped in double-quoted strings",
             SourceLocation(name, line, column),
         ) from exc
     except yaml.YAMLError as exc:
         raise error_type(f"invalid YAML: {exc}", SourceLocation(name, 1, 1)) from exc
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
     return Node(value, "", name, ynode, error_type)
