@@ -13,12 +13,12 @@ import argparse
 import json
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 from sdar_tamp.language import parse_domain, parse_problem
 from sdar_tamp.language.sexpr import read_sexpr
+from sdar_tamp.resources import domain_file
 
-DOMAIN = Path(__file__).resolve().parents[1] / "domains" / "logistics" / "domain.pddl"
+DOMAIN = domain_file("logistics")
 
 
 def logistics_problem(megabytes: float) -> str:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import re
 
 import pytest
@@ -154,3 +155,19 @@ def test_errors_name_the_first_problem(text: str, expected: str) -> None:
     with pytest.raises(PddlSyntaxError) as info:
         read_sexpr(text, "t")
     assert str(info.value) == expected
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_garbage_collector_state_is_restored(enabled: bool) -> None:
+    was = gc.isenabled()
+    try:
+        if not enabled:
+            gc.disable()
+        read_sexpr("(a (b))")
+        assert gc.isenabled() is enabled
+        with pytest.raises(PddlSyntaxError):
+            read_sexpr("(a))")
+        assert gc.isenabled() is enabled
+    finally:
+        if was:
+            gc.enable()
