@@ -4,7 +4,8 @@ Seeds are the shipped domains, problems and stream files, a shipped instance and
 plan file; mutations work on bytes (inserted brackets, control characters, bytes that are not
 UTF-8, deep nesting), on tokens (PDDL) and on values (YAML and JSON), so that many examples get
 past the syntax into the checks behind it. Examples are derandomised (same every run) and no
-example database is written. ``SDAR_FUZZ_EXAMPLES=5000`` runs more, random, examples.
+example database is written; Hypothesis keeps its caches in the system's temporary folder,
+not in the working directory. ``SDAR_FUZZ_EXAMPLES=5000`` runs more, random, examples.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import contextlib
 import json
 import os
 import re
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -22,6 +24,7 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from hypothesis.configuration import set_hypothesis_home_dir
 
 from sdar_tamp.errors import SdarError
 from sdar_tamp.language import parse_domain, parse_problem, parse_stream_file
@@ -47,6 +50,11 @@ FUZZ = settings(
     database=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
 )
+
+
+# Hypothesis caches facts about the code under test in ".hypothesis" of the working directory,
+# already while pytest collects the tests: keep them in the temporary folder instead.
+set_hypothesis_home_dir(Path(tempfile.gettempdir()) / "sdar-tamp-hypothesis")
 
 # Fragments that tend to reach corners: brackets, PDDL keywords, YAML and JSON syntax, control
 # characters, bytes that are not UTF-8 (a lone continuation byte, a cut multi-byte sequence),
