@@ -19,6 +19,7 @@ from sdar_tamp.arguments import (
     output_folder,
 )
 from sdar_tamp.errors import SdarError
+from sdar_tamp.textfile import read_text
 
 DEMO_DOMAIN = "dual_arm_rearrangement"
 DEMO_INSTANCE = "suites/paper/M1.yaml"
@@ -26,10 +27,7 @@ _FORCE = "replace output files that exist (default: refuse)"
 
 
 def _read(path: Path) -> str:
-    try:
-        return path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise SdarError(f"cannot read {path}: {error.strerror}") from None
+    return read_text(path)
 
 
 def cmd_plan(args: argparse.Namespace) -> int:

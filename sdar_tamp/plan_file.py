@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields, is_dataclass
 from pathlib import Path
@@ -31,7 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from sdar_tamp.errors import ParameterError, SdarError
+from sdar_tamp.errors import ParameterError, SdarError, SourceLocation
+from sdar_tamp.textfile import read_text
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
 
@@ -40,6 +42,7 @@ VERSION = 1
 UNITS = {"length": "m", "angle": "rad", "time": "s"}
 MAX_DT = 0.02  #: largest spacing of trajectory samples [s]
 EVENT_TYPES = ("grasp", "release")
+MAX_DEPTH = 64  #: deepest nesting of JSON lists and objects a plan file may have
 #: After the gripper events of one instant the robot stands still this long [s] (the gripper
 #: closes or opens; the 2F-85 takes about half a second).
 GRIPPER_DWELL = 0.5
@@ -251,16 +254,58 @@ def _show(v: Any) -> str:
 def load_plan(path: Path) -> PlanFile:
     """Read and check a plan file (see the module docstring)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise PlanFileError(str(path), "", f"cannot read file: {exc.strerror}") from exc
+    text = read_text(path, _file_error)
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         where = f"{path}:{exc.lineno}:{exc.colno}"
         raise PlanFileError(where, "", f"invalid JSON: {exc.msg}") from None
+    except RecursionError:
+        raise _too_deep(text, str(path)) from None
+    except ValueError as exc:  # such as an integer with more digits than Python converts
+        raise PlanFileError(str(path), "", f"invalid JSON: {exc}") from None
+    if _nesting_exceeds(data, MAX_DEPTH):
+        raise _too_deep(text, str(path))
     return plan_from_dict(data, str(path))
+
+
+def _file_error(detail: str, file: str, location: SourceLocation | None) -> PlanFileError:
+    return PlanFileError(str(location) if location is not None else file, "", detail)
+
+
+def _nesting_exceeds(data: Any, limit: int) -> bool:
+    """Whether lists and objects in ``data`` nest deeper than ``limit`` (without recursion)."""
+    if not isinstance(data, dict | list):
+        return False
+    stack: list[tuple[Any, int]] = [(data, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if depth > limit:
+            return True
+        children = value.values() if isinstance(value, dict) else value  # only dicts and lists
+        stack.extend((child, depth + 1) for child in children if isinstance(child, dict | list))
+    return False
+
+
+_JSON_NESTING = re.compile(r'"(?:[^"\\]|\\.)*"|[\[\]{}]')
+
+
+def _too_deep(text: str, file: str) -> PlanFileError:
+    """The error for JSON nested deeper than :data:`MAX_DEPTH`, at the first bracket too deep."""
+    depth = 0
+    for match in _JSON_NESTING.finditer(text):
+        token = match.group()
+        if token in ("[", "{"):
+            depth += 1
+            if depth > MAX_DEPTH:
+                start = match.start()
+                line = text.count("\n", 0, start) + 1
+                column = start - (text.rfind("\n", 0, start) + 1) + 1
+                file = f"{file}:{line}:{column}"
+                break
+        elif token in ("]", "}"):
+            depth -= 1
+    return PlanFileError(file, "", f"lists and objects nested deeper than {MAX_DEPTH} levels")
 
 
 _TOP = ["format", "version", "units", "instance", "arms", "trajectory", "events"]

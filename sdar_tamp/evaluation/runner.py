@@ -56,6 +56,7 @@ from sdar_tamp.evaluation.settings import (
     write_settings,
 )
 from sdar_tamp.evaluation.workers import WorkerFailure, WorkerPool
+from sdar_tamp.textfile import read_text
 
 log = logging.getLogger(__name__)
 
@@ -284,7 +285,7 @@ def read_rows(path: Path, columns: Sequence[str]) -> list[dict[str, str]]:
     by an interruption is dropped). Raises :class:`SdarError` if the header is not ``columns``."""
     if not path.exists():
         return []
-    text = path.read_text(encoding="utf-8")
+    text = read_text(path)
     lines = text.splitlines(keepends=True)
     if lines and not lines[-1].endswith("\n"):
         lines.pop()
@@ -322,7 +323,7 @@ def _repaired(
     those if it holds anything else."""
     rows = read_rows(path, columns)
     kept = [r for r in rows if keep(r)]
-    text = path.read_text(encoding="utf-8") if path.exists() else "\n"
+    text = read_text(path) if path.exists() else "\n"
     if not text.endswith("\n") or text.count("\n") != len(kept) + 1:
         path.unlink(missing_ok=True)
         append_rows(path, columns, kept)

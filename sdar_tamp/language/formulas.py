@@ -10,6 +10,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+from sdar_tamp.textfile import read_text
+
 TOTAL_COST = "total-cost"
 INF = math.inf
 
@@ -45,5 +47,9 @@ def Equal(left: Any, right: Any) -> Fact:
 
 
 def read(path: str | Path) -> str:
-    """The text of a domain or stream file."""
-    return Path(path).read_text(encoding="utf-8")
+    """The text of a domain or stream file.
+
+    Raises:
+        TextFileError: the file cannot be read or is not UTF-8 (naming the file and the place).
+    """
+    return read_text(path)

@@ -40,6 +40,10 @@ from sdar_tamp.language.model import (
 )
 from sdar_tamp.language.sexpr import SExpr, SList, Symbol
 
+MAX_FORMULA_DEPTH = 100
+"""Formulas and effects nested deeper than this are rejected with a located error (they are
+read, and later used by the planners, recursively)."""
+
 
 def expect_list(node: SExpr, what: str) -> SList:
     if not isinstance(node, SList):
@@ -49,7 +53,7 @@ def expect_list(node: SExpr, what: str) -> SList:
 
 def expect_symbol(node: SExpr, what: str) -> Symbol:
     if not isinstance(node, Symbol):
-        raise PddlSyntaxError(f"expected {what}, found a list {node}", node.location)
+        raise PddlSyntaxError(f"expected {what}, found a list {node.excerpt()}", node.location)
     return node
 
 
@@ -168,6 +172,14 @@ class FormulaReader:
 
     def __init__(self, vocabulary: Vocabulary) -> None:
         self.vocabulary = vocabulary
+        self._depth = 0
+
+    def _enter(self, node: SExpr, what: str) -> None:
+        if self._depth >= MAX_FORMULA_DEPTH:
+            raise PddlSyntaxError(
+                f"{what} nested deeper than {MAX_FORMULA_DEPTH} levels", node.location
+            )
+        self._depth += 1
 
     # --- terms and atoms ----------------------------------------------------------------------
 
@@ -210,6 +222,13 @@ class FormulaReader:
     # --- formulas -----------------------------------------------------------------------------
 
     def formula(self, node: SExpr, scope: Mapping[str, str]) -> Formula:
+        self._enter(node, "formula")
+        try:
+            return self._formula(node, scope)
+        finally:
+            self._depth -= 1
+
+    def _formula(self, node: SExpr, scope: Mapping[str, str]) -> Formula:
         lst = expect_list(node, "a formula")
         if not lst.items:
             return And(())
@@ -248,6 +267,13 @@ class FormulaReader:
     # --- effects ------------------------------------------------------------------------------
 
     def effect(self, node: SExpr, scope: Mapping[str, str]) -> Effect:
+        self._enter(node, "effect")
+        try:
+            return self._effect(node, scope)
+        finally:
+            self._depth -= 1
+
+    def _effect(self, node: SExpr, scope: Mapping[str, str]) -> Effect:
         lst = expect_list(node, "an effect")
         if not lst.items:
             return AndEffect(())

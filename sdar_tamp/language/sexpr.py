@@ -1,37 +1,123 @@
-"""S-expression reader with source positions, shared by the domain, problem and stream parsers."""
+"""S-expression reader with source positions, shared by the domain, problem and stream parsers.
+
+The reader tokenises the whole text with one regular expression and builds lists with an explicit
+stack, so nesting depth is not limited by Python's recursion limit. Nodes keep the character
+offset of their first character; ``line:column`` is computed only when a location is asked for
+(an error message, a declaration's place), by bisecting the line starts of the source.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TypeAlias
+import gc
+import re
+from bisect import bisect_right
+from itertools import accumulate
+from typing import NamedTuple, TypeAlias
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.errors import PddlSyntaxError
 
+# A token: a comment (skipped), a parenthesis or a symbol. Only the six whitespace characters
+# of the class, parentheses and ';' end a symbol.
+# A symbol takes its first character, then runs to whitespace, a parenthesis, a comment or a
+# '?': a '?' always starts a new token, as in Fast Downward and VAL ((at?x) reads as (at ?x)).
+_SPLIT = re.compile(r"(;[^\n]*|[()]|[^ \t\r\n\f\v();][^ \t\r\n\f\v();?]*)")
+_SYMBOL = re.compile(r"[^ \t\r\n\f\v();][^ \t\r\n\f\v();?]*")
+_NEWLINE = re.compile(r"\n")
 
-@dataclass(frozen=True)
-class Symbol:
+
+class SourceText:
+    """One source text and its file name; turns character offsets into :class:`SourceLocation`.
+
+    Lines end at ``\\n``; ``line`` and ``column`` count from 1, and a column counts characters
+    (a tab is one column).
+    """
+
+    __slots__ = ("_line_starts", "filename", "text")
+
+    def __init__(self, text: str, filename: str | None = None) -> None:
+        self.filename = filename
+        self.text = text
+        self._line_starts: list[int] | None = None
+
+    def location(self, offset: int) -> SourceLocation:
+        """The location of the character at ``offset`` (0-based) in the text."""
+        starts = self._line_starts
+        if starts is None:
+            starts = [0]
+            starts.extend(match.end() for match in _NEWLINE.finditer(self.text))
+            self._line_starts = starts
+        line = bisect_right(starts, offset)
+        return SourceLocation(self.filename, line, offset - starts[line - 1] + 1)
+
+    def __repr__(self) -> str:
+        return f"SourceText({self.filename!r}, {len(self.text)} characters)"
+
+
+class Symbol(NamedTuple):
     """One token; ``text`` is lower-cased (PDDL names are case-insensitive)."""
 
     text: str
-    location: SourceLocation
+    offset: int
+    source: SourceText
+
+    @property
+    def location(self) -> SourceLocation:
+        """Where the token starts."""
+        return self.source.location(self.offset)
 
     def __str__(self) -> str:
         return self.text
 
 
-@dataclass(frozen=True)
-class SList:
-    """A parenthesised list; ``location`` is that of its opening parenthesis."""
+class SList(NamedTuple):
+    """A parenthesised list; its ``location`` is that of its opening parenthesis.
+
+    ``len()`` counts the items. Nodes are named tuples: immutable and cheap to build.
+    """
 
     items: tuple[SExpr, ...]
-    location: SourceLocation
+    offset: int
+    source: SourceText
+
+    @property
+    def location(self) -> SourceLocation:
+        """Where the opening parenthesis is."""
+        return self.source.location(self.offset)
+
+    def with_items(self, items: tuple[SExpr, ...]) -> SList:
+        """A list at the same place with other ``items``."""
+        return SList(items, self.offset, self.source)
 
     def __len__(self) -> int:
         return len(self.items)
 
     def __str__(self) -> str:
-        return "(" + " ".join(str(item) for item in self.items) + ")"
+        # Iterative, so that printing a deeply nested list cannot exhaust the Python stack.
+        parts: list[str] = []
+        stack: list[SExpr | str] = [self]
+        while stack:
+            node = stack.pop()
+            if isinstance(node, str):
+                parts.append(node)
+            elif isinstance(node, Symbol):
+                parts.append(node.text)
+            else:
+                parts.append("(")
+                stack.append(")")
+                for index in range(len(node.items) - 1, -1, -1):
+                    stack.append(node.items[index])
+                    if index:
+                        stack.append(" ")
+        return "".join(parts)
+
+    def excerpt(self, limit: int = 60) -> str:
+        """The text of the list, cut to ``limit`` characters (for messages)."""
+        text = str(self)
+        return text if len(text) <= limit else text[: limit - 3] + "..."
+
+    def __repr__(self) -> str:
+        return f"SList({self.excerpt()} at {self.location})"
 
 
 SExpr: TypeAlias = Symbol | SList
@@ -43,54 +129,76 @@ def read_sexpr(text: str, filename: str | None = None) -> SList:
     Raises:
         PddlSyntaxError: unbalanced parentheses, an empty source or text after the list.
     """
-    stack: list[tuple[SourceLocation, list[SExpr]]] = []
-    result: SList | None = None
-    line, column = 1, 1
-    index, length = 0, len(text)
-    while index < length:
-        char = text[index]
-        here = SourceLocation(filename, line, column)
-        if char == "\n":
-            line, column = line + 1, 1
-            index += 1
-            continue
-        if char in " \t\r\f\v":
-            index, column = index + 1, column + 1
-            continue
-        if char == ";":
-            while index < length and text[index] != "\n":
-                index += 1
-            continue
-        if char == ")" and not stack:
-            raise PddlSyntaxError("unbalanced parentheses: ')' without a matching '('", here)
-        if result is not None:
-            raise PddlSyntaxError("unexpected text after the closing parenthesis", here)
-        if char == "(":
-            stack.append((here, []))
-            index, column = index + 1, column + 1
-        elif char == ")":
-            start, items = stack.pop()
-            node = SList(tuple(items), start)
-            if stack:
-                stack[-1][1].append(node)
-            else:
-                result = node
-            index, column = index + 1, column + 1
-        else:
-            # A '?' always starts a new token, as in Fast Downward and VAL: (at?x) is (at ?x).
-            end = index + 1
-            while end < length and text[end] not in " \t\r\n\f\v();?":
-                end += 1
-            if not stack:
-                raise PddlSyntaxError(f"expected '(' but found {text[index:end]!r}", here)
-            stack[-1][1].append(Symbol(text[index:end].lower(), here))
-            column += end - index
-            index = end
+    source = SourceText(text, filename)
+    # Building the tree creates no reference cycles, so the cyclic garbage collector can only
+    # waste time on it (a third of the reading time on large files): it is paused meanwhile.
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        top, stack = _build(source)
+    finally:
+        if collecting:
+            gc.enable()
+    _check_top(top, source)
     if stack:
-        raise PddlSyntaxError("unbalanced parentheses: '(' is never closed", stack[-1][0])
-    if result is None:
+        if top:
+            raise PddlSyntaxError(
+                "unexpected text after the closing parenthesis", source.location(stack[0][0])
+            )
+        raise PddlSyntaxError(
+            "unbalanced parentheses: '(' is never closed", source.location(stack[-1][0])
+        )
+    if not top:
         raise PddlSyntaxError(
             "expected a definition '(define ...)' but the source is empty",
-            SourceLocation(filename, line, column),
+            source.location(len(text)),
         )
-    return result
+    root = top[0]
+    assert isinstance(root, SList)  # _check_top rejects a symbol
+    return root
+
+
+def _build(source: SourceText) -> tuple[list[SExpr], list[tuple[int, list[SExpr]]]]:
+    """The top-level nodes of ``source`` and the lists still open at its end (offset, items)."""
+    text = source.text
+    # ASCII lower-casing maps each character to one character, so offsets stay valid.
+    ascii_text = text.isascii()
+    # parts alternates separators (whitespace, maybe empty) and tokens; the running sum of
+    # the part lengths gives each token's offset.
+    parts = _SPLIT.split(text.lower() if ascii_text else text)
+    ends = list(accumulate(map(len, parts)))
+    new = tuple.__new__
+    top: list[SExpr] = []
+    stack: list[tuple[int, list[SExpr]]] = []
+    items = top  # the items of the innermost open list
+    for index in range(1, len(parts), 2):
+        token = parts[index]
+        first = token[0]
+        if first == "(":
+            stack.append((ends[index - 1], items))
+            items = []
+        elif first == ")":
+            if not stack:
+                _check_top(top, source)
+                raise PddlSyntaxError(
+                    "unbalanced parentheses: ')' without a matching '('",
+                    source.location(ends[index - 1]),
+                )
+            start, parent = stack.pop()
+            parent.append(new(SList, (tuple(items), start, source)))
+            items = parent
+        elif first != ";":
+            if not ascii_text:
+                token = token.lower()
+            items.append(new(Symbol, (token, ends[index - 1], source)))
+    return top, stack
+
+
+def _check_top(top: list[SExpr], source: SourceText) -> None:
+    """The first error among the top-level nodes read so far, in text order."""
+    if top and isinstance(top[0], Symbol):
+        match = _SYMBOL.match(source.text, top[0].offset)
+        word = match.group() if match else top[0].text
+        raise PddlSyntaxError(f"expected '(' but found {word!r}", top[0].location)
+    if len(top) > 1:
+        raise PddlSyntaxError("unexpected text after the closing parenthesis", top[1].location)

@@ -246,7 +246,7 @@ def _stream(section: SList, reader: FormulaReader) -> Stream:
     name = expect_symbol(section.items[1], "a stream name").text
     what = f"stream {name!r}"
     options = _options(section, STREAM_OPTIONS, what, 2)
-    empty = SList((), section.location)
+    empty = section.with_items(())
     inputs = _variables(options.get(":inputs", empty), f"the inputs of {what}")
     outputs = _variables(options.get(":outputs", empty), f"the outputs of {what}")
     _check_unique((*inputs, *outputs), what)
@@ -317,7 +317,7 @@ def _head(section: SList, keyword: str) -> tuple[SList, Symbol]:
 
 def _function(section: SList, reader: FormulaReader) -> StreamFunctionDecl:
     head, name = _head(section, ":function")
-    inputs = _variables(SList(head.items[1:], head.location), f"function {name.text!r}")
+    inputs = _variables(head.with_items(head.items[1:]), f"function {name.text!r}")
     _check_unique(inputs, f"function {name.text!r}")
     scope = {n: "object" for n, _ in inputs}
     reader.function_arity(name, len(inputs), head.location)
@@ -328,7 +328,7 @@ def _function(section: SList, reader: FormulaReader) -> StreamFunctionDecl:
 
 def _predicate(section: SList, reader: FormulaReader) -> StreamPredicateDecl:
     head, name = _head(section, ":predicate")
-    inputs = _variables(SList(head.items[1:], head.location), f"predicate {name.text!r}")
+    inputs = _variables(head.with_items(head.items[1:]), f"predicate {name.text!r}")
     _check_unique(inputs, f"predicate {name.text!r}")
     scope = {n: "object" for n, _ in inputs}
     atom = reader.atom(head, scope)
@@ -350,7 +350,7 @@ def _optional_domain(
 
 def _rule(section: SList, reader: FormulaReader) -> Rule:
     options = _options(section, RULE_OPTIONS, "a rule", 1)
-    empty = SList((), section.location)
+    empty = section.with_items(())
     params_node = options.get(":inputs", options.get(":parameters", empty))
     params = _variables(params_node, "the parameters of a rule")
     _check_unique(params, "a rule")

@@ -13,7 +13,9 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from sdar_tamp.world.errors import KinematicsError
+from sdar_tamp.textfile import read_text
+from sdar_tamp.world._yaml import file_error
+from sdar_tamp.world.errors import KinematicsError, SceneError
 from sdar_tamp.world.transforms import FloatArray
 
 
@@ -39,7 +41,7 @@ class PinRobot:
     @staticmethod
     def load(urdf_path: Path) -> PinRobot:
         """Parse a URDF file (collision geometry included)."""
-        text = urdf_path.read_text(encoding="utf-8")
+        text = read_text(urdf_path, file_error(SceneError))
         model = pin.buildModelFromXML(text)
         geometry = pin.buildGeomFromUrdfString(model, text, pin.COLLISION)
         return PinRobot(urdf_path, model, geometry, model.createData())

@@ -7,6 +7,7 @@ place in the file, so every reader can raise an error that says where and what w
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,6 +15,7 @@ from pathlib import Path
 import yaml
 
 from sdar_tamp.errors import SourceLocation
+from sdar_tamp.textfile import ErrorFactory, read_text
 from sdar_tamp.world.errors import WorldFileError
 
 
@@ -122,23 +124,82 @@ def _number(value: object) -> float | None:
     return None
 
 
+MAX_DEPTH = 100
+"""Collections nested deeper than this are rejected with a located error."""
+_LINE_BREAK = re.compile("\r\n|[\r\n\x85\u2028\u2029]")  # YAML's line breaks
+
+
+class _Loader(yaml.SafeLoader):
+    """The safe loader with a nesting limit and located errors for values it cannot build."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__(text)
+        self._depth = 0
+
+    def compose_node(self, parent: yaml.Node | None, index: int) -> yaml.Node | None:
+        if self._depth >= MAX_DEPTH:
+            raise yaml.composer.ComposerError(
+                None,
+                None,
+                f"nesting deeper than {MAX_DEPTH} levels",
+                self.peek_event().start_mark,  # type: ignore[no-untyped-call]
+            )
+        self._depth += 1
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> object:
+        try:
+            return super().construct_object(node, deep)
+        except (ValueError, KeyError, TypeError, AttributeError, OverflowError) as exc:
+            # An explicit tag the value does not fit, such as "!!int abc" or a bad timestamp.
+            raise yaml.constructor.ConstructorError(
+                None, None, f"cannot read {node.value!r} as {node.tag}: {exc}", node.start_mark
+            ) from exc
+
+
+def file_error(error_type: type[WorldFileError]) -> ErrorFactory:
+    """An error factory for :func:`~sdar_tamp.textfile.read_text` raising ``error_type``."""
+
+    def build(detail: str, file: str, location: SourceLocation | None) -> WorldFileError:
+        return error_type(detail, location or SourceLocation(file, 1, 1))
+
+    return build
+
+
 def read_yaml(path: Path, error_type: type[WorldFileError]) -> Node:
-    """Parse ``path`` into a root :class:`Node`; a missing file or bad syntax raises."""
-    name = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise error_type(f"cannot read file: {exc.strerror}", SourceLocation(name, 1, 1)) from exc
-    return parse_yaml(text, name, error_type)
+    """Parse ``path`` into a root :class:`Node`; a missing file, bytes that are not UTF-8 or bad
+    syntax raise ``error_type``."""
+    return parse_yaml(read_text(path, file_error(error_type)), str(path), error_type)
 
 
 def parse_yaml(text: str, name: str, error_type: type[WorldFileError]) -> Node:
     """Parse YAML text; ``name`` is the file name used in messages."""
+    loader: _Loader | None = None
     try:
-        ynode = yaml.compose(text, Loader=yaml.SafeLoader)
-        value = yaml.safe_load(text)
+        loader = _Loader(text)  # checks the characters
+        ynode = loader.get_single_node()
+        value = loader.construct_document(ynode) if ynode is not None else None
     except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark
+        mark = exc.problem_mark or exc.context_mark
         loc = SourceLocation(name, mark.line + 1, mark.column + 1) if mark else None
-        raise error_type(f"invalid YAML: {exc.problem}", loc) from exc
+        raise error_type(f"invalid YAML: {exc.problem or exc.context}", loc) from exc
+    except yaml.reader.ReaderError as exc:
+        # Characters YAML does not allow (control characters); ``position`` indexes the text.
+        breaks = list(_LINE_BREAK.finditer(text, 0, exc.position))
+        line = len(breaks) + 1
+        column = exc.position - (breaks[-1].end() if breaks else 0) + 1
+        code = exc.character if isinstance(exc.character, int) else ord(exc.character)
+        raise error_type(
+            f"invalid YAML: character #x{code:04x} is not allowed; special characters must be "
+            "escaped in double-quoted strings",
+            SourceLocation(name, line, column),
+        ) from exc
+    except yaml.YAMLError as exc:
+        raise error_type(f"invalid YAML: {exc}", SourceLocation(name, 1, 1)) from exc
+    finally:
+        if loader is not None:
+            loader.dispose()
     return Node(value, "", name, ynode, error_type)

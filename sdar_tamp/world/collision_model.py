@@ -15,8 +15,11 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from sdar_tamp.textfile import read_text
 from sdar_tamp.world import _coal
 from sdar_tamp.world._pin import array_to_se3, se3_to_array
+from sdar_tamp.world._yaml import file_error
+from sdar_tamp.world.errors import SceneError
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
 
@@ -56,7 +59,7 @@ def _prefixed_urdf(text: str, prefix: str) -> str:
 
 def build_dual_arm(scene: Scene) -> DualArmModel:
     """Both arms of ``scene`` in one pinocchio model, bases at their world poses."""
-    text = scene.robot_urdf.read_text(encoding="utf-8")
+    text = read_text(scene.robot_urdf, file_error(SceneError))
     model = pin.Model()
     geometry = pin.GeometryModel()
     for spec in scene.arms:
