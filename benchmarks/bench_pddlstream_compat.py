@@ -13,8 +13,14 @@ program's ``import pddlstream...`` lines resolve to ``sdar_tamp.compat.pddlstrea
 checkout's own ``pddlstream`` package is never imported; the runner fails the example if it
 is), and every plan the program obtains is re-checked by simulation
 (:mod:`sdar_tamp.compat.pddlstream.check`). An example passes when it found at least one plan
-and every plan it found is valid. Its viewer (tkinter) may be unavailable: an error raised
-after a valid plan was found is reported but does not fail the example.
+and every plan it found is valid; an error raised after a valid plan was found is reported but
+does not fail the example.
+
+The runner fixes the environment, never the examples: without a display (no ``$DISPLAY``) the
+examples' tkinter viewers get a do-nothing stand-in; NumPy names removed in NumPy 2 that the
+examples use (``np.product``, ``np.mat``) are put back; ``discrete_belief`` and
+``table_belief`` need SciPy (their own dependency: ``pip install scipy``, or a folder on
+``PYTHONPATH``, which is passed on).
 
 Your own PDDLStream program runs the same way::
 
@@ -76,6 +82,16 @@ EXAMPLES = (
     Example("satellites", "examples.ipc.satellites.run"),
 )
 
+#: PDDLStream's examples predate NumPy 2 and use names it removed; the runner puts those
+#: aliases back in the example's process (an environment fix, the examples stay unmodified)
+NUMPY_ALIASES = (
+    ("product", "prod"),
+    ("cumproduct", "cumprod"),
+    ("alltrue", "all"),
+    ("sometrue", "any"),
+    ("mat", "asmatrix"),
+)
+
 #: loaded modules whose file lies in the checkout's own package mean the alias was bypassed
 _GUARD = (
     "import atexit, os, sys\n"
@@ -85,6 +101,23 @@ _GUARD = (
     "    if bad:\n"
     "        print('LOADED FROM CHECKOUT:', bad, file=sys.stderr); os._exit(97)\n"
     "atexit.register(_guard)\n"
+    "import numpy\n"
+    "for _old, _new in {numpy_aliases!r}:\n"
+    "    if _old not in dir(numpy):\n"
+    "        setattr(numpy, _old, getattr(numpy, _new) if isinstance(_new, str) else _new)\n"
+    "if not os.environ.get('DISPLAY'):\n"
+    "    import types\n"
+    "    class _Null:\n"
+    "        def __init__(self, *a, **k): pass\n"
+    "        def __call__(self, *a, **k): return _Null()\n"
+    "        def __getattr__(self, name): return _Null()\n"
+    "        def __iter__(self): return iter(())\n"
+    "        def __int__(self): return 0\n"
+    "        def __float__(self): return 0.0\n"
+    "    _tk = types.ModuleType('tkinter')\n"
+    "    _tk.Tk = _tk.Canvas = _tk.Toplevel = _Null\n"
+    "    _tk.LAST = 'last'\n"
+    "    sys.modules['tkinter'] = _tk\n"
     "sys.argv = ['sdar_tamp.compat.pddlstream', *sys.argv[1:]]\n"
     "from sdar_tamp.compat.pddlstream.__main__ import main\n"
     "sys.exit(main())\n"
@@ -95,7 +128,9 @@ def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, o
     """Run one example; returns its name, result, time [s] and details."""
     with tempfile.TemporaryDirectory() as scratch:
         report = Path(scratch) / "report.json"
-        guard = _GUARD.format(pkg=str(checkout / "pddlstream") + os.sep)
+        guard = _GUARD.format(
+            pkg=str(checkout / "pddlstream") + os.sep, numpy_aliases=NUMPY_ALIASES
+        )
         command = [
             sys.executable,
             "-c",
@@ -107,7 +142,8 @@ def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, o
             *example.args,
         ]
         env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join([str(ROOT), str(checkout)])
+        extra = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+        env["PYTHONPATH"] = os.pathsep.join([str(ROOT), str(checkout), *extra])
         env.setdefault("MPLBACKEND", "Agg")
         env.pop("DISPLAY", None)
         start = time.perf_counter()

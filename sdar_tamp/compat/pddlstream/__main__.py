@@ -13,9 +13,9 @@ from __future__ import annotations
 import json
 import logging
 import os
-import time
 import runpy
 import sys
+import time
 from collections.abc import Sequence
 from typing import Any
 
@@ -39,7 +39,8 @@ class _Recorder:
     def install(self) -> None:
         from sdar_tamp.compat.pddlstream.algorithms import meta, search
 
-        core_solve, classical_plan = meta.core_solve, search.plan
+        core_solve = getattr(meta, "core_solve")  # noqa: B009
+        classical_plan = getattr(search, "plan")  # noqa: B009
 
         def recorded_solve(problem: Any, *args: Any, **kwargs: Any) -> Any:
             from sdar_tamp.compat.pddlstream.check import check_solution
@@ -78,8 +79,8 @@ class _Recorder:
             )
             return result
 
-        meta.core_solve = recorded_solve  # type: ignore[assignment]
-        search.plan = recorded_plan  # type: ignore[assignment]
+        setattr(meta, "core_solve", recorded_solve)  # noqa: B010
+        setattr(search, "plan", recorded_plan)  # noqa: B010
 
     def write(self, path: str, failure: BaseException | None) -> None:
         record = {

@@ -35,7 +35,9 @@ def solve_abstract(
 solve_focused = solve_abstract
 
 
-def solve_focused_original(problem: PDDLProblem, fail_fast: bool = False, **kwargs: Any) -> Solution:
+def solve_focused_original(
+    problem: PDDLProblem, fail_fast: bool = False, **kwargs: Any
+) -> Solution:
     """The focused algorithm (optimistic plans, first-layer streams evaluated)."""
     kwargs.pop("max_skeletons", None)
     kwargs.pop("search_sample_ratio", None)

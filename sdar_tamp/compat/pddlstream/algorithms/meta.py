@@ -22,7 +22,7 @@ from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.options import PlanConstraints as _CorePlanConstraints
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Solution
-from solvers.solve import solve as core_solve
+from solvers.solve import solve as core_solve  # replaced by the runner's --report
 
 LOG = logging.getLogger(__name__)
 INF = math.inf
@@ -86,11 +86,12 @@ def _constraints(constraints: Any, max_cost: float) -> _CorePlanConstraints | No
         raise ParameterError(
             f"constraints must be a PlanConstraints, got {type(constraints).__name__}"
         )
-    if max_cost < constraints.max_cost:
-        constraints = dataclasses.replace(constraints, max_cost=max_cost)
-    if constraints.skeletons is None and math.isinf(constraints.max_cost):
+    result: _CorePlanConstraints = constraints
+    if max_cost < result.max_cost:
+        result = dataclasses.replace(result, max_cost=max_cost)
+    if result.skeletons is None and math.isinf(result.max_cost):
         return None
-    return constraints
+    return result
 
 
 def solve(

@@ -7,7 +7,8 @@ import math
 from typing import Any
 
 from sdar_tamp.language.pddl import parse_domain, parse_problem
-from solvers.classical import PlanStatus, plan, task_from_problem
+from solvers.classical import PlanStatus, task_from_problem
+from solvers.classical import plan as plan  # replaced by the runner's --report
 from solvers.solution import Action
 from solvers.solve import parse_planner
 

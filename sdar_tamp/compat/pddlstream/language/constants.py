@@ -8,9 +8,11 @@ import os
 from collections.abc import Iterable, Sequence
 from typing import Any, NamedTuple
 
-from sdar_tamp.compat.pddlstream.language.problem import PDDLProblem
+from sdar_tamp.compat.pddlstream.language.problem import PDDLProblem as PDDLProblem
 from sdar_tamp.compat.pddlstream.utils import INF, read, str_from_object
-from solvers.solution import Action, Certificate, Solution
+from solvers.solution import Action as Action
+from solvers.solution import Certificate as Certificate
+from solvers.solution import Solution as Solution
 
 EQ = "="
 AND = "and"
@@ -151,7 +153,7 @@ def get_parameter_name(expression: Any) -> Any:
 
 
 def is_head(expression: Sequence[Any]) -> bool:
-    return get_prefix(expression) not in OPERATORS
+    return bool(get_prefix(expression) not in OPERATORS)
 
 
 def is_plan(plan: Any) -> bool:
@@ -223,7 +225,7 @@ def partition_facts(facts: Iterable[Sequence[Any]]) -> tuple[list[Any], list[Any
 
 
 def is_cost(expression: Sequence[Any]) -> bool:
-    return get_prefix(expression) == MINIMIZE
+    return bool(get_prefix(expression) == MINIMIZE)
 
 
 def get_costs(objectives: Iterable[Sequence[Any]]) -> list[Any]:
@@ -239,7 +241,9 @@ def read_relative(file: str, relative_path: str) -> str:
     return read(os.path.join(os.path.dirname(os.path.abspath(file)), relative_path))
 
 
-def read_relative_dir(file: str, relative_dir: str = "./", filenames: Sequence[str] = ()) -> list[str]:
+def read_relative_dir(
+    file: str, relative_dir: str = "./", filenames: Sequence[str] = ()
+) -> list[str]:
     return [read_relative(file, os.path.join(relative_dir, name)) for name in filenames]
 
 
@@ -251,5 +255,3 @@ def read_pddl_pair(file: str, **kwargs: Any) -> list[str]:
 def read_pddlstream_pair(file: str, **kwargs: Any) -> list[str]:
     """``[domain.pddl, stream.pddl]`` texts from the folder of ``file``."""
     return read_relative_dir(file, filenames=PDDLSTREAM_FILES, **kwargs)
-
-

@@ -60,9 +60,7 @@ def fluent_predicates(domain: Domain) -> frozenset[str]:
 def exogenous_streams(domain: Domain, streams: StreamFile) -> list[str]:
     """Names of the streams whose domain mentions a fluent predicate."""
     fluent = fluent_predicates(domain)
-    return [
-        s.name for s in streams.streams if any(atom.predicate in fluent for atom in s.domain)
-    ]
+    return [s.name for s in streams.streams if any(atom.predicate in fluent for atom in s.domain)]
 
 
 def _rename(formula: Formula, mapping: Mapping[str, str]) -> Formula:
@@ -141,9 +139,7 @@ def compile_exogenous(
         condition = (result, *(_renamed(a, derived) for a in stream.domain))
         for fact in stream.certified:
             outer = tuple(dict.fromkeys(a for a in fact.args if a.startswith("?")))
-            inner = tuple(
-                Parameter(v) for v in (*stream.inputs, *stream.outputs) if v not in outer
-            )
+            inner = tuple(Parameter(v) for v in (*stream.inputs, *stream.outputs) if v not in outer)
             body: Formula = And(condition)
             if inner:
                 body = Exists(inner, body)
@@ -157,9 +153,7 @@ def compile_exogenous(
     for name in certified:
         params = tuple(f"?x{i}" for i in range(arity[name]))
         atom = Atom(name, params)
-        axioms.append(
-            Axiom(derived[name], tuple(Parameter(p) for p in params), And((atom,)))
-        )
+        axioms.append(Axiom(derived[name], tuple(Parameter(p) for p in params), And((atom,))))
     rules = list(streams.rules)
     for name in certified:
         params = tuple(f"?x{i}" for i in range(arity[name]))

@@ -103,4 +103,3 @@ def accelerate_list_gen_fn(
             yield batch
 
     return from_list_gen_fn(gen)
-

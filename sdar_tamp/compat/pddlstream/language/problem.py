@@ -35,6 +35,7 @@ LOG = logging.getLogger(__name__)
 DEBUG = "debug"
 SHARED_DEBUG = "shared_debug"
 DEBUG_MODES = (DEBUG, SHARED_DEBUG)
+TOTAL_COST = "total-cost"
 
 
 def parse_stream_files(stream_pddl: Any, domain: Domain) -> StreamFile:
@@ -108,6 +109,18 @@ def adapt_stream_map(stream_map: Any, streams: StreamFile) -> dict[str, Callable
     return result
 
 
+def _is_total_cost(fact: Any) -> bool:
+    """``('=', ('total-cost',), value)``: PDDLStream programs set the cost counter in ``init``;
+    the solvers keep their own, so the fact is dropped."""
+    return (
+        len(fact) == 3
+        and fact[0] == "="
+        and isinstance(fact[1], tuple | list)
+        and len(fact[1]) == 1
+        and str(fact[1][0]).lower() == TOTAL_COST
+    )
+
+
 @dataclass
 class PDDLProblem(_CorePDDLProblem):
     """``PDDLProblem(domain_pddl, constant_map, stream_pddl, stream_map, init, goal)``."""
@@ -120,6 +133,7 @@ class PDDLProblem(_CorePDDLProblem):
 
         if self.constant_map is None:
             self.constant_map = {}
+        self.init = [fact for fact in self.init if not _is_total_cost(fact)]
         given = (self.domain_pddl, self.stream_pddl)
         domain = (
             self.domain_pddl

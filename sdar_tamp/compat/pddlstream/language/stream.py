@@ -45,13 +45,16 @@ class PartialInputs:
 
 
 def _opt_gen_fn(value: Any) -> Callable[..., Any] | str | None:
-    if value is None or isinstance(value, str) or callable(value):
+    if value is None or isinstance(value, str):
         return value
+    if callable(value):
+        function: Callable[..., Any] = value
+        return function
     if isinstance(value, PartialInputs):
         if value.inputs:
             LOG.info("PartialInputs(inputs=%r): placeholders are shared per stream", value.inputs)
         return "unique" if value.unique else "shared"
-    raise TypeError(f"StreamInfo opt_gen_fn must be a PartialInputs, a callable or None")
+    raise TypeError("StreamInfo opt_gen_fn must be a PartialInputs, a callable or None")
 
 
 @dataclass(frozen=True, init=False)
