@@ -121,7 +121,7 @@ def test_max_cost_and_pddlstream_wildcard_skeletons() -> None:
     constraints = PlanConstraints(skeletons=[skeleton], exact=True, groups={}, hint=False)
     solution = solve(problem, constraints=constraints, max_time=30, verbose=False)
     assert [a.name for a in solution.plan or []] == ["pick", "place"]
-    bounded = solve(problem, max_cost=1.0, max_time=5, verbose=False)  # lifting costs 2
+    bounded = solve(problem, max_cost=1.0, max_time=1, verbose=False)  # lifting costs 2
     assert bounded.plan is None and math.isinf(bounded.cost)
 
 
