@@ -131,3 +131,14 @@ def test_check_solution_rejects_a_plan_that_misses_the_goal() -> None:
     truncated = Solution(solution.plan[:1], solution.cost, solution.certificate)
     assert "goal" in (check_solution(problem, truncated) or "")
     assert check_solution(problem, Solution(None)) == "no plan"
+
+
+def test_values_of_undeclared_functions_are_ignored_with_a_log_line(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    init = [*INIT, ("=", ("Speed",), 3.0), ("=", ("lift", "cup"), 2.0)]
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.compat"):
+        problem = PDDLProblem(DOMAIN, {}, STREAMS, stream_map(), init, GOAL)
+    assert ("=", ("lift", "cup"), 2.0) in problem.init
+    assert all(f[0] != "=" or f[1][0] != "Speed" for f in problem.init)
+    assert any("'speed' is not declared" in r.getMessage() for r in caplog.records)

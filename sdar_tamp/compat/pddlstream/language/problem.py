@@ -109,16 +109,28 @@ def adapt_stream_map(stream_map: Any, streams: StreamFile) -> dict[str, Callable
     return result
 
 
-def _is_total_cost(fact: Any) -> bool:
-    """``('=', ('total-cost',), value)``: PDDLStream programs set the cost counter in ``init``;
-    the solvers keep their own, so the fact is dropped."""
-    return (
-        len(fact) == 3
-        and fact[0] == "="
-        and isinstance(fact[1], tuple | list)
-        and len(fact[1]) == 1
-        and str(fact[1][0]).lower() == TOTAL_COST
-    )
+def _numeric_function(fact: Any) -> str | None:
+    """The function name of a numeric ``init`` fact ``('=', (function, ...), value)``."""
+    if len(fact) == 3 and fact[0] == "=" and isinstance(fact[1], tuple | list) and fact[1]:
+        return str(fact[1][0]).lower()
+    return None
+
+
+def _init_facts(init: Any, domain: Domain, streams: StreamFile) -> list[Any]:
+    """``init`` without the numeric facts the solvers do not take: the ``total-cost`` counter
+    (they keep their own) and values of functions no file declares (PDDLStream ignores them;
+    a log line names them)."""
+    declared = set(domain.functions) | {f.name for f in streams.functions}
+    kept = []
+    for fact in init:
+        function = _numeric_function(fact)
+        if function == TOTAL_COST:
+            continue
+        if function is not None and function not in declared:
+            LOG.info("init fact %r: function %r is not declared; ignored", fact, function)
+            continue
+        kept.append(fact)
+    return kept
 
 
 @dataclass
@@ -133,7 +145,6 @@ class PDDLProblem(_CorePDDLProblem):
 
         if self.constant_map is None:
             self.constant_map = {}
-        self.init = [fact for fact in self.init if not _is_total_cost(fact)]
         given = (self.domain_pddl, self.stream_pddl)
         domain = (
             self.domain_pddl
@@ -141,6 +152,7 @@ class PDDLProblem(_CorePDDLProblem):
             else parse_domain(self.domain_pddl, "domain.pddl")
         )
         streams = parse_stream_files(self.stream_pddl, domain)
+        self.init = _init_facts(self.init, domain, streams)
         stream_map = adapt_stream_map(self.stream_map, streams)
         domain, streams, renaming = compile_exogenous(domain, streams)
         self.domain_pddl, self.stream_pddl, self.stream_map = domain, streams, stream_map
