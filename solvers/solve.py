@@ -33,6 +33,57 @@ _LIMIT = Real(0.0, allow_inf=True)  # max_iterations, max_skeletons, search_samp
 _NATURAL = Integer(0)  # initial_complexity
 _WEIGHT = Real(0.0, closed=True)  # effort_weight
 
+_SEARCHES = ("gbfs", "astar", "wastar")
+_HEURISTICS = ("ff", "add", "max", "blind")
+#: PDDLStream's Fast Downward configurations -> (search, heuristic, weight) of the classical
+#: planner. Names whose heuristic is not available use the nearest one (noted in the log).
+PLANNER_ALIASES: dict[str, tuple[str, str, float]] = {
+    "dijkstra": ("astar", "blind", 1.0),
+    "max-astar": ("astar", "max", 1.0),
+    "lmcut-astar": ("astar", "max", 1.0),
+    "ff-astar": ("astar", "ff", 1.0),
+    "ff-eager": ("gbfs", "ff", 1.0),
+    "ff-eager-pref": ("gbfs", "ff", 1.0),
+    "ff-lazy": ("gbfs", "ff", 1.0),
+    "goal-lazy": ("gbfs", "ff", 1.0),
+    "add-random-lazy": ("gbfs", "add", 1.0),
+    "ff-eager-tiebreak": ("gbfs", "ff", 1.0),
+    "ff-lazy-tiebreak": ("gbfs", "ff", 1.0),
+    "ff-ehc": ("gbfs", "ff", 1.0),
+    **{f"ff-wastar{w}": ("wastar", "ff", float(w)) for w in range(1, 6)},
+    **{f"cea-wastar{w}": ("wastar", "ff", float(w)) for w in range(1, 6)},
+    **{f"ff-astar{w}": ("wastar", "ff", float(w)) for w in range(1, 6)},
+}
+_APPROXIMATED = {
+    "lmcut-astar": "h^lmcut is not available; A* with the admissible h^max",
+    "goal-lazy": "the goal-count heuristic is not available; greedy search with h^FF",
+    "cea-wastar": "h^cea is not available; weighted A* with h^FF",
+}
+
+
+def parse_planner(planner: str) -> tuple[str, str, float]:
+    """``(search, heuristic, weight)`` of a planner name: ``SEARCH-HEURISTIC`` (e.g.
+    ``wastar-ff``, ``gbfs-add``, ``astar-max``) or one of PDDLStream's names
+    (:data:`PLANNER_ALIASES`, e.g. ``ff-astar``, ``max-astar``, ``ff-wastar3``).
+
+    Raises:
+        ParameterError: an unknown name; the message lists the valid ones.
+    """
+    name = str(planner).lower()
+    if name in PLANNER_ALIASES:
+        for prefix, note in _APPROXIMATED.items():
+            if name.startswith(prefix):
+                LOG.info("planner %r: %s", planner, note)
+        return PLANNER_ALIASES[name]
+    search, _, heuristic = name.partition("-")
+    if search in _SEARCHES and (heuristic or "ff") in _HEURISTICS:
+        return search, heuristic or "ff", 2.0
+    native = [f"{s}-{h}" for s in _SEARCHES for h in _HEURISTICS]
+    raise ParameterError(
+        f"planner must be SEARCH-HEURISTIC ({', '.join(native)}) or one of PDDLStream's "
+        f"{', '.join(sorted(PLANNER_ALIASES))}; got {planner!r}"
+    )
+
 
 def solve(
     problem: PDDLProblem,
@@ -82,7 +133,8 @@ def solve(
             run in the calling thread (for code tied to it) and the deadline is checked after
             each call, so a blocking call delays the ``TIMEOUT`` until it returns.
         planner: ``SEARCH-HEURISTIC`` of the classical planner, e.g. ``wastar-ff``,
-            ``gbfs-ff``, ``astar-max``.
+            ``gbfs-ff``, ``astar-max``, or a PDDLStream planner name such as ``ff-astar``,
+            ``max-astar`` or ``ff-wastar2`` (see :func:`parse_planner`).
         task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``.
         seed: seeds Python's ``random`` and NumPy's global generator before solving, so
             samplers that draw from them give the same plan for the same seed.
@@ -117,7 +169,7 @@ def solve(
     max_planner_time = MAX_TIME.check("max_planner_time", max_planner_time)
     if algorithm == "sdar":
         return _solve_sdar(problem, task_planner, max_time, stream_info, verbose, seed)
-    search, _, heuristic = planner.partition("-")
+    search, heuristic, weight = parse_planner(planner)
     options = StreamOptions(
         algorithm=algorithm,
         unit_costs=unit_costs,
@@ -131,7 +183,8 @@ def solve(
         max_complexity=max_complexity,
         max_planner_time=max_planner_time,
         search=search,
-        heuristic=heuristic or "ff",
+        heuristic=heuristic,
+        weight=weight,
     )
     if constraints is not None and not isinstance(constraints, PlanConstraints):
         raise ParameterError(

@@ -1,0 +1,232 @@
+"""PDDLStream's own examples, unmodified, on the compatibility layer.
+
+Usage::
+
+    python benchmarks/bench_pddlstream_compat.py PATH_TO_PDDLSTREAM_CHECKOUT [--timeout S]
+                                                  [--only NAME ...]
+    PDDLSTREAM_PATH=... python benchmarks/bench_pddlstream_compat.py
+
+Each example runs in its own subprocess, exactly as PDDLStream's README runs it
+(``python -m examples.<folder>.run`` from the checkout's root), but started through
+``python -m sdar_tamp.compat.pddlstream --report FILE -m examples.<...>``: the alias makes the
+program's ``import pddlstream...`` lines resolve to ``sdar_tamp.compat.pddlstream`` (the
+checkout's own ``pddlstream`` package is never imported; the runner fails the example if it
+is), and every plan the program obtains is re-checked by simulation
+(:mod:`sdar_tamp.compat.pddlstream.check`). An example passes when it found at least one plan
+and every plan it found is valid; an error raised after a valid plan was found is reported but
+does not fail the example.
+
+The runner fixes the environment, never the examples: without a display (no ``$DISPLAY``) the
+examples' tkinter viewers get a do-nothing stand-in; NumPy names removed in NumPy 2 that the
+examples use (``np.product``, ``np.mat``) are put back; ``discrete_belief`` and
+``table_belief`` need SciPy (their own dependency: ``pip install scipy``, or a folder on
+``PYTHONPATH``, which is passed on).
+
+Your own PDDLStream program runs the same way::
+
+    python -m sdar_tamp.compat.pddlstream my_program.py [its args]
+    python -m sdar_tamp.compat.pddlstream -m my_package.my_module [its args]
+
+or add ``import sdar_tamp.compat.pddlstream.install`` as its first import.
+
+Prints a table example -> result -> time [s]; the last line is one JSON object.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class Example:
+    name: str
+    module: str
+    args: tuple[str, ...] = ()
+
+
+EXAMPLES = (
+    Example("blocksworld", "examples.blocksworld.run"),
+    Example("blocksworld_derived", "examples.blocksworld.run_derived"),
+    Example("kitchen", "examples.kitchen.run"),
+    Example("discrete_tamp", "examples.discrete_tamp.run"),
+    Example("discrete_tamp_push", "examples.discrete_tamp.push.run"),
+    Example("continuous_tamp", "examples.continuous_tamp.run"),
+    Example("continuous_tamp_unfactored", "examples.continuous_tamp.unfactored.run"),
+    Example("continuous_tamp_rmmp", "examples.continuous_tamp.rmmp.run"),
+    Example("continuous_tamp_ffrob", "examples.continuous_tamp.ffrob.run"),
+    Example("continuous_tamp_idtmp", "examples.continuous_tamp.idtmp.run"),
+    Example("motion", "examples.motion.run"),
+    Example("discrete_belief", "examples.discrete_belief.run"),
+    Example("table_belief", "examples.table_belief.run"),
+    Example("adl", "examples.advanced.adl.run"),
+    Example("adl_goal", "examples.advanced.adl.run_goal"),
+    Example("counting", "examples.advanced.counting.run"),
+    Example("defer", "examples.advanced.defer.run"),
+    Example("exogenous", "examples.advanced.exogenous.run"),
+    Example("fluent", "examples.advanced.fluent.run"),
+    Example("wild", "examples.advanced.wild.run"),
+    Example("multi_cost", "examples.advanced.multi_cost"),
+    Example("storage", "examples.advanced.storage"),
+    Example("satisfy", "examples.advanced.satisfy.run"),
+    Example("rovers", "examples.ipc.rovers.run"),
+    Example("satellites", "examples.ipc.satellites.run"),
+)
+
+#: PDDLStream's examples predate NumPy 2 and use names it removed; the runner puts those
+#: aliases back in the example's process (an environment fix, the examples stay unmodified)
+NUMPY_ALIASES = (
+    ("product", "prod"),
+    ("cumproduct", "cumprod"),
+    ("alltrue", "all"),
+    ("sometrue", "any"),
+    ("mat", "asmatrix"),
+)
+
+#: loaded modules whose file lies in the checkout's own package mean the alias was bypassed
+_GUARD = (
+    "import atexit, os, sys\n"
+    "def _guard():\n"
+    "    bad = sorted(n for n, m in list(sys.modules.items())\n"
+    "                 if (getattr(m, '__file__', None) or '').startswith({pkg!r}))\n"
+    "    if bad:\n"
+    "        print('LOADED FROM CHECKOUT:', bad, file=sys.stderr); os._exit(97)\n"
+    "atexit.register(_guard)\n"
+    "import numpy\n"
+    "for _old, _new in {numpy_aliases!r}:\n"
+    "    if _old not in dir(numpy):\n"
+    "        setattr(numpy, _old, getattr(numpy, _new) if isinstance(_new, str) else _new)\n"
+    "if not os.environ.get('DISPLAY'):\n"
+    "    import types\n"
+    "    class _Null:\n"
+    "        def __init__(self, *a, **k): pass\n"
+    "        def __call__(self, *a, **k): return _Null()\n"
+    "        def __getattr__(self, name): return _Null()\n"
+    "        def __iter__(self): return iter(())\n"
+    "        def __int__(self): return 0\n"
+    "        def __float__(self): return 0.0\n"
+    "    _tk = types.ModuleType('tkinter')\n"
+    "    _tk.Tk = _tk.Canvas = _tk.Toplevel = _Null\n"
+    "    _tk.LAST = 'last'\n"
+    "    sys.modules['tkinter'] = _tk\n"
+    "sys.argv = ['sdar_tamp.compat.pddlstream', *sys.argv[1:]]\n"
+    "from sdar_tamp.compat.pddlstream.__main__ import main\n"
+    "sys.exit(main())\n"
+)
+
+
+def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, object]:
+    """Run one example; returns its name, result, time [s] and details."""
+    with tempfile.TemporaryDirectory() as scratch:
+        report = Path(scratch) / "report.json"
+        guard = _GUARD.format(
+            pkg=str(checkout / "pddlstream") + os.sep, numpy_aliases=NUMPY_ALIASES
+        )
+        command = [
+            sys.executable,
+            "-c",
+            guard,
+            "--report",
+            str(report),
+            "-m",
+            example.module,
+            *example.args,
+        ]
+        env = dict(os.environ)
+        extra = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+        env["PYTHONPATH"] = os.pathsep.join([str(ROOT), str(checkout), *extra])
+        env.setdefault("MPLBACKEND", "Agg")
+        env.pop("DISPLAY", None)
+        start = time.perf_counter()
+        try:
+            done = subprocess.run(
+                command,
+                cwd=checkout,
+                env=env,
+                stdin=subprocess.DEVNULL,
+                capture_output=True,
+                text=True,
+                timeout=timeout,
+            )
+            seconds = time.perf_counter() - start
+            returncode: int | None = done.returncode
+            stderr = done.stderr
+        except subprocess.TimeoutExpired as expired:
+            seconds = time.perf_counter() - start
+            returncode = None
+            stderr = (expired.stderr or b"").decode() if isinstance(expired.stderr, bytes) else ""
+        record = json.loads(report.read_text()) if report.exists() else {"calls": []}
+    calls = record.get("calls", [])
+    solved = [c for c in calls if c.get("solved")]
+    invalid = [c for c in solved if not c.get("valid")]
+    if returncode == 97:
+        result = "alias bypassed"
+    elif invalid:
+        result = f"INVALID plan: {invalid[0].get('error')}"
+    elif solved:
+        result = "solved"
+        if returncode not in (0, None) and record.get("exception"):
+            result = f"solved (then: {str(record['exception'])[:60]})"
+    elif returncode is None:
+        result = f"timeout ({timeout:g} s)"
+    elif record.get("exception"):
+        result = f"error: {str(record['exception'])[:90]}"
+    elif returncode != 0:
+        tail = [line for line in stderr.strip().splitlines() if line.strip()][-1:]
+        result = f"error (exit {returncode}): {' '.join(tail)[:90]}"
+    else:
+        result = "no plan"
+    return {
+        "example": example.name,
+        "result": result,
+        "passed": bool(solved) and not invalid and returncode != 97,
+        "seconds": round(seconds, 2),
+        "solve_calls": len(calls),
+        "plans": len(solved),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("checkout", nargs="?", default=os.environ.get("PDDLSTREAM_PATH"))
+    parser.add_argument("--timeout", type=float, default=120.0, help="[s] per example")
+    parser.add_argument("--only", nargs="*", default=None, help="example names to run")
+    args = parser.parse_args(argv)
+    if not args.checkout or not (Path(args.checkout) / "examples").is_dir():
+        print(
+            "skipped: no PDDLStream checkout (pass its path or set PDDLSTREAM_PATH); "
+            f"got {args.checkout!r}"
+        )
+        print(json.dumps({"skipped": True, "reason": "no PDDLStream checkout"}))
+        return 0
+    checkout = Path(args.checkout).resolve()
+    chosen = [e for e in EXAMPLES if args.only is None or e.name in args.only]
+    rows = []
+    print(f"{'example':28} {'result':60} {'time [s]':>8}")
+    for example in chosen:
+        row = run_example(checkout, example, args.timeout)
+        rows.append(row)
+        print(f"{row['example']:28} {row['result']!s:60} {row['seconds']:8.2f}", flush=True)
+    passed = sum(bool(r["passed"]) for r in rows)
+    print(f"passed {passed} of {len(rows)}")
+    summary = {
+        "passed": passed,
+        "total": len(rows),
+        "failed": [r["example"] for r in rows if not r["passed"]],
+        "seconds": {str(r["example"]): r["seconds"] for r in rows},
+    }
+    print(json.dumps(summary))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""``pddlstream.algorithms``: the solvers under PDDLStream's module names."""

@@ -1,0 +1,55 @@
+"""``pddlstream.algorithms.search``: plain PDDL planning (``solve_from_pddl``)."""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+from sdar_tamp.language.pddl import parse_domain, parse_problem
+from solvers.classical import PlanStatus, task_from_problem
+from solvers.classical import plan as plan  # replaced by the runner's --report
+from solvers.solution import Action
+from solvers.solve import parse_planner
+
+__all__ = ["solve_from_pddl"]
+LOG = logging.getLogger(__name__)
+_NOTED = ("temp_dir", "clean", "debug", "hierarchy")
+
+
+def solve_from_pddl(
+    domain_pddl: str,
+    problem_pddl: str,
+    planner: str = "ff-astar2",
+    max_planner_time: float = 30.0,
+    max_cost: float = math.inf,
+    **keywords: Any,
+) -> tuple[list[Action] | None, float]:
+    """Solve a PDDL domain and problem (texts); returns ``(plan, cost)``: the plan a list of
+    ``Action(name, args)`` with object names as strings, or ``(None, inf)`` without a plan.
+
+    ``planner`` takes PDDLStream's names (``'dijkstra'``, ``'max-astar'``, ``'ff-astar'`` ...)
+    or ``SEARCH-HEURISTIC``. ``temp_dir``, ``clean``, ``debug`` and ``hierarchy`` are accepted
+    (nothing is written to disk). Costs follow the problem's ``(:metric minimize
+    (total-cost))``, else every action costs 1.
+    """
+    unknown = sorted(set(keywords) - set(_NOTED))
+    if unknown:
+        raise TypeError(f"solve_from_pddl() got unexpected keyword(s): {', '.join(unknown)}")
+    search, heuristic, weight = parse_planner(planner)
+    domain = parse_domain(domain_pddl, "domain.pddl")
+    problem = parse_problem(problem_pddl, domain, "problem.pddl")
+    task = task_from_problem(domain, problem)
+    limit = None if math.isinf(max_planner_time) or max_planner_time <= 0 else max_planner_time
+    result = plan(
+        task,
+        search=search,
+        heuristic=heuristic,
+        weight=max(1.0, weight),
+        time_limit=limit,
+        cost_bound=max_cost,
+    )
+    if result.status is not PlanStatus.SOLVED or result.plan is None:
+        LOG.info("solve_from_pddl: %s", result.status.value)
+        return None, math.inf
+    return [Action(step.name, tuple(step.args)) for step in result.plan], float(result.cost)

@@ -1,0 +1,61 @@
+"""Re-check a solution by simulation, independently of the solver that found it.
+
+The plan is run, with the classical validator (:func:`solvers.classical.validate_plan`), from
+the problem's initial facts plus every fact the solution's certificate says the streams
+certified; every precondition must hold on the way and the goal at the end. Costs are not
+re-checked (the values of cost functions are not part of the certificate).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from sdar_tamp.language.model import OBJECT_TYPE, AndEffect, Atom, Domain, Effect, IncreaseCost
+from sdar_tamp.language.problem import PDDLProblem
+from solvers.classical import GroundAction, PlanningTask, PlanValidationError, ground, validate_plan
+from solvers.solution import Solution
+
+
+def _without_costs(effect: Effect) -> Effect:
+    if isinstance(effect, AndEffect):
+        return AndEffect(
+            tuple(_without_costs(p) for p in effect.parts if not isinstance(p, IncreaseCost))
+        )
+    return AndEffect(()) if isinstance(effect, IncreaseCost) else effect
+
+
+def _cost_free(domain: Domain) -> Domain:
+    actions = tuple(replace(a, effect=_without_costs(a.effect)) for a in domain.actions)
+    return replace(domain, actions=actions)
+
+
+def check_solution(problem: PDDLProblem, solution: Solution) -> str | None:
+    """None when ``solution.plan`` reaches the goal of ``problem`` from its initial facts and
+    the certified facts; otherwise why not (also when there is no plan)."""
+    if solution.plan is None:
+        return "no plan"
+    table = problem.objects.copy()
+
+    def atom(fact: tuple[object, ...]) -> Atom:
+        return Atom(str(fact[0]).lower(), tuple(table.name(v) for v in fact[1:]))
+
+    facts = set(problem.facts.init)
+    facts.update(atom(f) for f in solution.certificate.all_facts)
+    facts.update(atom(f) for f in solution.certificate.preimage_facts)
+    steps = [
+        GroundAction(a.name.lower(), tuple(table.name(v) for v in a.args)) for a in solution.plan
+    ]
+    objects = {name: OBJECT_TYPE for name in table.names()}
+    objects.update(problem.facts.objects)
+    task = PlanningTask(
+        domain=_cost_free(problem.domain),
+        objects=objects,
+        init=frozenset(f for f in facts if not f.predicate.startswith("@")),
+        goal=problem.facts.goal,
+        use_costs=False,
+    )
+    try:
+        validate_plan(task, ground(task), steps)
+    except PlanValidationError as error:
+        return str(error)
+    return None

@@ -1,0 +1,1 @@
+"""``pddlstream.language``: the modules a PDDLStream program imports its language from."""

@@ -1,0 +1,1 @@
+"""``pddlstream.retired``: the retired entry points some examples still import."""

@@ -1,0 +1,180 @@
+"""``solve`` with PDDLStream's keywords and planner names, the ``solve_*`` entry points,
+``solve_from_pddl`` and constraint satisfaction."""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import pytest
+from compat_domains import DOMAIN, GOAL, INIT, STREAMS, stream_map
+
+from sdar_tamp.compat.pddlstream import (
+    WILD,
+    PDDLProblem,
+    PlanConstraints,
+    SatisfactionProblem,
+    constraint_satisfaction,
+    from_gen_fn,
+    from_test,
+    solve,
+    solve_adaptive,
+    solve_focused,
+    solve_from_pddl,
+    solve_incremental,
+    solve_pddlstream_satisfaction,
+)
+from sdar_tamp.compat.pddlstream.check import check_solution
+from sdar_tamp.errors import ParameterError
+from solvers.solve import PLANNER_ALIASES, parse_planner
+
+
+def _problem() -> PDDLProblem:
+    return PDDLProblem(DOMAIN, {}, STREAMS, stream_map(), INIT, GOAL)
+
+
+def test_pddlstream_keywords_are_accepted_and_noted(caplog: pytest.LogCaptureFixture) -> None:
+    problem = _problem()
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.compat"):
+        solution = solve(
+            problem,
+            algorithm="adaptive",
+            debug=True,
+            replan_actions={"pick"},
+            visualize=True,
+            hierarchy=[],
+            max_memory=1e9,
+            reorder=False,
+            max_failures=0,
+            max_effort=10,
+            planner="ff-eager",
+            max_planner_time=10,
+            max_time=30,
+            verbose=False,
+        )
+    assert solution.plan is not None and check_solution(problem, solution) is None
+    noted = " ".join(r.getMessage() for r in caplog.records)
+    for name in ("debug", "replan_actions", "visualize", "max_memory", "reorder"):
+        assert f"solve({name}=" in noted
+    assert "hierarchy" not in noted  # an empty hierarchy is the default: nothing to note
+
+
+def test_unknown_keyword_names_itself() -> None:
+    with pytest.raises(ParameterError, match="max_tme"):
+        solve(_problem(), max_tme=3)
+
+
+def test_unknown_algorithm_lists_the_valid_ones() -> None:
+    with pytest.raises(ParameterError, match="incremental, focused, binding, adaptive"):
+        solve(_problem(), algorithm="fast")
+
+
+@pytest.mark.parametrize(
+    ("name", "expected"),
+    [
+        ("dijkstra", ("astar", "blind", 1.0)),
+        ("max-astar", ("astar", "max", 1.0)),
+        ("lmcut-astar", ("astar", "max", 1.0)),
+        ("ff-astar", ("astar", "ff", 1.0)),
+        ("ff-eager", ("gbfs", "ff", 1.0)),
+        ("ff-lazy", ("gbfs", "ff", 1.0)),
+        ("add-random-lazy", ("gbfs", "add", 1.0)),
+        ("goal-lazy", ("gbfs", "ff", 1.0)),
+        ("ff-eager-pref", ("gbfs", "ff", 1.0)),
+        ("ff-wastar3", ("wastar", "ff", 3.0)),
+        ("ff-astar2", ("wastar", "ff", 2.0)),
+        ("wastar-ff", ("wastar", "ff", 2.0)),
+        ("gbfs-add", ("gbfs", "add", 2.0)),
+    ],
+)
+def test_planner_names_map_to_the_classical_planner(
+    name: str, expected: tuple[str, str, float]
+) -> None:
+    assert parse_planner(name) == expected
+
+
+def test_unknown_planner_lists_the_valid_names() -> None:
+    with pytest.raises(ParameterError) as error:
+        parse_planner("cerberus")
+    message = str(error.value)
+    assert "'cerberus'" in message and "max-astar" in message and "wastar-ff" in message
+    assert len(PLANNER_ALIASES) >= 12
+    with pytest.raises(ParameterError, match="planner"):
+        solve(_problem(), planner="lama")
+
+
+@pytest.mark.parametrize("planner", ["max-astar", "ff-astar", "dijkstra", "ff-wastar2"])
+def test_solve_entry_points_find_valid_plans(planner: str) -> None:
+    problem = _problem()
+    for solution in (
+        solve_incremental(problem, planner=planner, max_time=30, unit_costs=True, debug=False),
+        solve_focused(problem, planner=planner, max_time=30),
+        solve_adaptive(problem, planner=planner, max_time=30, verbose=False),
+    ):
+        assert solution.plan is not None
+        assert check_solution(problem, solution) is None
+
+
+def test_max_cost_and_pddlstream_wildcard_skeletons() -> None:
+    problem = _problem()
+    skeleton = [("pick", ["cup", WILD]), ("place", ["cup", "*"])]
+    constraints = PlanConstraints(skeletons=[skeleton], exact=True, groups={}, hint=False)
+    solution = solve(problem, constraints=constraints, max_time=30, verbose=False)
+    assert [a.name for a in solution.plan or []] == ["pick", "place"]
+    bounded = solve(problem, max_cost=1.0, max_time=1, verbose=False)  # lifting costs 2
+    assert bounded.plan is None and math.isinf(bounded.cost)
+
+
+def test_solve_from_pddl_returns_plan_and_cost() -> None:
+    domain = """(define (domain d) (:requirements :strips)
+      (:predicates (at ?x) (link ?x ?y))
+      (:action go :parameters (?x ?y) :precondition (and (at ?x) (link ?x ?y))
+         :effect (and (at ?y) (not (at ?x)))))"""
+    problem = """(define (problem p) (:domain d) (:objects a b c)
+      (:init (at a) (link a b) (link b c)) (:goal (at c)))"""
+    plan, cost = solve_from_pddl(domain, problem, planner="dijkstra", debug=True)
+    assert plan is not None and [(a.name, a.args) for a in plan] == [
+        ("go", ("a", "b")),
+        ("go", ("b", "c")),
+    ]
+    assert cost == 2.0
+    unsolvable = problem.replace("(link b c)", "")
+    assert solve_from_pddl(domain, unsolvable) == (None, math.inf)
+    with pytest.raises(TypeError, match="bogus"):
+        solve_from_pddl(domain, problem, bogus=1)
+
+
+SATISFY_STREAMS = """(define (stream numbers)
+  (:stream positive :outputs (?x) :certified (and (Positive ?x) (Integer ?x)))
+  (:stream test-large :inputs (?x) :domain (Integer ?x) :certified (Large ?x))
+  (:function (Size ?x) (Integer ?x)))"""
+
+
+def _satisfaction() -> SatisfactionProblem:
+    stream_map = {
+        "positive": from_gen_fn(lambda: ((x,) for x in range(1, 10))),
+        "test-large": from_test(lambda x: x >= 4),
+        "size": lambda x: float(x),
+    }
+    terms = [("Positive", "?a"), ("Large", "?a"), ("minimize", ("Size", "?a"))]
+    return SatisfactionProblem(SATISFY_STREAMS, stream_map, [], terms)
+
+
+def test_constraint_satisfaction_binds_the_free_parameters() -> None:
+    solution = constraint_satisfaction(_satisfaction(), max_time=30, verbose=False)
+    assert solution.bindings is not None and solution.bindings["?a"] >= 4
+    assert solution.cost == pytest.approx(float(solution.bindings["?a"]))
+    retired = solve_pddlstream_satisfaction(
+        _satisfaction(), algorithm="incremental", max_time=30, verbose=False
+    )
+    assert retired.bindings is not None and retired.bindings["?a"] >= 4
+
+
+def test_unsatisfiable_terms_give_no_bindings() -> None:
+    problem = _satisfaction()._replace(terms=[("Positive", "?a"), ("Large", "?a")])
+    stream_map = dict(problem.stream_map)  # type: ignore[arg-type]
+    stream_map["test-large"] = from_test(lambda x: False)
+    solution = constraint_satisfaction(
+        problem._replace(stream_map=stream_map), max_time=3, verbose=False
+    )
+    assert solution.bindings is None
