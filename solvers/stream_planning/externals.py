@@ -220,18 +220,23 @@ class FunctionExternal:
             self.declaration.domain, dict(zip(self.declaration.inputs, inputs, strict=True))
         )
 
+    def _describe(self, values: tuple[Any, ...]) -> str:
+        """What an error message calls this external (built only on errors: ``repr`` of large
+        values, such as arrays, is slow)."""
+        kind = "predicate" if self.is_predicate else "function"
+        if self.stream is not None:
+            kind = f"negated test stream {self.stream!r} for predicate"
+        return f"{kind} {self.name!r} on inputs ({', '.join(repr(v) for v in values)})"
+
     def evaluate(self, inputs: tuple[str, ...], table: ObjectTable) -> float | bool:
         if inputs in self.values:
             return self.values[inputs]
         values = tuple(table.value(n) for n in inputs)
-        kind = "predicate" if self.is_predicate else "function"
-        if self.stream is not None:
-            kind = f"negated test stream {self.stream!r} for predicate"
-        what = f"{kind} {self.name!r} on inputs ({', '.join(repr(v) for v in values)})"
         start = time.perf_counter()
         try:
             raw = self.fn(*values)
         except Exception as error:
+            what = self._describe(values)
             raise StreamError(f"{what} raised {type(error).__name__}: {error}") from error
         finally:
             self.counters.time += time.perf_counter() - start
@@ -241,8 +246,10 @@ class FunctionExternal:
             result = bool(raw)
         else:
             if isinstance(raw, bool) or not isinstance(raw, int | float):
+                what = self._describe(values)
                 raise StreamOutputError(f"{what} must return a number, got {raw!r}")
             if raw < 0:
+                what = self._describe(values)
                 raise StreamOutputError(f"{what} must return a non-negative cost, got {raw}")
             result = float(raw)
         self.counters.successes += 1
