@@ -282,6 +282,14 @@ class StreamSolver:
                     self._sample_state(state)
                     progress = True
 
+    def _world(self, level: int, lazy: bool) -> OptimisticWorld:
+        """The facts to plan over: the optimistic world, or in incremental without fluent
+        streams (nothing optimistic), just the real facts."""
+        engine = self.engine
+        if lazy and not any(self.fluent_streams.values()):
+            return OptimisticWorld(dict(engine.planning_facts()), {}, dict(engine.numeric))
+        return self.builder.build(level, lazy)
+
     def _complete(self, world: OptimisticWorld, lazy: bool) -> bool:
         """Nothing left out at this level: no plan now means no plan at all."""
         if not world.complete or self.blocks.temporary:
@@ -306,7 +314,7 @@ class StreamSolver:
             self.stats["complexity"] = level
             if lazy:
                 self._sample_up_to(level)
-            world = self.builder.build(level, lazy)
+            world = self._world(level, lazy)
             found = (
                 self.plan(world.facts, world.numeric)
                 if self.stats["skeletons"] < options.max_skeletons

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sdar_tamp.errors import SdarError
-from sdar_tamp.language.generators import ListGenFn, WildOutput
+from sdar_tamp.language.generators import SINGLE_CALL, ListGenFn, WildOutput
 from sdar_tamp.language.model import Atom, Stream, StreamFunction, StreamPredicate
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
@@ -159,6 +159,8 @@ class StreamInstance:
             external.counters.calls += 1
         call_index = self.calls
         self.calls += 1
+        if getattr(external.gen_fn, SINGLE_CALL, False):
+            self.exhausted = True  # its one answer is in: no second call to find that out
         outputs, wild = self._check(produced, table)
         results = [
             StreamResult(self, names, external.certified(self.inputs, names), call_index)
@@ -220,23 +222,18 @@ class FunctionExternal:
             self.declaration.domain, dict(zip(self.declaration.inputs, inputs, strict=True))
         )
 
-    def _describe(self, values: tuple[Any, ...]) -> str:
-        """What an error message calls this external (built only on errors: ``repr`` of large
-        values, such as arrays, is slow)."""
-        kind = "predicate" if self.is_predicate else "function"
-        if self.stream is not None:
-            kind = f"negated test stream {self.stream!r} for predicate"
-        return f"{kind} {self.name!r} on inputs ({', '.join(repr(v) for v in values)})"
-
     def evaluate(self, inputs: tuple[str, ...], table: ObjectTable) -> float | bool:
         if inputs in self.values:
             return self.values[inputs]
         values = tuple(table.value(n) for n in inputs)
+        kind = "predicate" if self.is_predicate else "function"
+        if self.stream is not None:
+            kind = f"negated test stream {self.stream!r} for predicate"
+        what = f"{kind} {self.name!r} on inputs ({', '.join(repr(v) for v in values)})"
         start = time.perf_counter()
         try:
             raw = self.fn(*values)
         except Exception as error:
-            what = self._describe(values)
             raise StreamError(f"{what} raised {type(error).__name__}: {error}") from error
         finally:
             self.counters.time += time.perf_counter() - start
@@ -246,10 +243,8 @@ class FunctionExternal:
             result = bool(raw)
         else:
             if isinstance(raw, bool) or not isinstance(raw, int | float):
-                what = self._describe(values)
                 raise StreamOutputError(f"{what} must return a number, got {raw!r}")
             if raw < 0:
-                what = self._describe(values)
                 raise StreamOutputError(f"{what} must return a non-negative cost, got {raw}")
             result = float(raw)
         self.counters.successes += 1
