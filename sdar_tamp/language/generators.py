@@ -75,6 +75,16 @@ def from_sampler(sampler: Callable[..., Any], max_attempts: int | None = None) -
     return stream
 
 
+#: Attribute of an adapter whose iterator gives exactly one answer (``from_fn``, ``from_test``,
+#: ...): the solver knows the instance is exhausted after one call, as PDDLStream does.
+SINGLE_CALL = "single_call"
+
+
+def _once(stream: ListGenFn) -> ListGenFn:
+    setattr(stream, SINGLE_CALL, True)
+    return stream
+
+
 def from_list_fn(list_fn: Callable[..., Any]) -> ListGenFn:
     def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
         outputs = list_fn(*inputs, **kwargs)
@@ -82,7 +92,7 @@ def from_list_fn(list_fn: Callable[..., Any]) -> ListGenFn:
             outputs if isinstance(outputs, WildOutput) else [_as_tuple(o) for o in (outputs or [])]
         )
 
-    return stream
+    return _once(stream)
 
 
 def from_fn(fn: Callable[..., Any]) -> ListGenFn:
@@ -90,7 +100,7 @@ def from_fn(fn: Callable[..., Any]) -> ListGenFn:
         output = fn(*inputs, **kwargs)
         yield output if isinstance(output, WildOutput) else _one(output)
 
-    return stream
+    return _once(stream)
 
 
 class TruthValueError(SdarError, TypeError):
@@ -120,7 +130,7 @@ def from_test(test: Callable[..., Any]) -> ListGenFn:
     def stream(*inputs: Any, **kwargs: Any) -> Iterator[Outputs | WildOutput]:
         yield [()] if truth_value(test(*inputs, **kwargs)) else []
 
-    return stream
+    return _once(stream)
 
 
 def from_constant(constant: Sequence[Any]) -> ListGenFn:

@@ -49,6 +49,7 @@ class _Simulator:
             for ancestor in task.domain.types.ancestors(obj_type):
                 self.objects.setdefault(ancestor, []).append(obj)
         facts = ground_task.facts
+        self._index: tuple[set[Atom], dict[str, list[tuple[str, ...]]]] | None = None
         self.axioms = [
             (
                 a.stratum,
@@ -100,20 +101,50 @@ class _Simulator:
             return not self.holds(formula.antecedent, state, binding) or self.holds(
                 formula.consequent, state, binding
             )
-        combos = self.bindings(formula.parameters, binding)
         if isinstance(formula, Exists):
+            # a witness satisfies the body's positive atoms: take candidates from the state
+            hints = self._candidates(formula.parameters, formula.body, state)
+            combos = self.bindings(formula.parameters, binding, hints)
             return any(self.holds(formula.body, state, b) for b in combos)
         assert isinstance(formula, ForAll)
+        combos = self.bindings(formula.parameters, binding)
         return all(self.holds(formula.body, state, b) for b in combos)
 
+    def _candidates(
+        self, parameters: Sequence[Parameter], body: Formula, state: set[Atom]
+    ) -> dict[str, set[str]]:
+        """For parameters that a positive conjunct of ``body`` names: the values that conjunct
+        allows in ``state`` (a superset of every witness's value)."""
+        if self._index is None or self._index[0] is not state:
+            index: dict[str, list[tuple[str, ...]]] = {}
+            for atom in state:
+                index.setdefault(atom.predicate, []).append(atom.args)
+            self._index = (state, index)
+        index = self._index[1]
+        parts = body.parts if isinstance(body, And) else (body,)
+        found: dict[str, set[str]] = {}
+        for part in parts:
+            if not isinstance(part, Atom) or part.predicate == EQUALITY:
+                continue
+            for parameter in parameters:
+                if parameter.name in part.args and parameter.name not in found:
+                    position = part.args.index(parameter.name)
+                    found[parameter.name] = {a[position] for a in index.get(part.predicate, ())}
+        return found
+
     def bindings(
-        self, parameters: Sequence[Parameter], binding: Mapping[str, str]
+        self,
+        parameters: Sequence[Parameter],
+        binding: Mapping[str, str],
+        candidates: Mapping[str, set[str]] | None = None,
     ) -> list[dict[str, str]]:
         result = [dict(binding)]
         for parameter in parameters:
-            result = [
-                {**b, parameter.name: o} for b in result for o in self.of_type(parameter.type)
-            ]
+            values = self.of_type(parameter.type)
+            if candidates is not None and parameter.name in candidates:
+                allowed = candidates[parameter.name]
+                values = [o for o in values if o in allowed]
+            result = [{**b, parameter.name: o} for b in result for o in values]
         return result
 
     def effects(

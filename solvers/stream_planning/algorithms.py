@@ -1,7 +1,8 @@
 """The stream planning algorithms: incremental, focused, binding and adaptive.
 
 - incremental: call every stream instance up to the complexity level, plan on real facts, raise
-  the level.
+  the level. ``:fluents`` streams are the exception: their answer depends on the state, so they
+  are offered optimistically and called, as in binding, in the state of the step that uses them.
 - focused: plan in the optimistic world, extract the stream plan the optimistic plan needs, call
   the instances of its first layer (real inputs) once each, disable failures until the level
   rises, plan again.
@@ -11,9 +12,11 @@
   search, each queued skeleton is worked on about ``search_sample_ratio`` times. The balance is
   counted in visits, not measured in seconds, so a seeded run is reproducible.
 
-A ``:fluents`` stream is called, in focused, binding and adaptive, with the fluent facts of the
-state in which the optimistic plan first needs its certified facts (:mod:`.fluents`);
-incremental samples before it has a plan, so it calls them with the initial state's facts.
+A ``:fluents`` stream is called with the fluent facts of the state of the step that uses its
+certified facts (:mod:`.fluents`); what it certifies holds in that state only, so it never
+becomes a fact an optimistic plan may use freely, and a stream plan with fluent streams is
+bound (as in binding) even by focused. A failed fluent call blocks the stream's facts in states
+like the one it failed in (:mod:`.blocking`), so the next optimistic plan goes another way.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from sdar_tamp.language.problem import PDDLProblem, infer_object_types
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
+from solvers.stream_planning.blocking import Blocks, guard_fluent_uses
 from solvers.stream_planning.calls import CallRunner, CallTimeout
 from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.costs import guard_costs, has_costs
@@ -88,6 +92,8 @@ class Skeleton:
     attempts: int = field(default=0, compare=False)
     chosen: dict[int, tuple[str, ...]] = field(default_factory=dict, compare=False)
     fluents: dict[int, Fluents] = field(default_factory=dict, compare=False)
+    used: dict[int, int] = field(default_factory=dict, compare=False)  # fluent results taken
+    states: dict[int, InstanceState] = field(default_factory=dict, compare=False)
 
 
 class _Timeout(Exception):
@@ -114,6 +120,7 @@ class StreamSolver:
         self.engine = Engine(problem, stream_info, self.runner)
         self.builder = OptimisticBuilder(self.engine, negated)
         self.fluent_streams = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
+        self.blocks = Blocks(guard_fluent_uses(self.domain, problem.streams.streams))
         self.stats: dict[str, float] = {
             "iterations": 0,
             "skeletons": 0,
@@ -158,9 +165,9 @@ class StreamSolver:
         self._check_time()
         limit = min(self.remaining(), self.options.max_planner_time)
         task = PlanningTask(
-            self.domain,
+            self.blocks.domain(),
             self._objects(facts),
-            frozenset(facts),
+            frozenset(facts) | self.blocks.facts(),
             self.goal,
             numeric,
             use_costs=not self.options.unit_costs,
@@ -172,8 +179,7 @@ class StreamSolver:
             heuristic=self.options.heuristic,
             weight=self.options.weight,
             time_limit=limit,
-            # anytime: once a plan is known, only cheaper optimistic plans are of interest
-            cost_bound=self.best[0] if self.best is not None else math.inf,
+            cost_bound=self._cost_bound(),
         )
         self.stats["search_time"] += time.perf_counter() - start
         if result.status is PlanStatus.TIMEOUT:
@@ -182,6 +188,12 @@ class StreamSolver:
         if result.plan is None:
             return None
         return [(step.name, step.args) for step in result.plan], result.cost
+
+    def _cost_bound(self) -> float:
+        """The planner keeps only plans cheaper than this: plans above ``max_cost`` are never
+        returned, and once a plan is known (anytime), only cheaper ones are of interest."""
+        bound = math.nextafter(self.options.max_cost, math.inf)
+        return min(bound, self.best[0]) if self.best is not None else bound
 
     def _sample(self, name: str, inputs: tuple[str, ...]) -> bool | None:
         """Call a real instance once; None when it does not exist."""
@@ -196,10 +208,38 @@ class StreamSolver:
         self.stats["sample_time"] += time.perf_counter() - start
         return produced
 
-    def _real_check(self, actions: PlanSteps) -> tuple[bool, frozenset[Atom]]:
-        facts = self.engine.store.levels
+    def _real_check(
+        self, actions: PlanSteps, trusted: frozenset[Atom] = frozenset()
+    ) -> tuple[bool, frozenset[Atom]]:
+        """Is the plan valid on the real facts, each fact a fluent stream certified used only
+        in the state it was certified in (or ``trusted``: bound by the plan's skeleton)?"""
+        engine = self.engine
+        facts = engine.store.levels
         check = simulate(self.problem.domain, self._objects(facts), facts, actions, self.goal)
-        return check.valid, check.needed
+        if not check.valid or not engine.hidden:
+            return check.valid, check.needed
+        for state, support in zip(check.states, check.supports, strict=True):
+            hidden = (support & engine.hidden) - trusted
+            if any(not engine.certified_in(a, state) for a in hidden):
+                return False, check.needed
+        return True, check.needed
+
+    def _failed(self, state: InstanceState) -> None:
+        """A call produced nothing: a fluent instance blocks its facts in states like its own
+        (for good once exhausted); another instance is disabled until the level rises."""
+        instance = state.instance
+        if instance.external.declaration.fluents:
+            self.blocks.add(
+                instance.external.name, instance.inputs, instance.fluents, instance.exhausted
+            )
+        else:
+            self.engine.disable(state)
+
+    def _lift(self) -> None:
+        """The complexity level rose: failures that may not repeat are forgotten."""
+        for state in self.engine.instances.values():
+            state.instance.disabled = False
+        self.blocks.lift()
 
     def _record(self, actions: PlanSteps, needed: frozenset[Atom]) -> bool:
         """Keep a real plan if it is the best so far; True when it is good enough to stop."""
@@ -228,67 +268,96 @@ class StreamSolver:
         return self._solution(status)
 
     def _incremental(self) -> Status:
-        level = self.options.initial_complexity
-        while True:
-            self.stats["iterations"] += 1
-            self.stats["complexity"] = level
-            progress = True
-            while progress:
-                progress = False
-                for key in sorted(self.engine.instances):
-                    self._check_time()
-                    state = self.engine.instances[key]
-                    if not state.instance.exhausted and state.next_level <= level:
-                        self._sample(*key)
-                        progress = True
-            found = self.plan(self.engine.store.levels, self.engine.numeric)
-            if found is not None:
-                valid, needed = self._real_check(found[0])
-                if valid and self._record(found[0], needed):
-                    return Status.SOLVED
-            pending = [s for s in self.engine.instances.values() if not s.instance.exhausted]
-            if not pending and found is None:
-                return Status.INFEASIBLE
-            if self.stats["iterations"] >= self.options.max_iterations:
-                return Status.TIMEOUT
-            level += self.options.complexity_step
-            if level > self.options.max_complexity:
-                return Status.INFEASIBLE
+        return self._search(lazy=True)
 
     def _focused(self) -> Status:
+        return self._search(lazy=False)
+
+    def _sample_up_to(self, level: int) -> None:
+        """Incremental: call every instance (but fluent ones) until all exceed ``level``."""
+        progress = True
+        while progress:
+            progress = False
+            for key in sorted(self.engine.instances):
+                state = self.engine.instances[key]
+                instance = state.instance
+                if instance.exhausted or instance.external.declaration.fluents:
+                    continue
+                if state.next_level <= level:
+                    self._check_time()
+                    self._sample_state(state)
+                    progress = True
+
+    def _world(self, level: int, lazy: bool) -> OptimisticWorld:
+        """The facts to plan over: the optimistic world, or in incremental without fluent
+        streams (nothing optimistic), just the real facts."""
+        engine = self.engine
+        if lazy and not any(self.fluent_streams.values()):
+            return OptimisticWorld(dict(engine.planning_facts()), {}, dict(engine.numeric))
+        return self.builder.build(level, lazy)
+
+    def _complete(self, world: OptimisticWorld, lazy: bool) -> bool:
+        """Nothing left out at this level: no plan now means no plan at all."""
+        if not world.complete or self.blocks.temporary:
+            return False
+        if any(s.instance.disabled for s in self.engine.instances.values()):
+            return False
+        return not lazy or all(
+            s.instance.exhausted or s.instance.external.declaration.fluents
+            for s in self.engine.instances.values()
+        )
+
+    def _search(self, lazy: bool) -> Status:
+        """The common loop. ``lazy`` (incremental): the real instances are all called up to the
+        level before planning, and only fluent streams stay optimistic."""
         options = self.options
         level = options.initial_complexity
+        tried: set[tuple[object, ...]] = set()  # (plan, optimistic results) met at this level
         while True:
             if self.stats["iterations"] >= options.max_iterations:
                 return Status.TIMEOUT
             self.stats["iterations"] += 1
             self.stats["complexity"] = level
-            world = self.builder.build(level)
+            if lazy:
+                self._sample_up_to(level)
+            world = self._world(level, lazy)
             found = (
                 self.plan(world.facts, world.numeric)
                 if self.stats["skeletons"] < options.max_skeletons
                 else None
             )
-            if found is None:
-                if self.queue:
-                    if self._process_queue():
-                        return Status.SOLVED
-                    continue
-                disabled = [s for s in self.engine.instances.values() if s.instance.disabled]
-                if world.complete and not disabled:
+            stream_plan: list[OptResult] = []
+            check = None
+            if found is not None:
+                check = simulate(
+                    self.problem.domain, self._objects(world.facts), world.facts, found[0],
+                    self.goal,
+                )  # fmt: skip
+                stream_plan = extract_stream_plan(check.needed, world)
+                # The same actions on the same optimistic results: nothing learnt since this
+                # plan was met, as if none. (The same actions on real facts are new.)
+                key = (
+                    tuple(found[0]),
+                    tuple((r.external, r.inputs) for r in stream_plan if r.kind == "stream"),
+                )
+                if key in tried:
+                    found = None
+                tried.add(key)
+            if found is None or check is None:
+                # no new plan: work on the queued skeletons, and raise the level (what they
+                # wait for may lie above it)
+                if self.queue and self._process_queue():
+                    return Status.SOLVED
+                if not self.queue and self._complete(world, lazy):
                     return Status.INFEASIBLE
                 level += options.complexity_step
                 if level > options.max_complexity:
                     return Status.INFEASIBLE
-                for state in disabled:
-                    state.instance.disabled = False
+                self._lift()
+                tried.clear()
                 continue
             actions, cost = found
-            check = simulate(
-                self.problem.domain, self._objects(world.facts), world.facts, actions, self.goal
-            )
-            stream_plan = extract_stream_plan(check.needed, world)
-            ordered = fluent_plan(stream_plan, check, self.fluent_streams)
+            ordered = fluent_plan(stream_plan, check, self.fluent_streams, actions)
             stream_plan = ordered.stream_plan
             if not any(r.kind == "stream" for r in stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
@@ -307,18 +376,17 @@ class StreamSolver:
                 effort = stream_plan_effort(stream_plan, efforts, options.unit_efforts)
                 priority += options.effort_weight * effort
             skeleton = Skeleton(
-                (0, priority, self._order), actions, stream_plan, fluents=ordered.fluents
+                (0, priority, self._order), ordered.actions, stream_plan, fluents=ordered.fluents
             )
             self._order += 1
-            if options.algorithm == "focused":
+            if options.algorithm == "focused" and not ordered.fluents:
                 self._sample_first_layer(skeleton)
-            elif options.algorithm == "binding":
-                if self._process(skeleton) is True:
-                    return Status.SOLVED
-            else:
+            elif options.algorithm == "adaptive":
                 heapq.heappush(self.queue, skeleton)
                 if self._process_queue():
                     return Status.SOLVED
+            elif self._process(skeleton) is True:
+                return Status.SOLVED
 
     def _sample_first_layer(self, skeleton: Skeleton) -> None:
         for index, result in enumerate(skeleton.stream_plan):
@@ -329,7 +397,7 @@ class StreamSolver:
                 continue
             self._check_time()
             if not self._sample_state(state):
-                self.engine.disable(state)
+                self._failed(state)
 
     def _instance(
         self, skeleton: Skeleton, index: int, inputs: tuple[str, ...], bindings: Mapping[str, str]
@@ -393,17 +461,14 @@ class StreamSolver:
             state = self._instance(skeleton, index, inputs, bindings)
             if state is None:
                 return None
+            skeleton.states[index] = state
             if index not in skeleton.chosen:
-                before = len(state.instance.results)
-                if not state.instance.exhausted:
-                    self._sample_state(state)
-                if len(state.instance.results) == before:
-                    if self.options.algorithm == "binding":
-                        self.engine.disable(state)
+                outputs = self._take(skeleton, index, state)
+                if outputs is None:
                     if not state.instance.exhausted:
                         return False
                     return self._upstream_retry(skeleton, index)
-                skeleton.chosen[index] = state.instance.results[-1].outputs
+                skeleton.chosen[index] = outputs
             for placeholder, value in zip(result.outputs, skeleton.chosen[index], strict=True):
                 if bindings.setdefault(placeholder, value) != value:
                     return None  # a shared placeholder would need two values: not this skeleton
@@ -412,23 +477,62 @@ class StreamSolver:
         ]
         if any(is_placeholder(a) for _, args in actions for a in args):
             return None
-        valid, needed = self._real_check(actions)
+        # a fluent result is certified for the state fluent_plan gave it (the state of its
+        # first use when it cannot be split): its facts are trusted at the steps it serves
+        trusted = frozenset(
+            Atom(a.predicate, tuple(bindings.get(n, n) for n in a.args))
+            for i, r in enumerate(skeleton.stream_plan)
+            if i in skeleton.fluents
+            for a in r.certified
+        )
+        valid, needed = self._real_check(actions, trusted)
         if valid:
             return True if self._record(actions, needed) else None
         return self._upstream_retry(skeleton, len(skeleton.stream_plan))
 
+    def _take(self, skeleton: Skeleton, index: int, state: InstanceState) -> tuple[str, ...] | None:
+        """Outputs for stream step ``index`` of a skeleton, or None when the call failed.
+
+        A test that already passed passes. A fluent instance's outputs hold in its state only,
+        so the planner never saw them: the skeleton takes those it has not tried yet before
+        calling again. Other generators are called afresh (the planner saw their outputs).
+        """
+        instance = state.instance
+        results = instance.results
+        if not instance.external.declaration.outputs and results:
+            return ()
+        fluent = bool(instance.external.declaration.fluents)
+        taken = skeleton.used.get(index, 0)
+        if fluent and taken < len(results):
+            skeleton.used[index] = taken + 1
+            return results[taken].outputs
+        before = len(results)
+        if not instance.exhausted:
+            self._sample_state(state)
+        if len(results) == before:
+            if fluent or self.options.algorithm != "adaptive":
+                self._failed(state)
+            return None
+        skeleton.used[index] = len(results)
+        return results[-1].outputs
+
     def _upstream_retry(self, skeleton: Skeleton, index: int) -> bool | None:
-        """Step ``index`` cannot succeed with the outputs chosen before it: resample those."""
+        """Step ``index`` cannot succeed with the outputs chosen before it: resample those
+        (False), unless no generator before it can give other outputs (None: dead)."""
         upstream = [i for i in skeleton.chosen if i < index]
         for i in upstream:
             del skeleton.chosen[i]
-        live = any(
-            (state := self.engine.instance(r.external, r.inputs)) is None
-            or not state.instance.exhausted
-            for i, r in enumerate(skeleton.stream_plan[:index])
-            if r.kind == "stream"
-        )
-        return False if upstream and live else None
+        live = any(self._can_retry(skeleton, i) for i in upstream)
+        return False if live else None
+
+    def _can_retry(self, skeleton: Skeleton, index: int) -> bool:
+        """Can stream step ``index`` give other outputs (a test cannot)?"""
+        state = skeleton.states.get(index)
+        if state is None or not state.instance.external.declaration.outputs:
+            return False
+        instance = state.instance
+        untried = skeleton.used.get(index, 0) < len(instance.results)
+        return not instance.exhausted or (bool(instance.external.declaration.fluents) and untried)
 
     # --- result -------------------------------------------------------------------------
 

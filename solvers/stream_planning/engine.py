@@ -6,11 +6,12 @@ facts reach level ``d`` and that was called ``k`` times before has level ``d + k
 cheap, and negated predicates need their value); ``:rule`` facts are added at once.
 
 A ``:fluents`` stream has one instance per input tuple and fluent state. The instance made when
-its domain first holds sees the initial state's facts of its fluent predicates; the focused
-algorithms ask for more (:meth:`Engine.fluent_instance`) with the state of the plan step that
-uses the output. Their certified facts join the one global fact base, as in PDDLStream: they are
-about new output objects (a trajectory valid among the objects as they were at that step), so
-the stream's author must not certify facts about input objects that depend on the state.
+its domain first holds sees the initial state's facts of its fluent predicates; the algorithms
+ask for more (:meth:`Engine.fluent_instance`) with the state of the plan step that uses the
+output. What such an instance certifies holds in that state only: those facts are kept in the
+store (streams on the outputs are instantiated) but are *hidden* from planning
+(:meth:`Engine.planning_facts`); a plan may use them only at a step whose state has exactly the
+instance's fluent facts (:meth:`Engine.certified_in`).
 
 Every user call goes through the engine's :class:`CallRunner` (the solve's deadline); the
 initial facts, which may call user code, are added by :meth:`Engine.start`.
@@ -110,6 +111,9 @@ class Engine:
         # instances of a (fluent stream, inputs) pair: the pair's complexity counts them all
         self.variants: dict[tuple[str, tuple[str, ...], tuple[Atom, ...]], InstanceState] = {}
         self.fluent_calls: dict[tuple[str, tuple[str, ...]], int] = {}
+        # facts only fluent instances certified, and the (stream, fluent facts) of each source
+        self.hidden: set[Atom] = set()
+        self.fluent_sources: dict[Atom, set[tuple[str, frozenset[Atom]]]] = {}
         queries = [
             Query(s.name, s.declaration.inputs, s.declaration.domain) for s in self.streams.values()
         ]
@@ -131,11 +135,18 @@ class Engine:
 
     # --- adding facts ---------------------------------------------------------------------
 
-    def add_facts(self, atoms: Iterable[Atom], level: int) -> list[Atom]:
+    def add_facts(self, atoms: Iterable[Atom], level: int, hidden: bool = False) -> list[Atom]:
         """Add real facts and everything that follows at once (instances, rules, functions,
-        and one call of every new instance of an ``eager`` stream)."""
+        and one call of every new instance of an ``eager`` stream). ``hidden``: ``atoms``
+        hold in one fluent state only (a fact known otherwise too is not hidden)."""
         new: list[Atom] = []
-        pending = list(atoms)
+        given = list(atoms)
+        for atom in given:
+            if not hidden:
+                self.hidden.discard(atom)
+            elif atom not in self.store:
+                self.hidden.add(atom)
+        pending = given
         while pending:
             atom = pending.pop()
             if self.store.add(atom, level):
@@ -198,8 +209,33 @@ class Engine:
             self.fluent_calls[key] = self.fluent_calls.get(key, 0) + 1
         results, wild = instance.next(self.table, self.runner)
         facts = [atom for result in results for atom in result.certified]
-        self.add_facts([*facts, *wild], level)
+        if instance.external.declaration.fluents:
+            source = (instance.external.name, frozenset(instance.fluents))
+            for atom in facts:
+                self.fluent_sources.setdefault(atom, set()).add(source)
+            self.add_facts(facts, level, hidden=True)
+            self.add_facts(wild, level)
+        else:
+            self.add_facts([*facts, *wild], level)
         return bool(results)
+
+    def planning_facts(self) -> dict[Atom, int]:
+        """The real facts a plan may use in any state (all but the hidden ones)."""
+        if not self.hidden:
+            return self.store.levels
+        return {a: level for a, level in self.store.levels.items() if a not in self.hidden}
+
+    def certified_in(self, atom: Atom, state: Iterable[Atom]) -> bool:
+        """Does ``atom`` hold in ``state``: known in every state, or certified by a fluent
+        instance that saw exactly ``state``'s facts of its fluent predicates?"""
+        if atom not in self.hidden:
+            return atom in self.store
+        facts = frozenset(state)
+        for stream, fluents in self.fluent_sources.get(atom, ()):
+            wanted = set(self.streams[stream].declaration.fluents)
+            if fluents == frozenset(a for a in facts if a.predicate in wanted):
+                return True
+        return False
 
     def instance(self, name: str, inputs: tuple[str, ...]) -> InstanceState | None:
         return self.instances.get((name, inputs))
@@ -228,10 +264,9 @@ class Engine:
         return self.fluent_calls.get((instance.external.name, instance.inputs), 0)
 
     def disable(self, state: InstanceState) -> None:
-        """Disable an instance until the complexity level rises; for a fluent instance, its
-        (stream, inputs) pair, which is what the optimistic world offers."""
-        base = self.instances.get((state.instance.external.name, state.instance.inputs), state)
-        base.instance.disabled = True
+        """Disable an instance until the complexity level rises (a fluent instance's failure
+        is recorded as a block instead: :mod:`.blocking`)."""
+        state.instance.disabled = True
 
 
 def cost_functions(domain: Domain) -> frozenset[str]:

@@ -17,7 +17,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sdar_tamp.errors import SdarError
-from sdar_tamp.language.generators import ListGenFn, TruthValueError, WildOutput, truth_value
+from sdar_tamp.language.generators import (
+    SINGLE_CALL,
+    ListGenFn,
+    TruthValueError,
+    WildOutput,
+    truth_value,
+)
 from sdar_tamp.language.model import Atom, Stream, StreamFunction, StreamPredicate
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
@@ -178,6 +184,8 @@ class StreamInstance:
             external.counters.calls += 1
         call_index = self.calls
         self.calls += 1
+        if getattr(external.gen_fn, SINGLE_CALL, False):
+            self.exhausted = True  # its one answer is in: no second call to find that out
         outputs, wild = self._check(produced, table)
         results = [
             StreamResult(self, names, external.certified(self.inputs, names), call_index)

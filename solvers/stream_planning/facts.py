@@ -9,11 +9,13 @@ from sdar_tamp.language.model import Atom, is_variable
 
 
 class FactStore:
-    """Ground atoms, each with the lowest complexity level at which it is known."""
+    """Ground atoms, each with the lowest complexity level at which it is known, indexed by
+    predicate and by (predicate, argument position, value) for joins."""
 
     def __init__(self) -> None:
         self.levels: dict[Atom, int] = {}
         self._by_predicate: dict[str, dict[tuple[str, ...], int]] = {}
+        self._by_argument: dict[tuple[str, int, str], dict[tuple[str, ...], int]] = {}
 
     def add(self, atom: Atom, level: int) -> bool:
         """Record ``atom``; True when it is new (a lower level for a known atom is kept too)."""
@@ -22,7 +24,22 @@ class FactStore:
             return False
         self.levels[atom] = level
         self._by_predicate.setdefault(atom.predicate, {})[atom.args] = level
+        for position, value in enumerate(atom.args):
+            self._by_argument.setdefault((atom.predicate, position, value), {})[atom.args] = level
         return old is None
+
+    def _candidates(self, atom: Atom, binding: dict[str, str]) -> dict[tuple[str, ...], int]:
+        """The known argument tuples of ``atom``'s predicate that may match it: those with the
+        value of its most selective bound argument, or all of them."""
+        best = self._by_predicate.get(atom.predicate, {})
+        for position, term in enumerate(atom.args):
+            value = binding.get(term) if is_variable(term) else term
+            if value is None:
+                continue
+            found = self._by_argument.get((atom.predicate, position, value), {})
+            if len(found) < len(best):
+                best = found
+        return best
 
     def __contains__(self, atom: object) -> bool:
         return atom in self.levels
@@ -47,7 +64,7 @@ class FactStore:
             key=lambda i: sum(1 for t in atoms[i].args if not is_variable(t) or t in binding),
         )
         atom, rest = atoms[index], [*atoms[:index], *atoms[index + 1 :]]
-        for args, fact_level in self._by_predicate.get(atom.predicate, {}).items():
+        for args, fact_level in self._candidates(atom, binding).items():
             extended = _unify(atom.args, args, binding)
             if extended is not None:
                 yield from self.join(rest, extended, max(level, fact_level))

@@ -6,12 +6,19 @@ initial state; a fluent result's state is the one before the first step whose pr
 effect condition, or the goal) relies on a fact certified by the result or by one of its
 descendants in the stream plan. Its fluent facts may name placeholders of other results (an
 object moved to a pose not sampled yet), so those results are ordered before it.
+
+A result the plan uses directly at several steps whose states differ (the same motion made
+twice, among objects that moved in between) is split, as in PDDLStream: one copy per state,
+each with its own output placeholders, which the steps of that state then use. A result that
+cannot be split (another result depends on it, or an action's effect or the goal names its
+outputs) is called in the state of its first use and trusted at its later uses (PDDLStream
+refuses such domains).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from sdar_tamp.language.model import Atom
 from solvers.stream_planning.optimistic import OptResult, is_placeholder
@@ -27,6 +34,7 @@ class FluentPlan:
 
     stream_plan: list[OptResult]
     fluents: dict[int, Fluents]
+    actions: list[tuple[str, tuple[str, ...]]]  # the plan, split results' outputs renamed
 
 
 def first_use(stream_plan: Sequence[OptResult], check: PlanCheck) -> dict[int, int]:
@@ -47,22 +55,71 @@ def fluent_plan(
     stream_plan: Sequence[OptResult],
     check: PlanCheck,
     declared: Mapping[str, tuple[str, ...]],
+    actions: Sequence[tuple[str, tuple[str, ...]]] = (),
 ) -> FluentPlan:
     """The fluent facts of each fluent result (``declared`` maps a stream to its ``:fluents``
     predicates) and the stream plan reordered so that the producers of placeholders in them
-    come first. ``check`` is the simulation of the optimistic plan over the optimistic facts."""
+    come first. ``check`` is the simulation of the optimistic plan ``actions`` over the
+    optimistic facts; a result used at steps of different states is split (see above)."""
     if not any(declared.get(r.external) for r in stream_plan) or not check.states:
-        return FluentPlan(list(stream_plan), {})
+        return FluentPlan(list(stream_plan), {}, list(actions))
     steps = first_use(stream_plan, check)
+    plan = list(stream_plan)
+    renamed = [list(args) for _, args in actions]
     facts: dict[int, Fluents] = {}
     for i, result in enumerate(stream_plan):
         wanted = set(declared.get(result.external, ()))
-        if wanted:
-            state = check.states[min(steps[i], len(check.states) - 1)]
-            facts[i] = tuple(sorted((a for a in state if a.predicate in wanted), key=str))
-    order = _order(stream_plan, facts)
+        if not wanted:
+            continue
+        state = check.states[min(steps[i], len(check.states) - 1)]
+        facts[i] = _fluents(state, wanted)
+        groups = _use_groups(i, stream_plan, check, wanted, actions)
+        for fluents, group in groups[1:]:
+            names = {o: f"{o}@{group[0]}" for o in result.outputs}
+            certified = tuple(
+                Atom(a.predicate, tuple(names.get(n, n) for n in a.args)) for a in result.certified
+            )
+            for k in group:
+                renamed[k] = [names.get(n, n) for n in renamed[k]]
+            facts[len(plan)] = fluents
+            plan.append(replace(result, outputs=tuple(names.values()), certified=certified))
+    order = _order(plan, facts)
     position = {old: new for new, old in enumerate(order)}
-    return FluentPlan([stream_plan[i] for i in order], {position[i]: f for i, f in facts.items()})
+    return FluentPlan(
+        [plan[i] for i in order],
+        {position[i]: f for i, f in facts.items()},
+        [(name, tuple(args)) for (name, _), args in zip(actions, renamed, strict=True)],
+    )
+
+
+def _fluents(state: frozenset[Atom], wanted: set[str]) -> Fluents:
+    return tuple(sorted((a for a in state if a.predicate in wanted), key=str))
+
+
+def _use_groups(
+    index: int,
+    stream_plan: Sequence[OptResult],
+    check: PlanCheck,
+    wanted: set[str],
+    actions: Sequence[tuple[str, tuple[str, ...]]],
+) -> list[tuple[Fluents, list[int]]]:
+    """The steps that use result ``index`` directly, grouped by their fluent facts (first use
+    first); a single group when the result cannot be split: another result depends on it, the
+    goal uses its outputs, or a step that does not use its facts names its outputs."""
+    result = stream_plan[index]
+    certified = set(result.certified)
+    if any(certified & set(r.domain) for r in stream_plan):
+        return []
+    uses = [k for k, support in enumerate(check.supports) if support & certified]
+    outputs = set(result.outputs)
+    if outputs and len(actions) in uses:
+        return []
+    if any(outputs & set(args) for k, (_, args) in enumerate(actions) if k not in uses):
+        return []
+    groups: dict[Fluents, list[int]] = {}
+    for k in uses:
+        groups.setdefault(_fluents(check.states[k], wanted), []).append(k)
+    return list(groups.items())
 
 
 def _order(stream_plan: Sequence[OptResult], fluents: Mapping[int, Fluents]) -> list[int]:

@@ -135,12 +135,16 @@ class OptimisticBuilder:
             self.producers[name] = str(key[0])
         return name
 
-    def build(self, limit: int) -> OptimisticWorld:
+    def build(self, limit: int, lazy: bool = False) -> OptimisticWorld:
+        """The optimistic world at complexity ``limit``. With ``lazy`` (incremental), only
+        fluent streams (called in the state of the step that uses them) and streams on
+        placeholders add optimistic results; the others are called for real beforehand."""
         engine = self.engine
         store = FactStore()
-        for atom, level in engine.store.levels.items():
+        facts = engine.planning_facts()
+        for atom, level in facts.items():
             store.add(atom, level)
-        world = OptimisticWorld(dict(engine.store.levels), {}, dict(engine.numeric))
+        world = OptimisticWorld(dict(facts), {}, dict(engine.numeric))
         queries = [
             Query(s.name, s.declaration.inputs, s.declaration.domain)
             for s in engine.streams.values()
@@ -157,7 +161,7 @@ class OptimisticBuilder:
         pending = list(instantiator.initial())
         while pending:
             query, inputs, level = pending.pop()
-            for result in self._results(query.name, inputs, level, limit, world):
+            for result in self._results(query.name, inputs, level, limit, world, lazy):
                 for atom in result.certified:
                     if store.add(atom, result.level):
                         world.facts[atom] = result.level
@@ -169,12 +173,20 @@ class OptimisticBuilder:
         return world
 
     def _results(
-        self, name: str, inputs: tuple[str, ...], level: int, limit: int, world: OptimisticWorld
+        self,
+        name: str,
+        inputs: tuple[str, ...],
+        level: int,
+        limit: int,
+        world: OptimisticWorld,
+        lazy: bool,
     ) -> list[OptResult]:
         engine = self.engine
         real = not any(is_placeholder(n) for n in inputs)
         if name in engine.streams:
             external = engine.streams[name]
+            if lazy and real and not external.declaration.fluents:
+                return []
             state = engine.instance(name, inputs) if real else None
             next_level = level + 1
             if state is not None:
