@@ -22,6 +22,7 @@ from types import TracebackType
 from typing import Any
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.textfile import decode_text
 
 INF = math.inf
 SEPARATOR = "\n" + 80 * "-" + "\n"
@@ -29,9 +30,12 @@ inf_generator = itertools.count
 
 
 def read(filename: str | os.PathLike[str]) -> str:
-    """The text of ``filename``."""
-    with open(filename, encoding="utf-8") as handle:
-        return handle.read()
+    """The text of the UTF-8 file ``filename``. A missing file raises ``OSError`` as the
+    original does; bytes that are not UTF-8 raise :class:`~sdar_tamp.textfile.TextFileError`
+    at ``file:line:col`` with the byte offset."""
+    with open(filename, "rb") as handle:
+        data = handle.read()
+    return decode_text(data, os.fspath(filename))
 
 
 def write(filename: str | os.PathLike[str], text: str) -> None:
