@@ -201,7 +201,15 @@ class FormulaReader:
     def atom(self, node: SList, scope: Mapping[str, str]) -> Atom:
         head = expect_symbol(node.items[0] if node.items else node, "a predicate name")
         name = head.text
-        args = tuple(self.term(arg, scope) for arg in node.items[1:])
+        constants = self.vocabulary.constants
+        # the common case (object names and bound variables) inline: init sections are large
+        args = tuple(
+            arg.text
+            if type(arg) is Symbol
+            and (arg.text in scope if arg.text[0] == "?" else arg.text in constants)
+            else self.term(arg, scope)  # the error, located
+            for arg in node.items[1:]
+        )
         if name == EQUALITY:
             expected = 2
         elif name in self.vocabulary.predicates:

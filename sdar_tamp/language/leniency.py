@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.errors import PddlError
-from sdar_tamp.language.sexpr import SList, Symbol
+from sdar_tamp.language.sexpr import SList
 
 LOGGER = logging.getLogger("sdar_tamp.language")
 
@@ -113,30 +113,24 @@ class LeniencyLog:
 def note_glued_variables(root: SList, log: LeniencyLog) -> None:
     """Note every variable written right after the previous token, as in ``(aircraft?a)``.
 
-    The reader splits such tokens; this finds them again from the token positions.
+    The reader splits such tokens and keeps their offsets (``SourceText.glued``).
     """
-    stack = [root]
-    while stack:
-        node = stack.pop()
-        previous: Symbol | None = None
-        for item in node.items:
-            if isinstance(item, SList):
-                stack.append(item)
-                previous = None
-                continue
-            if (
-                previous is not None
-                and item.text.startswith("?")
-                and item.location.line == previous.location.line
-                and item.location.column == previous.location.column + len(previous.text)
-            ):
-                log.add(
-                    GLUED_VARIABLE,
-                    f"{item.text!r} is glued to the token before it ({previous.text!r}); "
-                    "read as two tokens",
-                    item.location,
-                )
-            previous = item
+    source = root.source
+    for offset in source.glued:
+        end = offset + 1
+        while end < len(source.text) and source.text[end] not in " \t\r\n\f\v();?":
+            end += 1
+        before = offset
+        while before > 0 and source.text[before - 1] not in " \t\r\n\f\v();":
+            before -= 1
+            if source.text[before] == "?":
+                break  # the token before is a variable itself: (?x?y)
+        log.add(
+            GLUED_VARIABLE,
+            f"{source.text[offset:end].lower()!r} is glued to the token before it "
+            f"({source.text[before:offset].lower()!r}); read as two tokens",
+            source.location(offset),
+        )
 
 
 def _order(item: Leniency) -> tuple[int, int]:

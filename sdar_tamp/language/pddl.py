@@ -413,13 +413,13 @@ def parse_problem(
     numeric: dict[tuple[str, tuple[str, ...]], float] = {}
     goal = TRUE
     minimize = False
-    located: list[tuple[Atom, SourceLocation]] = []
+    located: list[tuple[Atom, SExpr]] = []
     for keyword, section in sections:
         if keyword == ":init":
             for node in section.items[1:]:
                 atom = _init_fact(node, reader, numeric)
                 if atom is not None:
-                    located.append((atom, node.location))
+                    located.append((atom, node))
                     init.append(atom)
         elif keyword == ":goal":
             if len(section.items) != 2:
@@ -486,7 +486,7 @@ def _init_fact(
 
 
 def _check_init_types(
-    facts: Iterable[tuple[Atom, SourceLocation]],
+    facts: Iterable[tuple[Atom, SExpr]],
     domain: Domain,
     objects: Mapping[str, str],
     log: LeniencyLog,
@@ -503,7 +503,8 @@ def _check_init_types(
             current = types.get(atom.args[0], OBJECT_TYPE)
             if hierarchy.is_subtype(atom.predicate, current):
                 types[atom.args[0]] = atom.predicate
-    for atom, location in facts:
+    subtype: dict[tuple[str, str], bool] = {}  # (type, expected type) -> is a subtype
+    for atom, node in facts:
         declaration = domain.predicates.get(atom.predicate)
         if declaration is None:
             continue
@@ -511,12 +512,16 @@ def _check_init_types(
             zip(atom.args, declaration.parameters, strict=True), 1
         ):
             own = types.get(arg, OBJECT_TYPE)
-            if not hierarchy.is_subtype(own, parameter.type):
+            key = (own, parameter.type)
+            fits = subtype.get(key)
+            if fits is None:
+                fits = subtype[key] = hierarchy.is_subtype(own, parameter.type)
+            if not fits:
                 log.add(
                     INIT_TYPE,
                     f"argument {position} of {atom} is {arg!r} of type {own!r}, but "
                     f"{atom.predicate!r} expects a {parameter.type!r}",
-                    location,
+                    node.location,  # worked out only for a fact that is noted
                 )
 
 

@@ -33,12 +33,15 @@ class SourceText:
     (a tab is one column).
     """
 
-    __slots__ = ("_line_starts", "filename", "text")
+    __slots__ = ("_line_starts", "filename", "glued", "text")
 
     def __init__(self, text: str, filename: str | None = None) -> None:
         self.filename = filename
         self.text = text
         self._line_starts: list[int] | None = None
+        #: offsets of the '?' tokens the reader split off the symbol right before them, as in
+        #: ``(aircraft?a)`` (filled by :func:`read_sexpr`)
+        self.glued: list[int] = []
 
     def location(self, offset: int) -> SourceLocation:
         """The location of the character at ``offset`` (0-based) in the text."""
@@ -171,9 +174,14 @@ def _build(source: SourceText) -> tuple[list[SExpr], list[tuple[int, list[SExpr]
     top: list[SExpr] = []
     stack: list[tuple[int, list[SExpr]]] = []
     items = top  # the items of the innermost open list
+    glued = source.glued
+    after_symbol = False  # the token before this one is a symbol
     for index in range(1, len(parts), 2):
         token = parts[index]
         first = token[0]
+        if first == "?" and after_symbol and not parts[index - 1]:
+            glued.append(ends[index - 1])
+        after_symbol = first not in "();"
         if first == "(":
             stack.append((ends[index - 1], items))
             items = []
