@@ -138,6 +138,9 @@ def solve(
         task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``.
         seed: seeds Python's ``random`` and NumPy's global generator before solving, so
             samplers that draw from them give the same plan for the same seed.
+        verbose: log a one-line summary of the result at INFO on the ``solvers`` logger
+            (else at DEBUG). Logger levels and handlers are the application's: ``solve`` never
+            changes them.
 
     Every numeric argument is checked (with ``algorithm="sdar"`` too) by the rules of
     :mod:`sdar_tamp.arguments`: NaN is refused everywhere; ``inf`` means "no limit" for the
@@ -196,7 +199,6 @@ def solve(
         unit_efforts=bool(unit_efforts),
         enforce_max_time=bool(enforce_max_time),
     )
-    logging.getLogger("solvers").setLevel(logging.INFO if verbose else logging.WARNING)
     if seed is not None:
         random.seed(seed)
         try:
@@ -208,7 +210,21 @@ def solve(
     if constraints is not None:
         options = dataclasses.replace(options, max_cost=constraints.max_cost)
         problem = compile_constraints(problem, constraints)
-    return StreamSolver(problem, options, stream_info).solve()
+    return _summarised(StreamSolver(problem, options, stream_info).solve(), algorithm, verbose)
+
+
+def _summarised(solution: Solution, algorithm: str, verbose: bool) -> Solution:
+    """``solution``, after logging its one-line summary (INFO if ``verbose``, else DEBUG)."""
+    LOG.log(
+        logging.INFO if verbose else logging.DEBUG,
+        "%s: %s, cost %s, %d action(s), %.3f s",
+        algorithm,
+        solution.status.value,
+        f"{solution.cost:g}",
+        len(solution.plan or ()),
+        float(solution.statistics.get("time", solution.statistics.get("planning_time", 0.0))),
+    )
+    return solution
 
 
 def _solve_sdar(
@@ -223,11 +239,10 @@ def _solve_sdar(
     from solvers.sdar.solver import SdarOptions, SdarSolver
 
     planner = make_task_planner(task_planner)
-    logging.getLogger("solvers").setLevel(logging.INFO if verbose else logging.WARNING)
     if seed is not None:
         random.seed(seed)
     options = SdarOptions(max_time=max_time)
-    return SdarSolver(problem, planner, options, stream_info).solve()
+    return _summarised(SdarSolver(problem, planner, options, stream_info).solve(), "sdar", verbose)
 
 
 def create_parser(default_algorithm: str = "adaptive") -> argparse.ArgumentParser:

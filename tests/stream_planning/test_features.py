@@ -80,6 +80,22 @@ def test_nothing_is_written_to_the_working_directory(
     assert os.listdir(tmp_path) == []
 
 
+@pytest.mark.parametrize("verbose", [True, False])
+def test_solve_leaves_logger_levels_alone_and_logs_a_summary(
+    verbose: bool, caplog: pytest.LogCaptureFixture
+) -> None:
+    import logging
+
+    loggers = [logging.getLogger(name) for name in ("", "solvers", "solvers.solve")]
+    with caplog.at_level(logging.DEBUG, logger="solvers"):
+        before = [logger.level for logger in loggers]
+        assert solve(line_problem(counting()), algorithm="focused", verbose=verbose).solved
+        assert [logger.level for logger in loggers] == before
+    summary = [r for r in caplog.records if r.name == "solvers.solve" and "focused:" in r.message]
+    assert len(summary) == 1 and "solved" in summary[0].message
+    assert summary[0].levelno == (logging.INFO if verbose else logging.DEBUG)
+
+
 def test_sampler_that_raises_names_stream_and_inputs() -> None:
     original = ZeroDivisionError("no pose today")
 
