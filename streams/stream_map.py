@@ -24,14 +24,14 @@ from typing import Any
 import numpy as np
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.world.collision import CollisionWorld, ObjectBox
+from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.buffers import sample_buffers
 from streams.context import WorldContext
 from streams.grasps import Grasp, sample_grasps
-from streams.ik import IKRequest, solve_ik_candidates
+from streams.ik import IKRequest, SceneCache, solve_ik_candidates
 from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
 from streams.validate import HeldObject
 
@@ -76,8 +76,9 @@ class DualConf:
         return np.array(self.left.q + self.right.q)
 
 
-#: Collision worlds kept for IK queries, one per object arrangement.
-WORLD_CACHE = 8
+#: Collision worlds kept for IK queries, one per object arrangement (a step of SDAR-M asks
+#: for a few: the current one, and per target the one after the pick plus the object there).
+WORLD_CACHE = 32
 #: Clearance [m] IK asks of grasp, pre-grasp and approach configurations from the other
 #: objects (the timed trajectory may deviate slightly from the checked configurations).
 IK_MARGIN = 0.003
@@ -111,7 +112,7 @@ class DualArmStreams:
         self.seed = seed
         self.world = ctx.new_world()
         self._arms_only = ctx.new_world()  # no objects: arm-arm checks of combine-confs
-        self._worlds: dict[Any, CollisionWorld] = {}
+        self.scenes = SceneCache(ctx, IK_MARGIN, WORLD_CACHE)  # IK worlds, one per arrangement
         self._planner = planner
         self.reserved = dict(reserved or {})
         self.motion = motion
@@ -149,30 +150,14 @@ class DualArmStreams:
     def inverse_kinematics(
         self, arm: str, obj: str, p: Pose2D, g: Grasp, fluents: Sequence[tuple[Any, ...]] = ()
     ) -> Iterator[tuple[ArmConf]]:
-        objects = self.resting(fluents)
-        objects[obj] = self.box(obj, p)
+        placed = {f[1]: f[2] for f in fluents if f[0] == "atpose"}
+        placed[obj] = p
+        objects = {o: self.box(o, q) for o, q in placed.items()}
         request = IKRequest(arm, obj, objects[obj], (g,))
         home = {a: self.ctx.home(a) for a in self.ctx.arm_names}
-        world = self._world_for(fluents, obj, p, IK_MARGIN)
+        world = self.scenes.world(frozenset(placed.items()), objects)
         for c in solve_ik_candidates(self.ctx, world, objects, [request], home):
             yield (ArmConf(arm, tuple(map(float, c.q)), tuple(map(float, c.q_pre))),)
-
-    def _world_for(
-        self, fluents: Sequence[tuple[Any, ...]], obj: str, p: Pose2D, margin: float
-    ) -> CollisionWorld:
-        """A collision world already holding this object set (a few are kept: building the
-        geometry of a new set costs milliseconds, and IK queries alternate between sets)."""
-        key = (frozenset((f[1], f[2]) for f in fluents if f[0] == "atpose"), obj, p, margin)
-        world = self._worlds.pop(key, None)
-        if world is None:
-            if len(self._worlds) >= WORLD_CACHE:  # reuse the least recently used world
-                old_key = next(iter(self._worlds))
-                reused = self._worlds.pop(old_key)
-                world = reused if old_key[-1] == margin else self.ctx.new_world(margin=margin)
-            else:
-                world = self.ctx.new_world(margin=margin)
-        self._worlds[key] = world  # most recently used last
-        return world
 
     def sample_buffer(
         self, obj: str, fluents: Sequence[tuple[Any, ...]] = ()
