@@ -44,7 +44,15 @@ from streams.context import WorldContext
 from streams.sphere_pairs import HeldSpheres
 from streams.spheres import object_spheres
 from streams.timing import TimedTrajectory, spline_curve, time_parameterize
-from streams.trajopt import DualArmTrajOpt, TrajOptOptions, TransferQuery, straight_line
+from streams.trajopt import (
+    OPTIMISERS,
+    DualArmTrajOpt,
+    OptimiserBuild,
+    OptimiserCache,
+    TrajOptOptions,
+    TransferQuery,
+    straight_line,
+)
 from streams.validate import HeldObject, ValidationReport, configure_world, validate_trajectory
 
 #: Spheres per resting object in the optimiser's obstacle model (8: one per octant, tight
@@ -113,9 +121,12 @@ DIRECT_LIFTS = (0.05, 0.12)
 
 
 class DualMotionPlanner:
-    """Owns the optimiser (built once) and scratch collision worlds: ``world`` for the exact
-    validation, ``margin_world`` (objects grown by ``direct_margin`` [m]) for transfers taken
-    without optimisation.
+    """Owns the optimiser and scratch collision worlds. The optimiser comes from
+    ``optimisers`` (default: the process-wide :data:`streams.trajopt.OPTIMISERS`; built once
+    per scene and options, in the background, so constructing a planner costs nothing and
+    only the first optimisation may wait for the build; None: a private cache). Worlds:
+    ``world`` for the exact validation, ``margin_world`` (objects grown by ``direct_margin``
+    [m]) for transfers taken without optimisation.
 
     ``direct_lifts``: TCP lifts [m] of the bent paths tried after the straight line (empty:
     the straight line only); ``direct=False`` always optimises (the sphere model's own
@@ -129,11 +140,14 @@ class DualMotionPlanner:
         direct: bool = True,
         direct_margin: float = DIRECT_MARGIN,
         direct_lifts: Sequence[float] = DIRECT_LIFTS,
+        optimisers: OptimiserCache | None = OPTIMISERS,
     ) -> None:
         if direct_margin < 0.0:
             raise ParameterError(f"direct_margin must be >= 0 [m], got {direct_margin}")
         self.ctx = ctx
-        self.trajopt = DualArmTrajOpt(ctx, options)
+        cache = optimisers if optimisers is not None else OptimiserCache()
+        self._build = cache.get(ctx, options)
+        self._trajopt: DualArmTrajOpt | None = None
         self.world = ctx.new_world()
         self.margin_world = ctx.new_world(margin=direct_margin)
         self.direct = direct
@@ -143,6 +157,22 @@ class DualMotionPlanner:
         self.optimisation_time = 0.0  # reset per plan_dual_motion call
         self.ipopt_solves = 0
         self.direct_paths = 0  # transfers taken without optimisation, per plan_dual_motion call
+
+    @property
+    def trajopt(self) -> DualArmTrajOpt:
+        """The trajectory optimiser; the first access waits for its background build."""
+        if self._trajopt is None:
+            self._trajopt = self._build.get()
+        return self._trajopt
+
+    @trajopt.setter
+    def trajopt(self, value: DualArmTrajOpt) -> None:
+        self._trajopt = value
+
+    @property
+    def build(self) -> OptimiserBuild:
+        """The optimiser's build: ``ready``, ``build_time`` (CPU [s]), ``waited`` [s]."""
+        return self._build
 
     # -- building blocks used by strategies ----------------------------------------------
     def nominal_duration(self, q_a: FloatArray, q_b: FloatArray) -> float:
@@ -226,7 +256,7 @@ class DualMotionPlanner:
         """A warm start ``(K, 12)`` (``knots``, default the optimiser's) through a via
         configuration whose TCPs are ``height`` [m] above the higher end, half-way between
         the two."""
-        K = knots if knots is not None else self.trajopt.options.knots
+        K = knots if knots is not None else self._build.options.knots
         mid = 0.5 * (q_a + q_b)
         via = mid.copy()
         for i, arm in enumerate(self.ctx.arm_names):
@@ -292,7 +322,7 @@ class DualMotionPlanner:
     def transfer_problem(
         self, request: MotionRequest, q_from: FloatArray, q_to: FloatArray
     ) -> TransferProblem:
-        o = self.trajopt.options
+        o = self._build.options
         held = []
         for arm in self.ctx.arm_names:
             h = request.held.get(arm)

@@ -113,17 +113,12 @@ class DualArmStreams:
         self.world = ctx.new_world()
         self._arms_only = ctx.new_world()  # no objects: arm-arm checks of combine-confs
         self.scenes = SceneCache(ctx, IK_MARGIN, WORLD_CACHE)  # IK worlds, one per arrangement
-        self._planner = planner
+        # the planner's optimiser starts building in the background now, while selection runs
+        self.planner = planner if planner is not None else DualMotionPlanner(ctx)
         self.reserved = dict(reserved or {})
         self.motion = motion
         self._grasps: dict[str, tuple[Grasp, ...]] = {}
         self._buffer_calls = 0
-
-    @property
-    def planner(self) -> DualMotionPlanner:
-        if self._planner is None:  # built on first use (about 3 s)
-            self._planner = DualMotionPlanner(self.ctx)
-        return self._planner
 
     def size(self, obj: str) -> Size:
         return self.sizes.get(obj, self.ctx.scene.object_size)
@@ -279,7 +274,8 @@ def make_stream_map(
     """Bind every stream of ``stream.pddl`` by name (see the module docstring).
 
     ``sizes``: object name -> (lx, ly, lz) [m] (default: the scene's object size);
-    ``planner``: a motion planner to share (default: one built on first use, about 3 s);
+    ``planner``: a motion planner to share (default: a new one; its optimiser comes from the
+    process-wide cache, built once in the background);
     ``reserved``: poses buffers keep clear of (the goals); ``motion``: ``sdar`` (optimisation,
     untangling, one arm at a time), ``plain`` (optimisation only) or ``sequential``.
     """

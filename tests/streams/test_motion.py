@@ -7,6 +7,7 @@ import pytest
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
+from streams import trajopt
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
@@ -20,7 +21,7 @@ from streams.motion import (
     plan_dual_motion,
 )
 from streams.timing import spline_curve
-from streams.trajopt import TransferQuery, straight_line
+from streams.trajopt import OptimiserCache, TrajOptOptions, TransferQuery, straight_line
 from streams.validate import configure_world, validate_trajectory
 
 # Two grasp configurations in M1 whose straight synchronous transfer is blocked (found by search).
@@ -193,7 +194,7 @@ def test_a_clear_straight_transfer_is_taken_without_optimising(
     _check(ctx, result.trajectory.t, result.trajectory.q, request)
     # the same transfer through the optimiser (direct paths off) is no faster to execute
     optimised = DualMotionPlanner(ctx, direct=False)
-    optimised.trajopt = planner.trajopt  # share the built NLP
+    assert optimised.trajopt is planner.trajopt  # one optimiser per scene and options
     again = plan_dual_motion(optimised, request)
     assert again.success and again.direct_paths == 0 and again.trajectory is not None
     assert result.trajectory.duration <= again.trajectory.duration + 1e-6
@@ -227,3 +228,29 @@ def test_direct_paths_need_the_margin_and_keep_waiting_arms_still(
 def test_direct_margin_must_not_be_negative(ctx: WorldContext) -> None:
     with pytest.raises(ParameterError, match="direct_margin must be >= 0"):
         DualMotionPlanner(ctx, direct_margin=-0.001)
+
+
+def test_optimisers_are_built_once_per_scene_and_options(
+    ctx: WorldContext, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    built: list[TrajOptOptions] = []
+
+    class Fake:
+        def __init__(self, ctx: WorldContext, options: TrajOptOptions) -> None:
+            built.append(options)
+            if options.knots == 3:
+                raise ParameterError("no NLP with 3 knots")
+
+    monkeypatch.setattr(trajopt, "DualArmTrajOpt", Fake)
+    cache = OptimiserCache()
+    a = cache.get(ctx, TrajOptOptions(knots=6))
+    b = cache.get(ctx, TrajOptOptions(knots=6))
+    c = cache.get(ctx, TrajOptOptions(knots=7), background=False)
+    assert a is b and c is not a and len(cache) == 2
+    assert a.get() is b.get() and a.ready and a.build_time >= 0.0
+    assert [o.knots for o in sorted(built, key=lambda o: o.knots)] == [6, 7]
+    planner = DualMotionPlanner(ctx, TrajOptOptions(knots=6), optimisers=cache)
+    assert planner.trajopt is a.get() and len(built) == 2  # no second build
+    broken = cache.get(ctx, TrajOptOptions(knots=3))
+    with pytest.raises(ParameterError, match="no NLP with 3 knots"):
+        broken.get()
