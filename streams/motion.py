@@ -90,6 +90,7 @@ class MotionResult:
     reason: str = ""
     ipopt_solves: int = 0  # optimiser calls that ran IPOPT (a feasible straight line needs none)
     direct_paths: int = 0  # transfers (or stages) taken straight or lightly bent, not optimised
+    sampled_paths: int = 0  # transfers found by the sampling-based planner (OMPL)
 
 
 @dataclass(frozen=True)
@@ -157,6 +158,7 @@ class DualMotionPlanner:
         self.optimisation_time = 0.0  # reset per plan_dual_motion call
         self.ipopt_solves = 0
         self.direct_paths = 0  # transfers taken without optimisation, per plan_dual_motion call
+        self.sampled_paths = 0  # transfers found by sampling, per plan_dual_motion call
 
     @property
     def trajopt(self) -> DualArmTrajOpt:
@@ -168,6 +170,11 @@ class DualMotionPlanner:
     @trajopt.setter
     def trajopt(self, value: DualArmTrajOpt) -> None:
         self._trajopt = value
+
+    @property
+    def limits(self) -> tuple[FloatArray, FloatArray]:
+        """Joint velocity [rad/s] and acceleration [rad/s^2] limits ``(12,)`` each."""
+        return self._v, self._a
 
     @property
     def build(self) -> OptimiserBuild:
@@ -484,12 +491,21 @@ class OneArmStrategy:
 
 
 def default_strategies(
-    fallbacks: bool = True, sequential_only: bool = False
+    fallbacks: bool = True, sequential_only: bool = False, sampling: bool = False
 ) -> tuple[TransferStrategy, ...]:
     """The ladder of Alg. 2: plain, untangle, sequential (or a part of it).
-    ``sequential_only``: the baseline motion planner (:class:`OneArmStrategy`)."""
+    ``sequential_only``: the baseline motion planner (:class:`OneArmStrategy`).
+    ``sampling`` (needs OMPL): when the straight or lightly bent path is not clear, a
+    sampled path (RRTConnect, shortcut) warm-starts the optimiser instead of the straight
+    line (the sampled path itself is kept when the optimiser does not shorten it), before
+    untangling."""
     if sequential_only:
         return (OneArmStrategy(),)
+    if sampling:
+        from streams.sampling import SampledStrategy
+
+        sampled = SampledStrategy(name="plain", refine=True)
+        return (sampled,) if not fallbacks else (sampled, UntangleStrategy(), SequentialStrategy())
     if not fallbacks:
         return (PlainStrategy(),)
     return (PlainStrategy(), UntangleStrategy(), SequentialStrategy())
@@ -527,13 +543,13 @@ def plan_dual_motion(
     planner.optimisation_time = 0.0
     planner.ipopt_solves = 0
     planner.direct_paths = 0
+    planner.sampled_paths = 0
     ladder = tuple(strategies) if strategies is not None else default_strategies(
         fallbacks, sequential_only)  # fmt: skip
     ctx = planner.ctx
     q_start = np.asarray(request.q_start, dtype=np.float64)
     configure_world(ctx, planner.world, request.objects, request.held, q_start)
-    if planner.direct:
-        configure_world(ctx, planner.margin_world, request.objects, request.held, q_start)
+    configure_world(ctx, planner.margin_world, request.objects, request.held, q_start)
     phases = _clear_phases(planner, request, sequential_only and strategies is None)
     if isinstance(phases, str):
         return MotionResult(False, None, None, 0.0, time.perf_counter() - t0, (),
@@ -554,7 +570,8 @@ def plan_dual_motion(
             return MotionResult(True, strategy.name, traj, planner.optimisation_time,
                                 time.perf_counter() - t0, tuple(attempts), report,
                                 ipopt_solves=planner.ipopt_solves,
-                                direct_paths=planner.direct_paths)  # fmt: skip
+                                direct_paths=planner.direct_paths,
+                                sampled_paths=planner.sampled_paths)  # fmt: skip
         attempts.append(
             f"{strategy.name}: validation failed ({report.reason} at sample {report.index}"
             + "".join(f", {p.first}-{p.second}" for p in report.pairs[:2])
@@ -563,4 +580,5 @@ def plan_dual_motion(
     return MotionResult(False, None, None, planner.optimisation_time, time.perf_counter() - t0,
                         tuple(attempts), report, reason="; ".join(attempts),
                         ipopt_solves=planner.ipopt_solves,
-                        direct_paths=planner.direct_paths)  # fmt: skip
+                        direct_paths=planner.direct_paths,
+                        sampled_paths=planner.sampled_paths)  # fmt: skip

@@ -33,6 +33,7 @@ from streams.context import WorldContext
 from streams.grasps import Grasp, sample_grasps
 from streams.ik import IKRequest, SceneCache, solve_ik_candidates
 from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
+from streams.sampling import SamplingOptions
 from streams.validate import HeldObject
 
 LOG = logging.getLogger(__name__)
@@ -83,8 +84,9 @@ WORLD_CACHE = 32
 #: objects (the timed trajectory may deviate slightly from the checked configurations).
 IK_MARGIN = 0.003
 
-#: Motion planners of ``plan-dual-motion``: SDAR-M's ladder, plain optimisation, one arm at a time.
-MOTION_PLANNERS = ("sdar", "plain", "sequential")
+#: Motion planners of ``plan-dual-motion``: SDAR-M's ladder, plain optimisation, one arm at a
+#: time, and OMPL's RRTConnect (optional extra ``sdar-tamp[ompl]``, :mod:`streams.sampling`).
+MOTION_PLANNERS = ("sdar", "plain", "sequential", "ompl")
 
 
 class DualArmStreams:
@@ -218,11 +220,17 @@ class DualArmStreams:
         retreat = (q1.left.pre is not None, q1.right.pre is not None)
         approach = (q2.left.pre is not None, q2.right.pre is not None)
         request = MotionRequest(q1.q, q2.q, objects, held, retreat, approach)
+        strategies = None
+        if self.motion == "ompl":
+            from streams.sampling import SampledStrategy
+
+            strategies = (SampledStrategy(options=SamplingOptions(seed=self.seed)),)
         result = plan_dual_motion(
             self.planner,
             request,
             fallbacks=self.motion == "sdar" and not quick,
             sequential_only=self.motion == "sequential",
+            strategies=strategies,
         )
         if result.success:
             yield (result,)
@@ -277,7 +285,8 @@ def make_stream_map(
     ``planner``: a motion planner to share (default: a new one; its optimiser comes from the
     process-wide cache, built once in the background);
     ``reserved``: poses buffers keep clear of (the goals); ``motion``: ``sdar`` (optimisation,
-    untangling, one arm at a time), ``plain`` (optimisation only) or ``sequential``.
+    untangling, one arm at a time), ``plain`` (optimisation only), ``sequential`` or ``ompl``
+    (RRTConnect, shortcut; needs the ``ompl`` extra).
     """
     s = DualArmStreams(world_context, sizes or {}, seed, planner, reserved, motion)
     return {
