@@ -11,8 +11,18 @@ planner) and with the full ladder (plain, untangle, sequential). Optimisation ti
 spent in the trajectory optimiser for the segment (all attempts of the ladder).
 
     python benchmarks/bench_motion.py [--segments 200] [--instance M1] [--seed 0]
+    python benchmarks/bench_motion.py --hard 12     # needs OMPL (pip install sdar-tamp[ompl])
 
 Prints a line per 20 segments, then one JSON object on the last line.
+
+``--hard N``: instead, N transfers whose straight joint-space line collides, for one arm
+(the other waits at home) and for both arms (N each): each arm goes from a grasp of one
+resting object to a grasp of another (retreat and approach included). Three motion planners
+side by side on the same requests: the optimiser alone (no direct paths, no fallbacks), the
+OMPL stream alone (RRTConnect, shortcut) and SDAR-M's ladder with sampling (direct paths,
+sampled path refined by the optimiser, untangling, one arm at a time). Times are CPU
+seconds of the planning call (the machine may be shared); execution times are compared on
+the transfers both planners solved.
 """
 
 from __future__ import annotations
@@ -46,13 +56,115 @@ def _footprint(box: ObjectBox) -> np.ndarray:
     return corners(pose, np.array([box.size[:2]]))
 
 
+def hard_set(instance: str, seed: int, count: int) -> None:
+    """See the module docstring (``--hard``)."""
+    from streams.motion import PlainStrategy, default_strategies
+    from streams.sampling import SampledStrategy
+
+    ctx = WorldContext.load()
+    inst = load_instance(domain_path(f"suites/paper/{instance}.yaml"))
+    objects = {o.name: _box(o.start.x, o.start.y, o.start.yaw, o.size) for o in inst.objects}
+    names = list(objects)
+    home = {a: ctx.home(a) for a in ctx.arm_names}
+    world = ctx.new_world()
+    ladder = DualMotionPlanner(ctx)
+    alone = DualMotionPlanner(ctx, direct=False)
+    planners = {
+        "optimiser": (alone, (PlainStrategy(lifted_warm_start=False),)),
+        "ompl": (ladder, (SampledStrategy(),)),
+        "ladder": (ladder, default_strategies(sampling=True)),
+    }
+    alone.trajopt  # noqa: B018  (wait for the build: not part of any planning time)
+    grasps = {
+        n: sample_grasps(objects[n].size, ctx.scene.gripper.max_graspable_width) for n in names
+    }
+    cands = {
+        (a, n): solve_ik_candidates(
+            ctx, world, objects, [IKRequest(a, n, objects[n], grasps[n])], home
+        )[:2]
+        for a in ctx.arm_names
+        for n in names
+    }
+    rng = np.random.default_rng(seed)
+    requests: dict[str, list[MotionRequest]] = {"one_arm": [], "both_arms": []}
+    tries = 0
+    while min(len(r) for r in requests.values()) < count and tries < 5000:
+        tries += 1
+        kind = "one_arm" if len(requests["one_arm"]) < count else "both_arms"
+        pick = [str(x) for x in rng.choice(names, 4, replace=False)]
+        qs = []
+        for i, arm in enumerate(ctx.arm_names):
+            if kind == "one_arm" and i == 1:
+                qs.append((home[arm], home[arm]))
+                continue
+            a, b = cands[(arm, pick[2 * i])], cands[(arm, pick[2 * i + 1])]
+            if not a or not b:
+                break
+            qs.append((a[int(rng.integers(len(a)))].q, b[int(rng.integers(len(b)))].q))
+        if len(qs) < 2:
+            continue
+        q0 = np.concatenate([qs[0][0], qs[1][0]])
+        q1 = np.concatenate([qs[0][1], qs[1][1]])
+        if world.in_collision(q0[:6], q0[6:]) or world.in_collision(q1[:6], q1[6:]):
+            continue
+        moving = (True, kind == "both_arms")
+        request = MotionRequest(q0, q1, objects, retreat=moving, approach=moving)
+        configure_world(ctx, ladder.world, objects, {}, q0)
+        phases = ladder.phases(request)
+        if phases is None:
+            continue
+        q_from, q_to = phases[0][0][-1], phases[1][0][0]
+        line = np.linspace(0.0, 1.0, 40)[:, None] * (q_to - q_from)[None] + q_from[None]
+        if validate_trajectory(ctx, ladder.world, line).ok:
+            continue  # the straight line is clear: not a hard transfer
+        requests[kind].append(request)
+    out: dict[str, object] = {"benchmark": "bench_motion_hard", "instance": instance, "seed": seed}
+    check = ctx.new_world()
+    for kind, reqs in requests.items():
+        rows: dict[str, list[tuple[bool, float, float]]] = {}
+        for name, (planner, strategies) in planners.items():
+            rows[name] = []
+            for request in reqs:
+                t = time.process_time()
+                result = plan_dual_motion(planner, request, strategies=strategies)
+                cpu = time.process_time() - t
+                ok = result.success and result.trajectory is not None
+                if ok and result.trajectory is not None:
+                    configure_world(ctx, check, request.objects, request.held, request.q_start)
+                    assert validate_trajectory(ctx, check, result.trajectory.q).ok
+                duration = result.trajectory.duration if result.trajectory else float("nan")
+                rows[name].append((ok, cpu, duration))
+        both = [all(rows[n][k][0] for n in ("ompl", "ladder")) for k in range(len(reqs))]
+        summary: dict[str, object] = {"transfers": len(reqs)}
+        for name, r in rows.items():
+            solved = [x for x in r if x[0]]
+            common = [x[2] for x, b in zip(r, both, strict=True) if b]
+            summary[name] = {
+                "solved": len(solved),
+                "time_median_s": float(np.median([x[1] for x in r])) if r else None,
+                "time_median_solved_s": float(np.median([x[1] for x in solved]))
+                if solved
+                else None,
+                "execution_median_common_s": float(np.median(common)) if common else None,
+            }
+            print(f"{kind:>9} {name:>9}: solved {len(solved)}/{len(r)}, median CPU "
+                  f"{summary[name]['time_median_s']:.3f} s, execution (common) "  # type: ignore[str-format]
+                  f"{summary[name]['execution_median_common_s']}", flush=True)  # fmt: skip
+        out[kind] = summary
+    print(json.dumps(out))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--segments", type=int, default=200)
     ap.add_argument("--instance", default="M1")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--verbose", action="store_true", help="print every non-plain segment")
+    ap.add_argument("--hard", type=int, default=0, help="the hard set instead (see above)")
     args = ap.parse_args()
+    if args.hard:
+        hard_set(args.instance, args.seed, args.hard)
+        return
 
     ctx = WorldContext.load()
     t_build = time.perf_counter()

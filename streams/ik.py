@@ -16,11 +16,13 @@ Values holding arrays (:class:`IKRequest`, :class:`IKCandidate`) compare by iden
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections import OrderedDict
+from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.transforms import FloatArray
 from streams.cartesian import straight_tool_move
@@ -148,6 +150,45 @@ def ensure_objects(world: CollisionWorld, objects: Mapping[str, ObjectBox]) -> N
     )
     if not same:
         world.set_objects(objects)
+
+
+class SceneCache:
+    """Collision worlds for IK queries, one per object arrangement, least recently used first
+    out.
+
+    The key is the arrangement itself (the set of ``(object, pose key)`` a query places on
+    the table, given by the caller), so every query of one arrangement (picks of different
+    objects, grasps, arms) shares one world; a new arrangement reuses the least recently
+    used world when ``capacity`` are kept. ``builds`` counts the worlds given a new object
+    set (each costs a geometry rebuild of a few milliseconds); ``hits`` the queries that
+    found theirs ready.
+    """
+
+    def __init__(self, ctx: WorldContext, margin: float, capacity: int = 8) -> None:
+        if capacity < 1:
+            raise ParameterError(f"scene cache capacity must be >= 1, got {capacity}")
+        self.ctx = ctx
+        self.margin = margin
+        self.capacity = capacity
+        self._worlds: OrderedDict[Hashable, CollisionWorld] = OrderedDict()
+        self.builds = 0
+        self.hits = 0
+
+    def world(self, key: Hashable, objects: Mapping[str, ObjectBox]) -> CollisionWorld:
+        """The world holding exactly ``objects`` (the arrangement ``key``)."""
+        world = self._worlds.get(key)
+        if world is not None:
+            self._worlds.move_to_end(key)
+            self.hits += 1
+            return world
+        if len(self._worlds) >= self.capacity:
+            _, world = self._worlds.popitem(last=False)
+        else:
+            world = self.ctx.new_world(margin=self.margin)
+        world.set_objects(objects)
+        self.builds += 1
+        self._worlds[key] = world
+        return world
 
 
 def compatible_pairs(

@@ -36,19 +36,31 @@ from typing import Protocol
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.transforms import FloatArray
 from streams.cartesian import straight_tool_move, tool_pose_ik
 from streams.context import WorldContext
 from streams.sphere_pairs import HeldSpheres
 from streams.spheres import object_spheres
-from streams.timing import TimedTrajectory, time_parameterize
-from streams.trajopt import DualArmTrajOpt, TrajOptOptions, TransferQuery, straight_line
+from streams.timing import TimedTrajectory, spline_curve, time_parameterize
+from streams.trajopt import (
+    OPTIMISERS,
+    DualArmTrajOpt,
+    OptimiserBuild,
+    OptimiserCache,
+    TrajOptOptions,
+    TransferQuery,
+    straight_line,
+)
 from streams.validate import HeldObject, ValidationReport, configure_world, validate_trajectory
 
 #: Spheres per resting object in the optimiser's obstacle model (8: one per octant, tight
 #: enough that a pre-grasp beside a neighbour does not start inside its sphere).
 OBSTACLE_SPHERES = 8
+#: Samples of the curve checked for a transfer taken without optimisation (the check
+#: refines them to 5 mm of TCP travel).
+DIRECT_SAMPLES = 16
 
 
 @dataclass(frozen=True)
@@ -77,6 +89,8 @@ class MotionResult:
     validation: ValidationReport | None = None
     reason: str = ""
     ipopt_solves: int = 0  # optimiser calls that ran IPOPT (a feasible straight line needs none)
+    direct_paths: int = 0  # transfers (or stages) taken straight or lightly bent, not optimised
+    sampled_paths: int = 0  # transfers found by the sampling-based planner (OMPL)
 
 
 @dataclass(frozen=True)
@@ -100,17 +114,72 @@ class TransferStrategy(Protocol):
     ) -> list[FloatArray] | None: ...
 
 
-class DualMotionPlanner:
-    """Owns the optimiser (built once) and a scratch collision world."""
+#: Clearance [m] a transfer taken without optimisation keeps from resting and held objects
+#: on the exact check (the optimiser's sphere model asks 15 mm of its spheres).
+DIRECT_MARGIN = 0.005
+#: TCP lifts [m] of the lightly bent paths tried when the straight line is not clear.
+DIRECT_LIFTS = (0.05, 0.12)
 
-    def __init__(self, ctx: WorldContext, options: TrajOptOptions | None = None) -> None:
+
+class DualMotionPlanner:
+    """Owns the optimiser and scratch collision worlds. The optimiser comes from
+    ``optimisers`` (default: the process-wide :data:`streams.trajopt.OPTIMISERS`; built once
+    per scene and options, in the background, so constructing a planner costs nothing and
+    only the first optimisation may wait for the build; None: a private cache). Worlds:
+    ``world`` for the exact validation, ``margin_world`` (objects grown by ``direct_margin``
+    [m]) for transfers taken without optimisation.
+
+    ``direct_lifts``: TCP lifts [m] of the bent paths tried after the straight line (empty:
+    the straight line only); ``direct=False`` always optimises (the sphere model's own
+    straight-line test still applies)."""
+
+    def __init__(
+        self,
+        ctx: WorldContext,
+        options: TrajOptOptions | None = None,
+        *,
+        direct: bool = True,
+        direct_margin: float = DIRECT_MARGIN,
+        direct_lifts: Sequence[float] = DIRECT_LIFTS,
+        optimisers: OptimiserCache | None = OPTIMISERS,
+    ) -> None:
+        if direct_margin < 0.0:
+            raise ParameterError(f"direct_margin must be >= 0 [m], got {direct_margin}")
         self.ctx = ctx
-        self.trajopt = DualArmTrajOpt(ctx, options)
+        cache = optimisers if optimisers is not None else OptimiserCache()
+        self._build = cache.get(ctx, options)
+        self._trajopt: DualArmTrajOpt | None = None
         self.world = ctx.new_world()
+        self.margin_world = ctx.new_world(margin=direct_margin)
+        self.direct = direct
+        self.direct_lifts = tuple(float(h) for h in direct_lifts)
         self._v = np.concatenate([ctx.scene.arm(a).velocity_limit for a in ctx.arm_names])
         self._a = np.concatenate([ctx.scene.arm(a).acceleration_limit for a in ctx.arm_names])
         self.optimisation_time = 0.0  # reset per plan_dual_motion call
         self.ipopt_solves = 0
+        self.direct_paths = 0  # transfers taken without optimisation, per plan_dual_motion call
+        self.sampled_paths = 0  # transfers found by sampling, per plan_dual_motion call
+
+    @property
+    def trajopt(self) -> DualArmTrajOpt:
+        """The trajectory optimiser; the first access waits for its background build."""
+        if self._trajopt is None:
+            self._trajopt = self._build.get()
+        return self._trajopt
+
+    @trajopt.setter
+    def trajopt(self, value: DualArmTrajOpt) -> None:
+        self._trajopt = value
+
+    @property
+    def limits(self) -> tuple[FloatArray, FloatArray]:
+        """Joint velocity [rad/s] and acceleration [rad/s^2] limits ``(12,)`` each."""
+        return self._v, self._a
+
+    @property
+    def build(self) -> OptimiserBuild:
+        """The optimiser's build: ``ready``, ``build_time`` (CPU [s]), ``waited`` [s]."""
+        return self._build
 
     # -- building blocks used by strategies ----------------------------------------------
     def nominal_duration(self, q_a: FloatArray, q_b: FloatArray) -> float:
@@ -135,6 +204,11 @@ class DualMotionPlanner:
             return np.stack([q_a, q_b])
         still = [bool(np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6])) for i in (0, 1)]
         fixed = (fixed[0] or still[0], fixed[1] or still[1])
+        if warm_start is None and self.direct:
+            direct = self.direct_path(q_a, q_b, fixed)
+            if direct is not None:
+                self.direct_paths += 1
+                return direct
         query = TransferQuery(
             q_a, q_b, problem.held, problem.obstacles, self.nominal_duration(q_a, q_b), fixed
         )
@@ -142,6 +216,33 @@ class DualMotionPlanner:
         self.optimisation_time += result.solve_time
         self.ipopt_solves += int(result.rounds > 0)
         return result.path if result.success else None
+
+    def direct_path(
+        self, q_a: FloatArray, q_b: FloatArray, fixed: tuple[bool, bool] = (False, False)
+    ) -> FloatArray | None:
+        """The straight joint-space line from ``q_a`` to ``q_b``, else a lightly bent path
+        through a lifted via configuration (:data:`DIRECT_LIFTS`), as waypoints ``(k, 12)``,
+        if the curve the time parameterisation follows through them passes the exact check
+        in ``margin_world`` (configured like ``world``); else None. Arms that wait stay put."""
+        still = [
+            fixed[i] or bool(np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6]))
+            for i in (0, 1)
+        ]
+        if any(f and not np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6])
+               for i, f in enumerate(fixed)):  # fmt: skip
+            return None
+        candidates = [np.stack([q_a, q_b])]
+        for height in self.direct_lifts:
+            via = self.lifted_via(q_a, q_b, height, knots=3)[1]
+            for i in (0, 1):
+                if still[i]:
+                    via[6 * i : 6 * i + 6] = q_a[6 * i : 6 * i + 6]
+            candidates.append(np.stack([q_a, via, q_b]))
+        for waypoints in candidates:
+            curve = spline_curve(waypoints, DIRECT_SAMPLES)
+            if validate_trajectory(self.ctx, self.margin_world, curve).ok:
+                return waypoints
+        return None
 
     def optimise_or_lift(
         self,
@@ -156,10 +257,13 @@ class DualMotionPlanner:
             path = self.optimise(problem, q_a, q_b, self.lifted_via(q_a, q_b), fixed)
         return path
 
-    def lifted_via(self, q_a: FloatArray, q_b: FloatArray, height: float = 0.15) -> FloatArray:
-        """A warm start ``(K, 12)`` through a via configuration whose TCPs are ``height`` [m]
-        above the higher end, half-way between the two."""
-        K = self.trajopt.options.knots
+    def lifted_via(
+        self, q_a: FloatArray, q_b: FloatArray, height: float = 0.15, knots: int | None = None
+    ) -> FloatArray:
+        """A warm start ``(K, 12)`` (``knots``, default the optimiser's) through a via
+        configuration whose TCPs are ``height`` [m] above the higher end, half-way between
+        the two."""
+        K = knots if knots is not None else self._build.options.knots
         mid = 0.5 * (q_a + q_b)
         via = mid.copy()
         for i, arm in enumerate(self.ctx.arm_names):
@@ -225,7 +329,7 @@ class DualMotionPlanner:
     def transfer_problem(
         self, request: MotionRequest, q_from: FloatArray, q_to: FloatArray
     ) -> TransferProblem:
-        o = self.trajopt.options
+        o = self._build.options
         held = []
         for arm in self.ctx.arm_names:
             h = request.held.get(arm)
@@ -387,12 +491,21 @@ class OneArmStrategy:
 
 
 def default_strategies(
-    fallbacks: bool = True, sequential_only: bool = False
+    fallbacks: bool = True, sequential_only: bool = False, sampling: bool = False
 ) -> tuple[TransferStrategy, ...]:
     """The ladder of Alg. 2: plain, untangle, sequential (or a part of it).
-    ``sequential_only``: the baseline motion planner (:class:`OneArmStrategy`)."""
+    ``sequential_only``: the baseline motion planner (:class:`OneArmStrategy`).
+    ``sampling`` (needs OMPL): when the straight or lightly bent path is not clear, a
+    sampled path (RRTConnect, shortcut) warm-starts the optimiser instead of the straight
+    line (the sampled path itself is kept when the optimiser does not shorten it), before
+    untangling."""
     if sequential_only:
         return (OneArmStrategy(),)
+    if sampling:
+        from streams.sampling import SampledStrategy
+
+        sampled = SampledStrategy(name="plain", refine=True)
+        return (sampled,) if not fallbacks else (sampled, UntangleStrategy(), SequentialStrategy())
     if not fallbacks:
         return (PlainStrategy(),)
     return (PlainStrategy(), UntangleStrategy(), SequentialStrategy())
@@ -429,11 +542,14 @@ def plan_dual_motion(
     t0 = time.perf_counter()
     planner.optimisation_time = 0.0
     planner.ipopt_solves = 0
+    planner.direct_paths = 0
+    planner.sampled_paths = 0
     ladder = tuple(strategies) if strategies is not None else default_strategies(
         fallbacks, sequential_only)  # fmt: skip
     ctx = planner.ctx
     q_start = np.asarray(request.q_start, dtype=np.float64)
     configure_world(ctx, planner.world, request.objects, request.held, q_start)
+    configure_world(ctx, planner.margin_world, request.objects, request.held, q_start)
     phases = _clear_phases(planner, request, sequential_only and strategies is None)
     if isinstance(phases, str):
         return MotionResult(False, None, None, 0.0, time.perf_counter() - t0, (),
@@ -453,7 +569,9 @@ def plan_dual_motion(
             attempts.append(f"{strategy.name}: ok")
             return MotionResult(True, strategy.name, traj, planner.optimisation_time,
                                 time.perf_counter() - t0, tuple(attempts), report,
-                                ipopt_solves=planner.ipopt_solves)  # fmt: skip
+                                ipopt_solves=planner.ipopt_solves,
+                                direct_paths=planner.direct_paths,
+                                sampled_paths=planner.sampled_paths)  # fmt: skip
         attempts.append(
             f"{strategy.name}: validation failed ({report.reason} at sample {report.index}"
             + "".join(f", {p.first}-{p.second}" for p in report.pairs[:2])
@@ -461,4 +579,6 @@ def plan_dual_motion(
         )
     return MotionResult(False, None, None, planner.optimisation_time, time.perf_counter() - t0,
                         tuple(attempts), report, reason="; ".join(attempts),
-                        ipopt_solves=planner.ipopt_solves)  # fmt: skip
+                        ipopt_solves=planner.ipopt_solves,
+                        direct_paths=planner.direct_paths,
+                        sampled_paths=planner.sampled_paths)  # fmt: skip

@@ -24,15 +24,16 @@ from typing import Any
 import numpy as np
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.world.collision import CollisionWorld, ObjectBox
+from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.buffers import sample_buffers
 from streams.context import WorldContext
 from streams.grasps import Grasp, sample_grasps
-from streams.ik import IKRequest, solve_ik_candidates
+from streams.ik import IKRequest, SceneCache, solve_ik_candidates
 from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
+from streams.sampling import SamplingOptions
 from streams.validate import HeldObject
 
 LOG = logging.getLogger(__name__)
@@ -76,14 +77,16 @@ class DualConf:
         return np.array(self.left.q + self.right.q)
 
 
-#: Collision worlds kept for IK queries, one per object arrangement.
-WORLD_CACHE = 8
+#: Collision worlds kept for IK queries, one per object arrangement (a step of SDAR-M asks
+#: for a few: the current one, and per target the one after the pick plus the object there).
+WORLD_CACHE = 32
 #: Clearance [m] IK asks of grasp, pre-grasp and approach configurations from the other
 #: objects (the timed trajectory may deviate slightly from the checked configurations).
 IK_MARGIN = 0.003
 
-#: Motion planners of ``plan-dual-motion``: SDAR-M's ladder, plain optimisation, one arm at a time.
-MOTION_PLANNERS = ("sdar", "plain", "sequential")
+#: Motion planners of ``plan-dual-motion``: SDAR-M's ladder, plain optimisation, one arm at a
+#: time, and OMPL's RRTConnect (optional extra ``sdar-tamp[ompl]``, :mod:`streams.sampling`).
+MOTION_PLANNERS = ("sdar", "plain", "sequential", "ompl")
 
 
 class DualArmStreams:
@@ -111,18 +114,13 @@ class DualArmStreams:
         self.seed = seed
         self.world = ctx.new_world()
         self._arms_only = ctx.new_world()  # no objects: arm-arm checks of combine-confs
-        self._worlds: dict[Any, CollisionWorld] = {}
-        self._planner = planner
+        self.scenes = SceneCache(ctx, IK_MARGIN, WORLD_CACHE)  # IK worlds, one per arrangement
+        # the planner's optimiser starts building in the background now, while selection runs
+        self.planner = planner if planner is not None else DualMotionPlanner(ctx)
         self.reserved = dict(reserved or {})
         self.motion = motion
         self._grasps: dict[str, tuple[Grasp, ...]] = {}
         self._buffer_calls = 0
-
-    @property
-    def planner(self) -> DualMotionPlanner:
-        if self._planner is None:  # built on first use (about 3 s)
-            self._planner = DualMotionPlanner(self.ctx)
-        return self._planner
 
     def size(self, obj: str) -> Size:
         return self.sizes.get(obj, self.ctx.scene.object_size)
@@ -149,30 +147,14 @@ class DualArmStreams:
     def inverse_kinematics(
         self, arm: str, obj: str, p: Pose2D, g: Grasp, fluents: Sequence[tuple[Any, ...]] = ()
     ) -> Iterator[tuple[ArmConf]]:
-        objects = self.resting(fluents)
-        objects[obj] = self.box(obj, p)
+        placed = {f[1]: f[2] for f in fluents if f[0] == "atpose"}
+        placed[obj] = p
+        objects = {o: self.box(o, q) for o, q in placed.items()}
         request = IKRequest(arm, obj, objects[obj], (g,))
         home = {a: self.ctx.home(a) for a in self.ctx.arm_names}
-        world = self._world_for(fluents, obj, p, IK_MARGIN)
+        world = self.scenes.world(frozenset(placed.items()), objects)
         for c in solve_ik_candidates(self.ctx, world, objects, [request], home):
             yield (ArmConf(arm, tuple(map(float, c.q)), tuple(map(float, c.q_pre))),)
-
-    def _world_for(
-        self, fluents: Sequence[tuple[Any, ...]], obj: str, p: Pose2D, margin: float
-    ) -> CollisionWorld:
-        """A collision world already holding this object set (a few are kept: building the
-        geometry of a new set costs milliseconds, and IK queries alternate between sets)."""
-        key = (frozenset((f[1], f[2]) for f in fluents if f[0] == "atpose"), obj, p, margin)
-        world = self._worlds.pop(key, None)
-        if world is None:
-            if len(self._worlds) >= WORLD_CACHE:  # reuse the least recently used world
-                old_key = next(iter(self._worlds))
-                reused = self._worlds.pop(old_key)
-                world = reused if old_key[-1] == margin else self.ctx.new_world(margin=margin)
-            else:
-                world = self.ctx.new_world(margin=margin)
-        self._worlds[key] = world  # most recently used last
-        return world
 
     def sample_buffer(
         self, obj: str, fluents: Sequence[tuple[Any, ...]] = ()
@@ -238,11 +220,17 @@ class DualArmStreams:
         retreat = (q1.left.pre is not None, q1.right.pre is not None)
         approach = (q2.left.pre is not None, q2.right.pre is not None)
         request = MotionRequest(q1.q, q2.q, objects, held, retreat, approach)
+        strategies = None
+        if self.motion == "ompl":
+            from streams.sampling import SampledStrategy
+
+            strategies = (SampledStrategy(options=SamplingOptions(seed=self.seed)),)
         result = plan_dual_motion(
             self.planner,
             request,
             fallbacks=self.motion == "sdar" and not quick,
             sequential_only=self.motion == "sequential",
+            strategies=strategies,
         )
         if result.success:
             yield (result,)
@@ -294,9 +282,11 @@ def make_stream_map(
     """Bind every stream of ``stream.pddl`` by name (see the module docstring).
 
     ``sizes``: object name -> (lx, ly, lz) [m] (default: the scene's object size);
-    ``planner``: a motion planner to share (default: one built on first use, about 3 s);
+    ``planner``: a motion planner to share (default: a new one; its optimiser comes from the
+    process-wide cache, built once in the background);
     ``reserved``: poses buffers keep clear of (the goals); ``motion``: ``sdar`` (optimisation,
-    untangling, one arm at a time), ``plain`` (optimisation only) or ``sequential``.
+    untangling, one arm at a time), ``plain`` (optimisation only), ``sequential`` or ``ompl``
+    (RRTConnect, shortcut; needs the ``ompl`` extra).
     """
     s = DualArmStreams(world_context, sizes or {}, seed, planner, reserved, motion)
     return {

@@ -77,6 +77,21 @@ def spline_eval(
     return val, der, dd
 
 
+def spline_curve(waypoints: FloatArray, samples: int) -> FloatArray:
+    """``samples`` points ``(samples, n)`` evenly spaced in chord length along the curve
+    :func:`time_parameterize` follows through ``waypoints`` ``(N, n)`` (two waypoints: the
+    straight line)."""
+    W = np.asarray(waypoints, dtype=np.float64)
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(W, axis=0), axis=1) > 1e-9])
+    W = W[keep]
+    if len(W) < 2:
+        return np.repeat(W[:1], samples, axis=0)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(W, axis=0), axis=1))])
+    q, _, _ = spline_eval(s, W, natural_spline(s, W), np.linspace(0.0, s[-1], samples))
+    q[-1] = W[-1]
+    return q
+
+
 def _accel_rows(
     dq: FloatArray, ddq: FloatArray, dq1: FloatArray, ddq1: FloatArray, ds: float
 ) -> FloatArray:

@@ -26,6 +26,7 @@ end points may touch, e.g. a held object on the table at a place), then ``lb`` i
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -298,6 +299,81 @@ class DualArmTrajOpt:
              np.tile(self._amax * dt * dt, K - 2)]
         )  # fmt: skip
         return p, lbg, ubg
+
+
+class OptimiserBuild:
+    """A :class:`DualArmTrajOpt` under construction in a background thread (building the NLP
+    takes a few seconds of CPU; planning that needs no optimisation goes on meanwhile).
+
+    :meth:`get` waits for it (``waited`` [s] adds up the waits) and re-raises an error of
+    the build. ``build_time`` [s] is the CPU time of the build (NaN until it is done)."""
+
+    def __init__(self, ctx: WorldContext, options: TrajOptOptions, background: bool = True) -> None:
+        self.options = options
+        self.build_time = float("nan")
+        self.waited = 0.0
+        self._result: DualArmTrajOpt | None = None
+        self._error: BaseException | None = None
+        self._done = threading.Event()
+        if background:
+            name = "sdar-trajopt-build"
+            threading.Thread(target=self._run, args=(ctx,), name=name, daemon=True).start()
+        else:
+            self._run(ctx)
+
+    def _run(self, ctx: WorldContext) -> None:
+        start = time.thread_time()
+        try:
+            self._result = DualArmTrajOpt(ctx, self.options)
+        except BaseException as error:  # handed to the caller of get()
+            self._error = error
+        finally:
+            self.build_time = time.thread_time() - start
+            self._done.set()
+
+    @property
+    def ready(self) -> bool:
+        return self._done.is_set()
+
+    def get(self) -> DualArmTrajOpt:
+        if not self._done.is_set():
+            start = time.perf_counter()
+            _log.info("waiting for the trajectory optimiser to be built")
+            self._done.wait()
+            self.waited += time.perf_counter() - start
+        if self._error is not None:
+            raise self._error
+        assert self._result is not None
+        return self._result
+
+
+class OptimiserCache:
+    """Optimisers by scene and options, each built once (in the background) and shared by
+    every planner that asks for the same pair. A solver is not safe to call from two
+    threads at once: share one cache between planners used in one thread."""
+
+    def __init__(self) -> None:
+        self._builds: dict[tuple[Any, TrajOptOptions], OptimiserBuild] = {}
+        self._lock = threading.Lock()
+
+    def get(
+        self, ctx: WorldContext, options: TrajOptOptions | None = None, background: bool = True
+    ) -> OptimiserBuild:
+        """The build for ``ctx.scene`` and ``options`` (started now if it is the first)."""
+        key = (ctx.scene, options or TrajOptOptions())
+        with self._lock:
+            build = self._builds.get(key)
+            if build is None:
+                build = self._builds[key] = OptimiserBuild(ctx, key[1], background)
+        return build
+
+    def __len__(self) -> int:
+        return len(self._builds)
+
+
+#: The process-wide cache of built optimisers (a warm start for every later solve in the
+#: process with the same scene and options).
+OPTIMISERS = OptimiserCache()
 
 
 def straight_line(q_a: FloatArray, q_b: FloatArray, knots: int) -> FloatArray:

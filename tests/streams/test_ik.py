@@ -1,9 +1,11 @@
 import numpy as np
+import pytest
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from streams.context import WorldContext
 from streams.grasps import pregrasp_offset, sample_grasps
-from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
+from streams.ik import IKRequest, SceneCache, compatible_pairs, solve_ik_candidates
 
 
 def _requests(
@@ -68,3 +70,25 @@ def test_compatible_pairs_are_jointly_collision_free(
     for a, b in pairs:
         assert a.arm == "left" and b.arm == "right"
         assert not world.in_collision(a.q_pre, b.q_pre)
+
+
+def test_scene_cache_keeps_one_world_per_arrangement(
+    ctx: WorldContext, objects: dict[str, ObjectBox]
+) -> None:
+    cache = SceneCache(ctx, margin=0.003, capacity=2)
+    names = list(objects)
+    fewer = {k: v for k, v in objects.items() if k != names[0]}
+    a = cache.world("all", objects)
+    assert cache.world("all", objects) is a and (cache.builds, cache.hits) == (1, 1)
+    assert set(a.objects) == set(objects)
+    b = cache.world("fewer", fewer)
+    assert b is not a and set(b.objects) == set(fewer) and cache.builds == 2
+    # a third arrangement reuses the least recently used world ("all")
+    c = cache.world("one", {names[0]: objects[names[0]]})
+    assert c is a and set(c.objects) == {names[0]} and cache.builds == 3
+    assert cache.world("fewer", fewer) is b and cache.hits == 2
+
+
+def test_scene_cache_refuses_no_capacity(ctx: WorldContext) -> None:
+    with pytest.raises(ParameterError, match="capacity must be >= 1, got 0"):
+        SceneCache(ctx, margin=0.003, capacity=0)

@@ -3,8 +3,11 @@
 from dataclasses import dataclass
 
 import numpy as np
+import pytest
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
+from streams import trajopt
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
@@ -17,7 +20,8 @@ from streams.motion import (
     default_strategies,
     plan_dual_motion,
 )
-from streams.trajopt import TransferQuery, straight_line
+from streams.timing import spline_curve
+from streams.trajopt import OptimiserCache, TrajOptOptions, TransferQuery, straight_line
 from streams.validate import configure_world, validate_trajectory
 
 # Two grasp configurations in M1 whose straight synchronous transfer is blocked (found by search).
@@ -176,3 +180,77 @@ def test_a_colliding_retreat_fails_at_once_without_optimising(
     result = plan_dual_motion(planner, request)
     assert not result.success and result.attempts == ()
     assert result.reason.startswith("retreat collides") and result.optimisation_time == 0.0
+
+
+def test_a_clear_straight_transfer_is_taken_without_optimising(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    names = list(objects)
+    q_goal = _pick_goal(ctx, objects, names[0], names[5])
+    request = MotionRequest(_home12(ctx), q_goal, objects, approach=(True, True))
+    result = plan_dual_motion(planner, request)
+    assert result.success and result.direct_paths == 1 and result.ipopt_solves == 0
+    assert result.optimisation_time == 0.0 and result.trajectory is not None
+    _check(ctx, result.trajectory.t, result.trajectory.q, request)
+    # the same transfer through the optimiser (direct paths off) is no faster to execute
+    optimised = DualMotionPlanner(ctx, direct=False)
+    assert optimised.trajopt is planner.trajopt  # one optimiser per scene and options
+    again = plan_dual_motion(optimised, request)
+    assert again.success and again.direct_paths == 0 and again.trajectory is not None
+    assert result.trajectory.duration <= again.trajectory.duration + 1e-6
+
+
+def test_direct_paths_need_the_margin_and_keep_waiting_arms_still(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    request = MotionRequest(BLOCKED_START, BLOCKED_GOAL, objects, retreat=(True, True),
+                            approach=(True, True))  # fmt: skip
+    configure_world(ctx, planner.world, objects, {}, BLOCKED_START)
+    configure_world(ctx, planner.margin_world, objects, {}, BLOCKED_START)
+    retreat, approach = planner.phases(request) or (None, None)
+    assert retreat is not None and approach is not None
+    q_a, q_b = retreat[-1][-1], approach[0][0]
+    path = planner.direct_path(q_a, q_b)
+    if path is not None:  # a bent path: it passes the check with the margin
+        assert len(path) == 3
+        curve = spline_curve(path, 64)
+        assert validate_trajectory(ctx, planner.margin_world, curve).ok
+    # an arm told to wait cannot reach a different goal directly
+    assert planner.direct_path(q_a, q_b, fixed=(True, False)) is None
+    # a waiting arm stays put on the bent paths too
+    q_b2 = q_b.copy()
+    q_b2[:6] = q_a[:6]
+    moved = planner.direct_path(q_a, q_b2, fixed=(True, False))
+    if moved is not None:
+        assert np.allclose(moved[:, :6], q_a[:6])
+
+
+def test_direct_margin_must_not_be_negative(ctx: WorldContext) -> None:
+    with pytest.raises(ParameterError, match="direct_margin must be >= 0"):
+        DualMotionPlanner(ctx, direct_margin=-0.001)
+
+
+def test_optimisers_are_built_once_per_scene_and_options(
+    ctx: WorldContext, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    built: list[TrajOptOptions] = []
+
+    class Fake:
+        def __init__(self, ctx: WorldContext, options: TrajOptOptions) -> None:
+            built.append(options)
+            if options.knots == 3:
+                raise ParameterError("no NLP with 3 knots")
+
+    monkeypatch.setattr(trajopt, "DualArmTrajOpt", Fake)
+    cache = OptimiserCache()
+    a = cache.get(ctx, TrajOptOptions(knots=6))
+    b = cache.get(ctx, TrajOptOptions(knots=6))
+    c = cache.get(ctx, TrajOptOptions(knots=7), background=False)
+    assert a is b and c is not a and len(cache) == 2
+    assert a.get() is b.get() and a.ready and a.build_time >= 0.0
+    assert [o.knots for o in sorted(built, key=lambda o: o.knots)] == [6, 7]
+    planner = DualMotionPlanner(ctx, TrajOptOptions(knots=6), optimisers=cache)
+    assert planner.trajopt is a.get() and len(built) == 2  # no second build
+    broken = cache.get(ctx, TrajOptOptions(knots=3))
+    with pytest.raises(ParameterError, match="no NLP with 3 knots"):
+        broken.get()

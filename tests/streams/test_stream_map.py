@@ -9,7 +9,7 @@ from sdar_tamp.language.streams import parse_stream_file
 from sdar_tamp.world.instance import Instance, Pose2D
 from streams.context import WorldContext
 from streams.motion import DualMotionPlanner
-from streams.stream_map import STREAM_KINDS, ArmConf, DualConf, make_stream_map
+from streams.stream_map import STREAM_KINDS, ArmConf, DualArmStreams, DualConf, make_stream_map
 
 DOMAIN = Path(__file__).resolve().parents[2] / "domains" / "dual_arm_rearrangement"
 
@@ -117,3 +117,22 @@ def test_buffers_keep_clear_of_reserved_goals(ctx: WorldContext, instance: Insta
 def test_unknown_motion_planner_is_refused(ctx: WorldContext) -> None:
     with pytest.raises(ParameterError, match="motion planner must be one of sdar, plain"):
         make_stream_map(ctx, motion="fast")
+
+
+def test_ik_queries_of_one_arrangement_share_one_collision_world(
+    ctx: WorldContext, instance: Instance
+) -> None:
+    sm_obj = DualArmStreams(ctx, {x.name: x.size for x in instance.objects})
+    fluents = [("atpose", x.name, x.start) for x in instance.objects]
+    grasps = [g for (g,) in sm_obj.sample_grasp(instance.objects[0].name)]
+    for o in instance.objects[:4]:  # picks of four objects where they rest, two grasps, both arms
+        for arm in ctx.arm_names:
+            for g in grasps[:2]:
+                list(sm_obj.inverse_kinematics(arm, o.name, o.start, g, fluents))
+    assert sm_obj.scenes.builds == 1 and sm_obj.scenes.hits == 15
+    # a place of the first object elsewhere is another arrangement: one more world
+    o = instance.objects[0]
+    after = [f for f in fluents if f[1] != o.name]
+    list(sm_obj.inverse_kinematics("left", o.name, o.goal, grasps[0], after))
+    list(sm_obj.inverse_kinematics("right", o.name, o.goal, grasps[0], after))
+    assert sm_obj.scenes.builds == 2 and sm_obj.scenes.hits == 16

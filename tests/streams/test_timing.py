@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from streams.timing import natural_spline, spline_eval, time_parameterize
+from streams.timing import natural_spline, spline_curve, spline_eval, time_parameterize
 
 V = np.full(12, np.pi)
 A = np.full(12, 5.0)
@@ -49,3 +49,18 @@ def test_spline_interpolates_waypoints() -> None:
 def test_single_point_is_a_zero_length_trajectory() -> None:
     traj = time_parameterize(np.ones((3, 12)), V, A)
     assert traj.duration == 0.0 and traj.q.shape == (1, 12)
+
+
+def test_spline_curve_is_the_path_the_parameterisation_follows() -> None:
+    a, b = np.zeros(3), np.array([1.0, -2.0, 0.5])
+    line = spline_curve(np.stack([a, b]), 5)
+    np.testing.assert_allclose(line, np.linspace(0.0, 1.0, 5)[:, None] * b[None], atol=1e-12)
+    via = np.array([0.5, 0.0, 1.0])
+    W = np.stack([a, via, b])
+    curve = spline_curve(W, 101)
+    np.testing.assert_allclose(curve[[0, -1]], W[[0, -1]], atol=1e-12)
+    assert np.min(np.linalg.norm(curve - via, axis=1)) < 0.02  # passes through the via point
+    traj = time_parameterize(W, np.ones(3), np.ones(3))
+    # every timed sample lies on the curve
+    dist = np.linalg.norm(traj.q[:, None] - curve[None], axis=2).min(axis=1)
+    assert dist.max() < 0.03

@@ -1,0 +1,241 @@
+"""Sampling-based synchronous dual-arm transfers: OMPL's RRTConnect in the 12-D joint space.
+
+An optional extra (``pip install sdar-tamp[ompl]``). The planner samples both arms' joints
+within their limits; a state is valid when the planner's ``margin_world`` (resting and held
+objects grown by the direct-path margin, see :class:`streams.motion.DualMotionPlanner`)
+reports no collision, and OMPL checks edges every ``resolution`` [rad] of joint-space
+length. The path found is shortcut by OMPL's simplifier, then the curve that
+:func:`streams.timing.time_parameterize` follows through its waypoints is checked exactly
+(5 mm of TCP travel) in the same world; if the spline bulges into an obstacle, the path is
+densified once and checked again. The motion is then assembled, timed and validated like
+any other strategy's (:func:`streams.motion.plan_dual_motion`).
+
+Work is bounded by counts, not seconds (``max_checks`` state checks for planning,
+``simplify_checks`` for shortcutting), so a query gives the same path for the same OMPL
+random state. OMPL seeds its generators from one process-wide seed, set once per process
+by the first query (``seed``): a process that runs the same queries in the same order gets
+the same paths. OMPL's console output is lowered to warnings during each query and restored.
+
+:class:`SampledStrategy` is a :class:`streams.motion.TransferStrategy`; with
+``refine=True`` the trajectory optimiser is warm-started from the sampled path and its
+result kept when it executes faster.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import threading
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from sdar_tamp.errors import ParameterError, SdarError
+from sdar_tamp.world.transforms import FloatArray
+from streams.timing import spline_curve, time_parameterize
+from streams.trajopt import densify
+from streams.validate import validate_trajectory
+
+if TYPE_CHECKING:
+    from streams.motion import DualMotionPlanner, TransferProblem
+
+
+class OmplUnavailableError(SdarError):
+    """The ``ompl`` package is not installed (``pip install sdar-tamp[ompl]``)."""
+
+
+def ompl_available() -> bool:
+    """True when the ``ompl`` Python package can be imported."""
+    return importlib.util.find_spec("ompl") is not None
+
+
+@dataclass(frozen=True)
+class SamplingOptions:
+    """Budgets and resolution of one sampled transfer."""
+
+    max_checks: int = 20_000  # state validity checks while planning
+    simplify_checks: int = 4_000  # state validity checks while shortcutting
+    resolution: float = 0.02  # [rad] joint-space length between edge checks
+    range: float = 0.0  # [rad] RRTConnect's step (0: OMPL's default, a fifth of the extent)
+    curve_samples: int = 24  # samples of the timed curve handed to the exact check
+    seed: int = 0  # OMPL's process-wide seed (plus one), set by the first query of the process
+
+    def __post_init__(self) -> None:
+        for name in ("max_checks", "simplify_checks", "curve_samples"):
+            if getattr(self, name) < 1:
+                raise ParameterError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if not self.resolution > 0.0:
+            raise ParameterError(f"resolution must be > 0 [rad], got {self.resolution}")
+        if self.seed < 0:
+            raise ParameterError(f"seed must be >= 0, got {self.seed}")
+        if self.range < 0.0:
+            raise ParameterError(f"range must be >= 0 [rad], got {self.range}")
+
+
+_SEEDED: list[int] = []  # OMPL's seed, once per process
+_SEED_LOCK = threading.Lock()
+
+
+def _ompl() -> tuple[Any, Any, Any]:
+    if not ompl_available():
+        raise OmplUnavailableError(
+            "the sampling-based motion planner needs OMPL: pip install 'sdar-tamp[ompl]'"
+        )
+    from ompl import base, geometric, util
+
+    return base, geometric, util
+
+
+def sample_path(
+    planner: DualMotionPlanner,
+    q_a: FloatArray,
+    q_b: FloatArray,
+    options: SamplingOptions | None = None,
+) -> FloatArray | None:
+    """Collision-free waypoints ``(k, 12)`` from ``q_a`` to ``q_b`` (``planner.margin_world``
+    configured for the segment), shortcut; None when the budget runs out."""
+    o = options or SamplingOptions()
+    ob, og, ou = _ompl()
+    with _SEED_LOCK:
+        if not _SEEDED:
+            ou.RNG.setSeed(o.seed + 1)  # OMPL refuses 0
+            _SEEDED.append(o.seed)
+    ctx, world = planner.ctx, planner.margin_world
+    lo = np.concatenate([ctx.scene.arm(a).lower_array for a in ctx.arm_names])
+    hi = np.concatenate([ctx.scene.arm(a).upper_array for a in ctx.arm_names])
+    q_a, q_b = np.asarray(q_a, dtype=np.float64), np.asarray(q_b, dtype=np.float64)
+    # arms that do not move are pinned: zero-width bounds keep them at their start
+    still = [bool(np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6])) for i in (0, 1)]
+    lo, hi = np.minimum(lo, np.minimum(q_a, q_b)), np.maximum(hi, np.maximum(q_a, q_b))
+    for i in (0, 1):
+        if still[i]:
+            lo[6 * i : 6 * i + 6] = hi[6 * i : 6 * i + 6] = q_a[6 * i : 6 * i + 6]
+    free = np.flatnonzero(hi > lo)
+    if len(free) == 0:
+        return np.stack([q_a, q_b])
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_WARN)
+    try:
+        return _plan(ob, og, world, q_a, q_b, lo, hi, free, o)
+    finally:
+        ou.setLogLevel(level)
+
+
+def _plan(
+    ob: Any,
+    og: Any,
+    world: Any,
+    q_a: FloatArray,
+    q_b: FloatArray,
+    lo: FloatArray,
+    hi: FloatArray,
+    free: Any,
+    o: SamplingOptions,
+) -> FloatArray | None:
+    n = len(free)
+    space = ob.RealVectorStateSpace(n)
+    bounds = ob.RealVectorBounds(n)
+    for k, j in enumerate(free):
+        bounds.setLow(k, float(lo[j]))
+        bounds.setHigh(k, float(hi[j]))
+    space.setBounds(bounds)
+    setup = og.SimpleSetup(space)
+    q = q_a.copy()
+    checks = [0]
+
+    def full(state: Any) -> FloatArray:
+        out = q.copy()
+        out[free] = [state[k] for k in range(n)]
+        return out
+
+    def valid(state: Any) -> bool:
+        checks[0] += 1
+        x = full(state)
+        return not world.in_collision(x[:6], x[6:])
+
+    if not valid(_state(space, q_a, free)) or not valid(_state(space, q_b, free)):
+        return None  # RRTConnect would wait for a valid start or goal
+    setup.setStateValidityChecker(valid)
+    info = setup.getSpaceInformation()
+    info.setStateValidityCheckingResolution(o.resolution / space.getMaximumExtent())
+    setup.setStartAndGoalStates(_state(space, q_a, free), _state(space, q_b, free))
+    rrt = og.RRTConnect(info)
+    if o.range > 0.0:
+        rrt.setRange(o.range)
+    setup.setPlanner(rrt)
+    polls = [0]  # the condition also counts its own polls: planning ends even without checks
+
+    def spent(limit: int) -> bool:
+        polls[0] += 1
+        return checks[0] >= limit or polls[0] >= 10 * limit
+
+    budget = ob.PlannerTerminationCondition(lambda: spent(o.max_checks))
+    solved = setup.solve(budget)
+    if not setup.haveExactSolutionPath() or not bool(solved):
+        return None
+    path = setup.getSolutionPath()
+    limit = checks[0] + o.simplify_checks
+    polls[0] = 0
+    simplifier = og.PathSimplifier(info)
+    simplifier.simplify(path, ob.PlannerTerminationCondition(lambda: spent(limit)))
+    W = np.stack([full(path.getState(k)) for k in range(path.getStateCount())])
+    W[0], W[-1] = q_a, q_b
+    return W
+
+
+def _state(space: Any, q: FloatArray, free: Any) -> Any:
+    state = space.allocState()
+    for k, j in enumerate(free):
+        state[k] = float(q[j])
+    return state
+
+
+def checked_waypoints(planner: DualMotionPlanner, W: FloatArray, samples: int) -> FloatArray | None:
+    """``W`` (or ``W`` densified) whose timed curve passes the exact check in
+    ``planner.margin_world``; None if neither does."""
+    for waypoints in (W, densify(W, 4)):
+        curve = spline_curve(waypoints, max(samples, 2 * len(waypoints)))
+        if validate_trajectory(planner.ctx, planner.margin_world, curve).ok:
+            return waypoints
+    return None
+
+
+@dataclass(frozen=True)
+class SampledStrategy:
+    """One transfer sampled by RRTConnect and shortcut (see the module docstring); with
+    ``refine``, the optimiser warm-started from it, kept when it executes faster."""
+
+    name: str = "sampled"
+    options: SamplingOptions = SamplingOptions()
+    refine: bool = False
+
+    def __call__(
+        self, planner: DualMotionPlanner, problem: TransferProblem
+    ) -> list[FloatArray] | None:
+        if self.refine and planner.direct:
+            direct = planner.direct_path(problem.q_from, problem.q_to)
+            if direct is not None:
+                planner.direct_paths += 1
+                return [direct]
+        W = sample_path(planner, problem.q_from, problem.q_to, self.options)
+        planner.sampled_paths += int(W is not None)
+        W = None if W is None else checked_waypoints(planner, W, self.options.curve_samples)
+        if W is None:
+            return None
+        if self.refine:
+            K = planner.build.options.knots
+            s = np.linspace(0.0, 1.0, K)
+            warm = spline_curve(W, 4 * K)[np.round(s * (4 * K - 1)).astype(int)]
+            refined = planner.optimise(problem, problem.q_from, problem.q_to, warm)
+            if (
+                refined is not None
+                and _duration(planner, refined) < _duration(planner, W)
+                and checked_waypoints(planner, refined, self.options.curve_samples) is not None
+            ):
+                return [refined]
+        return [W]
+
+
+def _duration(planner: DualMotionPlanner, path: FloatArray) -> float:
+    v, a = planner.limits
+    return time_parameterize(path, v, a).duration

@@ -1,0 +1,22 @@
+"""The command line's progress bar shows at once and keeps ticking between steps."""
+
+import io
+import time
+
+from sdar_tamp.solve_command import ProgressBar
+
+
+def test_bar_appears_at_once_and_refreshes_without_steps() -> None:
+    out = io.StringIO()
+    bar = ProgressBar("M1", stream=out, tick=0.01)
+    try:
+        first = out.getvalue()
+        assert first.startswith("\rM1:")  # drawn before any step
+        deadline = time.monotonic() + 10.0
+        while out.getvalue() == first and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert out.getvalue() != first  # the clock ticked with no progress call
+        bar(3, 12)
+    finally:
+        bar.close()
+    assert "3/12" in out.getvalue()

@@ -1,0 +1,103 @@
+"""The sampling-based transfer (OMPL RRTConnect): collision-free, validated, optional."""
+
+import numpy as np
+import pytest
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.world.collision import ObjectBox
+from streams import sampling
+from streams.context import WorldContext
+from streams.motion import DualMotionPlanner, MotionRequest, default_strategies, plan_dual_motion
+from streams.sampling import (
+    OmplUnavailableError,
+    SampledStrategy,
+    SamplingOptions,
+    sample_path,
+)
+from streams.validate import configure_world, validate_trajectory
+
+# Two grasp configurations in M1 whose straight synchronous transfer is blocked (as in
+# test_motion.py).
+BLOCKED_START = np.array([-0.9597713794940521, -1.487539072672206, 2.2951842532166142,
+    -2.3784415073393053, -1.5707963267948966, 0.6482225313692203, -0.5339339743344569,
+    -0.675777200007472, 1.1304521182278542, -1.6688772479994611, -0.8550081079150917,
+    -0.5163163995987907])  # fmt: skip
+BLOCKED_GOAL = np.array([0.04376532233356345, -0.9655976891109983, 1.5288636436242042,
+    -2.1340622813081023, -1.5707963267948966, 1.221061045296719, 0.2352577772079112,
+    -1.4271827367975796, 2.22417797686042, -2.3677915668577363, -1.5707963267948966,
+    1.0782072680107593])  # fmt: skip
+
+needs_ompl = pytest.mark.skipif(not sampling.ompl_available(), reason="OMPL not installed")
+
+
+def _blocked(objects: dict[str, ObjectBox]) -> MotionRequest:
+    return MotionRequest(BLOCKED_START, BLOCKED_GOAL, objects, retreat=(True, True),
+                         approach=(True, True))  # fmt: skip
+
+
+@needs_ompl
+def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    request = _blocked(objects)
+    configure_world(ctx, planner.world, objects, {}, BLOCKED_START)
+    configure_world(ctx, planner.margin_world, objects, {}, BLOCKED_START)
+    retreat, approach = planner.phases(request) or (None, None)
+    assert retreat is not None and approach is not None
+    q_a, q_b = retreat[-1][-1], approach[0][0]
+    straight = np.linspace(0.0, 1.0, 30)[:, None] * (q_b - q_a)[None] + q_a[None]
+    assert not validate_trajectory(ctx, planner.world, straight).ok
+    W = sample_path(planner, q_a, q_b)
+    assert W is not None and len(W) >= 3
+    np.testing.assert_allclose(W[[0, -1]], np.stack([q_a, q_b]))
+    for k in range(len(W)):  # every waypoint is clear, with the margin
+        assert not planner.margin_world.in_collision(W[k, :6], W[k, 6:])
+    # a waiting arm stays where it is
+    q_b2 = q_b.copy()
+    q_b2[:6] = q_a[:6]
+    W2 = sample_path(planner, q_a, q_b2)
+    assert W2 is not None and np.allclose(W2[:, :6], q_a[:6])
+    # a goal in collision ends at once (RRTConnect alone would wait for a valid goal)
+    q_bad = q_b.copy()
+    q_bad[6:] = q_a[6:]
+    assert planner.margin_world.in_collision(q_bad[:6], q_bad[6:])
+    assert sample_path(planner, q_a, q_bad) is None
+
+
+@needs_ompl
+def test_sampled_strategy_plans_a_validated_motion(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    request = _blocked(objects)
+    result = plan_dual_motion(planner, request, strategies=[SampledStrategy()])
+    assert result.success and result.level == "sampled" and result.sampled_paths == 1
+    assert result.ipopt_solves == 0 and result.trajectory is not None
+    check = ctx.new_world()
+    configure_world(ctx, check, objects, {}, BLOCKED_START)
+    assert validate_trajectory(ctx, check, result.trajectory.q).ok
+    ladder = default_strategies(sampling=True)
+    assert [s.name for s in ladder] == ["plain", "untangle", "sequential"]
+    assert isinstance(ladder[0], SampledStrategy) and ladder[0].refine
+    combined = plan_dual_motion(planner, request, strategies=ladder)
+    assert combined.success and combined.trajectory is not None
+    assert combined.direct_paths + combined.sampled_paths >= 1
+
+
+def test_sampling_options_are_checked() -> None:
+    with pytest.raises(ParameterError, match="max_checks must be >= 1, got 0"):
+        SamplingOptions(max_checks=0)
+    with pytest.raises(ParameterError, match=r"resolution must be > 0 \[rad\], got 0.0"):
+        SamplingOptions(resolution=0.0)
+    with pytest.raises(ParameterError, match=r"range must be >= 0 \[rad\]"):
+        SamplingOptions(range=-1.0)
+    with pytest.raises(ParameterError, match="seed must be >= 0"):
+        SamplingOptions(seed=-1)
+
+
+def test_missing_ompl_is_a_clear_error(
+    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(sampling, "ompl_available", lambda: False)
+    q = np.concatenate([ctx.home(a) for a in ctx.arm_names])
+    with pytest.raises(OmplUnavailableError, match=r"pip install 'sdar-tamp\[ompl\]'"):
+        sample_path(planner, q, q + 0.1)
