@@ -3,7 +3,10 @@
 Every precondition, effect condition, axiom body and the goal becomes a conjunction of literals:
 
 * ``Imply`` is rewritten and negations are pushed down to atoms (negation normal form);
-* ``ForAll`` is expanded over the (finite) objects of its parameter types;
+* ``ForAll`` is expanded over the (finite) objects of its parameter types when that gives at
+  most :data:`FORALL_EXPANSION_LIMIT` copies of its body; a larger one becomes, as in Fast
+  Downward, the negation of an auxiliary derived predicate ``(not (exists (..) (not body)))``
+  (its relaxation drops the condition, so grounding does not join one literal per copy);
 * ``Or`` and ``Exists`` become auxiliary derived predicates (one axiom per disjunct, the
   existential variables as extra axiom parameters), so grounding only ever joins conjunctions;
 * every typed parameter gets a *type literal* ``(type ?x)``; the type facts come from the object
@@ -15,6 +18,7 @@ Auxiliary predicates are named ``~aux<n>``, which is not a valid PDDL name, so t
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -41,6 +45,10 @@ from sdar_tamp.language.model import And as AndF
 from sdar_tamp.language.model import Or as OrF
 from solvers.classical.errors import GroundingError
 from solvers.classical.problem import PlanningTask
+
+#: a universally quantified condition over more parameter combinations than this is compiled
+#: into a negated auxiliary axiom instead of being expanded into one copy per combination
+FORALL_EXPANSION_LIMIT = 16
 
 
 @dataclass(frozen=True)
@@ -163,11 +171,17 @@ class _Normalizer:
             return [self.auxiliary(formula, formula.parameters, (formula.body,), context)]
         if isinstance(formula, Imply):
             return self.conjunction(nnf(formula), context)
-        # ForAll over finite objects: normalise the body once, then expand.
+        domains = [self.objects_of_type.get(p.type, ()) for p in formula.parameters]
+        if math.prod(len(d) for d in domains) > FORALL_EXPANSION_LIMIT:
+            # forall x: phi  ==  not (exists x: not phi)
+            counter = nnf(formula.body, negate=True)
+            exists = Exists(formula.parameters, counter)
+            lit = self.auxiliary(exists, formula.parameters, (counter,), context)
+            return [Lit(lit.predicate, lit.args, positive=False)]
+        # ForAll over few objects: normalise the body once, then expand.
         inner = dict(context)
         inner.update({p.name: p.type for p in formula.parameters})
         body = self.conjunction(formula.body, inner)
-        domains = [self.objects_of_type.get(p.type, ()) for p in formula.parameters]
         names = [p.name for p in formula.parameters]
         result: list[Lit] = []
         for values in itertools.product(*domains):
