@@ -49,6 +49,9 @@ def test_a_large_forall_is_one_negated_axiom_literal() -> None:
         (fact,) = op.negative_precondition
         assert grounded.facts[fact].predicate.startswith("~aux")
     assert grounded.axioms
+    # the static sibling (spot ?p) restricts the axiom to spots, not every object
+    heads = {grounded.facts[axiom.head] for axiom in grounded.axioms}
+    assert heads and all(atom.args[0].startswith("p") for atom in heads)
 
 
 @pytest.mark.parametrize("expanded", [False, True])
