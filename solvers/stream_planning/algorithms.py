@@ -290,6 +290,8 @@ class StreamSolver:
             stream_plan = extract_stream_plan(check.needed, world)
             ordered = fluent_plan(stream_plan, check, self.fluent_streams)
             stream_plan = ordered.stream_plan
+            if self.builder.refine(stream_plan):
+                continue  # it uses shared placeholders: plan again with the instances' own
             if not any(r.kind == "stream" for r in stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
             ):

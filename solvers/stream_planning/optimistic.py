@@ -2,7 +2,10 @@
 
 Each instance whose next result stays within the complexity limit contributes placeholder
 outputs (``#o<k>``). By default a placeholder belongs to its instance (``unique``); with
-``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output.
+``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output
+until an optimistic plan uses it: :meth:`OptimisticBuilder.refine` then gives the instances of
+that plan placeholders of their own (the solver plans again before sampling), as PDDLStream
+refines its shared optimistic values.
 
 With a callable ``StreamInfo(opt_gen_fn=gen_fn)`` (a stream with outputs; tests keep their
 default) an instance's optimistic outputs come from ``gen_fn`` called like the sampler on the
@@ -145,6 +148,8 @@ class OptimisticBuilder:
         self.producers: dict[str, str] = {}  # placeholder -> the stream that makes it
         # placeholder -> the value a callable opt_gen_fn gave it
         self.values: dict[str, object] = {}
+        self._shared: set[str] = set()  # placeholders shared by the instances of a stream
+        self.refined: set[tuple[str, tuple[str, ...]]] = set()  # instances with their own
         # (stream, inputs) -> the output tuples of its callable opt_gen_fn
         self._generated: dict[tuple[str, tuple[str, ...]], list[tuple[object, ...]]] = {}
 
@@ -223,11 +228,13 @@ class OptimisticBuilder:
                     )
                     for outputs in self._generated_outputs(external, inputs, generator)
                 ]
-            shared = external.info.opt_gen_fn == "shared"
+            shared = external.info.opt_gen_fn == "shared" and (name, inputs) not in self.refined
             outputs = tuple(
                 self.placeholder((name, i) if shared else (name, inputs, i))
                 for i in range(len(external.declaration.outputs))
             )
+            if shared:
+                self._shared.update(outputs)
             return [
                 OptResult(
                     name,
@@ -255,6 +262,18 @@ class OptimisticBuilder:
             Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.domain
         )
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
+
+    def refine(self, stream_plan: list[OptResult]) -> bool:
+        """Give the instances of ``stream_plan`` that produce shared placeholders placeholders
+        of their own in later builds; False when there is none (the plan is refined)."""
+        found = {
+            (r.external, r.inputs)
+            for r in stream_plan
+            if r.kind == "stream" and any(n in self._shared for n in r.outputs)
+        }
+        new = found - self.refined
+        self.refined.update(new)
+        return bool(new)
 
     def _values(self, inputs: tuple[str, ...]) -> tuple[object, ...]:
         return tuple(
