@@ -313,7 +313,7 @@ class OptimisticBuilder:
         values = self._values(inputs)
         what = f"the opt_gen_fn of stream {external.name!r} on inputs {values!r}"
         try:
-            produced = next(iter(generator(*values)), [])
+            produced: Any = next(iter(generator(*values)), [])
         except Exception as error:
             raise StreamError(f"{what} raised {type(error).__name__}: {error}") from error
         if isinstance(produced, WildOutput):
