@@ -173,6 +173,23 @@ class FormulaReader:
     def __init__(self, vocabulary: Vocabulary) -> None:
         self.vocabulary = vocabulary
         self._depth = 0
+        self._free: dict[str, SourceLocation] | None = None
+
+    def open_formula(
+        self, node: SExpr, scope: Mapping[str, str]
+    ) -> tuple[Formula, dict[str, SourceLocation]]:
+        """A formula that may use variables bound nowhere, and those variables.
+
+        Each free variable is returned with the location of its first use, in order of first
+        use; the caller decides what they mean (Fast Downward reads them as existentially
+        quantified over the whole formula).
+        """
+        outer = self._free
+        self._free = {}
+        try:
+            return self.formula(node, scope), self._free
+        finally:
+            self._free = outer
 
     def _enter(self, node: SExpr, what: str) -> None:
         if self._depth >= MAX_FORMULA_DEPTH:
@@ -193,6 +210,9 @@ class FormulaReader:
         text = token.text
         if text.startswith("?"):
             if text not in scope:
+                if self._free is not None:
+                    self._free.setdefault(text, token.location)
+                    return text
                 raise UnboundVariableError(f"variable {text} is not bound here", token.location)
         elif text not in self.vocabulary.constants:
             raise UndeclaredError(f"undeclared constant or object {text!r}", token.location)

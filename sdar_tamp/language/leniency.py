@@ -15,6 +15,10 @@ logged), and reject it only with ``strict=True`` (:class:`StrictModeError`). The
     a predicate declared twice with the same arity (the first declaration is kept).
 ``undeclared-parent-type``
     ``(:types a - b)`` where ``b`` is never declared: ``b`` becomes a subtype of ``object``.
+``free-variable``
+    a variable in an action precondition or a derived predicate's body that is neither a
+    parameter nor quantified: read as existentially quantified over that formula, as Fast
+    Downward's translator does.
 ``init-type``
     an initial fact whose argument's type is not the declared parameter type.
 
@@ -40,6 +44,7 @@ IMPLICIT_PREDICATE = "implicit-predicate"
 DUPLICATE_PREDICATE = "duplicate-predicate"
 UNDECLARED_PARENT_TYPE = "undeclared-parent-type"
 INIT_TYPE = "init-type"
+FREE_VARIABLE = "free-variable"
 
 KINDS = (
     GLUED_VARIABLE,
@@ -48,6 +53,7 @@ KINDS = (
     DUPLICATE_PREDICATE,
     UNDECLARED_PARENT_TYPE,
     INIT_TYPE,
+    FREE_VARIABLE,
 )
 _WARNING_KINDS = frozenset({UNDECLARED_PARENT_TYPE, INIT_TYPE})
 

@@ -32,7 +32,9 @@ class StreamInfo:
         overhead: expected cost of one call [s], >= 0.
         effort: fixed effort used in place of the one derived from p_success and overhead.
         opt_gen_fn: placeholder outputs: ``"unique"`` (default, one per instance) or
-            ``"shared"`` (one per stream); a callable is accepted but not used yet.
+            ``"shared"`` (one per stream), or a callable called like the sampler on the
+            instance's (optimistic) input values whose first batch of output tuples gives the
+            optimistic outputs and their values (see ``solvers.stream_planning.optimistic``).
         negate: for a test stream certifying one fact over its inputs: the domain may use
             that fact negated; ``(not (fact ...))`` holds where the test returns False.
         simultaneous: evaluate all instances of this stream together.

@@ -34,6 +34,7 @@ from sdar_tamp.language.grammar import (
 )
 from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
+    FREE_VARIABLE,
     IMPLICIT_PREDICATE,
     INIT_TYPE,
     REPEATED_VARIABLE,
@@ -50,6 +51,8 @@ from sdar_tamp.language.model import (
     Atom,
     Axiom,
     Domain,
+    Exists,
+    Formula,
     Function,
     Parameter,
     Predicate,
@@ -185,12 +188,12 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
     axioms: list[Axiom] = []
     for keyword, section in pending:
         if keyword == ":action":
-            action = _action(section, reader)
+            action = _action(section, reader, log)
             if any(existing.name == action.name for existing in actions):
                 raise DuplicateError(f"action {action.name!r} is defined twice", section.location)
             actions.append(action)
         else:
-            axioms.append(_axiom(section, reader, predicates))
+            axioms.append(_axiom(section, reader, predicates, log))
     for fname, arity in vocabulary.functions.items():
         if fname not in functions:
             params = tuple(Parameter(f"?x{i}") for i in range(arity))
@@ -311,7 +314,7 @@ def _options(section: SList, allowed: tuple[str, ...], what: str) -> dict[str, S
     return options
 
 
-def _action(section: SList, reader: FormulaReader) -> Action:
+def _action(section: SList, reader: FormulaReader, log: LeniencyLog) -> Action:
     if len(section.items) < 2:
         raise PddlSyntaxError("expected an action name after ':action'", section.location)
     name = expect_symbol(section.items[1], "an action name").text
@@ -324,13 +327,19 @@ def _action(section: SList, reader: FormulaReader) -> Action:
     )
     scope = {p.name: p.type for p in params}
     precondition = (
-        reader.formula(options[":precondition"], scope) if (":precondition" in options) else TRUE
+        _existential_closure(
+            reader, options[":precondition"], scope, f"the precondition of {what}", log
+        )
+        if ":precondition" in options
+        else TRUE
     )
     effect = reader.effect(options[":effect"], scope) if ":effect" in options else AndEffect(())
     return Action(name, params, precondition, effect, section.location)
 
 
-def _axiom(section: SList, reader: FormulaReader, predicates: dict[str, Predicate]) -> Axiom:
+def _axiom(
+    section: SList, reader: FormulaReader, predicates: dict[str, Predicate], log: LeniencyLog
+) -> Axiom:
     head = expect_list(section.items[1], "the derived predicate '(name ?params)'")
     declared = _declaration(head, reader, "the derived predicate")
     if declared.name not in predicates:
@@ -347,8 +356,27 @@ def _axiom(section: SList, reader: FormulaReader, predicates: dict[str, Predicat
         Parameter(p.name, decl.type if p.type == OBJECT_TYPE else p.type)
         for p, decl in zip(declared.parameters, predicates[declared.name].parameters, strict=True)
     )
-    body = reader.formula(section.items[2], {p.name: p.type for p in params})
+    scope = {p.name: p.type for p in params}
+    what = f"the body of derived predicate {declared.name!r}"
+    body = _existential_closure(reader, section.items[2], scope, what, log)
     return Axiom(declared.name, params, body, section.location)
+
+
+def _existential_closure(
+    reader: FormulaReader, node: SExpr, scope: Mapping[str, str], what: str, log: LeniencyLog
+) -> Formula:
+    """``node`` read as a formula, its free variables existentially quantified (noted)."""
+    formula, free = reader.open_formula(node, scope)
+    if not free:
+        return formula
+    for variable, location in free.items():
+        log.add(
+            FREE_VARIABLE,
+            f"variable {variable} in {what} is neither a parameter nor quantified; read as "
+            "existentially quantified (as Fast Downward does)",
+            location,
+        )
+    return Exists(tuple(Parameter(variable) for variable in free), formula)
 
 
 def parse_problem(

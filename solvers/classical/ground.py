@@ -8,12 +8,19 @@ are never reachable are trivially true and dropped too.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Mapping
 from operator import itemgetter
 
 from sdar_tamp.language.model import EQUALITY, Atom, FunctionTerm, NumericExpr
 from solvers.classical.errors import GroundingError
-from solvers.classical.join import FactBase, compile_join, run_join
+from solvers.classical.join import (
+    DEADLINE_STRIDE,
+    FactBase,
+    GroundingTimeout,
+    compile_join,
+    run_join,
+)
 from solvers.classical.normalize import Lit, NormAction, NormTask, normalize
 from solvers.classical.problem import PlanningTask
 from solvers.classical.reachability import (
@@ -50,7 +57,10 @@ def _positional(
 
 
 class _Instantiator:
-    def __init__(self, task: PlanningTask, norm: NormTask, base: FactBase) -> None:
+    def __init__(
+        self, task: PlanningTask, norm: NormTask, base: FactBase, deadline: float | None = None
+    ) -> None:
+        self.deadline = deadline
         self.task = task
         self.norm = norm
         self.base = base
@@ -143,6 +153,10 @@ class _Instantiator:
                 return None
         return positive, negative
 
+    def check_deadline(self) -> None:
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            raise GroundingTimeout
+
     def operators(self, action: NormAction) -> list[GroundOperator]:
         instances = sorted(self.base.relations.get(action_predicate(action.name), ()))
         params = action.parameters
@@ -164,7 +178,9 @@ class _Instantiator:
         fixed_cost = None if needs_binding else self.cost(action, {})
         ids = self.ids
         result = []
-        for args in instances:
+        for count, args in enumerate(instances):
+            if count % DEADLINE_STRIDE == 0:
+                self.check_deadline()
             pre = self.evaluate(pre_templates, args)
             if pre is None:  # pragma: no cover - reachability already checked this
                 continue
@@ -180,7 +196,7 @@ class _Instantiator:
                     found.append((condition, fact, positive))
             binding = dict(zip(params, args, strict=True)) if needs_binding else {}
             for effect, plan in general:
-                for full in run_join(plan, self.base, binding):
+                for full in run_join(plan, self.base, binding, deadline=self.deadline):
                     condition = self.literals(effect.condition, full)
                     lit = effect.literal
                     fact = ids.get((lit.predicate, _ground_args(lit, full)))
@@ -216,7 +232,8 @@ class _Instantiator:
             atoms, filters = split_condition(axiom.body, self.fixed)
             head = Lit(axiom.predicate, axiom.head)
             stratum = self.norm.strata[axiom.predicate]
-            for binding in run_join(compile_join(atoms, filters), self.base):
+            plan = compile_join(atoms, filters)
+            for binding in run_join(plan, self.base, deadline=self.deadline):
                 body = self.literals(axiom.body, binding)
                 head_id = self.ids.get((axiom.predicate, _ground_args(head, binding)))
                 if body is None or head_id is None:  # pragma: no cover - reachable by construction
@@ -231,7 +248,7 @@ def ground_normalized(
     task: PlanningTask, norm: NormTask, deadline: float | None = None
 ) -> GroundTask:
     base = reachable_facts(norm, deadline)
-    inst = _Instantiator(task, norm, base)
+    inst = _Instantiator(task, norm, base, deadline)
     operators = [op for action in norm.actions for op in inst.operators(action)]
     goal = inst.literals(norm.goal, {})
     init = frozenset(

@@ -8,6 +8,7 @@ up only the facts that agree with the values already bound (hash indexes built o
 
 from __future__ import annotations
 
+import time
 from collections.abc import Collection, Iterable, Iterator
 from dataclasses import dataclass
 
@@ -15,6 +16,13 @@ from sdar_tamp.language.model import EQUALITY
 from solvers.classical.normalize import Lit
 
 Fact = tuple[str, ...]
+
+#: a join with a deadline looks at the clock once per this many candidate facts
+DEADLINE_STRIDE = 1024
+
+
+class GroundingTimeout(Exception):
+    """The deadline passed while grounding (internal; :func:`plan` reports a timeout)."""
 
 
 class FactBase:
@@ -148,16 +156,23 @@ def run_join(
     facts: FactBase,
     binding: dict[str, str] | None = None,
     delta: Collection[Fact] | None = None,
+    deadline: float | None = None,
 ) -> Iterator[dict[str, str]]:
     """All bindings extending ``binding``; with ``delta`` the first step ranges over it only.
 
-    The yielded dictionary is reused: read it before asking for the next binding.
+    The yielded dictionary is reused: read it before asking for the next binding. With a
+    ``deadline`` (a ``time.perf_counter()`` value) the join checks the clock every
+    :data:`DEADLINE_STRIDE` candidate facts, so one large join cannot overrun it.
+
+    Raises:
+        GroundingTimeout: the deadline passed during the join.
     """
     current = dict(binding or {})
     if not all(check_filter(f, current, facts) for f in plan.initial_filters):
         return
     steps = plan.steps
     count = len(steps)
+    ticks = 0
 
     def extend(i: int) -> Iterator[dict[str, str]]:
         if i == count:
@@ -178,6 +193,11 @@ def run_join(
         else:
             candidates = facts.relations.get(step.predicate, ())
         for args in candidates:
+            if deadline is not None:
+                nonlocal ticks
+                ticks += 1
+                if ticks % DEADLINE_STRIDE == 0 and time.perf_counter() > deadline:
+                    raise GroundingTimeout
             if step.repeats and any(args[p] != args[q] for p, q in step.repeats):
                 continue
             for position, var in step.outputs:

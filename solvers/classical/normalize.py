@@ -3,7 +3,13 @@
 Every precondition, effect condition, axiom body and the goal becomes a conjunction of literals:
 
 * ``Imply`` is rewritten and negations are pushed down to atoms (negation normal form);
-* ``ForAll`` is expanded over the (finite) objects of its parameter types;
+* ``ForAll`` is expanded over the (finite) objects of its parameter types when that gives at
+  most :data:`FORALL_EXPANSION_LIMIT` copies of its body; a larger one becomes, as in Fast
+  Downward, the negation of an auxiliary derived predicate ``(not (exists (..) (not body)))``
+  (its relaxation drops the condition, so grounding does not join one literal per copy); the
+  axiom's body also gets the enclosing conjunction's atoms over static predicates that mention
+  its free variables (they hold wherever the condition is evaluated), which keeps its ground
+  instances to the argument combinations the condition can be evaluated on;
 * ``Or`` and ``Exists`` become auxiliary derived predicates (one axiom per disjunct, the
   existential variables as extra axiom parameters), so grounding only ever joins conjunctions;
 * every typed parameter gets a *type literal* ``(type ?x)``; the type facts come from the object
@@ -15,6 +21,7 @@ Auxiliary predicates are named ``~aux<n>``, which is not a valid PDDL name, so t
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -36,11 +43,16 @@ from sdar_tamp.language.model import (
     NumericExpr,
     Parameter,
     When,
+    iter_effect_literals,
 )
 from sdar_tamp.language.model import And as AndF
 from sdar_tamp.language.model import Or as OrF
 from solvers.classical.errors import GroundingError
 from solvers.classical.problem import PlanningTask
+
+#: a universally quantified condition over more parameter combinations than this is compiled
+#: into a negated auxiliary axiom instead of being expanded into one copy per combination
+FORALL_EXPANSION_LIMIT = 16
 
 
 @dataclass(frozen=True)
@@ -133,6 +145,14 @@ class _Normalizer:
         self.objects_of_type = {t: tuple(sorted(objs)) for t, objs in by_type.items()}
         self.aux_axioms: list[NormAxiom] = []
         self.aux_names: list[str] = []
+        domain = task.domain
+        changed = {
+            lit.atom.predicate for a in domain.actions for lit in iter_effect_literals(a.effect)
+        }
+        self.changing = changed | domain.derived_predicates | {EQUALITY}
+        # static atoms of the conjunctions enclosing the formula being normalised (no
+        # quantifier or disjunction in between)
+        self.guards: list[Atom] = []
 
     def type_lit(self, parameter: Parameter) -> Lit:
         return Lit(parameter.type, (parameter.name,))
@@ -152,7 +172,16 @@ class _Normalizer:
                 return self.conjunction(nnf(formula), context)
             return [Lit(negated.predicate, negated.args, positive=False)]
         if isinstance(formula, AndF):
-            return [lit for part in formula.parts for lit in self.conjunction(part, context)]
+            depth = len(self.guards)
+            self.guards += [
+                part
+                for part in formula.parts
+                if isinstance(part, Atom) and part.predicate not in self.changing
+            ]
+            try:
+                return [lit for part in formula.parts for lit in self.conjunction(part, context)]
+            finally:
+                del self.guards[depth:]
         if isinstance(formula, OrF):
             if len(formula.parts) == 1:
                 return self.conjunction(formula.parts[0], context)
@@ -163,11 +192,19 @@ class _Normalizer:
             return [self.auxiliary(formula, formula.parameters, (formula.body,), context)]
         if isinstance(formula, Imply):
             return self.conjunction(nnf(formula), context)
-        # ForAll over finite objects: normalise the body once, then expand.
+        domains = [self.objects_of_type.get(p.type, ()) for p in formula.parameters]
+        if math.prod(len(d) for d in domains) > FORALL_EXPANSION_LIMIT:
+            # forall x: phi  ==  not (exists x: not phi)
+            counter = nnf(formula.body, negate=True)
+            exists = Exists(formula.parameters, counter)
+            free = free_variables(exists)
+            guards = [g for g in self.guards if free.intersection(g.args)]
+            lit = self.auxiliary(exists, formula.parameters, (counter,), context, guards)
+            return [Lit(lit.predicate, lit.args, positive=False)]
+        # ForAll over few objects: normalise the body once, then expand.
         inner = dict(context)
         inner.update({p.name: p.type for p in formula.parameters})
         body = self.conjunction(formula.body, inner)
-        domains = [self.objects_of_type.get(p.type, ()) for p in formula.parameters]
         names = [p.name for p in formula.parameters]
         result: list[Lit] = []
         for values in itertools.product(*domains):
@@ -181,7 +218,11 @@ class _Normalizer:
         bound: tuple[Parameter, ...],
         disjuncts: tuple[Formula, ...],
         context: Mapping[str, str],
+        guards: list[Atom] | None = None,
     ) -> Lit:
+        """A new derived predicate over the free variables of ``formula``, one axiom per
+        disjunct; ``guards`` (static atoms, their other variables existential) are added to
+        each axiom's body."""
         free = sorted(free_variables(formula))
         for var in free:
             if var not in context:
@@ -191,12 +232,25 @@ class _Normalizer:
         inner.update({p.name: p.type for p in bound})
         head_types = [Lit(context[v], (v,)) for v in free]
         bound_types = [self.type_lit(p) for p in bound]
-        for disjunct in disjuncts:
-            body = self.conjunction(disjunct, inner)
-            self.aux_axioms.append(
-                NormAxiom(name, tuple(free), tuple(head_types + bound_types + body))
-            )
+        guard_lits = self._guard_lits(guards or [], {p.name for p in bound})
+        outer = self.guards
+        self.guards = []
+        try:
+            for disjunct in disjuncts:
+                body = self.conjunction(disjunct, inner)
+                lits = head_types + guard_lits + bound_types + body
+                self.aux_axioms.append(NormAxiom(name, tuple(free), tuple(dict.fromkeys(lits))))
+        finally:
+            self.guards = outer
         return Lit(name, tuple(free))
+
+    def _guard_lits(self, guards: list[Atom], bound: set[str]) -> list[Lit]:
+        """``guards`` as literals; variables that the quantifier rebinds are renamed apart."""
+        lits = []
+        for index, atom in enumerate(guards):
+            args = tuple(f"{a}~g{index}" if a in bound else a for a in atom.args)
+            lits.append(Lit(atom.predicate, args))
+        return lits
 
     def action(self, action: Action) -> NormAction:
         context = {p.name: p.type for p in action.parameters}

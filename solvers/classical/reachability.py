@@ -14,12 +14,23 @@ import time
 from dataclasses import dataclass
 
 from sdar_tamp.language.model import EQUALITY
-from solvers.classical.join import Fact, FactBase, JoinPlan, compile_join, run_join
+from solvers.classical.join import (
+    Fact,
+    FactBase,
+    GroundingTimeout,
+    JoinPlan,
+    compile_join,
+    run_join,
+)
 from solvers.classical.normalize import Lit, NormTask
 
-
-class GroundingTimeout(Exception):
-    """The deadline passed while grounding (internal; :func:`plan` reports a timeout)."""
+__all__ = [
+    "GroundingTimeout",
+    "action_predicate",
+    "fixed_predicates",
+    "reachable_facts",
+    "split_condition",
+]
 
 
 def action_predicate(name: str) -> str:
@@ -126,7 +137,7 @@ def reachable_facts(norm: NormTask, deadline: float | None = None) -> FactBase:
                 ]
             head = rule.head
             for plan, seed in plans:
-                for binding in run_join(plan, base, None, seed):
+                for binding in run_join(plan, base, None, seed, deadline):
                     args = tuple(binding[a] if a.startswith("?") else a for a in head.args)
                     if base.contains(head.predicate, args):
                         continue

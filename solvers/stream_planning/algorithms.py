@@ -359,6 +359,8 @@ class StreamSolver:
             actions, cost = found
             ordered = fluent_plan(stream_plan, check, self.fluent_streams, actions)
             stream_plan = ordered.stream_plan
+            if self.builder.refine(stream_plan):
+                continue  # it uses shared placeholders: plan again with the instances' own
             if not any(r.kind == "stream" for r in stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
             ):

@@ -335,12 +335,6 @@ def _warn_unsupported(
         supported = (
             stream_options if isinstance(options, StreamInfo) else SUPPORTED_FUNCTION_OPTIONS
         )
-        if isinstance(options, StreamInfo) and callable(options.opt_gen_fn):
-            LOG.warning(
-                "stream_info[%r].opt_gen_fn as a callable is not implemented; "
-                "placeholders are per instance",
-                name,
-            )
         for option in unsupported_options(options, supported):
             LOG.warning(
                 "stream_info[%r].%s is accepted but not implemented; it has no effect", name, option

@@ -2,17 +2,32 @@
 
 Each instance whose next result stays within the complexity limit contributes placeholder
 outputs (``#o<k>``). By default a placeholder belongs to its instance (``unique``); with
-``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output.
+``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output
+until an optimistic plan uses it: :meth:`OptimisticBuilder.refine` then gives the instances of
+that plan placeholders of their own (the solver plans again before sampling), as PDDLStream
+refines its shared optimistic values.
+
+With a callable ``StreamInfo(opt_gen_fn=gen_fn)`` (a stream with outputs; tests keep their
+default) an instance's optimistic outputs come from ``gen_fn`` called like the sampler on the
+instance's input values: its first batch of output tuples gives one set of placeholders per
+tuple, each placeholder standing for the value ``gen_fn`` produced (an empty batch: the instance
+adds nothing to the optimistic world). That value is what later optimistic calls see in place
+of the placeholder, so optimistic values chain through streams. ``gen_fn`` is called once per
+instance and solve.
+
 Functions on placeholders take their optimistic value (``FunctionInfo.opt_fn``, default 1,
-called with the Python values of real inputs and an :class:`OptimisticValue` for each
-placeholder);
+called with the Python values of real inputs, the optimistic value of placeholders that have
+one and an :class:`OptimisticValue` for the others);
 predicates on placeholders are optimistically true unless the domain uses them negated.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
+from sdar_tamp.language.generators import WildOutput
 from sdar_tamp.language.model import (
     AndEffect,
     Atom,
@@ -25,7 +40,12 @@ from sdar_tamp.language.model import (
     When,
 )
 from solvers.stream_planning.engine import Engine, function_guard
-from solvers.stream_planning.externals import FunctionExternal
+from solvers.stream_planning.externals import (
+    FunctionExternal,
+    StreamError,
+    StreamExternal,
+    StreamOutputError,
+)
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
 
 PLACEHOLDER = "#o"
@@ -126,6 +146,12 @@ class OptimisticBuilder:
         self.negated = negated
         self._placeholders: dict[tuple[object, ...], str] = {}
         self.producers: dict[str, str] = {}  # placeholder -> the stream that makes it
+        # placeholder -> the value a callable opt_gen_fn gave it
+        self.values: dict[str, object] = {}
+        self._shared: set[str] = set()  # placeholders shared by the instances of a stream
+        self.refined: set[tuple[str, tuple[str, ...]]] = set()  # instances with their own
+        # (stream, inputs) -> the output tuples of its callable opt_gen_fn
+        self._generated: dict[tuple[str, tuple[str, ...]], list[tuple[object, ...]]] = {}
 
     def placeholder(self, key: tuple[object, ...]) -> str:
         name = self._placeholders.get(key)
@@ -200,11 +226,27 @@ class OptimisticBuilder:
             if next_level > limit:
                 world.complete = False
                 return []
-            shared = external.info.opt_gen_fn == "shared"
+            generator = external.info.opt_gen_fn
+            if callable(generator) and external.declaration.outputs:
+                return [
+                    OptResult(
+                        name,
+                        inputs,
+                        outputs,
+                        external.domain(inputs),
+                        external.certified(inputs, outputs),
+                        next_level,
+                        "stream",
+                    )
+                    for outputs in self._generated_outputs(external, inputs, generator)
+                ]
+            shared = external.info.opt_gen_fn == "shared" and (name, inputs) not in self.refined
             outputs = tuple(
                 self.placeholder((name, i) if shared else (name, inputs, i))
                 for i in range(len(external.declaration.outputs))
             )
+            if shared:
+                self._shared.update(outputs)
             return [
                 OptResult(
                     name,
@@ -233,12 +275,71 @@ class OptimisticBuilder:
         )
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
 
+    def refine(self, stream_plan: list[OptResult]) -> bool:
+        """Give the instances of ``stream_plan`` that produce shared placeholders placeholders
+        of their own in later builds; False when there is none (the plan is refined)."""
+        found = {
+            (r.external, r.inputs)
+            for r in stream_plan
+            if r.kind == "stream" and any(n in self._shared for n in r.outputs)
+        }
+        new = found - self.refined
+        self.refined.update(new)
+        return bool(new)
+
     def _values(self, inputs: tuple[str, ...]) -> tuple[object, ...]:
         return tuple(
-            OptimisticValue(n, self.producers.get(n, "?")) if is_placeholder(n)
+            (self.values[n] if n in self.values else OptimisticValue(n, self.producers.get(n, "?")))
+            if is_placeholder(n)
             else self.engine.table.value(n)
             for n in inputs
         )  # fmt: skip
+
+    def _generated_outputs(
+        self, external: StreamExternal, inputs: tuple[str, ...], generator: Callable[..., Any]
+    ) -> list[tuple[str, ...]]:
+        """The placeholders of each output tuple of ``generator`` on ``inputs`` (called once).
+
+        Raises:
+            StreamError: ``generator`` raised.
+            StreamOutputError: it produced something other than a list of output tuples.
+        """
+        name = external.name
+        key = (name, inputs)
+        batch = self._generated.get(key)
+        if batch is None:
+            batch = self._generated[key] = self._call_generator(external, inputs, generator)
+        result = []
+        for index, values in enumerate(batch):
+            outputs = tuple(
+                self.placeholder((name, inputs, "opt", index, i)) for i in range(len(values))
+            )
+            for placeholder, value in zip(outputs, values, strict=True):
+                self.values[placeholder] = value
+            result.append(outputs)
+        return result
+
+    def _call_generator(
+        self, external: StreamExternal, inputs: tuple[str, ...], generator: Callable[..., Any]
+    ) -> list[tuple[object, ...]]:
+        values = self._values(inputs)
+        what = f"the opt_gen_fn of stream {external.name!r} on inputs {values!r}"
+        try:
+            produced: Any = next(iter(generator(*values)), [])
+        except Exception as error:
+            raise StreamError(f"{what} raised {type(error).__name__}: {error}") from error
+        if isinstance(produced, WildOutput):
+            produced = list(produced.values)
+        if produced is None:
+            return []
+        arity = len(external.declaration.outputs)
+        if not isinstance(produced, list | tuple) or not all(
+            isinstance(output, list | tuple) and len(output) == arity for output in produced
+        ):
+            raise StreamOutputError(
+                f"{what} must produce a list of tuples of {arity} value(s), got {produced!r}"
+            )
+        return [tuple(output) for output in produced]
 
     def _function(
         self,

@@ -101,6 +101,22 @@ def test_function_info_opt_fn_sees_pddlstream_optimistic_values() -> None:
     assert isinstance(seen[0], UniqueOptValue) and seen[0].output == "#o1"
 
 
+def test_stream_info_opt_gen_fn_sees_values_and_pddlstream_optimistic_values() -> None:
+    from solvers.stream_planning.optimistic import OptimisticValue
+
+    seen: list[object] = []
+
+    def guess(*inputs: object) -> tuple[int]:
+        seen.extend(inputs)
+        return (3,)
+
+    opt_gen_fn = StreamInfo(opt_gen_fn=from_fn(guess)).opt_gen_fn
+    assert callable(opt_gen_fn)
+    assert list(opt_gen_fn(2, OptimisticValue("#o1", "sample-pose"))) == [[(3,)]]
+    assert seen[0] == 2
+    assert isinstance(seen[1], UniqueOptValue) and seen[1].output == "#o1"
+
+
 def test_wild_output_unpacks_as_values_and_facts() -> None:
     values, facts = WildOutput(values=[(1,)], facts=[("safe", 1)])
     assert values == [(1,)] and facts == [("safe", 1)]

@@ -17,15 +17,17 @@ from sdar_tamp.language import (
     parse_problem,
     parse_stream_file,
 )
+from sdar_tamp.language.errors import UnboundVariableError
 from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
+    FREE_VARIABLE,
     GLUED_VARIABLE,
     IMPLICIT_PREDICATE,
     INIT_TYPE,
     REPEATED_VARIABLE,
     UNDECLARED_PARENT_TYPE,
 )
-from sdar_tamp.language.model import Atom, IncreaseCost, iter_effects
+from sdar_tamp.language.model import And, Atom, Exists, IncreaseCost, iter_effects
 from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.language.sexpr import Symbol, read_sexpr
 
@@ -260,3 +262,44 @@ def test_pddl_problem_numeric_value_must_be_finite(value: object) -> None:
 def test_pddl_problem_negative_initial_total_cost() -> None:
     with pytest.raises(ProblemDefinitionError, match="non-negative initial total-cost"):
         _pddl_problem([("=", ("total-cost",), -1)])
+
+
+# --- free variables in preconditions and derived bodies -----------------------------------------
+
+FREE = """(define (domain f) (:requirements :strips :derived-predicates)
+ (:predicates (on ?x ?y) (clear ?x) (covered ?x) (p ?x))
+ (:derived (covered ?x) (and (clear ?x) (on ?y ?x)))
+ (:action a :parameters (?x) :precondition (and (clear ?x) (on ?x ?z) (p ?z))
+  :effect (not (clear ?x))))
+"""
+
+
+def test_free_variable_in_a_derived_body_is_existential(caplog: pytest.LogCaptureFixture) -> None:
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.language"):
+        domain = parse_domain(FREE, "f.pddl")
+    (axiom,) = domain.axioms
+    assert isinstance(axiom.body, Exists)
+    assert [p.name for p in axiom.body.parameters] == ["?y"]
+    assert isinstance(axiom.body.body, And)
+    (action,) = domain.actions
+    assert isinstance(action.precondition, Exists)
+    assert [p.name for p in action.precondition.parameters] == ["?z"]
+    kinds = [item.kind for item in domain.leniencies]
+    assert kinds == [FREE_VARIABLE, FREE_VARIABLE]
+    assert "f.pddl:3:45: variable ?y in the body of derived predicate 'covered'" in caplog.text
+    assert any(r.levelno == logging.INFO for r in caplog.records)
+
+
+def test_free_variable_is_rejected_when_strict() -> None:
+    with pytest.raises(StrictModeError) as info:
+        parse_domain(FREE, "f.pddl", strict=True)
+    text = str(info.value)
+    assert "f.pddl:3:45: variable ?y" in text
+    assert "f.pddl:4:67: variable ?z in the precondition of action 'a'" in text
+    assert "[free-variable]" in text
+
+
+def test_free_variable_in_an_effect_is_still_an_error() -> None:
+    text = FREE.replace(":effect (not (clear ?x))", ":effect (not (clear ?w))")
+    with pytest.raises(UnboundVariableError, match=r"f\.pddl:5:23: variable \?w is not bound"):
+        parse_domain(text, "f.pddl")

@@ -168,3 +168,26 @@ def test_non_finite_cost_value_in_a_task_is_a_grounding_error(value: float) -> N
     task = PlanningTask(domain, {}, frozenset(), Atom("done"), numeric_init={("price", ()): value})
     with pytest.raises(GroundingError, match="finite and non-negative"):
         plan(task)
+
+
+FREE_VARIABLES = """(define (domain f) (:requirements :strips :derived-predicates)
+ (:predicates (on ?x ?y) (clear ?x) (covered ?x) (p ?x))
+ (:derived (covered ?x) (and (clear ?x) (on ?y ?x)))
+ (:action a :parameters (?x) :precondition (and (clear ?x) (on ?x ?z) (p ?z) (covered ?x))
+  :effect (and (not (clear ?x)) (p ?x))))
+"""
+
+
+@pytest.mark.parametrize(
+    ("init", "solvable"),
+    [("(clear b) (on b c) (p c) (on a b)", True), ("(clear b) (on b c) (on a b)", False)],
+)
+def test_free_variables_are_read_as_existential(init: str, solvable: bool) -> None:
+    # (covered b) needs some ?y on b; action a needs some ?z under ?x with (p ?z)
+    problem = f"(define (problem q) (:domain f) (:objects a b c) (:init {init}) (:goal (p b)))"
+    if solvable:
+        assert [s.name for s in _solve_and_validate(FREE_VARIABLES, problem)] == ["a"]
+    else:
+        domain = parse_domain(FREE_VARIABLES, "domain.pddl")
+        result = plan(task_from_problem(domain, parse_problem(problem, domain, "problem.pddl")))
+        assert not result.solved

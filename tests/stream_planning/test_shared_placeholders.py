@@ -39,3 +39,32 @@ def test_two_items_each_get_their_own_value() -> None:
         for action in solution.plan:
             item, slot = action.args
             assert slot.startswith(f"{item}-slot")
+
+
+def test_a_plan_on_shared_placeholders_refines_its_instances() -> None:
+    from solvers.stream_planning.engine import Engine
+    from solvers.stream_planning.optimistic import OptimisticBuilder
+
+    def slots(item: str):  # type: ignore[no-untyped-def]
+        yield (f"{item}-slot",)
+
+    problem = PDDLProblem(
+        DOMAIN,
+        {},
+        STREAMS,
+        {"sample-slot": from_gen_fn(slots)},
+        [("item", "a"), ("item", "b")],
+        ("and", ("placed", "a"), ("placed", "b")),
+    )
+    engine = Engine(problem, {"sample-slot": StreamInfo(opt_gen_fn="shared")})
+    engine.start()
+    builder = OptimisticBuilder(engine, frozenset())
+    shared = builder.build(10)
+    outputs = {r.outputs for r in shared.provenance.values() if r.external == "sample-slot"}
+    assert len(outputs) == 1  # one placeholder for both items
+    plan = list({id(r): r for r in shared.provenance.values()}.values())
+    assert builder.refine(plan) is True
+    assert builder.refine(plan) is False  # already refined
+    refined = builder.build(10)
+    outputs = {r.outputs for r in refined.provenance.values() if r.external == "sample-slot"}
+    assert len(outputs) == 2  # each item's instance has its own

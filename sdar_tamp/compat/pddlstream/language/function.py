@@ -15,9 +15,10 @@ from solvers.stream_planning.optimistic import OptimisticValue
 __all__ = ["FunctionInfo", "PredicateInfo", "add_opt_function"]
 
 
-def _with_opt_values(opt_fn: Callable[..., Any]) -> Callable[..., Any]:
-    """``opt_fn`` called with PDDLStream's optimistic values (:class:`UniqueOptValue`) in
-    place of the solver's placeholders, so ``type(x) in [UniqueOptValue, ...]`` checks work."""
+def with_opt_values(opt_fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``opt_fn`` (or an ``opt_gen_fn``) called with PDDLStream's optimistic values
+    (:class:`UniqueOptValue`) in place of the solver's placeholders that have no optimistic
+    value, so ``type(x) in [UniqueOptValue, ...]`` checks work."""
 
     def wrapped(*args: Any) -> Any:
         converted = tuple(
@@ -55,7 +56,7 @@ class FunctionInfo(_CoreFunctionInfo):
         if estimate:
             p_success = overhead = effort = None
         values = {
-            "opt_fn": None if opt_fn is None else _with_opt_values(opt_fn),
+            "opt_fn": None if opt_fn is None else with_opt_values(opt_fn),
             "eager": self._default_eager if eager is None else bool(eager),
             "p_success": p_success,
             "overhead": overhead,

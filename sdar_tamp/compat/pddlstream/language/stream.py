@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sdar_tamp.compat.pddlstream.language.external import never_defer
+from sdar_tamp.compat.pddlstream.language.function import with_opt_values
 from sdar_tamp.compat.pddlstream.language.generator import universe_test
 from sdar_tamp.compat.pddlstream.language.problem import DEBUG, DEBUG_MODES, SHARED_DEBUG
 from sdar_tamp.language.generators import WildOutput as _CoreWildOutput
@@ -48,8 +49,7 @@ def _opt_gen_fn(value: Any) -> Callable[..., Any] | str | None:
     if value is None or isinstance(value, str):
         return value
     if callable(value):
-        function: Callable[..., Any] = value
-        return function
+        return with_opt_values(value)
     if isinstance(value, PartialInputs):
         if value.inputs:
             LOG.info("PartialInputs(inputs=%r): placeholders are shared per stream", value.inputs)
