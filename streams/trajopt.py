@@ -316,8 +316,10 @@ class OptimiserBuild:
         self._error: BaseException | None = None
         self._done = threading.Event()
         if background:
+            # Not a daemon: the interpreter waits for a build in progress before it shuts down
+            # (CasADi code still running during finalisation crashes the process).
             name = "sdar-trajopt-build"
-            threading.Thread(target=self._run, args=(ctx,), name=name, daemon=True).start()
+            threading.Thread(target=self._run, args=(ctx,), name=name, daemon=False).start()
         else:
             self._run(ctx)
 
