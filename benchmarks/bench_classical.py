@@ -26,6 +26,7 @@ import json
 import math
 import re
 import resource
+import signal
 import subprocess
 import sys
 import tempfile
@@ -101,8 +102,9 @@ def run(
     lines = child.stdout.strip().splitlines()
     outcome = json.loads(lines[-1]) if child.returncode == 0 and lines else None
     solved = bool(outcome and outcome["solved"]) and cpu <= time_limit
+    killed = child.returncode in (-signal.SIGXCPU, -signal.SIGKILL)
     if outcome is None:
-        status = "timeout" if cpu >= time_limit - 0.5 else "error"
+        status = "timeout" if killed or cpu >= time_limit - 0.5 else "error"
     else:
         status = "solved" if solved else ("timeout" if cpu > time_limit else "unsolved")
     return {
