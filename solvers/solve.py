@@ -23,6 +23,7 @@ from sdar_tamp.arguments import (
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.options import FunctionInfo, PlanConstraints, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
+from solvers.classical import HEURISTICS, SEARCHES
 from solvers.solution import Solution, print_solution
 from solvers.stream_planning.algorithms import ALGORITHMS, StreamOptions, StreamSolver
 from solvers.stream_planning.constraints import compile_constraints
@@ -33,8 +34,6 @@ _LIMIT = Real(0.0, allow_inf=True)  # max_iterations, max_skeletons, search_samp
 _NATURAL = Integer(0)  # initial_complexity
 _WEIGHT = Real(0.0, closed=True)  # effort_weight
 
-_SEARCHES = ("gbfs", "astar", "wastar")
-_HEURISTICS = ("ff", "add", "max", "blind")
 #: PDDLStream's Fast Downward configurations -> (search, heuristic, weight) of the classical
 #: planner. Names whose heuristic is not available use the nearest one (noted in the log).
 PLANNER_ALIASES: dict[str, tuple[str, str, float]] = {
@@ -75,10 +74,14 @@ def parse_planner(planner: str) -> tuple[str, str, float]:
             if name.startswith(prefix):
                 LOG.info("planner %r: %s", planner, note)
         return PLANNER_ALIASES[name]
-    search, _, heuristic = name.partition("-")
-    if search in _SEARCHES and (heuristic or "ff") in _HEURISTICS:
-        return search, heuristic or "ff", 2.0
-    native = [f"{s}-{h}" for s in _SEARCHES for h in _HEURISTICS]
+    # the longest search name that prefixes it ("lazy-gbfs-ff" is lazy-gbfs with h_FF)
+    for search in sorted(SEARCHES, key=len, reverse=True):
+        if name == search or name.startswith(search + "-"):
+            heuristic = name[len(search) + 1 :] or "ff"
+            if heuristic in HEURISTICS:
+                return search, heuristic, 2.0
+            break
+    native = [f"{s}-{h}" for s in SEARCHES for h in HEURISTICS]
     raise ParameterError(
         f"planner must be SEARCH-HEURISTIC ({', '.join(native)}) or one of PDDLStream's "
         f"{', '.join(sorted(PLANNER_ALIASES))}; got {planner!r}"

@@ -11,3 +11,7 @@ class GroundingError(SdarError):
 
 class PlanValidationError(SdarError):
     """A plan does not solve its task. Raised by the validator; from :func:`plan` it means a bug."""
+
+
+class BackendUnavailableError(SdarError):
+    """An optional planner backend is not installed, or it failed to run."""

@@ -18,7 +18,8 @@ from math import inf
 
 from solvers.classical.compiled import CompiledTask, bits
 
-HEURISTICS = ("ff", "add", "max", "blind")
+# "lmcount": landmark count; "ff-lmcount": h_FF and landmark count in alternating queues
+HEURISTICS = ("ff", "add", "max", "blind", "lmcount", "ff-lmcount")
 
 
 class RelaxedHeuristic:

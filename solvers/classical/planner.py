@@ -12,6 +12,7 @@ from solvers.classical.compiled import CompiledTask
 from solvers.classical.errors import PlanValidationError
 from solvers.classical.ground import ground
 from solvers.classical.heuristics import HEURISTICS, RelaxedHeuristic
+from solvers.classical.landmarks import LandmarkCount
 from solvers.classical.postprocess import eliminate_redundant_actions
 from solvers.classical.problem import (
     PlanningTask,
@@ -20,11 +21,11 @@ from solvers.classical.problem import (
     SearchStatistics,
 )
 from solvers.classical.reachability import GroundingTimeout
-from solvers.classical.search import SearchOutcome, best_first_search
+from solvers.classical.search import Evaluator, SearchOutcome, best_first_search
 from solvers.classical.task import GroundTask
 from solvers.classical.validate import validate_plan
 
-SEARCHES = ("gbfs", "astar", "wastar")
+SEARCHES = ("gbfs", "astar", "wastar", "lazy-gbfs")
 logger = logging.getLogger(__name__)
 
 
@@ -46,15 +47,19 @@ def plan(
 ) -> SearchResult:
     """Find a plan for ``task``.
 
-    ``search``: ``"gbfs"`` (greedy best-first), ``"astar"`` or ``"wastar"`` (f = g + weight·h).
-    ``heuristic``: ``"ff"``, ``"add"``, ``"max"`` or ``"blind"``. Preferred operators (from the
-    relaxed plan; not used by ``"blind"``) feed a second, boosted queue; A* ignores them so that
+    ``search``: ``"gbfs"`` (greedy best-first), ``"lazy-gbfs"`` (greedy best-first with lazy
+    evaluation and unit action costs inside the heuristics, as LAMA's first iteration),
+    ``"astar"`` or ``"wastar"`` (f = g + weight·h).
+    ``heuristic``: ``"ff"``, ``"add"``, ``"max"``, ``"blind"``, ``"lmcount"`` (landmark count,
+    path-dependent and not admissible) or ``"ff-lmcount"`` (h_FF and landmark count in
+    alternating queues, LAMA's guidance). Preferred operators (from the relaxed plan; not used
+    by ``"blind"`` and ``"lmcount"``) feed boosted queues of their own; A* ignores them so that
     with an admissible heuristic (``"max"``, ``"blind"``) its plans stay optimal. ``lazy`` defers
-    evaluation to expansion time. Plans of greedy and weighted search are post-processed by
-    greedy action elimination (steps whose removal still reaches the goal are dropped; the
-    cost never rises); A* plans are returned as found. Greedy search adds 1 to every action
-    cost inside the heuristic (so zero-cost actions still count as steps); plan costs are always
-    the true costs.
+    evaluation to expansion time (always on for ``"lazy-gbfs"``). Plans of greedy and weighted
+    search are post-processed by greedy action elimination (steps whose removal still reaches
+    the goal are dropped; the cost never rises); A* plans are returned as found. ``"gbfs"`` adds
+    1 to every action cost inside the heuristic (so zero-cost actions still count as steps);
+    plan costs are always the true costs.
     ``time_limit`` [s] covers grounding and search. ``cost_bound``: only plans cheaper than it
     (states whose cost so far reaches it are pruned; the initial state is never pruned).
     """
@@ -113,18 +118,29 @@ def _search(
         return SearchOutcome("unsolvable", (), 0, 0, 0)
     compiled = CompiledTask(ground_task)
     costs = compiled.costs
-    if search == "gbfs" and ground_task.source.use_costs:
+    if search == "lazy-gbfs":
+        costs = [1.0] * len(costs)  # as LAMA's first iteration: distance to the goal in steps
+    elif search == "gbfs" and ground_task.source.use_costs:
         costs = [c + 1.0 for c in costs]  # "plusone": zero-cost actions still count
-    evaluator = RelaxedHeuristic(compiled, heuristic, costs)
-    g_weight, h_weight = {"gbfs": (0.0, 1.0), "astar": (1.0, 1.0), "wastar": (1.0, weight)}[search]
+    relaxed_name = heuristic.removesuffix("-lmcount")
+    relaxed = None if relaxed_name == "lmcount" else RelaxedHeuristic(compiled, relaxed_name, costs)
+    landmarks = LandmarkCount(compiled) if heuristic.endswith("lmcount") else None
+    if landmarks is not None:
+        logger.info("%d fact landmarks", len(landmarks))
+    g_weight, h_weight = {
+        "gbfs": (0.0, 1.0),
+        "lazy-gbfs": (0.0, 1.0),
+        "astar": (1.0, 1.0),
+        "wastar": (1.0, weight),
+    }[search]
     outcome = best_first_search(
         compiled,
-        evaluator,
+        Evaluator(relaxed, landmarks),
         g_weight=g_weight,
         h_weight=h_weight,
-        preferred=preferred and heuristic != "blind" and search != "astar",
-        lazy=lazy,
-        reopen=search != "gbfs",
+        preferred=preferred and relaxed_name not in ("blind", "lmcount") and search != "astar",
+        lazy=lazy or search == "lazy-gbfs",
+        reopen=search not in ("gbfs", "lazy-gbfs"),
         deadline=deadline,
         cost_bound=cost_bound,
     )

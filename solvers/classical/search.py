@@ -1,10 +1,13 @@
-"""Best-first search over bitset states: eager and lazy, with preferred-operator queues.
+"""Best-first search over bitset states: eager and lazy, with alternating queues.
 
 One loop covers greedy best-first (``f = h``), A* (``f = g + h``) and weighted A*
-(``f = g + w h``). With preferred operators, successors reached by a preferred operator go into
-a second queue as well; the queues alternate, and each time a new best h is seen the preferred
-queue gets 1000 extra turns (boosting). Lazy search stores (parent, operator) and evaluates a
-state only when it is taken out of a queue, with its parent's h as the priority.
+(``f = g + w h``). An :class:`Evaluator` gives one or more heuristic values per state (LAMA's
+configuration: h_FF and landmark count) and, optionally, preferred operators. Each value has a
+queue of its own, and with preferred operators a second queue that only takes successors
+reached by a preferred operator. The search takes turns between the queues (the one used least
+goes next); each time a heuristic reaches a new best value the preferred queues get 1000 extra
+turns (boosting). Lazy search stores (parent, operator) and evaluates a state only when it is
+taken out of a queue, with its parent's values as the priority.
 """
 
 from __future__ import annotations
@@ -14,13 +17,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from heapq import heappop, heappush
 from math import inf
-from typing import Generic, TypeVar
 
 from solvers.classical.compiled import CompiledTask
+from solvers.classical.landmarks import LandmarkCount
 
 Heuristic = Callable[[int, bool], tuple[float, "set[int] | None"]]
 BOOST = 1000
-Payload = TypeVar("Payload")
+# queue entry: (priority, tie-breaking h, insertion counter, payload)
+Entry = tuple[float, float, int, tuple[int, int, float]]
 
 
 @dataclass(frozen=True)
@@ -32,32 +36,79 @@ class SearchOutcome:
     evaluated: int
 
 
-class _Queues(Generic[Payload]):
-    """A regular and a preferred priority queue, alternated with boosting."""
+class Evaluator:
+    """A relaxed heuristic, a landmark count, or both (in that order of values).
 
-    def __init__(self, use_preferred: bool) -> None:
-        self.heaps: list[list[tuple[float, float, int, Payload]]] = [[], []]
-        self.priority = [0, 0]
-        self.use_preferred = use_preferred
+    ``evaluate(state, parent_reached, preferred)`` returns the values, the preferred operators
+    (from the relaxed heuristic) and the state's accepted-landmark set (0 without landmarks);
+    ``parent_reached`` is None for the initial state.
+    """
 
-    def push(self, entry: tuple[float, float, int, Payload], preferred: bool) -> None:
-        heappush(self.heaps[0], entry)
-        if preferred and self.use_preferred:
-            heappush(self.heaps[1], entry)
+    def __init__(self, relaxed: Heuristic | None, landmarks: LandmarkCount | None) -> None:
+        self.relaxed = relaxed
+        self.landmarks = landmarks
+        self.size = (relaxed is not None) + (landmarks is not None)
+
+    def evaluate(
+        self, state: int, parent_reached: int | None, preferred: bool
+    ) -> tuple[tuple[float, ...], set[int] | None, int]:
+        values: tuple[float, ...] = ()
+        prefs = None
+        if self.relaxed is not None:
+            h, prefs = self.relaxed(state, preferred)
+            if h == inf:
+                return (inf,), None, 0
+            values = (h,)
+        reached = 0
+        if self.landmarks is not None:
+            lm = self.landmarks
+            if parent_reached is None:
+                reached = lm.initial(state)
+            else:
+                reached = lm.update(parent_reached, state)
+            values = (*values, float(lm.value(reached, state)))
+        return values, prefs, reached
+
+
+class _Queues:
+    """One regular queue per heuristic value, plus one preferred queue each, alternated."""
+
+    def __init__(self, size: int, use_preferred: bool) -> None:
+        self.size = size
+        self.count = 2 * size if use_preferred else size
+        self.heaps: list[list[Entry]] = [[] for _ in range(self.count)]
+        self.priority = [0] * self.count
+
+    def push(
+        self,
+        values: tuple[float, ...],
+        g_part: float,
+        h_weight: float,
+        counter: int,
+        payload: tuple[int, int, float],
+        preferred: bool,
+    ) -> None:
+        heaps = self.heaps
+        for i, h in enumerate(values):
+            entry = (g_part + h_weight * h, h, counter, payload)
+            heappush(heaps[i], entry)
+            if preferred and self.count > self.size:
+                heappush(heaps[self.size + i], entry)
 
     def boost(self) -> None:
-        if self.use_preferred:
-            self.priority[1] -= BOOST
+        for i in range(self.size, self.count):
+            self.priority[i] -= BOOST
 
-    def pop(self) -> tuple[float, float, int, Payload] | None:
-        regular, preferred = self.heaps
-        if preferred and (not regular or self.priority[1] < self.priority[0]):
-            self.priority[1] += 1
-            return heappop(preferred)
-        if regular:
-            self.priority[0] += 1
-            return heappop(regular)
-        return None
+    def pop(self) -> Entry | None:
+        best = -1
+        priority = self.priority
+        for i, heap in enumerate(self.heaps):
+            if heap and (best < 0 or priority[i] < priority[best]):
+                best = i
+        if best < 0:
+            return None
+        priority[best] += 1
+        return heappop(self.heaps[best])
 
 
 def _trace(parent: dict[int, tuple[int, int] | None], state: int) -> tuple[int, ...]:
@@ -72,7 +123,7 @@ def _trace(parent: dict[int, tuple[int, int] | None], state: int) -> tuple[int, 
 
 def best_first_search(
     compiled: CompiledTask,
-    heuristic: Heuristic,
+    heuristic: Heuristic | Evaluator,
     *,
     g_weight: float,
     h_weight: float,
@@ -84,13 +135,14 @@ def best_first_search(
 ) -> SearchOutcome:
     """Search from ``compiled.init``; ``reopen`` re-expands states reached more cheaply.
     States whose cost so far reaches ``cost_bound`` are pruned (only cheaper plans)."""
+    evaluator = heuristic if isinstance(heuristic, Evaluator) else Evaluator(heuristic, None)
     run = _lazy if lazy else _eager
-    return run(compiled, heuristic, g_weight, h_weight, preferred, reopen, deadline, cost_bound)
+    return run(compiled, evaluator, g_weight, h_weight, preferred, reopen, deadline, cost_bound)
 
 
 def _eager(
     compiled: CompiledTask,
-    heuristic: Heuristic,
+    evaluator: Evaluator,
     g_weight: float,
     h_weight: float,
     preferred: bool,
@@ -101,22 +153,24 @@ def _eager(
     costs = compiled.costs
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
     init = compiled.init
-    h, prefs = heuristic(init, preferred)
+    evaluate = evaluator.evaluate
+    values, prefs, reached = evaluate(init, None, preferred)
     expanded, generated, evaluated = 0, 1, 1
-    if h == inf:
+    if values[0] == inf:
         return SearchOutcome("unsolvable", (), 0, generated, evaluated)
-    best_h = h
-    queues: _Queues[tuple[int, float, set[int] | None]] = _Queues(preferred)
-    queues.push((h_weight * h, h, 0, (init, 0.0, prefs)), False)
+    best = list(values)
+    queues = _Queues(evaluator.size, preferred)
+    queues.push(values, 0.0, h_weight, 0, (init, -1, 0.0), False)
     best_g: dict[int, float] = {init: 0.0}
     parent: dict[int, tuple[int, int] | None] = {init: None}
+    info: dict[int, tuple[set[int] | None, int]] = {init: (prefs, reached)}
     closed: set[int] = set()
     counter = 1
     while True:
         entry = queues.pop()
         if entry is None:
             return SearchOutcome("unsolvable", (), expanded, generated, evaluated)
-        state, g, prefs = entry[3]
+        state, _op, g = entry[3]
         if state in closed or g > best_g[state]:
             continue
         if is_goal(state):
@@ -125,6 +179,7 @@ def _eager(
             return SearchOutcome("timeout", (), expanded, generated, evaluated)
         closed.add(state)
         expanded += 1
+        prefs, reached = info[state]
         for op in applicable(state):
             succ = successor(state, op)
             new_g = g + costs[op]
@@ -137,21 +192,32 @@ def _eager(
             best_g[succ] = new_g
             parent[succ] = (state, op)
             closed.discard(succ)
-            h, succ_prefs = heuristic(succ, preferred)
+            values, succ_prefs, succ_reached = evaluate(succ, reached, preferred)
             evaluated += 1
-            if h == inf:
+            if values[0] == inf:
                 continue
-            if h < best_h:
-                best_h = h
+            info[succ] = (succ_prefs, succ_reached)
+            improved = False
+            for i, h in enumerate(values):
+                if h < best[i]:
+                    best[i] = h
+                    improved = True
+            if improved:
                 queues.boost()
-            entry = (g_weight * new_g + h_weight * h, h, counter, (succ, new_g, succ_prefs))
+            queues.push(
+                values,
+                g_weight * new_g,
+                h_weight,
+                counter,
+                (succ, op, new_g),
+                prefs is not None and op in prefs,
+            )
             counter += 1
-            queues.push(entry, prefs is not None and op in prefs)
 
 
 def _lazy(
     compiled: CompiledTask,
-    heuristic: Heuristic,
+    evaluator: Evaluator,
     g_weight: float,
     h_weight: float,
     preferred: bool,
@@ -161,43 +227,56 @@ def _lazy(
 ) -> SearchOutcome:
     costs = compiled.costs
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
+    evaluate = evaluator.evaluate
     expanded, generated, evaluated = 0, 1, 0
-    best_h = inf
-    queues: _Queues[tuple[int | None, int, float]] = _Queues(preferred)
-    queues.push((0.0, 0.0, 0, (None, -1, 0.0)), False)
+    best = [inf] * evaluator.size
+    queues = _Queues(evaluator.size, preferred)
+    init = compiled.init
+    queues.push((0.0,) * evaluator.size, 0.0, h_weight, 0, (-1, -1, 0.0), False)
     parent: dict[int, tuple[int, int] | None] = {}
     closed: dict[int, float] = {}
+    reached_of: dict[int, int] = {}
     counter = 1
     while True:
         entry = queues.pop()
         if entry is None:
             return SearchOutcome("unsolvable", (), expanded, generated, evaluated)
         origin, op, g = entry[3]
-        state = compiled.init if origin is None else successor(origin, op)
+        state = init if op < 0 else successor(origin, op)
         known = closed.get(state)
         if known is not None and (not reopen or g >= known):
             continue
         if deadline is not None and time.perf_counter() > deadline:
             return SearchOutcome("timeout", (), expanded, generated, evaluated)
         closed[state] = g
-        parent[state] = None if origin is None else (origin, op)
-        h, prefs = heuristic(state, preferred)
+        parent[state] = None if op < 0 else (origin, op)
+        values, prefs, reached = evaluate(state, None if op < 0 else reached_of[origin], preferred)
+        reached_of[state] = reached
         evaluated += 1
-        if h == inf:
+        if values[0] == inf:
             continue
         if is_goal(state):
             return SearchOutcome("solved", _trace(parent, state), expanded, generated, evaluated)
-        if h < best_h:
-            best_h = h
+        improved = False
+        for i, h in enumerate(values):
+            if h < best[i]:
+                best[i] = h
+                improved = True
+        if improved:
             queues.boost()
         expanded += 1
+        push = queues.push
         for succ_op in applicable(state):
             new_g = g + costs[succ_op]
             if new_g >= cost_bound:
                 continue
             generated += 1
-            key = g_weight * new_g + h_weight * h
-            queues.push(
-                (key, h, counter, (state, succ_op, new_g)), bool(prefs and succ_op in prefs)
+            push(
+                values,
+                g_weight * new_g,
+                h_weight,
+                counter,
+                (state, succ_op, new_g),
+                prefs is not None and succ_op in prefs,
             )
             counter += 1

@@ -85,6 +85,9 @@ def test_unknown_algorithm_lists_the_valid_ones() -> None:
         ("ff-astar2", ("wastar", "ff", 2.0)),
         ("wastar-ff", ("wastar", "ff", 2.0)),
         ("gbfs-add", ("gbfs", "add", 2.0)),
+        ("lazy-gbfs", ("lazy-gbfs", "ff", 2.0)),
+        ("lazy-gbfs-ff-lmcount", ("lazy-gbfs", "ff-lmcount", 2.0)),
+        ("gbfs-ff-lmcount", ("gbfs", "ff-lmcount", 2.0)),
     ],
 )
 def test_planner_names_map_to_the_classical_planner(
@@ -103,7 +106,9 @@ def test_unknown_planner_lists_the_valid_names() -> None:
         solve(_problem(), planner="lama")
 
 
-@pytest.mark.parametrize("planner", ["max-astar", "ff-astar", "dijkstra", "ff-wastar2"])
+@pytest.mark.parametrize(
+    "planner", ["max-astar", "ff-astar", "dijkstra", "ff-wastar2", "lazy-gbfs-ff-lmcount"]
+)
 def test_solve_entry_points_find_valid_plans(planner: str) -> None:
     problem = _problem()
     for solution in (

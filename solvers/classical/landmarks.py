@@ -1,0 +1,131 @@
+"""Fact landmarks and the landmark-count heuristic (as in LAMA).
+
+A *landmark* is a fact that every plan makes true at some point. They are found by label
+propagation over the delete relaxation (Zhu & Givan): the label of a fact is the set of facts
+that any relaxed plan reaching it must reach first, ``label(f) = {f} ∪ ⋂_achievers ⋃_pre
+label(pre)``, shrunk to a fixpoint from "everything". The goal's landmarks are the union of the
+goal facts' labels. ``q`` in ``label(p)`` orders ``q`` before ``p`` (natural ordering); ``q`` is
+*greedy-necessary* for ``p`` when it is a precondition of every achiever of ``p``.
+
+The heuristic is path-dependent: a state carries the set of landmarks *accepted* on the path to
+it (a landmark is accepted when it becomes true after all its predecessors were accepted).
+``h = |not accepted| + |accepted but needed again|``, where a landmark is needed again when it is
+false now and is a goal, or greedy-necessary for a landmark not yet accepted. All sets are
+Python ``int`` bitsets over fact ids, so an update costs a few big-integer operations.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+from solvers.classical.compiled import CompiledTask, bits, mask
+
+
+class LandmarkCount:
+    """Landmarks of a compiled task and the count heuristic over accepted-landmark sets."""
+
+    def __init__(self, compiled: CompiledTask) -> None:
+        task = compiled.task
+        count = len(task.facts)
+        upre: list[tuple[int, ...]] = []
+        ueff: list[tuple[int, ...]] = []
+        for op in task.operators:
+            groups = [(op.precondition, op.adds)]
+            groups += [(op.precondition + c.condition, c.adds) for c in op.conditional]
+            upre += [tuple(set(pre)) for pre, adds in groups if adds]
+            ueff += [adds for _pre, adds in groups if adds]
+        for axiom in task.axioms:
+            upre.append(tuple(set(axiom.body)))
+            ueff.append((axiom.head,))
+        pre_of: list[list[int]] = [[] for _ in range(count)]
+        for u, pre in enumerate(upre):
+            for fact in pre:
+                pre_of[fact].append(u)
+        init = compiled.init
+        label: list[int | None] = [None] * count
+        for fact in bits(init):
+            label[fact] = 1 << fact
+        # greedy-necessary candidates: the preconditions shared by every reachable achiever
+        shared: list[int | None] = [None] * count
+        queue = deque(u for u, pre in enumerate(upre) if all(label[p] is not None for p in pre))
+        queued = [False] * len(upre)
+        for u in queue:
+            queued[u] = True
+        while queue:
+            u = queue.popleft()
+            queued[u] = False
+            op_label = 0
+            for p in upre[u]:
+                lab = label[p]
+                if lab is None:
+                    break
+                op_label |= lab
+            else:
+                pre_mask = mask(upre[u])
+                for e in ueff[u]:
+                    if init >> e & 1:
+                        continue
+                    old = label[e]
+                    bit = 1 << e
+                    new = op_label | bit if old is None else old & (op_label | bit)
+                    previous = shared[e]
+                    shared[e] = pre_mask if previous is None else previous & pre_mask
+                    if new != old:
+                        label[e] = new
+                        for v in pre_of[e]:
+                            if not queued[v]:
+                                queued[v] = True
+                                queue.append(v)
+        self.reachable = all(label[g] is not None for g in task.goal)
+        landmarks = 0
+        for g in task.goal:
+            landmarks |= label[g] or 0
+        self.landmarks = landmarks
+        self.goal_mask = compiled.goal_mask
+        self.init_mask = init
+        # parents: every landmark ordered before p (natural orderings, from the labels)
+        self.parents: dict[int, int] = {}
+        children_gn: dict[int, int] = {}
+        for p in bits(landmarks):
+            self.parents[p] = (label[p] or 0) & landmarks & ~(1 << p)
+            for q in bits((shared[p] or 0) & landmarks):
+                children_gn[q] = children_gn.get(q, 0) | 1 << p
+        self.children_gn = children_gn
+        self.gn_sources = mask(children_gn)
+
+    def __len__(self) -> int:
+        return self.landmarks.bit_count()
+
+    def initial(self, state: int) -> int:
+        """The accepted set of the initial state: the landmarks true in it."""
+        return state & self.landmarks
+
+    def update(self, reached: int, state: int) -> int:
+        """The accepted set of ``state``, reached from a state whose accepted set is ``reached``."""
+        new = state & self.landmarks & ~reached
+        if not new:
+            return reached
+        parents = self.parents
+        accepted = reached
+        while new:
+            low = new & -new
+            new ^= low
+            if not parents[low.bit_length() - 1] & ~reached:
+                accepted |= low
+        return accepted
+
+    def value(self, reached: int, state: int) -> int:
+        """Landmarks not accepted, plus accepted ones needed again."""
+        h = (self.landmarks & ~reached).bit_count()
+        lost = reached & ~state
+        if not lost:
+            return h
+        h += (lost & self.goal_mask).bit_count()
+        candidates = lost & self.gn_sources & ~self.goal_mask
+        children = self.children_gn
+        while candidates:
+            low = candidates & -candidates
+            candidates ^= low
+            if children[low.bit_length() - 1] & ~reached:
+                h += 1
+        return h
