@@ -79,14 +79,15 @@ def parse_typed_list(
     types: frozenset[str] | None,
     variables: bool,
     repeats: list[tuple[str, SourceLocation]] | None = None,
-) -> list[tuple[str, str, SourceLocation]]:
-    """Parse ``a b - t c`` into ``[(a, t), (b, t), (c, object)]`` with locations.
+) -> list[tuple[str, str, Symbol]]:
+    """Parse ``a b - t c`` into ``[(a, t), (b, t), (c, object)]``, each with its name's token
+    (``token.location`` says where it is: worked out only when asked for).
 
     ``types`` None means the caller does not check types (type declarations themselves).
     ``variables`` requires every name to start with ``?``; otherwise none may. A name that
     appears twice is an error, unless ``repeats`` is given: then it is kept and noted there.
     """
-    result: list[tuple[str, str, SourceLocation]] = []
+    result: list[tuple[str, str, Symbol]] = []
     pending: list[Symbol] = []
     index = 0
     while index < len(items):
@@ -103,7 +104,7 @@ def parse_typed_list(
             if not pending:
                 raise PddlSyntaxError(f"expected a name before '-' in {what}", token.location)
             check_type(type_node, types)
-            result.extend((name.text, type_node.text, name.location) for name in pending)
+            result.extend((name.text, type_node.text, name) for name in pending)
             pending = []
             index += 2
             continue
@@ -114,13 +115,13 @@ def parse_typed_list(
             )
         pending.append(token)
         index += 1
-    result.extend((name.text, OBJECT_TYPE, name.location) for name in pending)
+    result.extend((name.text, OBJECT_TYPE, name) for name in pending)
     seen: set[str] = set()
-    for name, _, location in result:
+    for name, _, token in result:
         if name in seen:
             if repeats is None:
-                raise DuplicateError(f"{name!r} appears twice in {what}", location)
-            repeats.append((name, location))
+                raise DuplicateError(f"{name!r} appears twice in {what}", token.location)
+            repeats.append((name, token.location))
         seen.add(name)
     return result
 
@@ -224,11 +225,13 @@ class FormulaReader:
         constants = self.vocabulary.constants
         # the common case (object names and bound variables) inline: init sections are large
         args = tuple(
-            arg.text
-            if type(arg) is Symbol
-            and (arg.text in scope if arg.text[0] == "?" else arg.text in constants)
-            else self.term(arg, scope)  # the error, located
-            for arg in node.items[1:]
+            [
+                arg.text
+                if type(arg) is Symbol
+                and (arg.text in scope if arg.text[0] == "?" else arg.text in constants)
+                else self.term(arg, scope)  # the error, located
+                for arg in node.items[1:]
+            ]
         )
         if name == EQUALITY:
             expected = 2

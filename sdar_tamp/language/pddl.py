@@ -147,11 +147,11 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
             _declare_types(body, parents, log)
             vocabulary.types = frozenset({OBJECT_TYPE, *parents})
         elif keyword == ":constants":
-            for const, type_name, location in parse_typed_list(
+            for const, type_name, token in parse_typed_list(
                 body, "the constants", vocabulary.types, variables=False
             ):
                 if const in constants:
-                    raise DuplicateError(f"constant {const!r} is declared twice", location)
+                    raise DuplicateError(f"constant {const!r} is declared twice", token.location)
                 constants[const] = type_name
         elif keyword == ":predicates":
             for node in body:
@@ -220,11 +220,11 @@ def _derived_name(section: SList) -> str:
 
 
 def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str], log: LeniencyLog) -> None:
-    for child, parent, location in parse_typed_list(body, "the types", None, variables=False):
+    for child, parent, token in parse_typed_list(body, "the types", None, variables=False):
         if child == OBJECT_TYPE:
             continue
         if child in parents:
-            raise DuplicateError(f"type {child!r} is declared twice", location)
+            raise DuplicateError(f"type {child!r} is declared twice", token.location)
         parents[child] = parent
     noted: set[str] = set()
     for dash, node in itertools.pairwise(body):
@@ -430,11 +430,11 @@ def parse_problem(
                     section.location,
                 )
         elif keyword == ":objects":
-            for obj, type_name, location in parse_typed_list(
+            for obj, type_name, token in parse_typed_list(
                 section.items[1:], "the objects", types, variables=False
             ):
                 if obj in own:
-                    raise DuplicateError(f"object {obj!r} is declared twice", location)
+                    raise DuplicateError(f"object {obj!r} is declared twice", token.location)
                 own[obj] = type_name
                 objects[obj] = type_name
     init: list[Atom] = []
