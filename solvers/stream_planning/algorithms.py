@@ -133,6 +133,7 @@ class StreamSolver:
         self.use_costs = not options.unit_costs and has_costs(problem.domain)
         self.queue: list[Skeleton] = []
         self._order = 0
+        self._unreachable = False  # the last plan search found the goal relaxed-unreachable
 
     # --- helpers --------------------------------------------------------------------------
 
@@ -182,6 +183,10 @@ class StreamSolver:
             cost_bound=self._cost_bound(),
         )
         self.stats["search_time"] += time.perf_counter() - start
+        # nothing expanded: the goal is not reachable even ignoring deletes
+        self._unreachable = result.status is PlanStatus.UNSOLVABLE and (
+            result.statistics.expanded == 0
+        )
         if result.status is PlanStatus.TIMEOUT:
             self._check_time()
             return None
@@ -300,6 +305,11 @@ class StreamSolver:
         """Nothing left out at this level: no plan now means no plan at all."""
         if not world.complete or self.blocks.temporary:
             return False
+        # later calls (left out above the level) could give the several new values of one
+        # instance a plan needs; mapped onto its one placeholder, a relaxed plan stays one, so
+        # only a goal that is not relaxed-reachable proves that they would not help
+        if world.more_calls and not self._unreachable:
+            return False
         if any(s.instance.disabled for s in self.engine.instances.values()):
             return False
         return not lazy or all(
@@ -321,11 +331,14 @@ class StreamSolver:
             if lazy:
                 self._sample_up_to(level)
             world = self._world(level, lazy)
-            found = (
-                self.plan(world.facts, world.numeric)
-                if self.stats["skeletons"] < options.max_skeletons
-                else None
-            )
+            self._unreachable = False
+            found = None
+            if self.stats["skeletons"] < options.max_skeletons:
+                found = self.plan(world.facts, world.numeric)
+                if found is None and world.more_calls and not self._unreachable:
+                    # no plan with one new output per instance: offer later calls' outputs
+                    world = self.builder.build(level, lazy, further=True)
+                    found = self.plan(world.facts, world.numeric)
             stream_plan: list[OptResult] = []
             check = None
             if found is not None:
