@@ -29,7 +29,15 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from sdar_tamp.language.model import AndEffect, Atom, Domain, FunctionTerm, IncreaseCost
+from sdar_tamp.language.model import (
+    And,
+    AndEffect,
+    Atom,
+    Domain,
+    Formula,
+    FunctionTerm,
+    IncreaseCost,
+)
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
@@ -160,18 +168,30 @@ class StreamSolver:
         )
 
     def plan(
-        self, facts: Mapping[Atom, int], numeric: Mapping[tuple[str, tuple[str, ...]], float]
+        self,
+        facts: Mapping[Atom, int],
+        numeric: Mapping[tuple[str, tuple[str, ...]], float],
+        world: OptimisticWorld | None = None,
     ) -> tuple[PlanSteps, float] | None:
-        """A classical plan over ``facts``; None when there is none."""
+        """A classical plan over ``facts``; None when there is none. With ``effort_weight``,
+        each action of the optimistic ``world`` also pays for the stream effort behind it."""
         self._check_time()
         limit = min(self.remaining(), self.options.max_planner_time)
+        domain = self.blocks.domain()
+        extra = None
+        if self.options.effort_weight is not None and world is not None and world.provenance:
+            info = {n: e.info for n, e in self.engine.streams.items()}
+            extra = ActionEfforts(
+                domain, world, info, self.options.effort_weight, self.options.unit_efforts
+            )
         task = PlanningTask(
-            self.blocks.domain(),
+            domain,
             self._objects(facts),
             frozenset(facts) | self.blocks.facts(),
             self.goal,
             numeric,
             use_costs=not self.options.unit_costs,
+            extra_cost=extra,
         )
         start = time.perf_counter()
         result = classical_plan(
@@ -180,7 +200,8 @@ class StreamSolver:
             heuristic=self.options.heuristic,
             weight=self.options.weight,
             time_limit=limit,
-            cost_bound=self._cost_bound(),
+            # efforts raise the costs the search sees: the bound on true costs does not apply
+            cost_bound=self._cost_bound() if extra is None else math.inf,
         )
         self.stats["search_time"] += time.perf_counter() - start
         # nothing expanded: the goal is not reachable even ignoring deletes
@@ -334,11 +355,11 @@ class StreamSolver:
             self._unreachable = False
             found = None
             if self.stats["skeletons"] < options.max_skeletons:
-                found = self.plan(world.facts, world.numeric)
+                found = self.plan(world.facts, world.numeric, world)
                 if found is None and world.more_calls and not self._unreachable:
                     # no plan with one new output per instance: offer later calls' outputs
                     world = self.builder.build(level, lazy, further=True)
-                    found = self.plan(world.facts, world.numeric)
+                    found = self.plan(world.facts, world.numeric, world)
             stream_plan: list[OptResult] = []
             check = None
             if found is not None:
@@ -606,6 +627,45 @@ def stream_plan_effort(
             overhead = 1.0 if options.overhead is None else options.overhead
             total += overhead / (1.0 if options.p_success is None else options.p_success)
     return total
+
+
+class ActionEfforts:
+    """The extra cost of an optimistic action (PDDLStream's stream efforts in the plan cost):
+    ``weight`` times the effort (:func:`stream_plan_effort`) of the optimistic results behind
+    the positive preconditions of the action, each result counted once."""
+
+    def __init__(
+        self,
+        domain: Domain,
+        world: OptimisticWorld,
+        info: Mapping[str, StreamInfo],
+        weight: float,
+        unit_efforts: bool,
+    ) -> None:
+        self.domain = domain
+        self.world = world
+        self.info = info
+        self.weight = weight
+        self.unit_efforts = unit_efforts
+
+    def __call__(self, name: str, args: tuple[str, ...]) -> float:
+        action = self.domain.action(name)
+        binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
+        provenance = self.world.provenance
+        facts = [a for a in positive_atoms(action.precondition, binding) if a in provenance]
+        if not facts:
+            return 0.0
+        results = extract_stream_plan(facts, self.world)
+        return self.weight * stream_plan_effort(results, self.info, self.unit_efforts)
+
+
+def positive_atoms(formula: Formula, binding: Mapping[str, str]) -> list[Atom]:
+    """The atoms a formula needs true in every case: those under conjunctions only."""
+    if isinstance(formula, Atom):
+        return [Atom(formula.predicate, tuple(binding.get(a, a) for a in formula.args))]
+    if isinstance(formula, And):
+        return [atom for part in formula.parts for atom in positive_atoms(part, binding)]
+    return []
 
 
 def extract_stream_plan(needed: Iterable[Atom], world: OptimisticWorld) -> list[OptResult]:
