@@ -85,7 +85,7 @@ class StreamOptions:
     heuristic: str = "ff"
     weight: float = 2.0
     max_cost: float = math.inf  # plans above it are not returned (PlanConstraints.max_cost)
-    effort_weight: float | None = None  # skeletons ordered by cost + weight * stream effort
+    effort_weight: float | None = None  # optimistic actions pay weight * stream effort
     unit_efforts: bool = False  # every stream call has effort 1
     enforce_max_time: bool = True  # user calls in a worker thread, abandoned at max_time
 
@@ -402,6 +402,13 @@ class StreamSolver:
                 if not valid:
                     LOG.debug("plan on real facts failed validation; raising complexity")
                     level += options.complexity_step
+                elif lazy:
+                    # incremental looks for a cheaper plan on more facts (as PDDLStream's
+                    # does): the next search covers these facts too, bounded by this plan
+                    level += options.complexity_step
+                    if level > options.max_complexity:
+                        return Status.INFEASIBLE
+                    tried.clear()
                 continue
             self.stats["skeletons"] += 1
             priority = cost

@@ -25,7 +25,7 @@ from sdar_tamp.language.model import (
     Not,
     When,
 )
-from solvers.stream_planning.engine import Engine, function_guard
+from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import FunctionExternal
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
 
@@ -197,7 +197,7 @@ class OptimisticBuilder:
             if lazy and real and not external.declaration.fluents:
                 return []
             state = engine.instance(name, inputs) if real else None
-            next_level = level + 1
+            next_level = level + first_call_level(external)
             if state is not None:
                 # a fluent instance exhausted in one state may still produce in another
                 if state.instance.exhausted and not external.declaration.fluents:
@@ -205,7 +205,7 @@ class OptimisticBuilder:
                 if state.instance.disabled:
                     world.complete = False
                     return []
-                next_level = level + engine.calls(state) + 1
+                next_level = level + engine.calls(state) + first_call_level(external)
             if next_level > limit:
                 self._left_out(inputs, world)
                 return []
