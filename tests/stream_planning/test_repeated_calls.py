@@ -74,3 +74,13 @@ def test_goal_out_of_relaxed_reach_is_proven_infeasible(algorithm: str) -> None:
     solution = solve(problem(("taken", "nothing")), algorithm=algorithm, max_time=20, verbose=False)
     assert solution.status is Status.INFEASIBLE
     assert solution.statistics["iterations"] <= 20
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
+def test_a_test_adds_no_complexity_on_its_first_call(algorithm: str) -> None:
+    # one sample (level 1) and its test (still level 1, as in PDDLStream): solved at level 1
+    stream_map = {"sample-x": from_gen_fn(counting), "test-good": from_test(lambda x: True)}
+    goal_problem = PDDLProblem(DOMAIN, {}, STREAMS, stream_map, [], ("done",))
+    solution = solve(goal_problem, algorithm=algorithm, max_time=20, verbose=False)
+    assert solution.status is Status.SOLVED
+    assert solution.statistics["complexity"] == 1
