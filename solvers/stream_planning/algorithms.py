@@ -50,7 +50,7 @@ from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.costs import guard_costs, has_costs
 from solvers.stream_planning.diagnosis import diagnose
 from solvers.stream_planning.engine import Engine, InstanceState
-from solvers.stream_planning.fluents import Fluents, fluent_plan
+from solvers.stream_planning.fluents import FluentPlan, Fluents, fluent_plan
 from solvers.stream_planning.negation import check_negated_uses
 from solvers.stream_planning.optimistic import (
     OptimisticBuilder,
@@ -200,8 +200,8 @@ class StreamSolver:
             heuristic=self.options.heuristic,
             weight=self.options.weight,
             time_limit=limit,
-            # efforts raise the costs the search sees: the bound on true costs does not apply
-            cost_bound=self._cost_bound() if extra is None else math.inf,
+            # with efforts, the bound applies to cost plus effort (as in PDDLStream)
+            cost_bound=self._cost_bound(),
         )
         self.stats["search_time"] += time.perf_counter() - start
         # nothing expanded: the goal is not reachable even ignoring deletes
@@ -362,12 +362,13 @@ class StreamSolver:
                     found = self.plan(world.facts, world.numeric, world)
             stream_plan: list[OptResult] = []
             check = None
-            if found is not None:
+            if found is not None and world.provenance:  # (else all facts are real)
                 check = simulate(
                     self.problem.domain, self._objects(world.facts), world.facts, found[0],
                     self.goal,
                 )  # fmt: skip
                 stream_plan = extract_stream_plan(check.needed, world)
+            if found is not None:
                 # The same actions on the same optimistic results: nothing learnt since this
                 # plan was met, as if none. (The same actions on real facts are new.)
                 key = (
@@ -377,7 +378,7 @@ class StreamSolver:
                 if key in tried:
                     found = None
                 tried.add(key)
-            if found is None or check is None:
+            if found is None:
                 # no new plan: work on the queued skeletons, and raise the level (what they
                 # wait for may lie above it)
                 if self.queue and self._process_queue():
@@ -391,7 +392,11 @@ class StreamSolver:
                 tried.clear()
                 continue
             actions, cost = found
-            ordered = fluent_plan(stream_plan, check, self.fluent_streams, actions)
+            ordered = (
+                fluent_plan(stream_plan, check, self.fluent_streams, actions)
+                if check is not None
+                else FluentPlan([], {}, list(actions))
+            )
             stream_plan = ordered.stream_plan
             if not any(r.kind == "stream" for r in stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
