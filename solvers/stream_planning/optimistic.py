@@ -170,6 +170,9 @@ class OptimisticBuilder:
             query, inputs, level = pending.pop()
             results = self._results(query.name, inputs, level, limit, world, lazy)
             more = self._further(results, limit, world, further)
+            for result in results:  # what rests on a later call's output is "later" too
+                if any(n in self._later for n in result.inputs):
+                    self._later.update(result.outputs)
             for result in [*results, *more]:
                 for atom in result.certified:
                     if store.add(atom, result.level):
