@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_pddlstream_compat.py PATH_TO_PDDLSTREAM_CHECKOUT [--timeout S]
-                                                  [--only NAME ...]
+                                                  [--only NAME ...] [--repeat N]
     PDDLSTREAM_PATH=... python benchmarks/bench_pddlstream_compat.py
 
 Each example runs in its own subprocess, exactly as PDDLStream's README runs it
@@ -200,7 +200,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("checkout", nargs="?", default=os.environ.get("PDDLSTREAM_PATH"))
     parser.add_argument("--timeout", type=float, default=120.0, help="[s] per example")
     parser.add_argument("--only", nargs="*", default=None, help="example names to run")
+    parser.add_argument(
+        "--repeat", type=int, default=1, help="runs per example (unseeded ones vary: pass rates)"
+    )
     args = parser.parse_args(argv)
+    if args.repeat < 1:
+        parser.error(f"--repeat must be >= 1; got {args.repeat}")
     if not args.checkout or not (Path(args.checkout) / "examples").is_dir():
         print(
             "skipped: no PDDLStream checkout (pass its path or set PDDLSTREAM_PATH); "
@@ -212,18 +217,25 @@ def main(argv: list[str] | None = None) -> int:
     chosen = [e for e in EXAMPLES if args.only is None or e.name in args.only]
     rows = []
     print(f"{'example':28} {'result':60} {'time [s]':>8}")
+    rates: dict[str, str] = {}
     for example in chosen:
-        row = run_example(checkout, example, args.timeout)
-        rows.append(row)
-        print(f"{row['example']:28} {row['result']!s:60} {row['seconds']:8.2f}", flush=True)
+        runs = []
+        for _ in range(args.repeat):
+            row = run_example(checkout, example, args.timeout)
+            runs.append(row)
+            print(f"{row['example']:28} {row['result']!s:60} {row['seconds']:8.2f}", flush=True)
+        rows.extend(runs)
+        rates[example.name] = f"{sum(bool(r['passed']) for r in runs)}/{len(runs)}"
     passed = sum(bool(r["passed"]) for r in rows)
     print(f"passed {passed} of {len(rows)}")
-    summary = {
+    summary: dict[str, object] = {
         "passed": passed,
         "total": len(rows),
-        "failed": [r["example"] for r in rows if not r["passed"]],
+        "failed": sorted({str(r["example"]) for r in rows if not r["passed"]}),
         "seconds": {str(r["example"]): r["seconds"] for r in rows},
     }
+    if args.repeat > 1:
+        summary["pass_rates"] = rates
     print(json.dumps(summary))
     return 0
 

@@ -123,9 +123,11 @@ def solve(
             variables; ``exact``) and ``max_cost`` (see
             :mod:`solvers.stream_planning.constraints`).
         unit_costs: every action costs 1 instead of its ``total-cost`` increase.
-        effort_weight: when set, optimistic plans are tried in the order of cost plus this
-            weight times their stream effort (``StreamInfo.effort``, or ``overhead /
-            p_success``; 1 per call with ``unit_efforts``).
+        effort_weight: when set, each optimistic action costs, for the planner, this weight
+            times the effort of the stream results behind its preconditions more
+            (``StreamInfo.effort``, or ``overhead / p_success``; 1 per call with
+            ``unit_efforts``), and queued optimistic plans are tried in the order of cost
+            plus weighted effort.
         success_cost: stop at the first plan of at most this cost (else keep improving until
             ``max_time``).
         max_time: wall-clock limit [s].

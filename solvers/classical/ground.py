@@ -97,6 +97,16 @@ class _Instantiator:
                 return None
         return sorted(set(positive)), sorted(set(negative))
 
+    def extra(self, name: str, args: tuple[str, ...]) -> float:
+        """The task's ``extra_cost`` of a ground action (0 without one)."""
+        extra = self.task.extra_cost
+        if extra is None:
+            return 0.0
+        value = float(extra(name, args))
+        if not math.isfinite(value) or value < 0:
+            raise GroundingError(f"extra costs must be finite and non-negative, got {value}")
+        return value
+
     def cost(self, action: NormAction, binding: Mapping[str, str]) -> float:
         if not self.task.use_costs:
             return 1.0
@@ -221,7 +231,8 @@ class _Instantiator:
                         ConditionalEffect(pos, neg, tuple(sorted(a)), tuple(sorted(d)))
                         for (pos, neg), (a, d) in sorted(groups.items())
                     ),
-                    cost=self.cost(action, binding) if fixed_cost is None else fixed_cost,
+                    cost=(self.cost(action, binding) if fixed_cost is None else fixed_cost)
+                    + self.extra(action.name, args),
                 )
             )
         return result

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import enum
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from sdar_tamp.language.model import Atom, Domain, Formula, Problem
@@ -17,6 +17,9 @@ class PlanningTask:
     ``init`` holds ground atoms; type atoms such as ``(block b1)`` may be present or not (they are
     derived from ``objects`` either way). ``numeric_init`` maps ``(function, args)`` to a value and
     supplies the cost terms. With ``use_costs=False`` every action costs 1.
+    ``extra_cost``, when given, maps a ground action ``(name, args)`` to a non-negative amount
+    the search adds to that action's cost (a penalty steering the search); the reported plan
+    cost leaves it out.
     """
 
     domain: Domain
@@ -25,6 +28,7 @@ class PlanningTask:
     goal: Formula
     numeric_init: Mapping[tuple[str, tuple[str, ...]], float] = field(default_factory=dict)
     use_costs: bool = True
+    extra_cost: Callable[[str, tuple[str, ...]], float] | None = None
 
 
 def task_from_problem(

@@ -29,7 +29,15 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from sdar_tamp.language.model import AndEffect, Atom, Domain, FunctionTerm, IncreaseCost
+from sdar_tamp.language.model import (
+    And,
+    AndEffect,
+    Atom,
+    Domain,
+    Formula,
+    FunctionTerm,
+    IncreaseCost,
+)
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
@@ -42,7 +50,7 @@ from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.costs import guard_costs, has_costs
 from solvers.stream_planning.diagnosis import diagnose
 from solvers.stream_planning.engine import Engine, InstanceState
-from solvers.stream_planning.fluents import Fluents, fluent_plan
+from solvers.stream_planning.fluents import FluentPlan, Fluents, fluent_plan
 from solvers.stream_planning.negation import check_negated_uses
 from solvers.stream_planning.optimistic import (
     OptimisticBuilder,
@@ -77,7 +85,7 @@ class StreamOptions:
     heuristic: str = "ff"
     weight: float = 2.0
     max_cost: float = math.inf  # plans above it are not returned (PlanConstraints.max_cost)
-    effort_weight: float | None = None  # skeletons ordered by cost + weight * stream effort
+    effort_weight: float | None = None  # optimistic actions pay weight * stream effort
     unit_efforts: bool = False  # every stream call has effort 1
     enforce_max_time: bool = True  # user calls in a worker thread, abandoned at max_time
 
@@ -133,6 +141,7 @@ class StreamSolver:
         self.use_costs = not options.unit_costs and has_costs(problem.domain)
         self.queue: list[Skeleton] = []
         self._order = 0
+        self._unreachable = False  # the last plan search found the goal relaxed-unreachable
 
     # --- helpers --------------------------------------------------------------------------
 
@@ -159,18 +168,30 @@ class StreamSolver:
         )
 
     def plan(
-        self, facts: Mapping[Atom, int], numeric: Mapping[tuple[str, tuple[str, ...]], float]
+        self,
+        facts: Mapping[Atom, int],
+        numeric: Mapping[tuple[str, tuple[str, ...]], float],
+        world: OptimisticWorld | None = None,
     ) -> tuple[PlanSteps, float] | None:
-        """A classical plan over ``facts``; None when there is none."""
+        """A classical plan over ``facts``; None when there is none. With ``effort_weight``,
+        each action of the optimistic ``world`` also pays for the stream effort behind it."""
         self._check_time()
         limit = min(self.remaining(), self.options.max_planner_time)
+        domain = self.blocks.domain()
+        extra = None
+        if self.options.effort_weight is not None and world is not None and world.provenance:
+            info = {n: e.info for n, e in self.engine.streams.items()}
+            extra = ActionEfforts(
+                domain, world, info, self.options.effort_weight, self.options.unit_efforts
+            )
         task = PlanningTask(
-            self.blocks.domain(),
+            domain,
             self._objects(facts),
             frozenset(facts) | self.blocks.facts(),
             self.goal,
             numeric,
             use_costs=not self.options.unit_costs,
+            extra_cost=extra,
         )
         start = time.perf_counter()
         result = classical_plan(
@@ -179,9 +200,14 @@ class StreamSolver:
             heuristic=self.options.heuristic,
             weight=self.options.weight,
             time_limit=limit,
+            # with efforts, the bound applies to cost plus effort (as in PDDLStream)
             cost_bound=self._cost_bound(),
         )
         self.stats["search_time"] += time.perf_counter() - start
+        # nothing expanded: the goal is not reachable even ignoring deletes
+        self._unreachable = result.status is PlanStatus.UNSOLVABLE and (
+            result.statistics.expanded == 0
+        )
         if result.status is PlanStatus.TIMEOUT:
             self._check_time()
             return None
@@ -300,6 +326,11 @@ class StreamSolver:
         """Nothing left out at this level: no plan now means no plan at all."""
         if not world.complete or self.blocks.temporary:
             return False
+        # later calls (left out above the level) could give the several new values of one
+        # instance a plan needs; mapped onto its one placeholder, a relaxed plan stays one, so
+        # only a goal that is not relaxed-reachable proves that they would not help
+        if world.more_calls and not self._unreachable:
+            return False
         if any(s.instance.disabled for s in self.engine.instances.values()):
             return False
         return not lazy or all(
@@ -321,19 +352,23 @@ class StreamSolver:
             if lazy:
                 self._sample_up_to(level)
             world = self._world(level, lazy)
-            found = (
-                self.plan(world.facts, world.numeric)
-                if self.stats["skeletons"] < options.max_skeletons
-                else None
-            )
+            self._unreachable = False
+            found = None
+            if self.stats["skeletons"] < options.max_skeletons:
+                found = self.plan(world.facts, world.numeric, world)
+                if found is None and world.more_calls and not self._unreachable:
+                    # no plan with one new output per instance: offer later calls' outputs
+                    world = self.builder.build(level, lazy, further=True)
+                    found = self.plan(world.facts, world.numeric, world)
             stream_plan: list[OptResult] = []
             check = None
-            if found is not None:
+            if found is not None and world.provenance:  # (else all facts are real)
                 check = simulate(
                     self.problem.domain, self._objects(world.facts), world.facts, found[0],
                     self.goal,
                 )  # fmt: skip
                 stream_plan = extract_stream_plan(check.needed, world)
+            if found is not None:
                 # The same actions on the same optimistic results: nothing learnt since this
                 # plan was met, as if none. (The same actions on real facts are new.)
                 key = (
@@ -343,7 +378,7 @@ class StreamSolver:
                 if key in tried:
                     found = None
                 tried.add(key)
-            if found is None or check is None:
+            if found is None:
                 # no new plan: work on the queued skeletons, and raise the level (what they
                 # wait for may lie above it)
                 if self.queue and self._process_queue():
@@ -357,7 +392,11 @@ class StreamSolver:
                 tried.clear()
                 continue
             actions, cost = found
-            ordered = fluent_plan(stream_plan, check, self.fluent_streams, actions)
+            ordered = (
+                fluent_plan(stream_plan, check, self.fluent_streams, actions)
+                if check is not None
+                else FluentPlan([], {}, list(actions))
+            )
             stream_plan = ordered.stream_plan
             if self.builder.refine(stream_plan):
                 continue  # it uses shared placeholders: plan again with the instances' own
@@ -370,6 +409,13 @@ class StreamSolver:
                 if not valid:
                     LOG.debug("plan on real facts failed validation; raising complexity")
                     level += options.complexity_step
+                elif lazy:
+                    # incremental looks for a cheaper plan on more facts (as PDDLStream's
+                    # does): the next search covers these facts too, bounded by this plan
+                    level += options.complexity_step
+                    if level > options.max_complexity:
+                        return Status.INFEASIBLE
+                    tried.clear()
                 continue
             self.stats["skeletons"] += 1
             priority = cost
@@ -595,6 +641,45 @@ def stream_plan_effort(
             overhead = 1.0 if options.overhead is None else options.overhead
             total += overhead / (1.0 if options.p_success is None else options.p_success)
     return total
+
+
+class ActionEfforts:
+    """The extra cost of an optimistic action (PDDLStream's stream efforts in the plan cost):
+    ``weight`` times the effort (:func:`stream_plan_effort`) of the optimistic results behind
+    the positive preconditions of the action, each result counted once."""
+
+    def __init__(
+        self,
+        domain: Domain,
+        world: OptimisticWorld,
+        info: Mapping[str, StreamInfo],
+        weight: float,
+        unit_efforts: bool,
+    ) -> None:
+        self.domain = domain
+        self.world = world
+        self.info = info
+        self.weight = weight
+        self.unit_efforts = unit_efforts
+
+    def __call__(self, name: str, args: tuple[str, ...]) -> float:
+        action = self.domain.action(name)
+        binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
+        provenance = self.world.provenance
+        facts = [a for a in positive_atoms(action.precondition, binding) if a in provenance]
+        if not facts:
+            return 0.0
+        results = extract_stream_plan(facts, self.world)
+        return self.weight * stream_plan_effort(results, self.info, self.unit_efforts)
+
+
+def positive_atoms(formula: Formula, binding: Mapping[str, str]) -> list[Atom]:
+    """The atoms a formula needs true in every case: those under conjunctions only."""
+    if isinstance(formula, Atom):
+        return [Atom(formula.predicate, tuple(binding.get(a, a) for a in formula.args))]
+    if isinstance(formula, And):
+        return [atom for part in formula.parts for atom in positive_atoms(part, binding)]
+    return []
 
 
 def extract_stream_plan(needed: Iterable[Atom], world: OptimisticWorld) -> list[OptResult]:

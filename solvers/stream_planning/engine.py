@@ -1,7 +1,8 @@
 """The state every stream algorithm shares: externals, known (real) facts, stream instances.
 
 Real facts have complexity levels: init facts are level 0; a result of an instance whose domain
-facts reach level ``d`` and that was called ``k`` times before has level ``d + k + 1``.
+facts reach level ``d`` and that was called ``k`` times before has level ``d + k + 1``, or
+``d + k`` for a test (a stream without outputs: its first answer makes nothing new).
 ``:function`` and ``:predicate`` instances are evaluated as soon as their domain holds (they are
 cheap, and negated predicates need their value); ``:rule`` facts are added at once.
 
@@ -73,7 +74,14 @@ class InstanceState:
 
     @property
     def next_level(self) -> int:
-        return self.domain_level + self.instance.calls + 1
+        return self.domain_level + self.instance.calls + first_call_level(self.instance.external)
+
+
+def first_call_level(external: StreamExternal) -> int:
+    """What a stream's first call adds to the level of its domain facts: 1 for a stream with
+    outputs, 0 for a test (it makes no new object; as in PDDLStream, a test does not make its
+    facts more complex). Each further call adds 1."""
+    return 1 if external.declaration.outputs else 0
 
 
 class Engine:
@@ -205,7 +213,8 @@ class Engine:
         level = state.next_level
         if instance.external.declaration.fluents:
             key = (instance.external.name, instance.inputs)
-            level = state.domain_level + self.fluent_calls.get(key, 0) + 1
+            calls = self.fluent_calls.get(key, 0)
+            level = state.domain_level + calls + first_call_level(instance.external)
             self.fluent_calls[key] = self.fluent_calls.get(key, 0) + 1
         results, wild = instance.next(self.table, self.runner)
         facts = [atom for result in results for atom in result.certified]

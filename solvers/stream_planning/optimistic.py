@@ -27,7 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from sdar_tamp.language.generators import WildOutput
+from sdar_tamp.language.generators import SINGLE_CALL, WildOutput
 from sdar_tamp.language.model import (
     AndEffect,
     Atom,
@@ -39,7 +39,7 @@ from sdar_tamp.language.model import (
     Not,
     When,
 )
-from solvers.stream_planning.engine import Engine, function_guard
+from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import (
     FunctionExternal,
     StreamError,
@@ -87,6 +87,9 @@ class OptimisticWorld:
     numeric: dict[tuple[str, tuple[str, ...]], float]
     placeholders: list[str] = field(default_factory=list)
     complete: bool = True  # no instance was left out for the limit or for being disabled
+    # later calls of some instance were left out for the limit (see OptimisticBuilder._further):
+    # no plan proves nothing unless the goal is not even relaxed-reachable
+    more_calls: bool = False
 
 
 def negated_predicates(domain: Domain, goal: Formula) -> frozenset[str]:
@@ -152,6 +155,7 @@ class OptimisticBuilder:
         self.refined: set[tuple[str, tuple[str, ...]]] = set()  # instances with their own
         # (stream, inputs) -> the output tuples of its callable opt_gen_fn
         self._generated: dict[tuple[str, tuple[str, ...]], list[tuple[object, ...]]] = {}
+        self._later: set[str] = set()  # placeholders of later calls (see _further)
 
     def placeholder(self, key: tuple[object, ...]) -> str:
         name = self._placeholders.get(key)
@@ -161,10 +165,12 @@ class OptimisticBuilder:
             self.producers[name] = str(key[0])
         return name
 
-    def build(self, limit: int, lazy: bool = False) -> OptimisticWorld:
+    def build(self, limit: int, lazy: bool = False, further: bool = False) -> OptimisticWorld:
         """The optimistic world at complexity ``limit``. With ``lazy`` (incremental), only
         fluent streams (called in the state of the step that uses them) and streams on
-        placeholders add optimistic results; the others are called for real beforehand."""
+        placeholders add optimistic results; the others are called for real beforehand.
+        With ``further``, instances also offer the outputs of later calls (:meth:`_further`);
+        without, ``more_calls`` only says whether some instance could."""
         engine = self.engine
         store = FactStore()
         facts = engine.planning_facts()
@@ -187,7 +193,12 @@ class OptimisticBuilder:
         pending = list(instantiator.initial())
         while pending:
             query, inputs, level = pending.pop()
-            for result in self._results(query.name, inputs, level, limit, world, lazy):
+            results = self._results(query.name, inputs, level, limit, world, lazy)
+            more = self._further(results, limit, world, further)
+            for result in results:  # what rests on a later call's output is "later" too
+                if any(n in self._later for n in result.inputs):
+                    self._later.update(result.outputs)
+            for result in [*results, *more]:
                 for atom in result.certified:
                     if store.add(atom, result.level):
                         world.facts[atom] = result.level
@@ -214,7 +225,7 @@ class OptimisticBuilder:
             if lazy and real and not external.declaration.fluents:
                 return []
             state = engine.instance(name, inputs) if real else None
-            next_level = level + 1
+            next_level = level + first_call_level(external)
             if state is not None:
                 # a fluent instance exhausted in one state may still produce in another
                 if state.instance.exhausted and not external.declaration.fluents:
@@ -222,9 +233,9 @@ class OptimisticBuilder:
                 if state.instance.disabled:
                     world.complete = False
                     return []
-                next_level = level + engine.calls(state) + 1
+                next_level = level + engine.calls(state) + first_call_level(external)
             if next_level > limit:
-                world.complete = False
+                self._left_out(inputs, world)
                 return []
             generator = external.info.opt_gen_fn
             if callable(generator) and external.declaration.outputs:
@@ -286,6 +297,66 @@ class OptimisticBuilder:
         new = found - self.refined
         self.refined.update(new)
         return bool(new)
+
+    def _left_out(self, inputs: tuple[str, ...], world: OptimisticWorld) -> None:
+        """An instance was left out for the limit. On an output of a later call it stands
+        for one on the first call's output (:meth:`_further`), so it counts as those calls."""
+        if any(n in self._later for n in inputs):
+            world.more_calls = True
+        else:
+            world.complete = False
+
+    def _further(
+        self, results: list[OptResult], limit: int, world: OptimisticWorld, wanted: bool
+    ) -> list[OptResult]:
+        """New outputs of later calls of the instances behind ``results``.
+
+        A placeholder stands for the next new output of its instance; a plan may need more
+        than one (two distinct values of a stream without inputs, say). The instance's ``k``-th
+        later call gives outputs of level ``level + k``, offered while that is within ``limit``
+        (the level incremental reaches by calling the instance ``k`` more times). Not for tests,
+        single-answer adapters (``from_fn``), fluent streams or placeholder inputs.
+        """
+        further: list[OptResult] = []
+        for result in results:
+            if result.kind != "stream" or not result.outputs:
+                continue
+            external = self.engine.streams[result.external]
+            if (
+                external.declaration.fluents
+                or getattr(external.gen_fn, SINGLE_CALL, False)
+                or callable(external.info.opt_gen_fn)
+                or any(is_placeholder(n) for n in result.inputs)
+            ):
+                continue
+            if not wanted:
+                world.more_calls = True
+                continue
+            shared = external.info.opt_gen_fn == "shared"
+            k = 1
+            while True:
+                level = result.level + k
+                if level > limit:
+                    world.more_calls = True
+                    break
+                base: tuple[object, ...] = (
+                    (result.external,) if shared else (result.external, result.inputs)
+                )
+                outputs = tuple(self.placeholder((*base, i, k)) for i in range(len(result.outputs)))
+                self._later.update(outputs)
+                further.append(
+                    OptResult(
+                        result.external,
+                        result.inputs,
+                        outputs,
+                        result.domain,
+                        external.certified(result.inputs, outputs),
+                        level,
+                        "stream",
+                    )
+                )
+                k += 1
+        return further
 
     def _values(self, inputs: tuple[str, ...]) -> tuple[object, ...]:
         return tuple(

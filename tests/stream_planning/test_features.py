@@ -22,8 +22,11 @@ from sdar_tamp.language.generators import (
     from_sampler,
     from_test,
 )
+from sdar_tamp.language.model import Atom
 from sdar_tamp.language.options import StreamInfo
+from sdar_tamp.language.pddl import parse_domain
 from sdar_tamp.language.problem import PDDLProblem
+from solvers.classical import GroundingError
 from solvers.solution import Status
 from solvers.solve import solve
 from solvers.stream_planning.externals import StreamError, StreamOutputError
@@ -397,14 +400,63 @@ def test_stream_plan_effort_follows_the_cost_model() -> None:
     assert stream_plan_effort(plan, info, unit_efforts=True) == 5.0 + 1.0 + 1.0
 
 
-def test_effort_weight_is_accepted_and_solves() -> None:
+@pytest.mark.parametrize("algorithm", ["focused", "binding", "adaptive"])
+@pytest.mark.parametrize(
+    ("costly", "cheap", "value"),
+    [("sample-pose", "sample-other", 7.0), ("sample-other", "sample-pose", 5.0)],
+)
+def test_effort_weight_chooses_the_cheaper_stream(
+    algorithm: str, costly: str, cheap: str, value: float
+) -> None:
+    # both streams certify the same facts; with effort_weight the optimistic plan pays for
+    # the effort of the stream behind its facts, so the costly stream is never called
     problem = line_problem(counting(), TWO_SAMPLERS, **{"sample-other": counting(7.0)})
-    info = {"sample-pose": StreamInfo(effort=100.0)}
-    solution = solve(problem, stream_info=info, effort_weight=1.0, unit_efforts=True,
-                     verbose=False)  # fmt: skip
+    info = {costly: StreamInfo(effort=100.0)}
+    solution = solve(problem, algorithm=algorithm, stream_info=info, effort_weight=1.0,
+                     unit_efforts=True, verbose=False)  # fmt: skip
     assert solution.solved
+    assert [(a.name, a.args) for a in solution.plan or []] == [("move", ("a", 0.0, value))]
+    assert solution.streams[costly].calls == 0
+    assert solution.streams[cheap].calls >= 1
+
+
+def test_effort_weight_is_validated() -> None:
+    problem = line_problem(counting(), TWO_SAMPLERS, **{"sample-other": counting(7.0)})
     with pytest.raises(ParameterError, match="effort_weight"):
         solve(problem, effort_weight=-1.0, verbose=False)
+
+
+def test_action_efforts_count_each_result_once() -> None:
+    from solvers.classical import PlanningTask
+    from solvers.classical import plan as classical_plan
+    from solvers.stream_planning.algorithms import ActionEfforts, positive_atoms
+    from solvers.stream_planning.optimistic import OptimisticWorld, OptResult
+
+    pose = OptResult("sample-pose", ("a", "goal"), ("#o0",), (), (), 1, "stream")
+    facts = {
+        Atom("pose", ("a", "#o0")): pose,
+        Atom("contained", ("a", "#o0", "goal")): pose,
+    }
+    world = OptimisticWorld(dict.fromkeys(facts, 1), dict(facts), {})
+    info = {"sample-pose": StreamInfo(effort=3.0)}
+    domain = parse_domain(LINE)
+    efforts = ActionEfforts(domain, world, info, 2.0, unit_efforts=False)
+    assert efforts("move", ("a", "0", "#o0")) == 6.0  # one result behind the preconditions
+    assert efforts("move", ("a", "#o0", "0")) == 0.0  # (pose a 0) is real
+    move = domain.action("move")
+    binding = {"?b": "a", "?p1": "x", "?p2": "y"}
+    assert Atom("pose", ("a", "y")) in positive_atoms(move.precondition, binding)
+    assert not any(a.predicate == "unsafe" for a in positive_atoms(move.precondition, binding))
+    # the planner adds the extra cost in its search but reports the true cost
+    init = frozenset({Atom("atpose", ("a", "0")), Atom("pose", ("a", "0")), *facts})
+    objects = dict.fromkeys(("a", "goal", "0", "#o0"), "object")
+    task = PlanningTask(domain, objects, init, Atom("atpose", ("a", "#o0")),
+                        extra_cost=efforts)  # fmt: skip
+    result = classical_plan(task)
+    assert result.plan is not None and result.cost == 0.0  # the domain has no action costs
+    with pytest.raises(GroundingError, match="extra costs"):
+        classical_plan(PlanningTask(domain, objects, init, Atom("atpose", ("a", "#o0")),
+                                    extra_cost=lambda n, a: -1.0))  # fmt: skip
 
 
 def test_from_fn_stream_runs_once() -> None:
