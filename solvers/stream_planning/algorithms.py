@@ -320,7 +320,7 @@ class StreamSolver:
         engine = self.engine
         if lazy and not any(self.fluent_streams.values()):
             return OptimisticWorld(dict(engine.planning_facts()), {}, dict(engine.numeric))
-        return self.builder.build(level, lazy)
+        return self.builder.build(level, lazy, check_time=self._check_time)
 
     def _complete(self, world: OptimisticWorld, lazy: bool) -> bool:
         """Nothing left out at this level: no plan now means no plan at all."""
@@ -358,7 +358,9 @@ class StreamSolver:
                 found = self.plan(world.facts, world.numeric, world)
                 if found is None and world.more_calls and not self._unreachable:
                     # no plan with one new output per instance: offer later calls' outputs
-                    world = self.builder.build(level, lazy, further=True)
+                    world = self.builder.build(
+                        level, lazy, further=True, check_time=self._check_time
+                    )
                     found = self.plan(world.facts, world.numeric, world)
             stream_plan: list[OptResult] = []
             check = None

@@ -165,12 +165,19 @@ class OptimisticBuilder:
             self.producers[name] = str(key[0])
         return name
 
-    def build(self, limit: int, lazy: bool = False, further: bool = False) -> OptimisticWorld:
+    def build(
+        self,
+        limit: int,
+        lazy: bool = False,
+        further: bool = False,
+        check_time: Callable[[], None] | None = None,
+    ) -> OptimisticWorld:
         """The optimistic world at complexity ``limit``. With ``lazy`` (incremental), only
         fluent streams (called in the state of the step that uses them) and streams on
         placeholders add optimistic results; the others are called for real beforehand.
         With ``further``, instances also offer the outputs of later calls (:meth:`_further`);
-        without, ``more_calls`` only says whether some instance could."""
+        without, ``more_calls`` only says whether some instance could. ``check_time`` is
+        called every so often (it raises when the solve's time is up: a world can grow large)."""
         engine = self.engine
         store = FactStore()
         facts = engine.planning_facts()
@@ -191,7 +198,11 @@ class OptimisticBuilder:
         queries += [Query(n, r.parameters, r.domain) for n, r in engine.rules.items()]
         instantiator = Instantiator(queries, store)
         pending = list(instantiator.initial())
+        steps = 0
         while pending:
+            steps += 1
+            if check_time is not None and steps % 256 == 0:
+                check_time()
             query, inputs, level = pending.pop()
             results = self._results(query.name, inputs, level, limit, world, lazy)
             more = self._further(results, limit, world, further)
