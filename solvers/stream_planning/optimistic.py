@@ -250,35 +250,28 @@ class OptimisticBuilder:
                 return []
             generator = external.info.opt_gen_fn
             if callable(generator) and external.declaration.outputs:
-                return [
-                    OptResult(
-                        name,
-                        inputs,
-                        outputs,
-                        external.domain(inputs),
-                        external.certified(inputs, outputs),
-                        next_level,
-                        "stream",
-                    )
-                    for outputs in self._generated_outputs(external, inputs, generator)
-                ]
-            shared = external.info.opt_gen_fn == "shared" and (name, inputs) not in self.refined
-            outputs = tuple(
-                self.placeholder((name, i) if shared else (name, inputs, i))
-                for i in range(len(external.declaration.outputs))
-            )
-            if shared:
-                self._shared.update(outputs)
+                batches = self._generated_outputs(external, inputs, generator)
+            else:
+                shared = generator == "shared" and (name, inputs) not in self.refined
+                outputs = tuple(
+                    self.placeholder((name, i) if shared else (name, inputs, i))
+                    for i in range(len(external.declaration.outputs))
+                )
+                if shared:
+                    self._shared.update(outputs)
+                batches = [outputs]
+            domain = external.domain(inputs)
             return [
                 OptResult(
                     name,
                     inputs,
                     outputs,
-                    external.domain(inputs),
+                    domain,
                     external.certified(inputs, outputs),
                     next_level,
                     "stream",
                 )
+                for outputs in batches
             ]
         if name in engine.functions:
             function = engine.functions[name]
