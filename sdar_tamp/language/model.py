@@ -17,7 +17,7 @@ Formulas::
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import TypeAlias
 
@@ -369,6 +369,42 @@ def iter_effects(effect: Effect) -> Iterator[Literal | IncreaseCost]:
 def iter_effect_literals(effect: Effect) -> Iterator[Literal]:
     """Every add/delete literal inside ``effect``, including conditional and universal ones."""
     return (e for e in iter_effects(effect) if isinstance(e, Literal))
+
+
+def map_atoms(
+    formula: Formula, fn: Callable[[Atom, bool], Formula], positive: bool = True
+) -> Formula:
+    """``formula`` with every atom replaced by ``fn(atom, positive)``; ``positive`` says
+    whether the atom is used positively (under an even number of negations, an implication's
+    antecedent counting as one). Quantifiers are kept as they are."""
+    if isinstance(formula, Atom):
+        return fn(formula, positive)
+    if isinstance(formula, Not):
+        return Not(map_atoms(formula.formula, fn, not positive))
+    if isinstance(formula, And):
+        return And(tuple(map_atoms(p, fn, positive) for p in formula.parts))
+    if isinstance(formula, Or):
+        return Or(tuple(map_atoms(p, fn, positive) for p in formula.parts))
+    if isinstance(formula, Imply):
+        return Imply(
+            map_atoms(formula.antecedent, fn, not positive),
+            map_atoms(formula.consequent, fn, positive),
+        )
+    body = map_atoms(formula.body, fn, positive)
+    if isinstance(formula, Exists):
+        return Exists(formula.parameters, body)
+    return ForAll(formula.parameters, body)
+
+
+def map_conditions(effect: Effect, fn: Callable[[Formula], Formula]) -> Effect:
+    """``effect`` with the condition of every conditional effect replaced by ``fn(condition)``."""
+    if isinstance(effect, AndEffect):
+        return AndEffect(tuple(map_conditions(p, fn) for p in effect.parts))
+    if isinstance(effect, ForAllEffect):
+        return ForAllEffect(effect.parameters, map_conditions(effect.effect, fn))
+    if isinstance(effect, When):
+        return When(fn(effect.condition), map_conditions(effect.effect, fn))
+    return effect
 
 
 def substitute(formula: Formula, mapping: Mapping[str, str]) -> Formula:

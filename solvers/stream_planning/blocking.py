@@ -23,23 +23,17 @@ from dataclasses import dataclass, replace
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.model import (
     And,
-    AndEffect,
     Atom,
     Axiom,
     Domain,
-    Effect,
-    Exists,
-    ForAll,
-    ForAllEffect,
     Formula,
-    Imply,
     Not,
-    Or,
     Parameter,
     Predicate,
     Stream,
-    When,
     is_variable,
+    map_atoms,
+    map_conditions,
 )
 
 BLOCKED = "@blocked:"
@@ -79,40 +73,19 @@ def guard_fluent_uses(domain: Domain, streams: Iterable[Stream]) -> Domain:
     if not certifiers:
         return domain
 
-    def guard(formula: Formula, positive: bool) -> Formula:
-        if isinstance(formula, Atom):
-            found = certifiers.get(formula.predicate) if positive else None
-            if found is None:
-                return formula
-            stream, template = found
-            mapping = {
-                t: a for t, a in zip(template.args, formula.args, strict=True) if is_variable(t)
-            }
-            if not all(i in mapping for i in stream.inputs):
-                return formula
-            blocked = Atom(blocked_predicate(stream.name), tuple(mapping[i] for i in stream.inputs))
-            return And((formula, Not(blocked)))
-        if isinstance(formula, Not):
-            return Not(guard(formula.formula, not positive))
-        if isinstance(formula, And):
-            return And(tuple(guard(p, positive) for p in formula.parts))
-        if isinstance(formula, Or):
-            return Or(tuple(guard(p, positive) for p in formula.parts))
-        if isinstance(formula, Imply):
-            antecedent = guard(formula.antecedent, not positive)
-            return Imply(antecedent, guard(formula.consequent, positive))
-        if isinstance(formula, Exists):
-            return Exists(formula.parameters, guard(formula.body, positive))
-        return ForAll(formula.parameters, guard(formula.body, positive))
+    def guard(atom: Atom, positive: bool) -> Formula:
+        found = certifiers.get(atom.predicate) if positive else None
+        if found is None:
+            return atom
+        stream, template = found
+        mapping = {t: a for t, a in zip(template.args, atom.args, strict=True) if is_variable(t)}
+        if not all(i in mapping for i in stream.inputs):
+            return atom
+        blocked = Atom(blocked_predicate(stream.name), tuple(mapping[i] for i in stream.inputs))
+        return And((atom, Not(blocked)))
 
-    def effect(node: Effect) -> Effect:
-        if isinstance(node, When):
-            return When(guard(node.condition, True), effect(node.effect))
-        if isinstance(node, AndEffect):
-            return AndEffect(tuple(effect(p) for p in node.parts))
-        if isinstance(node, ForAllEffect):
-            return ForAllEffect(node.parameters, effect(node.effect))
-        return node
+    def guarded(formula: Formula) -> Formula:
+        return map_atoms(formula, guard)
 
     predicates = dict(domain.predicates)
     for stream, _ in certifiers.values():
@@ -120,10 +93,10 @@ def guard_fluent_uses(domain: Domain, streams: Iterable[Stream]) -> Domain:
         parameters = tuple(Parameter(f"?x{i}") for i in range(len(stream.inputs)))
         predicates[name] = Predicate(name, parameters)
     actions = tuple(
-        replace(a, precondition=guard(a.precondition, True), effect=effect(a.effect))
+        replace(a, precondition=guarded(a.precondition), effect=map_conditions(a.effect, guarded))
         for a in domain.actions
     )
-    axioms = tuple(replace(a, body=guard(a.body, True)) for a in domain.axioms)
+    axioms = tuple(replace(a, body=guarded(a.body)) for a in domain.axioms)
     return replace(domain, predicates=predicates, actions=actions, axioms=axioms)
 
 

@@ -22,25 +22,20 @@ from dataclasses import replace
 
 from sdar_tamp.language.model import (
     And,
-    AndEffect,
     Atom,
     Axiom,
     Domain,
     Effect,
     Exists,
-    ForAll,
-    ForAllEffect,
     Formula,
-    Imply,
-    Not,
-    Or,
     Parameter,
     Predicate,
     Rule,
     Stream,
     StreamFile,
-    When,
     iter_effect_literals,
+    map_atoms,
+    map_conditions,
 )
 
 LOG = logging.getLogger(__name__)
@@ -64,29 +59,11 @@ def exogenous_streams(domain: Domain, streams: StreamFile) -> list[str]:
 
 
 def _rename(formula: Formula, mapping: Mapping[str, str]) -> Formula:
-    if isinstance(formula, Atom):
-        return Atom(mapping.get(formula.predicate, formula.predicate), formula.args)
-    if isinstance(formula, Not):
-        return Not(_rename(formula.formula, mapping))
-    if isinstance(formula, And):
-        return And(tuple(_rename(p, mapping) for p in formula.parts))
-    if isinstance(formula, Or):
-        return Or(tuple(_rename(p, mapping) for p in formula.parts))
-    if isinstance(formula, Imply):
-        return Imply(_rename(formula.antecedent, mapping), _rename(formula.consequent, mapping))
-    if isinstance(formula, Exists):
-        return Exists(formula.parameters, _rename(formula.body, mapping))
-    return ForAll(formula.parameters, _rename(formula.body, mapping))
+    return map_atoms(formula, lambda atom, _positive: _renamed(atom, mapping))
 
 
 def _rename_conditions(effect: Effect, mapping: Mapping[str, str]) -> Effect:
-    if isinstance(effect, AndEffect):
-        return AndEffect(tuple(_rename_conditions(p, mapping) for p in effect.parts))
-    if isinstance(effect, ForAllEffect):
-        return ForAllEffect(effect.parameters, _rename_conditions(effect.effect, mapping))
-    if isinstance(effect, When):
-        return When(_rename(effect.condition, mapping), _rename_conditions(effect.effect, mapping))
-    return effect
+    return map_conditions(effect, lambda condition: _rename(condition, mapping))
 
 
 def _renamed(atom: Atom, mapping: Mapping[str, str]) -> Atom:
