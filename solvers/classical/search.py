@@ -78,6 +78,7 @@ class _Queues:
         self.count = 2 * size if use_preferred else size
         self.heaps: list[list[Entry]] = [[] for _ in range(self.count)]
         self.priority = [0] * self.count
+        self.best = [inf] * size  # the lowest value seen of each heuristic
 
     def push(
         self,
@@ -98,6 +99,17 @@ class _Queues:
     def boost(self) -> None:
         for i in range(self.size, self.count):
             self.priority[i] -= BOOST
+
+    def note(self, values: tuple[float, ...]) -> None:
+        """Record a state's heuristic values; boost the preferred queues when one improves."""
+        best = self.best
+        improved = False
+        for i, h in enumerate(values):
+            if h < best[i]:
+                best[i] = h
+                improved = True
+        if improved:
+            self.boost()
 
     def pop(self) -> Entry | None:
         best = -1
@@ -158,8 +170,8 @@ def _eager(
     expanded, generated, evaluated = 0, 1, 1
     if values[0] == inf:
         return SearchOutcome("unsolvable", (), 0, generated, evaluated)
-    best = list(values)
     queues = _Queues(evaluator.size, preferred)
+    queues.best = list(values)  # the initial state's values improve nothing: no boost
     queues.push(values, 0.0, h_weight, 0, (init, -1, 0.0), False)
     best_g: dict[int, float] = {init: 0.0}
     parent: dict[int, tuple[int, int] | None] = {init: None}
@@ -197,13 +209,7 @@ def _eager(
             if values[0] == inf:
                 continue
             info[succ] = (succ_prefs, succ_reached)
-            improved = False
-            for i, h in enumerate(values):
-                if h < best[i]:
-                    best[i] = h
-                    improved = True
-            if improved:
-                queues.boost()
+            queues.note(values)
             queues.push(
                 values,
                 g_weight * new_g,
@@ -229,7 +235,6 @@ def _lazy(
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
     evaluate = evaluator.evaluate
     expanded, generated, evaluated = 0, 1, 0
-    best = [inf] * evaluator.size
     queues = _Queues(evaluator.size, preferred)
     init = compiled.init
     queues.push((0.0,) * evaluator.size, 0.0, h_weight, 0, (-1, -1, 0.0), False)
@@ -257,13 +262,7 @@ def _lazy(
             continue
         if is_goal(state):
             return SearchOutcome("solved", _trace(parent, state), expanded, generated, evaluated)
-        improved = False
-        for i, h in enumerate(values):
-            if h < best[i]:
-                best[i] = h
-                improved = True
-        if improved:
-            queues.boost()
+        queues.note(values)
         expanded += 1
         push = queues.push
         for succ_op in applicable(state):
