@@ -7,7 +7,9 @@ The plan's samples are its trajectory; between samples the motion is linear in j
 * velocity at an inner sample ``i``: the derivative at ``t[i]`` of the parabola through the
   samples ``i - 1``, ``i``, ``i + 1``, ``(h[i] * m[i-1] + h[i-1] * m[i]) / (h[i-1] + h[i])``
   with ``m[k] = (q[k+1] - q[k]) / h[k]`` and ``h[k] = t[k+1] - t[k]`` (the central difference
-  on a uniform grid); zero at the first and the last sample (a plan starts and ends at rest);
+  on a uniform grid), a weighted mean of the two neighbouring interval velocities, so within
+  the velocity limits the validator checks on those; zero at the first and the last sample
+  (a plan starts and ends at rest);
 * acceleration at every sample: the second divided difference the validator bounds,
   ``(m[i] - m[i-1]) / ((h[i-1] + h[i]) / 2)``, with the robot at rest before ``t = 0`` and
   after the end (inner samples: the parabola's second derivative, so both agree).

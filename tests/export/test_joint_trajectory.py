@@ -71,6 +71,10 @@ def test_velocities_and_accelerations_are_the_local_parabola(
         coef = np.polyfit(s, q[i - 1 : i + 2], 2)  # exact through three points
         np.testing.assert_allclose(v[i], coef[1], atol=1e-7)
         np.testing.assert_allclose(a[i], 2 * coef[0], atol=1e-5)
+    # between the neighbouring interval velocities (those the validator bounds)
+    m = np.diff(q, axis=0) / np.diff(t)[:, None]
+    low, high = np.minimum(m[:-1], m[1:]), np.maximum(m[:-1], m[1:])
+    assert np.all((low - 1e-12 <= v[1:-1]) & (v[1:-1] <= high + 1e-12))
     # uniform stretches: the central difference
     h = np.diff(t)
     uniform = np.flatnonzero(np.abs(h[1:] - h[:-1]) < 1e-12) + 1
