@@ -19,6 +19,7 @@ from sdar_tamp.arguments import (
     output_folder,
 )
 from sdar_tamp.errors import SdarError
+from sdar_tamp.export.command import add_export_parser
 from sdar_tamp.textfile import read_text
 
 DEMO_DOMAIN = "dual_arm_rearrangement"
@@ -392,6 +393,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     demo.add_argument("--out", type=Path, default=None, help="output folder (default: temp)")
     demo.set_defaults(func=cmd_demo)
+
+    add_export_parser(sub)  # sdar export, defined in sdar_tamp/export/command.py
     return parser
 
 
