@@ -204,6 +204,12 @@ class StreamSolver:
             cost_bound=self._cost_bound(),
         )
         self.stats["search_time"] += time.perf_counter() - start
+        statistics = result.statistics
+        LOG.debug(
+            "plan search: %s, %d facts, %d ground operators, %d expanded, %.3f s",
+            result.status.value, len(facts), statistics.ground_actions, statistics.expanded,
+            time.perf_counter() - start,
+        )  # fmt: skip
         # nothing expanded: the goal is not reachable even ignoring deletes
         self._unreachable = result.status is PlanStatus.UNSOLVABLE and (
             result.statistics.expanded == 0

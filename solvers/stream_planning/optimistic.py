@@ -2,10 +2,12 @@
 
 Each instance whose next result stays within the complexity limit contributes placeholder
 outputs (``#o<k>``). By default a placeholder belongs to its instance (``unique``); with
-``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output
-until an optimistic plan uses it: :meth:`OptimisticBuilder.refine` then gives the instances of
-that plan placeholders of their own (the solver plans again before sampling), as PDDLStream
-refines its shared optimistic values.
+``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output.
+A plan whose stream plan takes one shared placeholder from two instances (or feeds one back to
+the instance that made it) is ambiguous: :meth:`OptimisticBuilder.refine` then gives those
+instances placeholders of their own and the solver plans again before sampling, as PDDLStream
+refines its shared optimistic values; a shared placeholder one instance of the plan makes is
+bound to that instance's output directly.
 
 With a callable ``StreamInfo(opt_gen_fn=gen_fn)`` (a stream with outputs; tests keep their
 default) an instance's optimistic outputs come from ``gen_fn`` called like the sampler on the
@@ -291,13 +293,25 @@ class OptimisticBuilder:
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
 
     def refine(self, stream_plan: list[OptResult]) -> bool:
-        """Give the instances of ``stream_plan`` that produce shared placeholders placeholders
-        of their own in later builds; False when there is none (the plan is refined)."""
-        found = {
-            (r.external, r.inputs)
-            for r in stream_plan
-            if r.kind == "stream" and any(n in self._shared for n in r.outputs)
-        }
+        """Give the instances behind the ambiguous shared placeholders of ``stream_plan``
+        placeholders of their own in later builds; False when there is none (the plan binds
+        as it is).
+
+        A shared placeholder is ambiguous when two results of the plan make it (the plan takes
+        the outputs of two instances for one value) or when a result takes its own output as
+        an input. One that a single result of the plan makes stands for that result's output
+        alone (every fact of the plan on it rests on that result): binding gives it one value,
+        so the plan needs no new search.
+        """
+        results = [r for r in stream_plan if r.kind == "stream"]
+        producers: dict[str, set[tuple[str, tuple[str, ...]]]] = {}
+        for result in results:
+            for name in result.outputs:
+                if name in self._shared:
+                    producers.setdefault(name, set()).add((result.external, result.inputs))
+        ambiguous = {n for n, made in producers.items() if len(made) > 1}
+        ambiguous.update(n for r in results for n in r.outputs if n in r.inputs)
+        found = {(r.external, r.inputs) for r in results if any(n in ambiguous for n in r.outputs)}
         new = found - self.refined
         self.refined.update(new)
         return bool(new)

@@ -183,3 +183,26 @@ def test_unsatisfiable_terms_give_no_bindings() -> None:
         problem._replace(stream_map=stream_map), max_time=3, verbose=False
     )
     assert solution.bindings is None
+
+
+def test_streams_without_stream_info_get_pddlstream_shared_default(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from sdar_tamp.compat.pddlstream.algorithms import meta
+    from sdar_tamp.compat.pddlstream.language.stream import PartialInputs, StreamInfo
+
+    seen: dict[str, object] = {}
+
+    def capture(problem: object, **options: object) -> object:
+        seen.update(options["stream_info"])  # type: ignore[call-overload]
+        return "captured"
+
+    monkeypatch.setattr(meta, "core_solve", capture)
+    problem = _problem()
+    unique = StreamInfo(opt_gen_fn=PartialInputs(unique=True))
+    first, *others = [s.name for s in problem.streams.streams]
+    assert others  # the shared test problem declares several streams
+    assert meta.solve(problem, stream_info={first: unique}) == "captured"
+    assert seen[first] is unique  # given: kept
+    assert all(seen[name].opt_gen_fn == "shared" for name in others)  # type: ignore[attr-defined]
+    assert StreamInfo().opt_gen_fn == "shared"

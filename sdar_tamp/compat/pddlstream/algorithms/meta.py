@@ -17,6 +17,7 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 from sdar_tamp.compat.pddlstream.algorithms.constraints import PlanConstraints
+from sdar_tamp.compat.pddlstream.language.stream import StreamInfo as PddlstreamStreamInfo
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.options import PlanConstraints as _CorePlanConstraints
@@ -144,7 +145,7 @@ def solve(
     return core_solve(
         problem,
         algorithm=algorithm,
-        stream_info=dict(stream_info or {}),
+        stream_info=_with_default_info(problem, stream_info),
         constraints=_constraints(constraints, max_cost),
         unit_costs=unit_costs,
         success_cost=success_cost,
@@ -192,3 +193,16 @@ def analyze_goal(*_args: Any, **_kwargs: Any) -> None:
     available: it returns None, as PDDLStream does when it finds nothing to report."""
     LOG.info("analyze_goal is not available; nothing is reported")
     return None
+
+
+def _with_default_info(
+    problem: PDDLProblem, stream_info: Mapping[str, StreamInfo | FunctionInfo] | None
+) -> dict[str, StreamInfo | FunctionInfo]:
+    """``stream_info`` with PDDLStream's default ``StreamInfo()`` for every stream it omits
+    (shared optimistic outputs, refined when a plan uses them)."""
+    info = dict(stream_info or {})
+    given = {name.lower() for name in info}
+    for stream in problem.streams.streams:
+        if stream.name.lower() not in given:
+            info[stream.name] = PddlstreamStreamInfo()
+    return info

@@ -46,7 +46,9 @@ class PartialInputs:
 
 
 def _opt_gen_fn(value: Any) -> Callable[..., Any] | str | None:
-    if value is None or isinstance(value, str):
+    if value is None:
+        return "shared"  # PDDLStream's default, PartialInputs(): shared until a plan uses it
+    if isinstance(value, str):
         return value
     if callable(value):
         return with_opt_values(value)
