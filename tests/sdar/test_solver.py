@@ -8,13 +8,13 @@ from typing import Any
 import numpy as np
 import pytest
 
-from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.problem import PDDLProblem
-from sdar_tamp.rearrangement import (
+from sdar_tamp.app import (
     plan_file_from_solution,
     rearrangement_problem,
     solve_rearrangement,
 )
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
