@@ -188,9 +188,7 @@ def test_the_checks_catch_a_break_and_a_cycle() -> None:
         ("from . import errors\n", ["sdar_tamp.errors"]),
     ],
 )  # fmt: skip
-def test_imports_are_found_at_any_depth(
-    tmp_path: Path, source: str, expected: list[str]
-) -> None:
+def test_imports_are_found_at_any_depth(tmp_path: Path, source: str, expected: list[str]) -> None:
     path = tmp_path / "mod.py"
     path.write_text(source)
     found = [m for m, _ in imports("sdar_tamp.mod", path, {"sdar_tamp.errors"})]
