@@ -221,3 +221,31 @@ def test_planner_cache_builds_once_per_scene_and_optimiser_options() -> None:
     if scene.exists():
         cache.world(scene, TrajOptOptions(knots=12))
         assert cache.builds == 3
+
+
+def test_the_command_line_reaches_the_planner_config(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import sdar_tamp.app.command as command
+    from sdar_tamp.cli import main
+
+    instance = str(domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml"))
+    seen: list[PlannerConfig] = []
+
+    class Stop(Exception):
+        pass
+
+    def capture(path: Path, config: PlannerConfig, **kwargs: Any) -> None:
+        seen.append(config)
+        raise Stop
+
+    monkeypatch.setattr(command, "solve_instance", capture)
+    args = ["solve", instance, "-q", "--grasps", "10", "--motion-planner", "sequential"]
+    with pytest.raises(Stop):
+        main([*args, "--time-limit", "5", "--seed", "2"])
+    (config,) = seen
+    assert config.sdar.grasps == 10 and config.motion_planner == "sequential"
+    assert (config.max_time, config.seed) == (5.0, 2)
+    with pytest.raises(SystemExit):
+        main(["solve", instance, "--grasps", "0"])
+    assert "argument --grasps: expected an integer >= 1" in capsys.readouterr().err
