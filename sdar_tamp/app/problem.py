@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from sdar_tamp.app.config import PlannerConfig
+from sdar_tamp.app.config import MOTION_PLANNERS, PlannerConfig, check_choice
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.generators import from_gen_fn, from_test
 from sdar_tamp.language.problem import PDDLProblem
@@ -75,6 +75,8 @@ def rearrangement_problem(
     Raises:
         ParameterError: a value out of range, an unknown motion planner or stream name.
     """
+    if motion is not None:
+        check_choice("motion", motion, MOTION_PLANNERS)
     config = (config or PlannerConfig()).replace(
         seed=seed, motion_planner=motion, gripper_time=gripper_time
     )

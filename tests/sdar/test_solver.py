@@ -195,7 +195,7 @@ def test_unknown_task_planner_and_override_are_refused(ctx: WorldContext) -> Non
         solve(r.problem, algorithm="sdar", task_planner="greedy")
     with pytest.raises(ParameterError, match="overrides: unknown streams"):
         rearrangement_problem(_swap(), ctx, overrides={"sample-pose": print})
-    with pytest.raises(ParameterError, match="motion planner must be one of"):
+    with pytest.raises(ParameterError, match="motion must be one of sdar, plain, sequential"):
         rearrangement_problem(_swap(), ctx, motion="fast")
 
 
