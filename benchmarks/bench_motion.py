@@ -58,8 +58,8 @@ def _footprint(box: ObjectBox) -> np.ndarray:
 
 def hard_set(instance: str, seed: int, count: int) -> None:
     """See the module docstring (``--hard``)."""
-    from streams.motion import PlainStrategy, default_strategies
-    from streams.sampling import SampledStrategy
+    from streams.motion import PlainStrategy
+    from streams.sampling import SampledStrategy, sampled_strategies
 
     ctx = WorldContext.load()
     inst = load_instance(domain_path(f"suites/paper/{instance}.yaml"))
@@ -72,7 +72,7 @@ def hard_set(instance: str, seed: int, count: int) -> None:
     planners = {
         "optimiser": (alone, (PlainStrategy(lifted_warm_start=False),)),
         "ompl": (ladder, (SampledStrategy(),)),
-        "ladder": (ladder, default_strategies(sampling=True)),
+        "ladder": (ladder, sampled_strategies()),
     }
     alone.trajopt  # noqa: B018  (wait for the build: not part of any planning time)
     grasps = {

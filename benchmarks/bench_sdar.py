@@ -22,8 +22,10 @@ import statistics
 import time
 from pathlib import Path
 
+from sdar_tamp.app.cache import PlannerCache
+from sdar_tamp.app.command import solve_instance
+from sdar_tamp.app.records import SolveOutcome
 from sdar_tamp.resources import domain_file
-from sdar_tamp.solve_command import solve_instance
 from sdar_tamp.world.instance import load_instance
 
 
@@ -56,7 +58,7 @@ def main() -> None:
         compare_adaptive(args.time_limit)
         return
 
-    shared: dict[str, object] = {}
+    cache = PlannerCache()
     rows = []
     step_times: list[float] = []
     step_selection: list[float] = []
@@ -76,7 +78,7 @@ def main() -> None:
             seed=args.seed,
             task_planner=args.task_planner,
             motion_planner=args.motion_planner,
-            shared=shared,
+            cache=cache,
         )
         n = len(outcome.instance.objects)
         f = outcome.figures
@@ -86,9 +88,9 @@ def main() -> None:
             "status": outcome.status,
             "valid": outcome.valid,
             "success": outcome.success,
-            "planning_time": f.get("planning_time", 0.0),
-            "selection_time": f.get("selection_time", 0.0),
-            "motion_time": f.get("motion_time", 0.0),
+            "planning_time": f.planning_time,
+            "selection_time": f.selection_time,
+            "motion_time": f.motion_time,
         }
         if outcome.plan is not None:
             m = outcome.plan.metrics
@@ -97,9 +99,9 @@ def main() -> None:
                 steps=m["steps"],
                 dual_arm_steps=m["dual_arm_steps"],
                 execution_time=m["execution_time"],
-                step_time_median=f["step_time_median"],
-                levels=f["levels"],
-                buffer_moves=f["buffer_moves"],
+                step_time_median=f.step_time_median,
+                levels=dict(f.levels),
+                buffer_moves=f.buffer_moves,
             )
         rows.append(row)
         print(
@@ -148,7 +150,7 @@ def main() -> None:
 
 def compare_adaptive(time_limit: float) -> None:
     """The same PDDL domain solved by the generic ``adaptive`` algorithm and by ``sdar``."""
-    from sdar_tamp.rearrangement import rearrangement_problem
+    from sdar_tamp.app.problem import rearrangement_problem
     from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
     from sdar_tamp.world.scene import Workspace
     from solvers.solve import solve
@@ -175,8 +177,8 @@ def compare_adaptive(time_limit: float) -> None:
     print(json.dumps({"benchmark": "sdar-vs-adaptive", "objects": 1, **results}))
 
 
-def _steps(outcome: object) -> list[tuple[float, float]]:
-    return list(getattr(outcome, "figures", {}).get("step_times", []))
+def _steps(outcome: SolveOutcome) -> list[tuple[float, float]]:
+    return [(step.selection, step.motion) for step in outcome.figures.step_times]
 
 
 def _quantile(values: list[float], q: float) -> float | None:

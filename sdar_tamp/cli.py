@@ -112,9 +112,10 @@ def cmd_demo(args: argparse.Namespace) -> int:
     system's temporary directory; nothing is written to the working directory)."""
     import tempfile
 
+    from sdar_tamp.app.command import solve_instance
+    from sdar_tamp.app.summary import ProgressBar, format_summary
     from sdar_tamp.plan_file import save_plan
     from sdar_tamp.resources import domain_file
-    from sdar_tamp.solve_command import ProgressBar, format_summary, solve_instance
     from sdar_tamp.viewer import write_html, write_storyboard
 
     instance = domain_file(DEMO_DOMAIN, DEMO_INSTANCE)
@@ -139,21 +140,26 @@ def cmd_demo(args: argparse.Namespace) -> int:
 def cmd_solve(args: argparse.Namespace) -> int:
     """Plan a rearrangement instance with SDAR, validate the plan by independent replay and
     write it (JSON, see the README). Exit status 0 only when solved and valid."""
+    import dataclasses
+
+    from sdar_tamp.app.command import solve_instance
+    from sdar_tamp.app.config import PlannerConfig
+    from sdar_tamp.app.summary import ProgressBar, format_summary
     from sdar_tamp.plan_file import save_plan
-    from sdar_tamp.solve_command import ProgressBar, format_summary, solve_instance
 
     if args.output is not None:
         output_file(args.output, suffixes=(".json",), force=args.force)
     bar = ProgressBar(f"{args.instance.stem}") if not args.quiet else None
     try:
-        outcome = solve_instance(
-            args.instance,
-            time_limit=args.time_limit,
-            seed=args.seed,
+        config = PlannerConfig(
             task_planner=args.task_planner,
             motion_planner=args.motion_planner,
-            progress=bar,
+            max_time=args.time_limit,
+            seed=args.seed,
         )
+        if args.grasps is not None:
+            config = config.replace(sdar=dataclasses.replace(config.sdar, grasps=args.grasps))
+        outcome = solve_instance(args.instance, config, progress=bar)
     finally:
         if bar is not None:
             bar.close()
@@ -324,6 +330,12 @@ def build_parser() -> argparse.ArgumentParser:
         default="sdar",
         help="sdar: optimisation, untangling, one arm at a time; plain: optimisation only; "
         "sequential: one arm at a time (default: sdar)",
+    )
+    solve.add_argument(
+        "--grasps",
+        type=COUNT.parse,
+        default=None,
+        help="grasps tried per object, in the grasp set's order (default: 6)",
     )
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     solve.set_defaults(func=cmd_solve)

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import logging
 import math
 import random
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 from sdar_tamp.arguments import (
     COST_BOUND,
@@ -23,12 +24,16 @@ from sdar_tamp.arguments import (
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.options import FunctionInfo, PlanConstraints, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.logs import get_logger
 from solvers.classical import HEURISTICS, SEARCHES
 from solvers.solution import Solution, print_solution
 from solvers.stream_planning.algorithms import ALGORITHMS, StreamOptions, StreamSolver
 from solvers.stream_planning.constraints import compile_constraints
 
-LOG = logging.getLogger(__name__)
+if TYPE_CHECKING:
+    from solvers.sdar.solver import SdarOptions
+
+LOG = get_logger(__name__)
 INF = math.inf
 _LIMIT = Real(0.0, allow_inf=True)  # max_iterations, max_skeletons, search_sample_ratio
 _NATURAL = Integer(0)  # initial_complexity
@@ -110,6 +115,7 @@ def solve(
     seed: int | None = None,
     planner: str = "wastar-ff",
     task_planner: str = "sdar",
+    sdar_options: SdarOptions | None = None,
     **unknown: Any,
 ) -> Solution:
     """Solve ``problem``; returns a :class:`Solution` (``plan, cost, certificate = solution``).
@@ -141,11 +147,17 @@ def solve(
             ``gbfs-ff``, ``astar-max``, or a PDDLStream planner name such as ``ff-astar``,
             ``max-astar`` or ``ff-wastar2`` (see :func:`parse_planner`).
         task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``.
-        seed: seeds Python's ``random`` and NumPy's global generator before solving, so
-            samplers that draw from them give the same plan for the same seed.
-        verbose: log a one-line summary of the result at INFO on the ``solvers`` logger
-            (else at DEBUG). Logger levels and handlers are the application's: ``solve`` never
-            changes them.
+        sdar_options: with ``algorithm="sdar"``: SDAR-M's budgets and switches
+            (:class:`solvers.sdar.solver.SdarOptions`; its ``max_time`` is replaced by
+            ``max_time``). A rearrangement built by :mod:`sdar_tamp.app` gets them from its
+            ``PlannerConfig`` (``config.sdar_options()``), as ``solve_rearrangement`` does.
+        seed: Python's ``random`` and NumPy's global generator are seeded with it for the
+            duration of the solve, so samplers that draw from them (as PDDLStream programs'
+            samplers do) give the same plan for the same seed; their previous states are
+            restored when ``solve`` returns. The solvers draw no random numbers themselves.
+        verbose: log a one-line summary of the result at INFO on the ``sdar_tamp.solvers``
+            logger (else at DEBUG). Logger levels and handlers are the application's:
+            ``solve`` never changes them.
 
     Every numeric argument is checked (with ``algorithm="sdar"`` too) by the rules of
     :mod:`sdar_tamp.arguments`: NaN is refused everywhere; ``inf`` means "no limit" for the
@@ -176,7 +188,10 @@ def solve(
     search_sample_ratio = _LIMIT.check("search_sample_ratio", search_sample_ratio)
     max_planner_time = MAX_TIME.check("max_planner_time", max_planner_time)
     if algorithm == "sdar":
-        return _solve_sdar(problem, task_planner, max_time, stream_info, verbose, seed)
+        with _seeded_globals(seed):
+            return _solve_sdar(problem, task_planner, max_time, stream_info, verbose, sdar_options)
+    if sdar_options is not None:
+        raise ParameterError(f"sdar_options applies to algorithm 'sdar' only, not {algorithm!r}")
     search, heuristic, weight = parse_planner(planner)
     options = StreamOptions(
         algorithm=algorithm,
@@ -204,18 +219,31 @@ def solve(
         unit_efforts=bool(unit_efforts),
         enforce_max_time=bool(enforce_max_time),
     )
-    if seed is not None:
-        random.seed(seed)
-        try:
-            import numpy
-
-            numpy.random.seed(seed % 2**32)
-        except ImportError:  # pragma: no cover - numpy is a dependency
-            pass
     if constraints is not None:
         options = dataclasses.replace(options, max_cost=constraints.max_cost)
         problem = compile_constraints(problem, constraints)
-    return _summarised(StreamSolver(problem, options, stream_info).solve(), algorithm, verbose)
+    with _seeded_globals(seed):
+        solution = StreamSolver(problem, options, stream_info).solve()
+    return _summarised(solution, algorithm, verbose)
+
+
+@contextlib.contextmanager
+def _seeded_globals(seed: int | None) -> Iterator[None]:
+    """Seed ``random`` and NumPy's global generator with ``seed`` inside the block and restore
+    their states after it (nothing happens for ``seed=None``)."""
+    if seed is None:
+        yield
+        return
+    import numpy
+
+    saved = random.getstate(), numpy.random.get_state()
+    random.seed(seed)
+    numpy.random.seed(seed % 2**32)
+    try:
+        yield
+    finally:
+        random.setstate(saved[0])
+        numpy.random.set_state(saved[1])
 
 
 def _summarised(solution: Solution, algorithm: str, verbose: bool) -> Solution:
@@ -238,15 +266,17 @@ def _solve_sdar(
     max_time: float,
     stream_info: Mapping[str, StreamInfo | FunctionInfo] | None,
     verbose: bool,
-    seed: int | None,
+    sdar_options: SdarOptions | None,
 ) -> Solution:
     from solvers.sdar.planners import make_task_planner
     from solvers.sdar.solver import SdarOptions, SdarSolver
 
     planner = make_task_planner(task_planner)
-    if seed is not None:
-        random.seed(seed)
-    options = SdarOptions(max_time=max_time)
+    if sdar_options is not None and not isinstance(sdar_options, SdarOptions):
+        raise ParameterError(
+            f"sdar_options must be a SdarOptions, got {type(sdar_options).__name__}"
+        )
+    options = dataclasses.replace(sdar_options or SdarOptions(), max_time=max_time)
     return _summarised(SdarSolver(problem, planner, options, stream_info).solve(), "sdar", verbose)
 
 

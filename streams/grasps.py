@@ -19,10 +19,28 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.transforms import FloatArray
 
 #: The paper's grasp set: top-down, then 45 degrees either way.
 DEFAULT_TILTS = (np.pi / 4,)
+
+
+@dataclass(frozen=True)
+class GraspOptions:
+    """Which grasps :func:`sample_grasps` builds for each object (the grasp set).
+
+    ``tilts`` [rad]: growing approach angles in (0, pi/2), each tried as ``+t`` then ``-t``
+    after every top-down grasp; ``symmetric``: both 180-degree wrist variants of each grasp.
+    With the defaults an object graspable across both sides has 12 grasps.
+    """
+
+    tilts: tuple[float, ...] = DEFAULT_TILTS
+    symmetric: bool = True
+
+    def __post_init__(self) -> None:
+        if any(not 0.0 < t < np.pi / 2 for t in self.tilts):
+            raise ParameterError(f"grasp tilts must lie in (0, pi/2) [rad], got {list(self.tilts)}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,6 +64,10 @@ class Grasp:
     @property
     def is_top_down(self) -> bool:
         return abs(self.tilt) < 1e-12
+
+
+#: The paper's grasp set (:data:`DEFAULT_TILTS`, both wrist variants).
+DEFAULT_GRASPS = GraspOptions()
 
 
 def _rot_y(angle: float) -> FloatArray:

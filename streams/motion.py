@@ -491,21 +491,13 @@ class OneArmStrategy:
 
 
 def default_strategies(
-    fallbacks: bool = True, sequential_only: bool = False, sampling: bool = False
+    fallbacks: bool = True, sequential_only: bool = False
 ) -> tuple[TransferStrategy, ...]:
     """The ladder of Alg. 2: plain, untangle, sequential (or a part of it).
-    ``sequential_only``: the baseline motion planner (:class:`OneArmStrategy`).
-    ``sampling`` (needs OMPL): when the straight or lightly bent path is not clear, a
-    sampled path (RRTConnect, shortcut) warm-starts the optimiser instead of the straight
-    line (the sampled path itself is kept when the optimiser does not shorten it), before
-    untangling."""
+    ``sequential_only``: the baseline motion planner (:class:`OneArmStrategy`). The ladder
+    with a sampled first rung is :func:`streams.sampling.sampled_strategies`."""
     if sequential_only:
         return (OneArmStrategy(),)
-    if sampling:
-        from streams.sampling import SampledStrategy
-
-        sampled = SampledStrategy(name="plain", refine=True)
-        return (sampled,) if not fallbacks else (sampled, UntangleStrategy(), SequentialStrategy())
     if not fallbacks:
         return (PlainStrategy(),)
     return (PlainStrategy(), UntangleStrategy(), SequentialStrategy())

@@ -26,18 +26,22 @@ from __future__ import annotations
 import importlib.util
 import threading
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from sdar_tamp.errors import ParameterError, SdarError
 from sdar_tamp.world.transforms import FloatArray
+from streams.motion import (
+    DualMotionPlanner,
+    SequentialStrategy,
+    TransferProblem,
+    TransferStrategy,
+    UntangleStrategy,
+)
 from streams.timing import spline_curve, time_parameterize
 from streams.trajopt import densify
 from streams.validate import validate_trajectory
-
-if TYPE_CHECKING:
-    from streams.motion import DualMotionPlanner, TransferProblem
 
 
 class OmplUnavailableError(SdarError):
@@ -239,3 +243,12 @@ class SampledStrategy:
 def _duration(planner: DualMotionPlanner, path: FloatArray) -> float:
     v, a = planner.limits
     return time_parameterize(path, v, a).duration
+
+
+def sampled_strategies(fallbacks: bool = True) -> tuple[TransferStrategy, ...]:
+    """The ladder of Alg. 2 with a sampled first rung (needs OMPL): when the straight or
+    lightly bent path is not clear, a sampled path (RRTConnect, shortcut) warm-starts the
+    optimiser instead of the straight line (the sampled path itself is kept when the optimiser
+    does not shorten it), then untangling and one arm at a time (``fallbacks``)."""
+    sampled = SampledStrategy(name="plain", refine=True)
+    return (sampled,) if not fallbacks else (sampled, UntangleStrategy(), SequentialStrategy())

@@ -15,7 +15,6 @@ Fluent facts (``atpose ?o ?p``, ``holding ?a ?o ?g``) arrive as tuples in ``flue
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -24,19 +23,20 @@ from typing import Any
 import numpy as np
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.logs import get_logger
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.buffers import sample_buffers
 from streams.context import WorldContext
-from streams.grasps import Grasp, sample_grasps
+from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, sample_grasps
 from streams.ik import IKRequest, SceneCache, solve_ik_candidates
 from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
 from streams.sampling import SamplingOptions
 from streams.validate import HeldObject
 
-LOG = logging.getLogger(__name__)
+LOG = get_logger(__name__)
 Size = tuple[float, float, float]
 
 #: Kind of every stream of the file: "gen" (generator of output tuples), "test" or "function".
@@ -104,6 +104,7 @@ class DualArmStreams:
         planner: DualMotionPlanner | None = None,
         reserved: Mapping[str, Pose2D] | None = None,
         motion: str = "sdar",
+        grasps: GraspOptions = DEFAULT_GRASPS,
     ) -> None:
         if motion not in MOTION_PLANNERS:
             raise ParameterError(
@@ -119,6 +120,7 @@ class DualArmStreams:
         self.planner = planner if planner is not None else DualMotionPlanner(ctx)
         self.reserved = dict(reserved or {})
         self.motion = motion
+        self.grasp_options = grasps
         self._grasps: dict[str, tuple[Grasp, ...]] = {}
         self._buffer_calls = 0
 
@@ -132,7 +134,10 @@ class DualArmStreams:
     def grasps(self, obj: str) -> tuple[Grasp, ...]:
         if obj not in self._grasps:
             self._grasps[obj] = sample_grasps(
-                self.size(obj), self.ctx.scene.gripper.max_graspable_width
+                self.size(obj),
+                self.ctx.scene.gripper.max_graspable_width,
+                self.grasp_options.tilts,
+                self.grasp_options.symmetric,
             )
         return self._grasps[obj]
 
@@ -278,6 +283,7 @@ def make_stream_map(
     planner: DualMotionPlanner | None = None,
     reserved: Mapping[str, Pose2D] | None = None,
     motion: str = "sdar",
+    grasps: GraspOptions = DEFAULT_GRASPS,
 ) -> dict[str, Callable[..., Any]]:
     """Bind every stream of ``stream.pddl`` by name (see the module docstring).
 
@@ -286,9 +292,10 @@ def make_stream_map(
     process-wide cache, built once in the background);
     ``reserved``: poses buffers keep clear of (the goals); ``motion``: ``sdar`` (optimisation,
     untangling, one arm at a time), ``plain`` (optimisation only), ``sequential`` or ``ompl``
-    (RRTConnect, shortcut; needs the ``ompl`` extra).
+    (RRTConnect, shortcut; needs the ``ompl`` extra); ``grasps``: the grasp set of
+    ``sample-grasp``.
     """
-    s = DualArmStreams(world_context, sizes or {}, seed, planner, reserved, motion)
+    s = DualArmStreams(world_context, sizes or {}, seed, planner, reserved, motion, grasps)
     return {
         "sample-grasp": s.sample_grasp,
         "inverse-kinematics": s.inverse_kinematics,

@@ -25,7 +25,6 @@ end points may touch, e.g. a held object on the table at a place), then ``lb`` i
 
 from __future__ import annotations
 
-import logging
 import threading
 import time
 from dataclasses import dataclass, field
@@ -33,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from sdar_tamp.logs import get_logger
 from sdar_tamp.world.transforms import FloatArray
 from streams._casadi import ca, sx_sym, to_array
 from streams.context import WorldContext
@@ -46,7 +46,7 @@ from streams.sphere_pairs import (
     table_clearance,
 )
 
-_log = logging.getLogger(__name__)
+_log = get_logger(__name__)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ import pytest
 from sdar_tamp.cli import main
 from sdar_tamp.compat.pddlstream import read
 from sdar_tamp.errors import SdarError
-from sdar_tamp.evaluation.runner import read_rows
+from sdar_tamp.evaluation.results import read_rows
 from sdar_tamp.plan_file import PlanFileError, load_plan
 from sdar_tamp.resources import domain_file
 from sdar_tamp.textfile import TextFileError, decode_text, read_text

@@ -14,7 +14,6 @@ from typing import Any
 from matplotlib.figure import Figure
 
 from sdar_tamp.evaluation.report import (
-    Row,
     action_counts,
     combinations_in,
     execution_ratios,
@@ -23,7 +22,7 @@ from sdar_tamp.evaluation.report import (
     step_stats,
     succeeded,
 )
-from sdar_tamp.evaluation.runner import instance_sort_key, load_results, load_steps
+from sdar_tamp.evaluation.results import Row, instance_sort_key, load_results, load_steps
 
 #: The paper's family colours (light: SDAR-T, dark: baseline): yellow R, green S, blue D, red M.
 FAMILY_COLOURS = {

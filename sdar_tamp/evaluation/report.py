@@ -14,15 +14,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from sdar_tamp.evaluation.runner import (
+from sdar_tamp.evaluation.results import (
     COMBINATIONS,
     Combination,
+    Row,
     instance_sort_key,
     load_results,
     load_steps,
 )
 
-Row = dict[str, str]
 REPORT = "report.md"
 
 

@@ -18,19 +18,17 @@ and replay come on top of the time limit) or whose worker crashes is recorded as
 row, and no worker outlives the benchmark, even if it is killed.
 
 A run succeeds when it is solved *and* its plan passes the independent replay. Each row also
-holds the task planner's geometry-free action count (:func:`solvers.sdar.abstract.run_abstract`
-on the instance's dependency graph), which compares SDAR-T with the baseline independently of
-motion failures. Every worker process keeps one ``shared`` cache, so it builds the motion
-planner once. Parallel runs share the cores: compare planning times only between runs made with
-the same ``workers``.
+holds the task planner's geometry-free action count (:mod:`sdar_tamp.app.abstract`), which
+compares SDAR-T with the baseline independently of motion failures. Every worker process
+keeps one :class:`~sdar_tamp.app.cache.PlannerCache`, so it builds the motion planner once.
+Parallel runs share the cores: compare planning times only between runs made with the same
+``workers``.
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import functools
-import io
 import logging
 import re
 import shlex
@@ -42,11 +40,24 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sdar_tamp import __version__
 from sdar_tamp.arguments import COUNT, SEED, TIME_LIMIT
 from sdar_tamp.errors import ParameterError, SdarError
+from sdar_tamp.evaluation.results import (
+    COLUMNS,
+    COMBINATIONS,
+    RESULTS,
+    STEP_COLUMNS,
+    STEPS,
+    Combination,
+    append_rows,
+    instance_sort_key,
+    load_results,
+    parse_combos,
+    read_rows,
+)
 from sdar_tamp.evaluation.settings import (
     SETTINGS,
     BenchSettings,
@@ -58,66 +69,10 @@ from sdar_tamp.evaluation.settings import (
 from sdar_tamp.evaluation.workers import WorkerFailure, WorkerPool
 from sdar_tamp.textfile import read_text
 
+if TYPE_CHECKING:
+    from sdar_tamp.app.cache import PlannerCache
+
 log = logging.getLogger(__name__)
-
-RESULTS = "results.csv"
-STEPS = "steps.csv"
-COLUMNS = (
-    "instance", "family", "objects", "combination", "task_planner", "motion_planner", "seed",
-    "time_limit_s", "success", "status", "valid", "actions", "steps", "dual_arm_steps",
-    "buffer_moves", "execution_time_s", "planning_time_s", "selection_time_s", "motion_time_s",
-    "step_time_median_s", "setup_time_s", "wall_time_s", "abstract_actions",
-    "abstract_buffer_moves", "abstract_steps", "violation", "diagnosis",
-)  # fmt: skip
-STEP_COLUMNS = ("instance", "combination", "step", "selection_s", "motion_s")
-FAMILY_ORDER = "RSDM"
-
-
-@dataclass(frozen=True)
-class Combination:
-    """A task planner paired with a motion planner (the paper's six, :data:`COMBINATIONS`)."""
-
-    id: str
-    label: str
-    task_planner: str  # sdar | baseline
-    motion_planner: str  # sdar | plain | sequential
-
-
-COMBINATIONS = (
-    Combination("sdar", "SDAR", "sdar", "sdar"),
-    Combination("baseline", "Baseline", "baseline", "sequential"),
-    Combination("baseline-tp+sdar-m", "Baseline TP + SDAR-M", "baseline", "sdar"),
-    Combination("sdar-t+baseline-mp", "SDAR-T + Baseline MP", "sdar", "sequential"),
-    Combination("sdar-t+plain", "SDAR-T + plain TO", "sdar", "plain"),
-    Combination("baseline-tp+plain", "Baseline TP + plain TO", "baseline", "plain"),
-)
-
-
-def parse_combos(spec: str | Sequence[str]) -> tuple[Combination, ...]:
-    """``"all"`` or comma-separated ids (or a list of ids), returned in :data:`COMBINATIONS`
-    order. Raises :class:`ParameterError` for an unknown, empty or repeated id."""
-    names = [s.strip() for s in (spec.split(",") if isinstance(spec, str) else spec)]
-    if names == ["all"]:
-        return COMBINATIONS
-    choices = f"'all' or a comma-separated list of {', '.join(c.id for c in COMBINATIONS)}"
-    unknown = [n for n in names if n not in {c.id for c in COMBINATIONS}]
-    if unknown:
-        raise ParameterError(f"combos must be {choices}; unknown: {', '.join(map(repr, unknown))}")
-    repeated = sorted({n for n in names if names.count(n) > 1})
-    if repeated:
-        raise ParameterError(f"combos: {', '.join(repeated)} given more than once")
-    return tuple(c for c in COMBINATIONS if c.id in names)
-
-
-def instance_sort_key(name: str) -> tuple[int, int, str]:
-    """R, S, D, M (then others), by the number in the name: R4 < R10 < S4 < M1."""
-    family = FAMILY_ORDER.find(name[:1]) if name[:1] else -1
-    digits = re.search(r"\d+", name)
-    return (
-        family if family >= 0 else len(FAMILY_ORDER),
-        int(digits.group()) if digits else 0,
-        name,
-    )
 
 
 @dataclass(frozen=True)
@@ -183,30 +138,24 @@ class _Task:
 
 
 @functools.cache
-def _worker_cache() -> dict[str, dict[Any, Any]]:
-    """Per worker process: ``solve`` is the ``shared`` dict of :func:`solve_instance`,
-    ``abstract`` the geometry-free runs by (instance file, task planner)."""
-    return {"solve": {}, "abstract": {}}
+def _worker_cache() -> PlannerCache:
+    """Per worker process: the world and motion planner kept between runs."""
+    from sdar_tamp.app.cache import PlannerCache
+
+    return PlannerCache()
 
 
+@functools.cache
 def _abstract_figures(path: Path, task_planner: str) -> dict[str, int | None]:
-    from sdar_tamp.world.dependency import instance_dependency_graph
-    from sdar_tamp.world.instance import load_instance
-    from solvers.sdar.abstract import AbstractRunError, run_abstract
-    from solvers.sdar.planners import make_task_planner
+    """The task planner's geometry-free counts, once per worker, instance and planner."""
+    from sdar_tamp.app.abstract import abstract_figures
 
-    cache = _worker_cache()["abstract"]
-    key = (str(path), task_planner)
-    if key not in cache:
-        graph = instance_dependency_graph(load_instance(path))
-        try:
-            run = run_abstract(make_task_planner(task_planner), graph)
-            cache[key] = (run.actions, run.buffer_moves, len(run.steps))
-        except AbstractRunError as error:
-            log.warning("%s: abstract %s run failed: %s", path.stem, task_planner, error)
-            cache[key] = (None, None, None)
-    actions, buffers, steps = cache[key]
-    return {"abstract_actions": actions, "abstract_buffer_moves": buffers, "abstract_steps": steps}
+    run = abstract_figures(path, task_planner)
+    return {
+        "abstract_actions": run.actions,
+        "abstract_buffer_moves": run.buffer_moves,
+        "abstract_steps": run.steps,
+    }
 
 
 def _task_row(task: _Task) -> dict[str, Any]:
@@ -221,7 +170,7 @@ def _task_row(task: _Task) -> dict[str, Any]:
 
 def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
     """One solve in a worker process: the CSV row and the per-step planning times."""
-    from sdar_tamp.solve_command import solve_instance
+    from sdar_tamp.app.command import solve_instance
 
     e, c = task.entry, task.combo
     row = _task_row(task)
@@ -230,7 +179,7 @@ def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
     try:
         outcome = solve_instance(
             e.path, time_limit=task.time_limit, seed=task.seed, task_planner=c.task_planner,
-            motion_planner=c.motion_planner, shared=_worker_cache()["solve"],
+            motion_planner=c.motion_planner, cache=_worker_cache(),
         )  # fmt: skip
     except Exception as error:  # one broken run is recorded as such, not the end of the bench
         log.exception("%s with %s raised", e.name, c.id)
@@ -241,8 +190,8 @@ def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
     row.update(
         status=outcome.status, success=outcome.success, valid=outcome.valid,
         violation=outcome.violation, diagnosis=outcome.diagnosis[0] if outcome.diagnosis else "",
-        planning_time_s=f.get("planning_time"), selection_time_s=f.get("selection_time"),
-        motion_time_s=f.get("motion_time"), setup_time_s=f.get("setup_time"),
+        planning_time_s=f.planning_time, selection_time_s=f.selection_time,
+        motion_time_s=f.motion_time, setup_time_s=f.setup_time,
         wall_time_s=time.perf_counter() - start,
     )  # fmt: skip
     if outcome.plan is None:
@@ -250,60 +199,10 @@ def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
     m = outcome.plan.metrics
     row.update(
         actions=m["actions"], steps=m["steps"], dual_arm_steps=m["dual_arm_steps"],
-        execution_time_s=m["execution_time"], buffer_moves=f.get("buffer_moves"),
-        step_time_median_s=f.get("step_time_median"),
+        execution_time_s=m["execution_time"], buffer_moves=f.buffer_moves,
+        step_time_median_s=f.step_time_median,
     )  # fmt: skip
-    return row, [(float(s), float(t)) for s, t in f.get("step_times", [])]
-
-
-def _cell(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return str(int(value))
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return " ".join(str(value).split())  # one line per row, whatever a message holds
-
-
-def append_rows(path: Path, columns: Sequence[str], rows: Iterable[Mapping[str, Any]]) -> None:
-    """Append ``rows`` to the CSV file ``path`` (header first if new) and flush. The text is
-    written in one call, so an interruption (``KeyboardInterrupt``) leaves whole lines."""
-    new = not path.exists() or path.stat().st_size == 0
-    text = io.StringIO()
-    writer = csv.writer(text)
-    if new:
-        writer.writerow(columns)
-    writer.writerows([_cell(r.get(c)) for c in columns] for r in rows)
-    with path.open("a", newline="", encoding="utf-8") as fh:
-        fh.write(text.getvalue())
-        fh.flush()
-
-
-def read_rows(path: Path, columns: Sequence[str]) -> list[dict[str, str]]:
-    """The complete rows of a CSV file written by :func:`append_rows` (a last line cut short
-    by an interruption is dropped). Raises :class:`SdarError` if the header is not ``columns``."""
-    if not path.exists():
-        return []
-    text = read_text(path)
-    lines = text.splitlines(keepends=True)
-    if lines and not lines[-1].endswith("\n"):
-        lines.pop()
-    reader = csv.reader(lines)
-    header = next(reader, None)
-    if header is not None and tuple(header) != tuple(columns):
-        raise SdarError(
-            f"{path}: unexpected columns (written by another version?); use a new folder"
-        )
-    return [dict(zip(columns, r, strict=True)) for r in reader if len(r) == len(columns)]
-
-
-def load_results(out_dir: Path) -> list[dict[str, str]]:
-    return read_rows(Path(out_dir) / RESULTS, COLUMNS)
-
-
-def load_steps(out_dir: Path) -> list[dict[str, str]]:
-    return read_rows(Path(out_dir) / STEPS, STEP_COLUMNS)
+    return row, [(step.selection, step.motion) for step in f.step_times]
 
 
 def finished_pairs(out_dir: Path) -> set[tuple[str, str]]:

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
-import logging
 import math
 import time
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.logs import get_logger
 from solvers.classical.compiled import CompiledTask
 from solvers.classical.errors import PlanValidationError
 from solvers.classical.ground import ground
@@ -26,7 +26,7 @@ from solvers.classical.task import GroundTask
 from solvers.classical.validate import validate_plan
 
 SEARCHES = ("gbfs", "astar", "wastar", "lazy-gbfs")
-logger = logging.getLogger(__name__)
+logger = get_logger(__name__)
 
 
 def _check(name: str, value: object, choices: tuple[str, ...]) -> None:

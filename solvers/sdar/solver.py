@@ -37,7 +37,7 @@ from solvers.solution import Action, Certificate, Solution, Status, StreamStatis
 from solvers.stream_planning.engine import bind_externals
 from solvers.stream_planning.externals import StreamExternal, StreamInstance
 
-LOG = logging.getLogger(__name__)
+LOG = logging.getLogger(f"sdar_tamp.{__name__}")  # under the package prefix (sdar_tamp.logs)
 
 
 @dataclass(frozen=True)

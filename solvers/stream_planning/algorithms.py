@@ -22,7 +22,6 @@ like the one it failed in (:mod:`.blocking`), so the next optimistic plan goes a
 from __future__ import annotations
 
 import heapq
-import logging
 import math
 import time
 from collections.abc import Iterable, Mapping, Sequence
@@ -41,6 +40,7 @@ from sdar_tamp.language.model import (
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
+from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
@@ -61,7 +61,7 @@ from solvers.stream_planning.optimistic import (
 )
 from solvers.stream_planning.preimage import simulate
 
-LOG = logging.getLogger(__name__)
+LOG = get_logger(__name__)
 ALGORITHMS = ("incremental", "focused", "binding", "adaptive")
 PlanSteps = list[tuple[str, tuple[str, ...]]]
 
@@ -617,7 +617,15 @@ class StreamSolver:
                 status,
                 dict(self.stats),
                 streams,
-                diagnose(self, status),
+                diagnose(
+                    engine,
+                    self.problem.domain,
+                    self.goal,
+                    status,
+                    max_time=self.options.max_time,
+                    overruns=self.runner.overruns,
+                    complexity=self.stats["complexity"],
+                ),
             )
         cost, actions, needed = self.best
         plan = [

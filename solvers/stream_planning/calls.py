@@ -19,7 +19,6 @@ overrun is kept for the solution's diagnosis.
 
 from __future__ import annotations
 
-import logging
 import math
 import queue
 import threading
@@ -28,7 +27,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, NoReturn, TypeVar
 
-LOG = logging.getLogger(__name__)
+from sdar_tamp.logs import get_logger
+
+LOG = get_logger(__name__)
 T = TypeVar("T")
 #: [s] a call may end this long after the deadline without being reported as an overrun
 #: (threaded mode waits this much longer before it abandons a call).

@@ -2,55 +2,60 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
 
-from sdar_tamp.language.model import iter_atoms, iter_effect_literals
+from sdar_tamp.language.model import Domain, Formula, iter_atoms, iter_effect_literals
 from solvers.solution import Status
-
-if TYPE_CHECKING:
-    from solvers.stream_planning.algorithms import StreamSolver
+from solvers.stream_planning.calls import Overrun
+from solvers.stream_planning.engine import Engine
 
 MAX_LISTED = 5  # instances named one by one before the rest are counted
 
 
-def _produced_predicates(solver: StreamSolver) -> set[str]:
-    domain = solver.problem.domain
-    produced = {a.predicate for a in solver.engine.store.levels}
+def _produced_predicates(engine: Engine, domain: Domain) -> set[str]:
+    produced = {a.predicate for a in engine.store.levels}
     for action in domain.actions:
         produced |= {lit.atom.predicate for lit in iter_effect_literals(action.effect)}
     produced |= {axiom.predicate for axiom in domain.axioms}
-    for external in solver.engine.streams.values():
+    for external in engine.streams.values():
         produced |= {a.predicate for a in external.declaration.certified}
-    produced |= {f.name for f in solver.engine.functions.values() if f.is_predicate}
+    produced |= {f.name for f in engine.functions.values() if f.is_predicate}
     produced |= set(domain.types.parents)
     produced.add("=")
     return produced
 
 
-def diagnose(solver: StreamSolver, status: Status) -> list[str]:
-    """Short sentences: goals never reachable, streams never instantiated, streams that failed."""
+def diagnose(
+    engine: Engine,
+    domain: Domain,
+    goal: Formula,
+    status: Status,
+    *,
+    max_time: float,
+    overruns: Sequence[Overrun],
+    complexity: float,
+) -> list[str]:
+    """Short sentences: goals never reachable, streams never instantiated, streams that failed.
+
+    ``max_time`` [s] and ``overruns`` (calls that outlived the deadline) explain a timeout;
+    ``complexity`` is the last complexity bound of the search."""
     reasons: list[str] = []
     if status is Status.TIMEOUT:
-        reasons.append(
-            f"the time limit ({solver.options.max_time:g} s) or the iteration limit "
-            "ended the search"
-        )
-        reasons.extend(overrun.describe() for overrun in solver.runner.overruns)
-    produced = _produced_predicates(solver)
-    table = solver.engine.table
-    for atom in iter_atoms(solver.goal):
+        reasons.append(f"the time limit ({max_time:g} s) or the iteration limit ended the search")
+        reasons.extend(overrun.describe() for overrun in overruns)
+    produced = _produced_predicates(engine, domain)
+    table = engine.table
+    for atom in iter_atoms(goal):
         if atom.predicate not in produced:
             args = " ".join(repr(table.value(a)) if a in table else a for a in atom.args)
             reasons.append(
                 f"goal fact ({atom.predicate} {args}) is never reached: nothing "
                 f"makes '{atom.predicate}' true (no init fact, action, axiom or stream)"
             )
-    known = solver.engine.store.predicates()
-    certified = {
-        a.predicate for s in solver.engine.streams.values() for a in s.declaration.certified
-    }
-    instantiated = {name for name, _ in solver.engine.instances}
-    for name, external in sorted(solver.engine.streams.items()):
+    known = engine.store.predicates()
+    certified = {a.predicate for s in engine.streams.values() for a in s.declaration.certified}
+    instantiated = {name for name, _ in engine.instances}
+    for name, external in sorted(engine.streams.items()):
         if name not in instantiated:
             missing = sorted(
                 {a.predicate for a in external.declaration.domain if a.predicate not in known}
@@ -73,7 +78,7 @@ def diagnose(solver: StreamSolver, status: Status) -> list[str]:
                 f"stream '{name}' was called {external.counters.calls} time(s) and "
                 "never produced an output"
             )
-    states = list(solver.engine.instances.values())
+    states = list(engine.instances.values())
     dry = [
         s.instance
         for s in states
@@ -93,7 +98,6 @@ def diagnose(solver: StreamSolver, status: Status) -> list[str]:
         reasons.append(f"{exhausted} stream instance(s) were exhausted")
     if not reasons:
         reasons.append(
-            "no plan exists over every fact the streams could certify "
-            f"(complexity {solver.stats['complexity']:g})"
+            f"no plan exists over every fact the streams could certify (complexity {complexity:g})"
         )
     return reasons

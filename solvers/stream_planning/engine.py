@@ -20,7 +20,6 @@ initial facts, which may call user code, are added by :meth:`Engine.start`.
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -38,6 +37,7 @@ from sdar_tamp.language.model import (
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo, unsupported_options
 from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.logs import get_logger
 from solvers.stream_planning.calls import CallRunner
 from solvers.stream_planning.externals import (
     FunctionExternal,
@@ -48,7 +48,7 @@ from solvers.stream_planning.externals import (
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
 from solvers.stream_planning.negation import split_negated
 
-LOG = logging.getLogger(__name__)
+LOG = get_logger(__name__)
 # Options every solver acts on; any other option set to a non-default value is logged as
 # not implemented (simultaneous, defer_fn, ...). p_success, overhead and effort act through
 # solve(effort_weight=...). The stream algorithms also act on negate (see negation.py).

@@ -10,7 +10,6 @@ or ``:predicate`` must answer with a bool (:func:`truth_value`). Calls go throug
 from __future__ import annotations
 
 import itertools
-import logging
 import time
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
@@ -27,9 +26,10 @@ from sdar_tamp.language.generators import (
 from sdar_tamp.language.model import Atom, Stream, StreamFunction, StreamPredicate
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
+from sdar_tamp.logs import get_logger
 from solvers.stream_planning.calls import CallRunner, CallTimeout
 
-LOG = logging.getLogger(__name__)
+LOG = get_logger(__name__)
 
 
 class StreamError(SdarError):

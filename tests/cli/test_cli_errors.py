@@ -173,12 +173,12 @@ def test_show_does_not_overwrite_without_force(
 def test_solve_checks_its_output_before_planning(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import sdar_tamp.solve_command as solve_command
+    import sdar_tamp.app.command as command
 
     def no_planning(*args: object, **kwargs: object) -> None:
         raise AssertionError("the output must be checked before planning")
 
-    monkeypatch.setattr(solve_command, "solve_instance", no_planning)
+    monkeypatch.setattr(command, "solve_instance", no_planning)
     existing = tmp_path / "plan.json"
     existing.write_text("{}")
     assert "exists; pass --force" in refused(["solve", S4, "-q", "-o", str(existing)], capsys)

@@ -3,7 +3,7 @@
 import io
 import time
 
-from sdar_tamp.solve_command import ProgressBar
+from sdar_tamp.app.summary import ProgressBar
 
 
 def test_bar_appears_at_once_and_refreshes_without_steps() -> None:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from sdar_tamp.evaluation.runner import RESULTS, load_results
+from sdar_tamp.evaluation.results import RESULTS, load_results
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")

@@ -12,16 +12,9 @@ import pytest
 from sdar_tamp import __version__
 from sdar_tamp.cli import main
 from sdar_tamp.errors import SdarError
-from sdar_tamp.evaluation.runner import (
-    COLUMNS,
-    COMBINATIONS,
-    RESULTS,
-    SETTINGS,
-    append_rows,
-    load_results,
-    run_bench,
-    suite_entries,
-)
+from sdar_tamp.evaluation.results import COLUMNS, COMBINATIONS, RESULTS, append_rows, load_results
+from sdar_tamp.evaluation.runner import run_bench, suite_entries
+from sdar_tamp.evaluation.settings import SETTINGS
 
 
 def _row(instance: str, combo: str, seed: int = 0, time_limit: float = 60.0) -> dict[str, Any]:

@@ -10,21 +10,19 @@ import pytest
 from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError, SdarError
 from sdar_tamp.evaluation.report import action_counts, execution_ratios, percentile, write_report
-from sdar_tamp.evaluation.runner import (
+from sdar_tamp.evaluation.results import (
     COLUMNS,
     COMBINATIONS,
     RESULTS,
     STEP_COLUMNS,
     STEPS,
     append_rows,
-    finished_pairs,
     instance_sort_key,
     load_results,
     load_steps,
     parse_combos,
-    run_bench,
-    suite_entries,
 )
+from sdar_tamp.evaluation.runner import finished_pairs, run_bench, suite_entries
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

@@ -8,13 +8,13 @@ from typing import Any
 import numpy as np
 import pytest
 
-from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.problem import PDDLProblem
-from sdar_tamp.rearrangement import (
+from sdar_tamp.app import (
     plan_file_from_solution,
     rearrangement_problem,
     solve_rearrangement,
 )
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
@@ -195,7 +195,7 @@ def test_unknown_task_planner_and_override_are_refused(ctx: WorldContext) -> Non
         solve(r.problem, algorithm="sdar", task_planner="greedy")
     with pytest.raises(ParameterError, match="overrides: unknown streams"):
         rearrangement_problem(_swap(), ctx, overrides={"sample-pose": print})
-    with pytest.raises(ParameterError, match="motion planner must be one of"):
+    with pytest.raises(ParameterError, match="motion must be one of sdar, plain, sequential"):
         rearrangement_problem(_swap(), ctx, motion="fast")
 
 

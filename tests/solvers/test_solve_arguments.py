@@ -66,7 +66,7 @@ def test_solve_accepts_the_limits_of_the_ranges() -> None:
 
 
 def test_solve_instance_refuses_bad_numbers_before_loading_anything() -> None:
-    from sdar_tamp.solve_command import solve_instance
+    from sdar_tamp.app import solve_instance
 
     missing = Path("no-such-instance.yaml")
     for kwargs, message in [
@@ -81,7 +81,7 @@ def test_solve_instance_refuses_bad_numbers_before_loading_anything() -> None:
 
 
 def test_solve_rearrangement_uses_the_checks_of_solve() -> None:
-    from sdar_tamp.rearrangement import rearrangement_problem, solve_rearrangement
+    from sdar_tamp.app import rearrangement_problem, solve_rearrangement
     from sdar_tamp.world.instance import load_instance
     from streams.context import WorldContext
 

@@ -89,12 +89,15 @@ def test_solve_leaves_logger_levels_alone_and_logs_a_summary(
 ) -> None:
     import logging
 
-    loggers = [logging.getLogger(name) for name in ("", "solvers", "solvers.solve")]
-    with caplog.at_level(logging.DEBUG, logger="solvers"):
+    names = ("", "sdar_tamp", "sdar_tamp.solvers", "sdar_tamp.solvers.solve")
+    loggers = [logging.getLogger(name) for name in names]
+    with caplog.at_level(logging.DEBUG, logger="sdar_tamp.solvers"):
         before = [logger.level for logger in loggers]
         assert solve(line_problem(counting()), algorithm="focused", verbose=verbose).solved
         assert [logger.level for logger in loggers] == before
-    summary = [r for r in caplog.records if r.name == "solvers.solve" and "focused:" in r.message]
+    summary = [
+        r for r in caplog.records if r.name == "sdar_tamp.solvers.solve" and "focused:" in r.message
+    ]
     assert len(summary) == 1 and "solved" in summary[0].message
     assert summary[0].levelno == (logging.INFO if verbose else logging.DEBUG)
 

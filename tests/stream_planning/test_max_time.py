@@ -28,7 +28,7 @@ from solvers.stream_planning.externals import StreamError
 
 ALGORITHMS = ("incremental", "focused", "binding", "adaptive")
 BLOCK = 30.0  # [s] how long a blocking sampler blocks (unless released)
-CALLS_LOGGER = "solvers.stream_planning.calls"
+CALLS_LOGGER = "sdar_tamp.solvers.stream_planning.calls"
 
 
 @pytest.fixture

@@ -7,7 +7,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from streams import sampling
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner, MotionRequest, default_strategies, plan_dual_motion
+from streams.motion import DualMotionPlanner, MotionRequest, plan_dual_motion
 from streams.sampling import (
     OmplUnavailableError,
     SampledStrategy,
@@ -75,7 +75,7 @@ def test_sampled_strategy_plans_a_validated_motion(
     check = ctx.new_world()
     configure_world(ctx, check, objects, {}, BLOCKED_START)
     assert validate_trajectory(ctx, check, result.trajectory.q).ok
-    ladder = default_strategies(sampling=True)
+    ladder = sampling.sampled_strategies()
     assert [s.name for s in ladder] == ["plain", "untangle", "sequential"]
     assert isinstance(ladder[0], SampledStrategy) and ladder[0].refine
     combined = plan_dual_motion(planner, request, strategies=ladder)

@@ -1,0 +1,63 @@
+"""How a run is shown to people: a few summary lines and a progress bar."""
+
+from __future__ import annotations
+
+import sys
+from typing import Any, TextIO
+
+from sdar_tamp.app.records import SolveOutcome
+
+
+def format_summary(outcome: SolveOutcome) -> str:
+    """A few lines for people: result, actions, steps, times."""
+    f = outcome.figures
+    head = f"{outcome.instance.name}: {outcome.status}"
+    if outcome.plan is None:
+        return "\n".join([head, *(f"  {d}" for d in outcome.diagnosis)])
+    m = outcome.plan.metrics
+    lines = [
+        head + (", plan valid" if outcome.valid else f", plan INVALID ({outcome.violation})"),
+        f"  actions {m['actions']} ({f.buffer_moves} to buffers), synchronous steps "
+        f"{m['steps']} ({m['dual_arm_steps']} with both arms moving at once)",
+        f"  execution time {float(m['execution_time']):.2f} s",
+        f"  planning time {f.planning_time:.2f} s: selection/IK {f.selection_time:.2f} s, "
+        f"motion {f.motion_time:.2f} s (setup {f.setup_time:.2f} s not counted; "
+        f"optimiser built in the background, waited for {f.optimiser_wait:.2f} s)",
+        f"  per step: median {f.step_time_median:.3f} s (selection "
+        f"{f.step_selection_median:.3f} s, motion {f.step_motion_median:.3f} s), "
+        f"max {f.step_time_max:.3f} s",
+        "  motion levels: " + ", ".join(f"{k} {v}" for k, v in f.levels.items()),
+    ]
+    return "\n".join(lines)
+
+
+class ProgressBar:
+    """A ``progress(done, total)`` callback drawing a tqdm bar of the objects at their goals.
+    The bar appears at once and its clock ticks every ``tick`` [s] between steps (set-up,
+    long steps, validation), so no wait passes silently."""
+
+    def __init__(self, label: str, stream: TextIO = sys.stderr, tick: float = 0.5) -> None:
+        import threading
+
+        from tqdm import tqdm
+
+        self.label = label
+        self.stream = stream
+        self._bar: Any = tqdm(total=None, desc=label, unit="obj", file=stream)
+        self._stop = threading.Event()
+        self._ticker = threading.Thread(target=self._tick, args=(tick,), daemon=True)
+        self._ticker.start()
+
+    def _tick(self, tick: float) -> None:
+        while not self._stop.wait(tick):
+            self._bar.refresh()
+
+    def __call__(self, done: int, total: int) -> None:
+        if self._bar.total != total:
+            self._bar.total = total
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        self._stop.set()
+        self._ticker.join()
+        self._bar.close()

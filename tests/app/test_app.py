@@ -1,0 +1,251 @@
+"""The application layer: one planner configuration for every entry point, typed run
+records, plan actions read through the vocabulary, the planner cache."""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from sdar_tamp.app import (
+    ActionDecoder,
+    PlannerCache,
+    PlannerConfig,
+    TaskRecord,
+    rearrangement_problem,
+    solve_rearrangement,
+)
+from sdar_tamp.app.plan_export import GripperAction
+from sdar_tamp.app.problem import grasp_set_sizes
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.pddl import parse_domain
+from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.resources import domain_file
+from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
+from sdar_tamp.world.scene import Workspace
+from solvers.sdar.solver import SdarOptions
+from solvers.solution import Action, Solution
+from solvers.solve import solve
+from streams.context import WorldContext
+from streams.grasps import GraspOptions
+from streams.motion import DualMotionPlanner
+from streams.trajopt import TrajOptOptions
+
+SQUARE = (0.04, 0.04, 0.05)  # graspable across both sides: 12 grasps in the default set
+WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
+
+
+@pytest.fixture(scope="module")
+def ctx() -> WorldContext:
+    return WorldContext.load()
+
+
+@pytest.fixture(scope="module")
+def planner(ctx: WorldContext) -> DualMotionPlanner:
+    return DualMotionPlanner(ctx)
+
+
+def _one() -> Instance:
+    spec = ObjectSpec("a", SQUARE, Pose2D(-0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.3))
+    return Instance("one", WORKSPACE, (spec,))
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"task_planner": "greedy"}, "task_planner must be one of sdar, baseline"),
+        ({"motion_planner": "fast"}, "motion_planner must be one of sdar, plain, sequential"),
+        ({"max_time": math.nan}, r"max_time must be a number > 0 \[s\] or inf"),
+        ({"seed": -1}, "seed must be an integer >= 0, got -1"),
+        ({"gripper_time": -0.1}, "gripper_time must be a finite number >= 0"),
+        ({"sdar": SdarOptions(max_time=5.0)}, "sdar.max_time is set by the configuration"),
+        ({"sdar": SdarOptions(progress=print)}, "sdar.progress is set by the configuration"),
+        (
+            {"sdar": SdarOptions(one_arm_at_a_time=True)},
+            "sdar.one_arm_at_a_time .*motion_planner='sequential'",
+        ),
+        ({"grasps": (0.5,)}, "grasps must be a GraspOptions, got tuple"),
+        ({"trajopt": {}}, "trajopt must be a TrajOptOptions, got dict"),
+    ],
+)
+def test_planner_config_refuses_bad_values(changes: dict[str, Any], message: str) -> None:
+    with pytest.raises(ParameterError, match=message):
+        PlannerConfig(**changes)
+
+
+def test_grasp_options_refuse_tilts_outside_the_open_quarter_turn() -> None:
+    with pytest.raises(ParameterError, match=r"grasp tilts must lie in \(0, pi/2\)"):
+        GraspOptions(tilts=(np.pi / 2,))
+
+
+@pytest.mark.parametrize(
+    ("motion", "one_arm", "quick"),
+    [("sdar", False, 5), ("plain", False, 0), ("sequential", True, 0)],
+)
+def test_sdar_options_follow_the_motion_planner(motion: str, one_arm: bool, quick: int) -> None:
+    config = PlannerConfig(
+        motion_planner=motion, max_time=7.0, sdar=SdarOptions(quick_attempts=5, grasps=9)
+    )
+    options = config.sdar_options(progress=print)
+    assert (options.one_arm_at_a_time, options.quick_attempts) == (one_arm, quick)
+    assert (options.max_time, options.progress, options.grasps) == (7.0, print, 9)
+
+
+def test_replace_keeps_fields_given_as_none() -> None:
+    config = PlannerConfig(seed=3).replace(seed=None, task_planner="baseline")
+    assert (config.seed, config.task_planner) == (3, "baseline")
+
+
+def test_both_entry_points_pass_the_same_sdar_options(
+    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``solve_rearrangement`` is ``solve(..., algorithm="sdar", sdar_options=...)`` with the
+    options of the rearrangement's configuration (here: the sequential motion planner)."""
+    import sdar_tamp.app.solving as solving
+
+    calls: list[dict[str, Any]] = []
+
+    def spy(problem: PDDLProblem, **kwargs: Any) -> Solution:
+        calls.append(kwargs)
+        return Solution(None)
+
+    monkeypatch.setattr(solving, "solve", spy)
+    config = PlannerConfig(sdar=SdarOptions(grasps=12, candidates=4))
+    r = rearrangement_problem(_one(), ctx, config=config, motion="sequential", planner=planner)
+    solve_rearrangement(r, "baseline", 9.0)
+    (kwargs,) = calls
+    assert kwargs["algorithm"] == "sdar" and kwargs["task_planner"] == "baseline"
+    assert kwargs["max_time"] == 9.0
+    expected = dataclasses.replace(config.sdar, max_time=9.0, one_arm_at_a_time=True)
+    assert kwargs["sdar_options"] == dataclasses.replace(expected, quick_attempts=0)
+    assert kwargs["sdar_options"] == r.config.replace(max_time=9.0).sdar_options()
+
+
+def test_solve_checks_sdar_options() -> None:
+    from domains.pick_place_2d.samplers import make_problem
+
+    with pytest.raises(ParameterError, match="sdar_options applies to algorithm 'sdar' only"):
+        solve(make_problem(), algorithm="adaptive", sdar_options=SdarOptions())
+    with pytest.raises(ParameterError, match="sdar_options must be a SdarOptions, got int"):
+        solve(make_problem(), algorithm="sdar", sdar_options=5)  # type: ignore[arg-type]
+
+
+def test_a_larger_grasp_set_reaches_the_stream_and_its_cut_is_logged(
+    ctx: WorldContext, planner: DualMotionPlanner, caplog: pytest.LogCaptureFixture
+) -> None:
+    grasps = GraspOptions(tilts=(np.pi / 8, np.pi / 4))  # 5 angles x 2 sides x 2 wrists
+    config = PlannerConfig(grasps=grasps)
+    assert grasp_set_sizes(_one(), ctx, config) == {"a": 20}
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.app"):
+        r = rearrangement_problem(_one(), ctx, config=config, planner=planner)
+    sample = r.problem.stream_map["sample-grasp"]
+    assert len(_outputs(sample("a"))) == 20
+    assert any("tries the first 6 grasps" in m and "up to 20" in m for m in caplog.messages)
+    caplog.clear()
+    wide = config.replace(sdar=SdarOptions(grasps=20))
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.app"):
+        rearrangement_problem(_one(), ctx, config=wide, planner=planner)
+    assert not any("tries the first" in m for m in caplog.messages)
+
+
+def _outputs(generator: Any) -> list[Any]:
+    """Every output of a wrapped stream generator (it yields lists of output tuples)."""
+    return [output for batch in generator for output in batch]
+
+
+def test_actions_are_read_by_name_through_the_vocabulary(ctx: WorldContext) -> None:
+    r = rearrangement_problem(_one(), ctx, planner=DualMotionPlanner(ctx))
+    decoder = ActionDecoder(r.problem.domain, r.problem.streams)
+    g1, g2 = object(), object()
+    args = ("d", "left", "o1", "p1", g1, "q1", "right", "o2", "p2", g2, "q2")
+    pick, parts = decoder.gripper(Action("pick-both", args))
+    assert pick and [(p.arm, p.obj, p.grasp) for p in parts] == [
+        ("left", "o1", g1),
+        ("right", "o2", g2),
+    ]
+    place, (one,) = decoder.gripper(Action("place", ("right", "o", "p", g1, "q", "d")))
+    assert not place and one == GripperAction("right", "o", g1)  # type: ignore[arg-type]
+    assert decoder.is_move(Action("move", ("d1", "t", "d2")))
+    with pytest.raises(ParameterError, match="move: no trajectory"):
+        decoder.trajectory(Action("move", ("d1", "t", "d2")))
+    with pytest.raises(ParameterError, match="'wave' is neither a move nor a gripper action"):
+        decoder.gripper(Action("wave", ()))
+
+
+def test_a_domain_without_the_vocabulary_cannot_be_decoded() -> None:
+    text = domain_file("dual_arm_rearrangement").read_text(encoding="utf-8")
+    domain = parse_domain(text.replace("(:action place-both", "(:action put-both"))
+    problem_streams = rearrangement_streams()
+    with pytest.raises(ParameterError, match=r"the domain has no action.* place-both"):
+        ActionDecoder(domain, problem_streams)
+
+
+def rearrangement_streams() -> Any:
+    from sdar_tamp.language.streams import parse_stream_file
+
+    domain = parse_domain(domain_file("dual_arm_rearrangement").read_text(encoding="utf-8"))
+    text = domain_file("dual_arm_rearrangement", "stream.pddl").read_text(encoding="utf-8")
+    return parse_stream_file(text, domain)
+
+
+def test_task_records_are_typed_and_share_wasted_time() -> None:
+    record = TaskRecord.from_trace(
+        {
+            "kind": "swap", "objects": ("a", "b"), "arms": ("left", "right"),
+            "to_buffer": (False, True), "selection_time": 0.4, "motion_time": 1.0,
+            "motions": 2, "tried": 3, "motion_times": (0.3, 0.5),
+        }
+    )  # fmt: skip
+    assert record.buffer_moves == 1 and record.objects == ("a", "b")
+    steps = record.step_times()
+    assert [s.selection for s in steps] == [0.2, 0.2]
+    assert [round(s.motion, 9) for s in steps] == [0.4, 0.6]
+    assert math.isclose(sum(s.total for s in steps), 1.4)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        record.kind = "pair"  # type: ignore[misc]
+
+
+def test_planner_cache_builds_once_per_scene_and_optimiser_options() -> None:
+    cache = PlannerCache()
+    first = cache.world(None, TrajOptOptions())
+    again = cache.world(None, TrajOptOptions())
+    assert again.ctx is first.ctx and again.planner is first.planner and cache.builds == 1
+    other = cache.world(None, TrajOptOptions(knots=12))
+    assert other.planner is not first.planner and cache.builds == 2
+    scene = Path(domain_file("dual_arm_rearrangement").parent / "scene.yaml")
+    if scene.exists():
+        cache.world(scene, TrajOptOptions(knots=12))
+        assert cache.builds == 3
+
+
+def test_the_command_line_reaches_the_planner_config(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import sdar_tamp.app.command as command
+    from sdar_tamp.cli import main
+
+    instance = str(domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml"))
+    seen: list[PlannerConfig] = []
+
+    class Stop(Exception):
+        pass
+
+    def capture(path: Path, config: PlannerConfig, **kwargs: Any) -> None:
+        seen.append(config)
+        raise Stop
+
+    monkeypatch.setattr(command, "solve_instance", capture)
+    args = ["solve", instance, "-q", "--grasps", "10", "--motion-planner", "sequential"]
+    with pytest.raises(Stop):
+        main([*args, "--time-limit", "5", "--seed", "2"])
+    (config,) = seen
+    assert config.sdar.grasps == 10 and config.motion_planner == "sequential"
+    assert (config.max_time, config.seed) == (5.0, 2)
+    with pytest.raises(SystemExit):
+        main(["solve", instance, "--grasps", "0"])
+    assert "argument --grasps: expected an integer >= 1" in capsys.readouterr().err
