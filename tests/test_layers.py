@@ -43,6 +43,8 @@ LAYERS: dict[str, str] = {
     "sdar_tamp.evaluation": "evaluation",
     "sdar_tamp.compat": "compat",
     "sdar_tamp.viewer": "viewer",
+    "sdar_tamp.export": "export",
+    "sdar_tamp.schemas": "leaves",  # JSON Schema files and their loader
     # the command line on top
     "sdar_tamp.cli": "cli",
 }
@@ -61,6 +63,7 @@ ALLOWED: dict[str, set[str]] = {
     "evaluation": _BASE | {"world", "plan", "app", "evaluation"},
     "compat": _BASE | {"language", "solvers", "compat"},
     "viewer": _BASE | {"world", "plan", "viewer"},
+    "export": _BASE | {"world", "plan", "export"},
     "cli": set(LAYERS.values()),
 }
 

@@ -11,7 +11,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from sdar_tamp.export.command import CSV_RATE, FORMATS, default_output, export_plan, run_export
+from sdar_tamp.export.command import default_output, export_plan, run_export
+from sdar_tamp.export.formats import CSV_RATE, FORMATS
 
 if TYPE_CHECKING:
     from sdar_tamp.export.joint_trajectory import (

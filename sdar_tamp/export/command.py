@@ -12,13 +12,12 @@ from typing import TYPE_CHECKING, Any
 
 from sdar_tamp.arguments import FPS, Real, output_file, output_folder
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.export.formats import CSV_RATE, FORMATS
 
 if TYPE_CHECKING:
     from sdar_tamp.export.urscript import ServoSettings
     from sdar_tamp.plan_file import PlanFile
 
-FORMATS = ("joint-trajectory", "csv", "urscript")
-CSV_RATE = 50.0  #: rows per second of the CSV table [1/s]
 #: What ``-o`` names per format, and the default name next to the plan.
 _DEFAULT_SUFFIX = {"joint-trajectory": ".trajectory.json", "csv": ".csv", "urscript": ".urscript"}
 

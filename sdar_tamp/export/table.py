@@ -14,7 +14,7 @@ import csv
 from pathlib import Path
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.export.command import CSV_RATE
+from sdar_tamp.export.formats import CSV_RATE
 from sdar_tamp.export.timeline import controller_grid, gripper_states, positions_at
 from sdar_tamp.plan_file import PlanFile
 
