@@ -114,7 +114,7 @@ def solve(
     verbose: bool = True,
     seed: int | None = None,
     planner: str = "wastar-ff",
-    task_planner: str = "sdar",
+    task_planner: str | None = None,
     sdar_options: SdarOptions | None = None,
     **unknown: Any,
 ) -> Solution:
@@ -146,11 +146,14 @@ def solve(
         planner: ``SEARCH-HEURISTIC`` of the classical planner, e.g. ``wastar-ff``,
             ``gbfs-ff``, ``astar-max``, or a PDDLStream planner name such as ``ff-astar``,
             ``max-astar`` or ``ff-wastar2`` (see :func:`parse_planner`).
-        task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``.
+        task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``
+            (default: the problem's ``solve_defaults``, else ``sdar``).
         sdar_options: with ``algorithm="sdar"``: SDAR-M's budgets and switches
             (:class:`solvers.sdar.solver.SdarOptions`; its ``max_time`` is replaced by
-            ``max_time``). A rearrangement built by :mod:`sdar_tamp.app` gets them from its
-            ``PlannerConfig`` (``config.sdar_options()``), as ``solve_rearrangement`` does.
+            ``max_time``; default: the problem's ``solve_defaults``, else the defaults). A
+            rearrangement built by :mod:`sdar_tamp.app` carries its ``PlannerConfig``'s
+            task planner and options in ``solve_defaults``, so ``solve(r.problem,
+            algorithm="sdar")`` plans as ``solve_rearrangement(r)`` does.
         seed: Python's ``random`` and NumPy's global generator are seeded with it for the
             duration of the solve, so samplers that draw from them (as PDDLStream programs'
             samplers do) give the same plan for the same seed; their previous states are
@@ -188,6 +191,7 @@ def solve(
     search_sample_ratio = _LIMIT.check("search_sample_ratio", search_sample_ratio)
     max_planner_time = MAX_TIME.check("max_planner_time", max_planner_time)
     if algorithm == "sdar":
+        task_planner, sdar_options = _sdar_defaults(problem, task_planner, sdar_options)
         with _seeded_globals(seed):
             return _solve_sdar(problem, task_planner, max_time, stream_info, verbose, sdar_options)
     if sdar_options is not None:
@@ -258,6 +262,32 @@ def _summarised(solution: Solution, algorithm: str, verbose: bool) -> Solution:
         float(solution.statistics.get("time", solution.statistics.get("planning_time", 0.0))),
     )
     return solution
+
+
+#: The keywords of ``solve()`` a problem's ``solve_defaults`` may carry.
+SOLVE_DEFAULTS = ("task_planner", "sdar_options")
+
+
+def _sdar_defaults(
+    problem: PDDLProblem, task_planner: str | None, sdar_options: SdarOptions | None
+) -> tuple[str, SdarOptions | None]:
+    """The task planner and SDAR-M options: the arguments, else the problem's defaults."""
+    defaults = getattr(problem, "solve_defaults", None) or {}
+    if not isinstance(defaults, Mapping):
+        raise ParameterError(
+            f"PDDLProblem.solve_defaults must be a mapping, got {type(defaults).__name__}"
+        )
+    unknown = sorted(set(defaults) - set(SOLVE_DEFAULTS))
+    if unknown:
+        raise ParameterError(
+            f"PDDLProblem.solve_defaults may hold {', '.join(SOLVE_DEFAULTS)}; "
+            f"got {', '.join(map(repr, unknown))}"
+        )
+    if task_planner is None:
+        task_planner = defaults.get("task_planner", "sdar")
+    if sdar_options is None:
+        sdar_options = defaults.get("sdar_options")
+    return str(task_planner), sdar_options
 
 
 def _solve_sdar(

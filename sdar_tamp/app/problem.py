@@ -113,6 +113,10 @@ def rearrangement_problem(
         wrapped,
         init,
         goal,
+        solve_defaults={
+            "task_planner": config.task_planner,
+            "sdar_options": config.sdar_options(),
+        },
     )
     return Rearrangement(instance, ctx, problem, home, config)
 

@@ -4,7 +4,9 @@
 meaning: the domain and stream files are given as text (or parsed models), ``constant_map`` maps
 the domain's constants to Python values, ``stream_map`` maps stream and function names
 (case-insensitive) to callables, or is ``"debug"``, and ``init``/``goal`` are tuples whose
-arguments are arbitrary Python values. Building the object validates all of it.
+arguments are arbitrary Python values. Building the object validates all of it. The keyword
+``solve_defaults`` (not in PDDLStream) lets whoever builds a problem attach the ``solve()``
+options it was built for, so that every entry point solves it the same way.
 
 As in PDDLStream, ``init`` and ``goal`` may use predicates that neither the domain nor the stream
 files declare: each is declared by its first use (logged at info level and kept in
@@ -74,6 +76,9 @@ class PDDLProblem:
     stream_map: Mapping[str, Callable[..., Any]] | str | None
     init: Iterable[Sequence[Any]]
     goal: Any
+    #: Keyword arguments of ``solve()`` this problem was configured with (for example by an
+    #: application that builds it); an argument given to ``solve()`` itself wins.
+    solve_defaults: Mapping[str, Any] = field(default_factory=dict, kw_only=True)
     domain: Domain = field(init=False)
     streams: StreamFile = field(init=False)
     objects: ObjectTable = field(init=False)

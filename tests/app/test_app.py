@@ -126,6 +126,49 @@ def test_both_entry_points_pass_the_same_sdar_options(
     assert kwargs["sdar_options"] == r.config.replace(max_time=9.0).sdar_options()
 
 
+def test_plain_solve_of_a_rearrangement_plans_as_solve_rearrangement(
+    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``solve(r.problem, algorithm="sdar")`` takes the task planner and SDAR-M options the
+    rearrangement was configured with (carried by the problem), as ``solve_rearrangement``;
+    arguments given to ``solve`` win."""
+    import solvers.sdar.solver as sdar_solver
+
+    seen: list[tuple[str, SdarOptions]] = []
+
+    class Spy:
+        def __init__(self, problem: Any, task: Any, options: SdarOptions, info: Any) -> None:
+            seen.append((type(task).__name__, options))
+
+        def solve(self) -> Solution:
+            return Solution(None)
+
+    monkeypatch.setattr(sdar_solver, "SdarSolver", Spy)
+    config = PlannerConfig(task_planner="baseline", sdar=SdarOptions(grasps=12, candidates=4))
+    r = rearrangement_problem(_one(), ctx, config=config, motion="sequential", planner=planner)
+    solve(r.problem, algorithm="sdar", max_time=9.0, verbose=False)
+    solve(r.problem, algorithm="sdar", max_time=9.0, task_planner="sdar", verbose=False)
+    explicit = SdarOptions(candidates=2)
+    solve(r.problem, algorithm="sdar", max_time=9.0, sdar_options=explicit, verbose=False)
+    expected = r.config.replace(max_time=9.0).sdar_options()
+    assert expected.one_arm_at_a_time and expected.grasps == 12
+    assert seen[0][1] == expected and seen[1][1] == expected
+    assert seen[2][1] == dataclasses.replace(explicit, max_time=9.0)
+    assert seen[0][0] != seen[1][0]  # the baseline by default, SDAR-T when asked
+
+
+def test_solve_refuses_unknown_solve_defaults() -> None:
+    from domains.pick_place_2d.samplers import make_problem
+
+    problem = make_problem()
+    problem.solve_defaults = {"planner": "ff-astar"}
+    with pytest.raises(ParameterError, match="solve_defaults may hold task_planner, sdar_options"):
+        solve(problem, algorithm="sdar")
+    problem.solve_defaults = [("task_planner", "sdar")]  # type: ignore[assignment]
+    with pytest.raises(ParameterError, match="solve_defaults must be a mapping, got list"):
+        solve(problem, algorithm="sdar")
+
+
 def test_solve_checks_sdar_options() -> None:
     from domains.pick_place_2d.samplers import make_problem
 
