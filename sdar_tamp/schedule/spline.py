@@ -123,7 +123,7 @@ def retime(
     rate = float(min(rate_v.min(), rate_a.min(), max_rate))
     if not math.isfinite(rate):  # no motion at all
         return np.stack([q[0], q[-1]])
-    n = max(1, math.ceil(spline.duration / (rate * tick) * (1.0 + 1e-9)))
+    n = max(1, math.ceil(spline.duration / (rate * tick) - 1e-9))  # within 1e-9 relative
     x = t[0] + np.arange(n + 1) * (spline.duration / n)
     out = spline(x)
     out[0], out[-1] = q[0], q[-1]
