@@ -8,7 +8,7 @@ Layout (``version`` 1; every length in m, angle in rad, time in s)::
                "T_tool0_tcp" (4x4), "home" (6)}, ...two arms, scene order],
      "trajectory": {"t": [n times from 0, spacing <= 0.02], "q": [n rows of 12: arm 1, arm 2]},
      "events": [{"t", "arm", "type": "grasp" | "release", "object", "T_tcp_object" (4x4)}],
-                # after the events of one instant the robot stands still GRIPPER_DWELL (0.5 s)
+                # after its gripper event an arm stands still GRIPPER_DWELL (0.5 s)
      "final_poses": {"o1": [x, y, yaw]},
      "metrics": {"actions", "steps", "dual_arm_steps", "execution_time", "planning_time", ...},
      "steps": [{"t_start", "t_end", "level", "objects", "kind"}]}   # optional
@@ -43,8 +43,8 @@ UNITS = {"length": "m", "angle": "rad", "time": "s"}
 MAX_DT = 0.02  #: largest spacing of trajectory samples [s]
 EVENT_TYPES = ("grasp", "release")
 MAX_DEPTH = 64  #: deepest nesting of JSON lists and objects a plan file may have
-#: After the gripper events of one instant the robot stands still this long [s] (the gripper
-#: closes or opens; the 2F-85 takes about half a second).
+#: After its gripper event an arm stands still this long [s] (the gripper closes or opens;
+#: the 2F-85 takes about half a second). :func:`build_plan_file` keeps both arms still.
 GRIPPER_DWELL = 0.5
 
 

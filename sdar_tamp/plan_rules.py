@@ -251,8 +251,8 @@ def _at(plan: PlanFile, t: float) -> FloatArray:
 
 
 def _dwell(plan: PlanFile, scene: Scene, dwell: float) -> Violation | None:
-    """After the gripper events of one instant, the robot (both arms) stands still for
-    ``dwell`` [s]; an arm's gripper acts at most once per dwell."""
+    """After its gripper event an arm stands still for ``dwell`` [s] (the gripper closes or
+    opens; the other arm may move); an arm's gripper acts at most once per dwell."""
     last: dict[str, tuple[float, str]] = {}
     for e in plan.events:
         prev = last.get(e.arm)
@@ -266,26 +266,29 @@ def _dwell(plan: PlanFile, scene: Scene, dwell: float) -> Violation | None:
         last[e.arm] = (e.t, e.type)
     t, q = plan.t, plan.q
     for t_e in sorted({e.t for e in plan.events}):
-        what = ", ".join(f"{e.arm} {e.type} of {e.object}" for e in plan.events if e.t == t_e)
+        group = [e for e in plan.events if e.t == t_e]
+        what = ", ".join(f"{e.arm} {e.type} of {e.object}" for e in group)
         end = max(t_e, t_e + dwell - TIME_TOL)
         if end > t[-1]:
             return Violation(
                 t_e,
                 "dwell",
-                f"the plan ends {t[-1] - t_e:.3f} s after the {what}; the robot must stand "
+                f"the plan ends {t[-1] - t_e:.3f} s after the {what}; the arm must stand "
                 f"still for {dwell} s after a gripper event",
             )
-        q_e = _at(plan, t_e)
+        arms = [i for i, name in enumerate(plan.arm_names) if any(e.arm == name for e in group)]
+        cols = np.concatenate([np.arange(6 * i, 6 * i + 6) for i in arms])
+        q_e = _at(plan, t_e)[cols]
         inside = (t > t_e) & (t < end)
         times = np.concatenate([t[inside], [end]])
-        moved = np.abs(np.concatenate([q[inside], _at(plan, end)[None]]) - q_e)
+        moved = np.abs(np.concatenate([q[inside][:, cols], _at(plan, end)[None, cols]]) - q_e)
         if moved.max() > STILL_TOL:
             k, j = np.argwhere(moved > STILL_TOL)[0]
             return Violation(
                 t_e,
                 "dwell",
-                f"after the {what} at t = {t_e:.3f} s the robot must stand still for "
-                f"{dwell} s; {_joint(scene, j)} has moved {moved[k, j]:.3g} rad at "
+                f"after the {what} at t = {t_e:.3f} s the arm must stand still for "
+                f"{dwell} s; {_joint(scene, int(cols[j]))} has moved {moved[k, j]:.3g} rad at "
                 f"t = {times[k]:.3f} s",
             )
     return None

@@ -31,6 +31,7 @@ The README section "What `sdar validate` checks" lists every rule with its toler
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -181,6 +182,41 @@ def _planar_error(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, fl
     return math.hypot(a[0] - b[0], a[1] - b[1]), min(d, math.pi - d)
 
 
+def tcp_positions(
+    q: FloatArray, kins: Mapping[str, ArmKinematics], arm_names: Sequence[str]
+) -> FloatArray:
+    """Both TCP positions ``(m, 2, 3)`` [m] for ``q`` ``(m, 12)`` (closed-form FK)."""
+    out = []
+    for i, arm in enumerate(arm_names):
+        kin = kins[arm]
+        out.append((kin.fk_batch(q[:, 6 * i : 6 * i + 6]) @ kin.T_tool0_tcp)[:, :3, 3])
+    return np.stack(out, axis=1)
+
+
+def tcp_subdivisions(
+    q: FloatArray, kins: Mapping[str, ArmKinematics], arm_names: Sequence[str], step: float
+) -> NDArray[np.int_]:
+    """Per interval of ``q`` ``(K, 12)``: the number of linear steps after which no TCP has
+    moved more than ``step`` [m] (refined until it holds). Each interval's count depends on its
+    two ends only, so a plan and any stretch of it agree on the points the replay checks."""
+    chord = np.linalg.norm(np.diff(tcp_positions(q, kins, arm_names), axis=0), axis=2).max(axis=1)
+    n: NDArray[np.int_] = np.maximum(1, np.ceil(chord / step)).astype(int)
+    for _ in range(30):
+        off = np.cumsum(n + 1) - (n + 1)  # first dense point of every interval
+        idx = np.repeat(np.arange(len(n)), n + 1)
+        frac = (np.arange(len(idx)) - np.repeat(off, n + 1)) / np.repeat(n, n + 1)
+        dense = q[idx] + frac[:, None] * (q[idx + 1] - q[idx])
+        d = np.linalg.norm(np.diff(tcp_positions(dense, kins, arm_names), axis=0), axis=2)
+        d = d.max(axis=1)
+        d[off[1:] - 1] = 0.0  # steps across intervals
+        worst = np.maximum.reduceat(np.append(d, 0.0), off)
+        bad = worst > step
+        if not bad.any():
+            break
+        n[bad] = np.maximum(n[bad] + 1, np.ceil(1.1 * n[bad] * worst[bad] / step))
+    return n
+
+
 class _Replay:
     """The state of the world along the timeline: resting and held objects."""
 
@@ -240,32 +276,9 @@ class _Replay:
                 return True
         return False
 
-    def tcp_positions(self, q: FloatArray) -> FloatArray:
-        """Both TCP positions ``(m, 2, 3)`` [m] for ``q`` ``(m, 12)`` (closed-form FK)."""
-        out = []
-        for i, arm in enumerate(self.scene.arm_names):
-            kin = self.kins[arm]
-            out.append((kin.fk_batch(q[:, 6 * i : 6 * i + 6]) @ kin.T_tool0_tcp)[:, :3, 3])
-        return np.stack(out, axis=1)
-
     def subdivisions(self, q: FloatArray) -> NDArray[np.int_]:
-        """Per interval of ``q`` ``(K, 12)``: the number of linear steps after which no TCP
-        has moved more than ``self.step`` [m] (refined until it holds)."""
-        chord = np.linalg.norm(np.diff(self.tcp_positions(q), axis=0), axis=2).max(axis=1)
-        n: NDArray[np.int_] = np.maximum(1, np.ceil(chord / self.step)).astype(int)
-        for _ in range(30):
-            off = np.cumsum(n + 1) - (n + 1)  # first dense point of every interval
-            idx = np.repeat(np.arange(len(n)), n + 1)
-            frac = (np.arange(len(idx)) - np.repeat(off, n + 1)) / np.repeat(n, n + 1)
-            dense = q[idx] + frac[:, None] * (q[idx + 1] - q[idx])
-            d = np.linalg.norm(np.diff(self.tcp_positions(dense), axis=0), axis=2).max(axis=1)
-            d[off[1:] - 1] = 0.0  # steps across intervals
-            worst = np.maximum.reduceat(np.append(d, 0.0), off)
-            bad = worst > self.step
-            if not bad.any():
-                break
-            n[bad] = np.maximum(n[bad] + 1, np.ceil(1.1 * n[bad] * worst[bad] / self.step))
-        return n
+        """See :func:`tcp_subdivisions`."""
+        return tcp_subdivisions(q, self.kins, self.scene.arm_names, self.step)
 
     # -- the walk -------------------------------------------------------------------------------
     def walk(self, t_stop: float) -> Violation | None:

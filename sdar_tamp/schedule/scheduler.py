@@ -1,0 +1,325 @@
+"""Asynchronous dual-arm execution: a synchronous plan re-scheduled so each arm runs on its own.
+
+In a synchronous plan a step lasts as long as the slower arm's motion and one arm's gripper
+dwell stops the other arm too. :func:`schedule_async` cuts each arm's timeline into blocks
+(:mod:`sdar_tamp.schedule.pieces`: rest-to-rest motions, each optionally ending in a gripper
+event and the arm's own dwell) and places them on a new common timeline of ``tick`` [s], one
+block at a time in the order they ended in the synchronous plan, each at the earliest tick that
+
+* follows the arm's previous block (and its dwell),
+* keeps the cross-arm order of gripper events (``order="objects"``: the events on one object,
+  the later one at least a dwell after the earlier; ``order="events"``: every event keeps its
+  place relative to the other arm's events),
+* and passes the replay (:mod:`sdar_tamp.schedule.sweep`) of everything from the arm's last
+  block to the end of both timelines: no collision between the arms, their held objects, the
+  table and the resting objects where they rest at that time; released objects land on free
+  spots. An arm whose next block is not placed yet stands where its last block left it.
+
+Every stretch of the result is replayed once both arms are fixed there, so the schedule is
+collision-free at the validator's points. Blocks start and end at rest and are sampled on the
+common grid, so the limits hold (see :mod:`sdar_tamp.schedule.spline`). When no placement is
+found for a block within ``max_wait`` [s] (a block blocked by the other arm standing still
+where it will stay), the next ordering is tried, and at last the synchronous plan is kept.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.plan_file import GRIPPER_DWELL, MAX_DT, PlanEvent, PlanFile, StepRecord
+from sdar_tamp.plan_rules import check_timeline
+from sdar_tamp.schedule.pieces import Block, arm_blocks, arm_columns
+from sdar_tamp.schedule.sweep import Conflict, TimedEvent, WorldSweep
+from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import FloatArray
+
+ORDERS = ("objects", "events")
+MAX_PULLS = 4  #: blocks of the other arm that may go first when a block finds no start
+
+
+@dataclass(frozen=True)
+class ScheduleOptions:
+    """``tick`` [s]: the common grid (at most the plan format's 0.02 s); ``retime``: play each
+    motion as fast as its arm's limits allow (else at its synchronous pace); ``orders``: the
+    cross-arm event orderings to try, in turn; ``max_tcp_step`` [m]: the replay's resolution;
+    ``max_wait`` [s]: the longest delay tried for one block."""
+
+    tick: float = MAX_DT
+    retime: bool = True
+    orders: tuple[str, ...] = ORDERS
+    max_tcp_step: float = 0.005
+    dwell: float = GRIPPER_DWELL
+    max_wait: float = 20.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.tick) and 0.0 < self.tick <= MAX_DT):
+            raise ParameterError(f"tick: expected a time in (0, {MAX_DT}] s, got {self.tick!r}")
+        for name in ("max_tcp_step", "dwell", "max_wait"):
+            value = getattr(self, name)
+            positive = value > 0.0 or name != "max_tcp_step"
+            if not (math.isfinite(value) and value >= 0.0 and positive):
+                raise ParameterError(
+                    f"{name}: expected a finite number >= 0 (> 0 for max_tcp_step), got {value!r}"
+                )
+        bad = [o for o in self.orders if o not in ORDERS]
+        if bad or not self.orders:
+            raise ParameterError(f"orders: expected some of {list(ORDERS)}, got {self.orders!r}")
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """The outcome: ``plan`` (the asynchronous one when it is shorter, else the input),
+    ``asynchronous``, both durations [s] (``async_duration`` None when no schedule was found),
+    the ``order`` that worked, ``reason`` (why the synchronous plan was kept) and ``checks``
+    (collision queries made)."""
+
+    plan: PlanFile
+    asynchronous: bool
+    sync_duration: float
+    async_duration: float | None
+    order: str
+    reason: str
+    checks: int
+
+
+@dataclass(frozen=True, eq=False)
+class _Entry:
+    """A block to place, as samples ``q`` ``(n + 1, 6)``, ``offset`` ticks after the start
+    of its group."""
+
+    arm: int
+    block: Block
+    q: FloatArray
+    offset: int
+
+
+def _events_of(entries: list[_Entry], new: list[TimedEvent]) -> list[TimedEvent | None]:
+    """The new event of each entry (None for an entry without one)."""
+    found = {id(e.event): e for e in new}
+    return [found.get(id(x.block.event)) if x.block.event is not None else None for x in entries]
+
+
+class _NoPlacement(Exception):
+    def __init__(self, block: Block, conflict: Conflict | None, detail: str) -> None:
+        super().__init__(detail)
+        self.block, self.conflict = block, conflict
+
+
+def schedule_async(
+    plan: PlanFile, instance: Instance, scene: Scene, options: ScheduleOptions | None = None
+) -> Schedule:
+    """Re-schedule the synchronous ``plan`` of ``instance`` for asynchronous execution (see the
+    module docstring). The plan is assumed valid for ``instance`` in ``scene``."""
+    options = options or ScheduleOptions()
+    blocks = [arm_blocks(plan, scene, i, options.tick, options.retime) for i in range(2)]
+    sweep = WorldSweep(instance, scene, options.max_tcp_step)
+    reasons = []
+    for order in options.orders:
+        try:
+            result = _Placement(plan, blocks, sweep, options, order).run()
+        except _NoPlacement as exc:
+            reasons.append(f"order {order}: {exc}")
+            continue
+        limit = check_timeline(result, scene, options.dwell)
+        if limit is not None:  # by construction this does not happen
+            reasons.append(f"order {order}: {limit.kind} at t={limit.t:.3f} s: {limit.message}")
+            continue
+        if result.duration >= plan.duration:
+            reason = f"not shorter ({result.duration:.2f} s >= {plan.duration:.2f} s)"
+            return Schedule(
+                plan, False, plan.duration, result.duration, order, reason, sweep.checks
+            )
+        return Schedule(result, True, plan.duration, result.duration, order, "", sweep.checks)
+    return Schedule(plan, False, plan.duration, None, "", "; ".join(reasons), sweep.checks)
+
+
+class _Placement:
+    """The greedy placement of both arms' blocks for one event ordering."""
+
+    def __init__(
+        self,
+        plan: PlanFile,
+        blocks: list[list[Block]],
+        sweep: WorldSweep,
+        options: ScheduleOptions,
+        order: str,
+    ) -> None:
+        self.plan, self.blocks, self.sweep, self.order = plan, blocks, sweep, order
+        self.tick = options.tick
+        self.dwell = math.ceil(options.dwell / options.tick - 1e-9)
+        self.max_wait = math.ceil(options.max_wait / options.tick)
+        self.traj: list[list[FloatArray]] = [[plan.q[0, arm_columns(i)]] for i in range(2)]
+        self.events: list[TimedEvent] = []
+        self.event_tick: dict[int, int] = {}  # id(sync event) -> tick
+        self.steps: list[StepRecord] = []
+
+    def horizon(self, arm: int) -> int:
+        return len(self.traj[arm]) - 1
+
+    def run(self) -> PlanFile:
+        """Place every block in the order the blocks ended in the synchronous plan. A block
+        that finds no start goes together with the other arm's next block, both at their
+        synchronous pace and offset, when the two moved at the same time there; else the
+        other arm's next blocks may go first (at most ``MAX_PULLS``)."""
+        nxt = [0, 0]
+        while nxt[0] < len(self.blocks[0]) or nxt[1] < len(self.blocks[1]):
+            keys = [
+                self.blocks[a][nxt[a]].sync_key if nxt[a] < len(self.blocks[a]) else math.inf
+                for a in range(2)
+            ]
+            arm = 0 if keys[0] <= keys[1] else 1
+            block = self.blocks[arm][nxt[arm]]
+            try:
+                self.place([_Entry(arm, block, block.q, 0)])
+            except _NoPlacement as failure:
+                nxt[1 - arm] += self.recover(arm, block, nxt[1 - arm], failure)
+            nxt[arm] += 1
+        return self.assemble()
+
+    def recover(self, arm: int, block: Block, k: int, failure: _NoPlacement) -> int:
+        """Place ``block`` after its failure, with or after the other arm's blocks from its
+        ``k``-th on; the number of those placed. Raises ``failure`` when nothing works."""
+        other = self.blocks[1 - arm]
+        if k < len(other) and self.ready(other[k]):
+            ahead = other[k]
+            if ahead.sync_start < block.sync_end and block.sync_start < ahead.sync_end:
+                offset = ahead.sync_index - block.sync_index
+                pair = [
+                    _Entry(arm, block, block.q_sync, max(0, -offset)),
+                    _Entry(1 - arm, ahead, ahead.q_sync, max(0, offset)),
+                ]
+                try:
+                    self.place(pair)
+                    return 1
+                except _NoPlacement:
+                    pass
+        for pulled in range(1, MAX_PULLS + 1):
+            j = k + pulled - 1
+            if j >= len(other) or not self.ready(other[j]):
+                break
+            try:
+                self.place([_Entry(1 - arm, other[j], other[j].q, 0)])
+            except _NoPlacement:
+                break
+            try:
+                self.place([_Entry(arm, block, block.q, 0)])
+                return pulled
+            except _NoPlacement:
+                continue
+        raise failure
+
+    def ready(self, block: Block) -> bool:
+        """Whether the events ``block``'s event must follow are placed."""
+        e = block.event
+        return e is None or all(
+            id(o) in self.event_tick for o in self.plan.events if self.must_follow(e, o)
+        )
+
+    def must_follow(self, e: PlanEvent, other: PlanEvent) -> bool:
+        """Whether event ``e`` must come after ``other`` of the other arm."""
+        if other.arm == e.arm or other.t >= e.t:
+            return False
+        return self.order == "events" or other.object == e.object
+
+    def earliest(self, entry: _Entry) -> int:
+        """The first start tick of the group the arm's horizon and the event orderings
+        allow for ``entry``."""
+        s = self.horizon(entry.arm)
+        e = entry.block.event
+        if e is not None:
+            for other in self.plan.events:
+                if self.must_follow(e, other):
+                    same = other.object == e.object
+                    k = self.event_tick[id(other)] + (self.dwell if same else 0)
+                    s = max(s, k - (len(entry.q) - 1))
+        return s - entry.offset
+
+    def rows(self, arm: int, k0: int, k1: int) -> FloatArray:
+        """Arm ``arm``'s configurations ``(k1 - k0 + 1, 6)`` at ticks ``k0 .. k1`` (standing
+        at its last one after its horizon)."""
+        traj = self.traj[arm]
+        idx = np.minimum(np.arange(k0, k1 + 1), len(traj) - 1)
+        return np.array([traj[i] for i in idx])
+
+    def length(self, entry: _Entry) -> int:
+        """Ticks of the entry's motion and of the dwell after its event."""
+        return len(entry.q) - 1 + (self.dwell if entry.block.event is not None else 0)
+
+    def place(self, entries: list[_Entry]) -> None:
+        """Place the blocks of ``entries`` (one per arm) at the earliest common start ``s``
+        (each at ``s + offset``) whose replay passes; raises :class:`_NoPlacement`."""
+        arms = [e.arm for e in entries]
+        k0 = min(self.horizon(a) for a in arms)
+        start = max(self.earliest(e) for e in entries)
+        before = [e for e in self.events if e.tick < k0]
+        later = [e for e in self.events if e.tick >= k0]
+        conflict: Conflict | None = None
+        for s in range(start, start + self.max_wait + 1):
+            ends = [s + e.offset + self.length(e) for e in entries]
+            k1 = max(*ends, *(self.horizon(a) for a in range(2)))
+            q = np.concatenate([self.rows(0, k0, k1), self.rows(1, k0, k1)], axis=1)
+            new: list[TimedEvent] = []
+            for e in entries:
+                begin = s + e.offset
+                cols = arm_columns(e.arm)
+                q[begin - k0 : begin - k0 + len(e.q), cols] = e.q
+                q[begin - k0 + len(e.q) :, cols] = e.q[-1]
+                if e.block.event is not None:
+                    new.append(TimedEvent(begin + len(e.q) - 1, e.block.event, e.q[-1]))
+            events = sorted([*later, *new], key=lambda e: e.tick)
+            self.sweep.reset(before)
+            conflict = self.sweep.run(k0, q, events)
+            if conflict is None:
+                for e, end, timed in zip(entries, ends, _events_of(entries, new), strict=True):
+                    self.commit(e, s + e.offset, q[: end - k0 + 1, arm_columns(e.arm)], k0, timed)
+                return
+            if conflict.tick < s:  # while an arm waits for its start: later is no better
+                break
+            if all(s > self.horizon(a) for a in range(2) if a not in arms):
+                break  # the other arm stands still from now on: nothing changes
+        block = entries[0].block
+        detail = (
+            f"no start for a block of {self.plan.arm_names[entries[0].arm]} "
+            f"(synchronous t = {block.sync_start:.2f}..{block.sync_end:.2f} s)"
+        )
+        if conflict is not None:
+            detail += f"; at t = {conflict.tick * self.tick:.2f} s: {conflict.message}"
+        raise _NoPlacement(block, conflict, detail)
+
+    def commit(
+        self, entry: _Entry, s: int, rows: FloatArray, k0: int, timed: TimedEvent | None
+    ) -> None:
+        horizon = self.horizon(entry.arm)
+        self.traj[entry.arm].extend(rows[horizon - k0 + 1 :])
+        if timed is not None:
+            self.events.append(timed)
+            self.events.sort(key=lambda e: e.tick)
+            self.event_tick[id(timed.event)] = timed.tick
+        st = entry.block.step
+        if len(entry.q) > 1 and st is not None:
+            t0, t1 = s * self.tick, (s + len(entry.q) - 1) * self.tick
+            self.steps.append(StepRecord(t0, t1, st.level, st.objects, st.kind))
+
+    def assemble(self) -> PlanFile:
+        n = max(self.horizon(0), self.horizon(1))
+        q = np.concatenate([self.rows(0, 0, n), self.rows(1, 0, n)], axis=1)
+        t = np.arange(n + 1, dtype=np.float64) * np.float64(self.tick)
+        events = tuple(
+            PlanEvent(float(t[e.tick]), e.event.arm, e.event.type, e.event.object,
+                      e.event.T_tcp_object)
+            for e in self.events
+        )  # fmt: skip
+        metrics = dict(self.plan.metrics)
+        metrics.update(
+            execution="async",
+            execution_time=float(t[-1]),
+            execution_time_sync=self.plan.duration,
+        )
+        steps = tuple(sorted(self.steps, key=lambda s: (s.t_start, s.t_end)))
+        return dataclasses.replace(self.plan, t=t, q=q, events=events, metrics=metrics, steps=steps)

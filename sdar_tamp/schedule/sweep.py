@@ -1,0 +1,152 @@
+"""Replaying a stretch of a timeline against the world, as the plan validator does.
+
+:class:`WorldSweep` checks configurations ``(m, 12)`` one tick apart, with the gripper events
+inside the stretch, against the collision world in the state the earlier events left it: the
+same points as the replay of :mod:`sdar_tamp.replay` (its subdivision of every interval, which
+depends only on the interval's ends), the same contact rule at grasps and releases, and the
+rule that a released object lands on a free spot. A stretch that passes here passes there.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.plan_file import PlanEvent
+from sdar_tamp.plan_rules import STILL_TOL
+from sdar_tamp.replay import POS_TOL, tcp_subdivisions
+from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
+from sdar_tamp.world.footprint import corners, overlap_matrix
+from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
+
+
+@dataclass(frozen=True, eq=False)
+class TimedEvent:
+    """A gripper event at tick ``tick``, the arm at ``q_arm`` ``(6,)`` [rad]."""
+
+    tick: int
+    event: PlanEvent
+    q_arm: FloatArray
+
+
+@dataclass(frozen=True)
+class Conflict:
+    """The first broken rule of a stretch: at tick ``tick``, ``kind`` (collision, grasp,
+    release) and what."""
+
+    tick: int
+    kind: str
+    message: str
+
+
+class WorldSweep:
+    """The world of one instance; :meth:`run` checks a stretch of a timeline."""
+
+    def __init__(self, instance: Instance, scene: Scene, max_tcp_step: float) -> None:
+        self.scene, self.step = scene, max_tcp_step
+        self.names = scene.arm_names
+        self.kins = {a: ArmKinematics.from_scene(scene, a) for a in self.names}
+        self.sizes = {o.name: o.size for o in instance.objects}
+        self.start = {o.name: o.start.as_tuple() for o in instance.objects}
+        self.world = CollisionWorld(scene)
+        self.rest: dict[str, tuple[float, float, float]] = {}
+        self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
+        self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
+        self.checks = 0
+
+    def box(self, name: str, pose: tuple[float, float, float]) -> ObjectBox:
+        size = self.sizes[name]
+        return ObjectBox(pose_xyz_yaw(pose[0], pose[1], size[2] / 2.0, pose[2]), size)
+
+    def reset(self, before: Sequence[TimedEvent]) -> None:
+        """The world after the events ``before`` (in time order; assumed valid)."""
+        for arm in self.names:
+            if self.world.held_by(arm) is not None:
+                self.world.detach(arm)
+        self.rest = dict(self.start)
+        self.held, self.exempt = {}, {}
+        self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
+        for e in before:
+            self.apply(e)
+            self.exempt[e.event.arm] = (e.event.object, e.q_arm)
+
+    def run(self, k0: int, q: FloatArray, events: Sequence[TimedEvent]) -> Conflict | None:
+        """Check the configurations ``q`` ``(m, 12)`` at ticks ``k0 .. k0 + m - 1`` and the
+        ``events`` among them (in time order); the first conflict, or None."""
+        counts = tcp_subdivisions(q, self.kins, self.names, self.step) if len(q) > 1 else None
+        pending = list(events)
+        for k in range(len(q)):
+            group = [e for e in pending if e.tick <= k0 + k]
+            pending = pending[len(group) :]
+            for e in group:
+                self.exempt[e.event.arm] = (e.event.object, e.q_arm)
+            found = self.collide(q[k], k0 + k)
+            for e in group:
+                found = found or self.apply(e)
+            if group and found is None:
+                found = self.collide(q[k], k0 + k)
+            if found is not None:
+                return found
+            if counts is not None and k + 1 < len(q):
+                n = int(counts[k])
+                for s in range(1, n):
+                    found = self.collide(q[k] + (q[k + 1] - q[k]) * (s / n), k0 + k)
+                    if found is not None:
+                        return found
+        return None
+
+    def collide(self, q: FloatArray, tick: int) -> Conflict | None:
+        self.checks += 1
+        for arm, (_, q_event) in list(self.exempt.items()):
+            i = self.names.index(arm)
+            if np.abs(q[6 * i : 6 * i + 6] - q_event).max() > STILL_TOL:
+                del self.exempt[arm]
+        if not self.world.in_collision(q[:6], q[6:]):
+            return None
+        pairs = [p for p in self.world.report(q[:6], q[6:]) if not self.allowed(p)]
+        if not pairs:
+            return None
+        return Conflict(tick, "collision", ", ".join(f"{p.first} with {p.second}" for p in pairs))
+
+    def allowed(self, p: CollisionPair) -> bool:
+        for arm, (obj, _) in self.exempt.items():
+            target = f"object:{obj}"
+            other = p.second if p.first == target else p.first if p.second == target else ""
+            if other.startswith(f"{arm}_gripper"):
+                return True
+        return False
+
+    def apply(self, timed: TimedEvent) -> Conflict | None:
+        """Perform one event: a grasp of a resting object, a release onto a free spot."""
+        e, tick = timed.event, timed.tick
+        T_world_tcp = self.kins[e.arm].fk_tcp(timed.q_arm)
+        if e.type == "grasp":
+            if e.arm in self.held or e.object not in self.rest:
+                return Conflict(tick, "grasp", f"{e.arm} grasps {e.object}, which is not free")
+            T_obj = self.box(e.object, self.rest.pop(e.object)).T_world_obj
+            self.held[e.arm] = (e.object, inverse(T_world_tcp) @ T_obj)
+            self.world.attach(e.arm, e.object, timed.q_arm)
+            return None
+        holding = self.held.get(e.arm)
+        if holding is None or holding[0] != e.object:
+            return Conflict(tick, "release", f"{e.arm} releases {e.object}, which it does not hold")
+        T = T_world_tcp @ holding[1]
+        pose = (float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0]))
+        size = np.array(self.sizes[e.object][:2])
+        shrunk = corners(np.array([pose]), size - 2.0 * POS_TOL)
+        for other, p in self.rest.items():
+            if overlap_matrix(shrunk, corners(np.array([p]), np.array(self.sizes[other][:2])))[
+                0, 0
+            ]:
+                return Conflict(tick, "release", f"{e.object} released onto {other}")
+        del self.held[e.arm]
+        self.world.detach(e.arm, timed.q_arm)
+        self.world.set_object(e.object, self.box(e.object, pose))
+        self.rest[e.object] = pose
+        return None

@@ -1,0 +1,234 @@
+"""Asynchronous execution: schedules of solved instances replay as valid, are never longer
+than the synchronous plan, and the separation the scheduler keeps is needed (without it the
+validator rejects the plan)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile, load_plan, save_plan
+from sdar_tamp.plan_rules import STILL_TOL, check_timeline
+from sdar_tamp.rearrangement import (
+    plan_file_from_solution,
+    rearrangement_problem,
+    solve_rearrangement,
+)
+from sdar_tamp.replay import validate_plan
+from sdar_tamp.schedule import ScheduleOptions, schedule_async
+from sdar_tamp.schedule.pieces import arm_blocks, arm_columns, on_ticks
+from sdar_tamp.schedule.scheduler import _Placement
+from sdar_tamp.schedule.spline import ClampedSpline, retime
+from sdar_tamp.schedule.sweep import Conflict, TimedEvent, WorldSweep
+from sdar_tamp.world.instance import Instance, load_instance
+from sdar_tamp.world.suites import shipped_suite_dir
+from sdar_tamp.world.transforms import FloatArray
+from solvers.solution import Status
+from streams.context import WorldContext
+from streams.motion import DualMotionPlanner
+
+
+@dataclass(frozen=True)
+class Solved:
+    ctx: WorldContext
+    instance: Instance
+    plan: PlanFile
+
+
+def _solve(ctx: WorldContext, planner: DualMotionPlanner, instance: Instance) -> Solved:
+    r = rearrangement_problem(instance, ctx, planner=planner)
+    solution = solve_rearrangement(r, "sdar", 60.0)
+    assert solution.status is Status.SOLVED
+    plan = plan_file_from_solution(r, solution)
+    assert validate_plan(instance, plan, ctx.scene).ok
+    return Solved(ctx, instance, plan)
+
+
+@pytest.fixture(scope="module")
+def r4(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
+    """Four objects of the paper suite: the arms' motions differ in length."""
+    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "R4.yaml"))
+
+
+@pytest.fixture(scope="module")
+def swap(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
+    """Five objects of the paper suite, two swaps among them: the arms cross each other's
+    paths holding objects, so they must move at the same time."""
+    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "D5.yaml"))
+
+
+def _dwell_overlaps(plan: PlanFile) -> int:
+    """Events during whose dwell the other arm moves (impossible in a synchronous plan)."""
+    count = 0
+    for e in plan.events:
+        other = arm_columns(1 - plan.arm_names.index(e.arm))
+        inside = (plan.t >= e.t) & (plan.t <= e.t + GRIPPER_DWELL)
+        count += bool(np.abs(np.diff(plan.q[inside][:, other], axis=0)).max() > STILL_TOL)
+    return count
+
+
+# -- the schedule -----------------------------------------------------------------------------
+def test_an_async_plan_validates_and_is_shorter(r4: Solved, tmp_path: Path) -> None:
+    s = schedule_async(r4.plan, r4.instance, r4.ctx.scene)
+    assert s.asynchronous, s.reason
+    assert s.async_duration is not None and s.async_duration < s.sync_duration
+    assert s.plan.duration == pytest.approx(s.async_duration)
+    assert s.plan.metrics["execution"] == "async"
+    assert s.plan.metrics["execution_time"] == pytest.approx(s.plan.duration)
+    assert _dwell_overlaps(s.plan) >= 1  # one arm moves while the other's gripper acts
+    assert _dwell_overlaps(r4.plan) == 0
+    # the same events per object, in the same order per object
+    for name in r4.instance.names:
+        sync = [(e.arm, e.type) for e in r4.plan.events if e.object == name]
+        assert [(e.arm, e.type) for e in s.plan.events if e.object == name] == sync
+    report = validate_plan(r4.instance, s.plan, r4.ctx.scene)
+    assert report.ok, report.violation
+    path = save_plan(s.plan, tmp_path / "async.json")  # the file format round trip
+    assert validate_plan(r4.instance, load_plan(path), r4.ctx.scene).ok
+
+
+def test_the_synchronous_pace_and_every_ordering_validate(r4: Solved) -> None:
+    for options in (
+        ScheduleOptions(retime=False),
+        ScheduleOptions(orders=("events",)),
+        ScheduleOptions(orders=("objects",)),
+    ):
+        s = schedule_async(r4.plan, r4.instance, r4.ctx.scene, options)
+        assert s.plan.duration <= r4.plan.duration
+        if s.asynchronous:
+            assert s.order in options.orders
+            report = validate_plan(r4.instance, s.plan, r4.ctx.scene)
+            assert report.ok, (options, report.violation)
+
+
+def test_a_crossing_swap_keeps_its_arms_apart(swap: Solved) -> None:
+    """The two arms cross each other's paths: the schedule is never longer and valid."""
+    s = schedule_async(swap.plan, swap.instance, swap.ctx.scene)
+    assert s.plan.duration <= swap.plan.duration
+    assert validate_plan(swap.instance, s.plan, swap.ctx.scene).ok
+
+
+class _Blind(WorldSweep):
+    """A mutant of the scheduler's replay that sees no conflict (no separation kept)."""
+
+    def run(self, k0: int, q: FloatArray, events: list[TimedEvent]) -> Conflict | None:  # type: ignore[override]
+        return None
+
+
+def test_without_the_separation_the_validator_rejects_the_schedule(swap: Solved) -> None:
+    scene, options = swap.ctx.scene, ScheduleOptions()
+    blocks = [arm_blocks(swap.plan, scene, i, options.tick) for i in range(2)]
+    blind = _Blind(swap.instance, scene, options.max_tcp_step)
+    mutant = _Placement(swap.plan, blocks, blind, options, "objects").run()
+    assert check_timeline(mutant, scene) is None  # limits and dwells still hold
+    report = validate_plan(swap.instance, mutant, scene)
+    assert not report.ok and report.violation is not None
+    assert report.violation.kind == "collision"
+    names = report.violation.message
+    assert "left" in names and "right" in names  # the two arms (or what they hold) touch
+
+
+def test_a_per_arm_dwell_violation_is_rejected(r4: Solved) -> None:
+    plan = schedule_async(r4.plan, r4.instance, r4.ctx.scene).plan
+    e = next(
+        e
+        for e in plan.events
+        if np.abs(
+            np.diff(
+                plan.q[(plan.t >= e.t) & (plan.t <= e.t + GRIPPER_DWELL)][
+                    :, arm_columns(1 - plan.arm_names.index(e.arm))
+                ],
+                axis=0,
+            )
+        ).max()
+        > STILL_TOL
+    )
+    k = int(np.searchsorted(plan.t, e.t))
+    mine = arm_columns(plan.arm_names.index(e.arm))
+    q = np.array(plan.q)
+    bump = 1e-4 * np.sin(np.linspace(0.0, np.pi, 26)) ** 2
+    q[k : k + 26, mine.start] += bump  # the arm of the event moves during its dwell
+    report = validate_plan(r4.instance, dataclasses.replace(plan, q=q), r4.ctx.scene)
+    assert not report.ok and report.violation is not None
+    assert report.violation.kind == "dwell" and e.arm in report.violation.message
+    assert validate_plan(r4.instance, plan, r4.ctx.scene).ok  # the other arm moving is fine
+
+
+# -- the parts --------------------------------------------------------------------------------
+def test_spline_bounds_are_the_true_peaks() -> None:
+    t = np.linspace(0.0, 1.0, 25)
+    q = np.stack([np.sin(3 * t), t**3 - t], axis=1)
+    q[0], q[-1] = q[0], q[-1]
+    s = ClampedSpline.fit(t, q)
+    x = np.linspace(0.0, 1.0, 200_001)
+    y = s(x)
+    h = x[1] - x[0]
+    v = np.abs(np.diff(y, axis=0) / h).max(axis=0)
+    a = np.abs(np.diff(y, 2, axis=0) / h**2).max(axis=0)
+    assert np.allclose(s(t), q)
+    assert np.allclose(v, s.peak_velocity(), rtol=1e-4)
+    assert np.allclose(a, s.peak_acceleration(), rtol=1e-3)
+
+
+def _divided_differences(x: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Velocities and accelerations as the plan rules measure them (at rest outside)."""
+    h = np.diff(x)
+    vel = np.diff(y, axis=0) / h[:, None]
+    rest = np.zeros((1, y.shape[1]))
+    h_ext = np.concatenate([h[:1], h, h[-1:]])
+    acc = np.diff(np.concatenate([rest, vel, rest]), axis=0)
+    return vel, acc / (0.5 * (h_ext[1:] + h_ext[:-1]))[:, None]
+
+
+def test_retimed_samples_meet_the_limits_on_any_grid() -> None:
+    t = np.linspace(0.0, 2.0, 101)
+    q = np.stack([0.5 * (1 - np.cos(np.pi * t / 2.0)), 0.1 * np.sin(np.pi * t / 2.0) ** 2], 1)
+    v_max, a_max = np.array([1.0, 1.0]), np.array([2.0, 2.0])
+    out = retime(t, q, v_max, a_max, 0.02)
+    assert np.array_equal(out[0], q[0]) and np.array_equal(out[-1], q[-1])
+    assert len(out) - 1 < 100  # faster than the original 2 s
+    vel, acc = _divided_differences(np.arange(len(out)) * 0.02, out)
+    use = max((np.abs(vel) / v_max).max(), np.sqrt((np.abs(acc) / a_max).max()))
+    assert use == pytest.approx(1.0, rel=0.05)  # one limit is (nearly) reached
+    spline = ClampedSpline.fit(t, q)
+    T = (len(out) - 1) * 0.02
+    rng = np.random.default_rng(0)
+    for x in (
+        np.union1d(np.arange(0.0, T, 0.013), [T]),
+        np.union1d(np.sort(rng.uniform(0.0, T, 400)), [0.0, T]),
+    ):
+        y = spline(x * spline.duration / T)  # the same motion sampled on another grid
+        vel, acc = _divided_differences(x, y)
+        assert np.all(np.abs(vel) <= v_max * (1 + 1e-6))
+        assert np.all(np.abs(acc) <= a_max * (1 + 1e-6))
+    slow = retime(t, q, v_max, a_max, 0.02, max_rate=1.0)
+    assert len(slow) - 1 == 100  # never faster than the original
+
+
+def test_on_ticks_keeps_the_samples_when_no_step_exceeds_the_tick() -> None:
+    t = np.array([0.0, 0.019, 0.038, 0.057])
+    q = np.arange(24.0).reshape(4, 6)
+    assert np.array_equal(on_ticks(t, q, 0.02, np.ones(6), np.ones(6)), q)
+
+
+def test_options_are_checked() -> None:
+    for kwargs in (
+        {"tick": 0.0},
+        {"tick": 0.03},
+        {"max_tcp_step": 0.0},
+        {"dwell": -1.0},
+        {"max_wait": float("nan")},
+        {"orders": ()},
+        {"orders": ("fifo",)},
+    ):
+        with pytest.raises(ParameterError):
+            ScheduleOptions(**kwargs)  # type: ignore[arg-type]
+    with pytest.raises(ParameterError, match="tick"):
+        retime(np.array([0.0, 1.0]), np.zeros((2, 1)), np.ones(1), np.ones(1), -1.0)
+    with pytest.raises(ParameterError, match="increasing"):
+        ClampedSpline.fit(np.array([0.0, 0.0]), np.zeros((2, 1)))
