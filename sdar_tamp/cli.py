@@ -156,6 +156,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
             motion_planner=args.motion_planner,
             max_time=args.time_limit,
             seed=args.seed,
+            execution=args.execution,
         )
         if args.grasps is not None:
             config = config.replace(sdar=dataclasses.replace(config.sdar, grasps=args.grasps))
@@ -336,6 +337,13 @@ def build_parser() -> argparse.ArgumentParser:
         type=COUNT.parse,
         default=None,
         help="grasps tried per object, in the grasp set's order (default: 6)",
+    )
+    solve.add_argument(
+        "--execution",
+        choices=("sync", "async"),
+        default="sync",
+        help="sync: both arms on one synchronous timeline; async: each arm on its own, "
+        "kept only when shorter and collision-free (default: sync)",
     )
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     solve.set_defaults(func=cmd_solve)

@@ -44,6 +44,7 @@ LAYERS: dict[str, str] = {
     "sdar_tamp.compat": "compat",
     "sdar_tamp.viewer": "viewer",
     "sdar_tamp.export": "export",
+    "sdar_tamp.schedule": "schedule",
     "sdar_tamp.schemas": "leaves",  # JSON Schema files and their loader
     # the command line on top
     "sdar_tamp.cli": "cli",
@@ -59,11 +60,12 @@ ALLOWED: dict[str, set[str]] = {
     "solvers": _BASE | {"language", "solvers"},
     "streams": _BASE | {"world", "streams"},
     "domains": _BASE | {"language", "domains"},
-    "app": _BASE | {"language", "world", "plan", "solvers", "streams", "app"},
+    "app": _BASE | {"language", "world", "plan", "schedule", "solvers", "streams", "app"},
     "evaluation": _BASE | {"world", "plan", "app", "evaluation"},
     "compat": _BASE | {"language", "solvers", "compat"},
     "viewer": _BASE | {"world", "plan", "viewer"},
     "export": _BASE | {"world", "plan", "export"},
+    "schedule": _BASE | {"world", "plan", "schedule"},
     "cli": set(LAYERS.values()),
 }
 

@@ -1,12 +1,14 @@
 """``sdar solve``: plan a rearrangement instance, time it, validate it, build the plan file.
 
 :func:`solve_instance` is the one pipeline the command line, the demo and the benchmarks
-share: instance file -> world -> problem -> SDAR -> plan file -> independent replay.
+share: instance file -> world -> problem -> SDAR -> plan file (re-scheduled per arm with
+``execution="async"``) -> independent replay.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -19,6 +21,7 @@ from sdar_tamp.app.solving import solve_rearrangement
 from sdar_tamp.arguments import SEED, TIME_LIMIT
 from sdar_tamp.plan_rules import Violation
 from sdar_tamp.replay import validate_plan
+from sdar_tamp.schedule import schedule_async
 from sdar_tamp.world.instance import load_instance
 
 
@@ -96,6 +99,10 @@ def solve_instance(
         "buffer_moves": figures.buffer_moves,
     }
     plan = plan_file_from_solution(rearrangement, solution, metrics)
+    if config.execution == "async":
+        started = time.perf_counter()
+        plan = schedule_async(plan, instance, rearrangement.ctx.scene).plan
+        figures = dataclasses.replace(figures, schedule_time=time.perf_counter() - started)
     report = validate_plan(instance, plan, rearrangement.ctx.scene)
     violation = "" if report.ok or report.violation is None else describe(report.violation)
     return SolveOutcome(instance, "solved", plan, report.ok, violation, figures)

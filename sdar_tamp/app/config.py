@@ -6,6 +6,9 @@ sdar_options=config.sdar_options())`` all read it, so every entry point plans al
 
 - ``task_planner`` (SDAR-T or the baseline), ``motion_planner`` (the stream behind
   ``plan-dual-motion``), ``max_time`` [s], ``seed``, ``gripper_time`` [s];
+- ``execution``: ``sync`` (one synchronous timeline, as planned) or ``async`` (each arm on
+  its own timeline, :mod:`sdar_tamp.schedule`; the synchronous plan is kept when the
+  schedule is not shorter);
 - ``grasps``: the grasp set (:class:`streams.grasps.GraspOptions`);
 - ``sdar``: SDAR-M's budgets (:class:`solvers.sdar.solver.SdarOptions`: candidates, grasps
   tried per object, buffers, ...). The fields that follow from the motion planner
@@ -32,6 +35,9 @@ from streams.trajopt import TrajOptOptions
 
 TASK_PLANNERS = ("sdar", "baseline")
 MOTION_PLANNERS = ("sdar", "plain", "sequential")
+#: How the plan is executed: one synchronous timeline, or each arm on its own
+#: (:mod:`sdar_tamp.schedule`, kept only when shorter and valid).
+EXECUTIONS = ("sync", "async")
 GRIPPER_TIME = GRIPPER_DWELL  # [s] one gripper action (both grippers at once take as long)
 _DURATION = Real(0.0, closed=True, unit="s")  # gripper_time
 
@@ -57,6 +63,7 @@ class PlannerConfig:
     motion_planner: str = "sdar"
     max_time: float = 60.0  # [s] planning budget; inf: none
     seed: int = 0
+    execution: str = "sync"
     gripper_time: float = GRIPPER_TIME  # [s]
     grasps: GraspOptions = DEFAULT_GRASPS
     sdar: SdarOptions = field(default_factory=SdarOptions)
@@ -65,6 +72,7 @@ class PlannerConfig:
     def __post_init__(self) -> None:
         check_choice("task_planner", self.task_planner, TASK_PLANNERS)
         check_choice("motion_planner", self.motion_planner, MOTION_PLANNERS)
+        check_choice("execution", self.execution, EXECUTIONS)
         MAX_TIME.check("max_time", self.max_time)
         SEED.check("seed", self.seed)
         _DURATION.check("gripper_time", self.gripper_time)

@@ -108,6 +108,7 @@ class RunFigures:
     step_times: tuple[StepTime, ...] = ()
     levels: Mapping[str, int] = field(default_factory=dict)  # motion level -> motions
     buffer_moves: int = 0
+    schedule_time: float = 0.0  # [s] spent on the asynchronous schedule (not planning time)
 
     @property
     def step_time_median(self) -> float:
