@@ -155,6 +155,12 @@ def test_an_unbound_variable_is_an_error(domain: Domain) -> None:
         _evaluator(domain).holds(Atom("on", ("?nobody", "p1")), {})
 
 
+def test_a_derived_atom_with_the_wrong_arity_is_an_error(domain: Domain) -> None:
+    with pytest.raises(EvaluationError, match="takes 1 argument") as info:
+        _evaluator(domain).holds(Atom("empty", ("p1", "p2")), {})
+    assert isinstance(info.value, SdarError)
+
+
 # --- derived predicates -----------------------------------------------------------------------
 
 

@@ -3,43 +3,22 @@
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
 
 import pytest
 from stream_helpers import ALGORITHMS, CHECKS
 
-from solvers.solution import Solution, Status
+from solvers.solution import Status
 from solvers.solve import solve
-
-Solve = Callable[[str, str], Solution]
 
 
 def _problem(domain: str, seed: int = 0):  # type: ignore[no-untyped-def]
     return importlib.import_module(f"domains.{domain}.samplers").make_problem(seed=seed)
 
 
-def _solve(domain: str, algorithm: str) -> Solution:
-    """A fresh solve of ``domain`` with ``algorithm``, every random choice from seed 0."""
-    return solve(_problem(domain), algorithm=algorithm, max_time=30, seed=0, verbose=False)
-
-
-@pytest.fixture(scope="module")
-def solved() -> Solve:
-    """:func:`_solve`, each (domain, algorithm) solved once for the module's tests."""
-    cache: dict[tuple[str, str], Solution] = {}
-
-    def get(domain: str, algorithm: str) -> Solution:
-        if (domain, algorithm) not in cache:
-            cache[domain, algorithm] = _solve(domain, algorithm)
-        return cache[domain, algorithm]
-
-    return get
-
-
 @pytest.mark.parametrize("algorithm", ALGORITHMS)
 @pytest.mark.parametrize("domain", sorted(CHECKS))
-def test_algorithm_solves_domain(domain: str, algorithm: str, solved: Solve) -> None:
-    solution = solved(domain, algorithm)
+def test_algorithm_solves_domain(domain: str, algorithm: str) -> None:
+    solution = solve(_problem(domain), algorithm=algorithm, max_time=30, seed=0, verbose=False)
     assert solution.status is Status.SOLVED, solution.diagnosis
     CHECKS[domain](solution)
     plan, cost, certificate = solution
@@ -56,9 +35,9 @@ def test_algorithm_solves_domain(domain: str, algorithm: str, solved: Solve) -> 
     + [("dual_arm_swap", a) for a in ALGORITHMS]
     + [("kitchen", "focused")],
 )
-def test_same_seed_same_plan(domain: str, algorithm: str, solved: Solve) -> None:
-    first = solved(domain, algorithm)  # the module's solve, and an independent one
-    second = _solve(domain, algorithm)
+def test_same_seed_same_plan(domain: str, algorithm: str) -> None:
+    first = solve(_problem(domain, seed=3), algorithm=algorithm, seed=3, verbose=False)
+    second = solve(_problem(domain, seed=3), algorithm=algorithm, seed=3, verbose=False)
     assert first.solved and first.plan == second.plan and first.cost == second.cost
     if algorithm == "adaptive":
         return  # adaptive balances sampling against search by wall-clock time: counts vary
