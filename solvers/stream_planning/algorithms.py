@@ -39,6 +39,7 @@ from sdar_tamp.language.model import (
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
+from sdar_tamp.language.semantics import ground_atom
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
@@ -467,10 +468,7 @@ class StreamSolver:
             return self.engine.instance(name, inputs)
         fluents = tuple(
             sorted(
-                (
-                    Atom(a.predicate, tuple(bindings.get(n, n) for n in a.args))
-                    for a in skeleton.fluents[index]
-                ),
+                (ground_atom(a, bindings) for a in skeleton.fluents[index]),
                 key=str,
             )
         )
@@ -538,7 +536,7 @@ class StreamSolver:
         # a fluent result is certified for the state fluent_plan gave it (the state of its
         # first use when it cannot be split): its facts are trusted at the steps it serves
         trusted = frozenset(
-            Atom(a.predicate, tuple(bindings.get(n, n) for n in a.args))
+            ground_atom(a, bindings)
             for i, r in enumerate(skeleton.stream_plan)
             if i in skeleton.fluents
             for a in r.certified
@@ -686,7 +684,7 @@ class ActionEfforts:
 def positive_atoms(formula: Formula, binding: Mapping[str, str]) -> list[Atom]:
     """The atoms a formula needs true in every case: those under conjunctions only."""
     if isinstance(formula, Atom):
-        return [Atom(formula.predicate, tuple(binding.get(a, a) for a in formula.args))]
+        return [ground_atom(formula, binding)]
     if isinstance(formula, And):
         return [atom for part in formula.parts for atom in positive_atoms(part, binding)]
     return []
