@@ -141,7 +141,7 @@ def validate(domain: Path, problem: Path, plan_file: Path) -> bool:
         return check.returncode == 0 and "Plan valid" in check.stdout
     sys.path.insert(0, str(ROOT))
     from sdar_tamp.language import parse_domain, parse_problem
-    from solvers.classical import GroundAction, ground, task_from_problem, validate_plan
+    from solvers.classical import GroundAction, task_from_problem, validated_plan_cost
     from solvers.classical.errors import PlanValidationError
 
     parsed_domain = parse_domain(domain.read_text())
@@ -152,7 +152,7 @@ def validate(domain: Path, problem: Path, plan_file: Path) -> bool:
             name, *args = line.strip().strip("()").lower().split()
             steps.append(GroundAction(name, tuple(args)))
     try:
-        validate_plan(task, ground(task), tuple(steps))
+        validated_plan_cost(task, tuple(steps))
     except PlanValidationError:
         return False
     return True

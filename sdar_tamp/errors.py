@@ -36,3 +36,12 @@ class LocatedError(SdarError):
 
 class ParameterError(SdarError, ValueError):
     """A bad argument value: names the parameter and what was expected."""
+
+
+class ActionError(SdarError):
+    """An action applied with the wrong arguments or where its precondition does not hold (in a
+    solver, a bug rather than a user error)."""
+
+
+class EvaluationError(SdarError):
+    """A formula that cannot be evaluated, such as an atom with a variable nothing binds."""

@@ -10,9 +10,9 @@ import math
 from pathlib import Path
 from typing import Any
 
+from sdar_tamp.language.model import TOTAL_COST as TOTAL_COST
 from sdar_tamp.textfile import read_text
 
-TOTAL_COST = "total-cost"
 INF = math.inf
 
 Fact = tuple[Any, ...]

@@ -14,6 +14,7 @@ from sdar_tamp.language.errors import (
     PddlSyntaxError,
     UnboundVariableError,
     UndeclaredError,
+    UnknownKeywordError,
     UnsupportedFeatureError,
 )
 from sdar_tamp.language.model import (
@@ -63,6 +64,28 @@ def expect_head(node: SExpr, keyword: str, what: str) -> SList:
     if not lst.items or not isinstance(lst.items[0], Symbol) or lst.items[0].text != keyword:
         raise PddlSyntaxError(f"expected {what} starting with '{keyword}'", lst.location)
     return lst
+
+
+def parse_options(
+    section: SList, allowed: tuple[str, ...], what: str, start: int
+) -> dict[str, SExpr]:
+    """The ``:keyword value`` pairs of ``section`` from item ``start`` on (an action's or a
+    stream's options), each keyword one of ``allowed`` and given once."""
+    items = section.items[start:]
+    if len(items) % 2:
+        raise PddlSyntaxError(f"{what}: expected ':keyword value' pairs", section.location)
+    options: dict[str, SExpr] = {}
+    for key_node, value in zip(items[::2], items[1::2], strict=True):
+        key = expect_symbol(key_node, "a keyword")
+        if key.text not in allowed:
+            raise UnknownKeywordError(
+                f"unknown keyword {key.text!r} in {what}; expected one of {', '.join(allowed)}",
+                key.location,
+            )
+        if key.text in options:
+            raise DuplicateError(f"{key.text} is given twice in {what}", key.location)
+        options[key.text] = value
+    return options
 
 
 def parse_name_header(node: SExpr, keyword: str) -> str:

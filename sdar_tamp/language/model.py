@@ -168,7 +168,10 @@ class Function:
 
 
 @dataclass(frozen=True)
-class Action:
+class ActionSchema:
+    """A domain's ``(:action ...)``: the lifted schema (a plan step is
+    :class:`solvers.solution.Action`)."""
+
     name: str
     parameters: tuple[Parameter, ...]
     precondition: Formula
@@ -214,7 +217,7 @@ class Domain:
     constants: Mapping[str, str]  # name -> type
     predicates: Mapping[str, Predicate]
     functions: Mapping[str, Function]
-    actions: tuple[Action, ...]
+    actions: tuple[ActionSchema, ...]
     axioms: tuple[Axiom, ...]
     source: str | None = field(default=None, compare=False)
     leniencies: tuple[Leniency, ...] = field(default=(), compare=False)
@@ -224,7 +227,7 @@ class Domain:
     def derived_predicates(self) -> frozenset[str]:
         return frozenset(axiom.predicate for axiom in self.axioms)
 
-    def action(self, name: str) -> Action:
+    def action(self, name: str) -> ActionSchema:
         for action in self.actions:
             if action.name == name.lower():
                 return action

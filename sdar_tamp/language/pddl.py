@@ -30,6 +30,7 @@ from sdar_tamp.language.grammar import (
     expect_symbol,
     parse_name_header,
     parse_number,
+    parse_options,
     parse_typed_list,
 )
 from sdar_tamp.language.leniency import (
@@ -46,7 +47,7 @@ from sdar_tamp.language.model import (
     OBJECT_TYPE,
     TOTAL_COST,
     TRUE,
-    Action,
+    ActionSchema,
     AndEffect,
     Atom,
     Axiom,
@@ -184,7 +185,7 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
     vocabulary.derived = frozenset(
         _derived_name(section) for keyword, section in pending if keyword == ":derived"
     )
-    actions: list[Action] = []
+    actions: list[ActionSchema] = []
     axioms: list[Axiom] = []
     for keyword, section in pending:
         if keyword == ":action":
@@ -296,30 +297,12 @@ def _declare_functions(
         index += 1
 
 
-def _options(section: SList, allowed: tuple[str, ...], what: str) -> dict[str, SExpr]:
-    options: dict[str, SExpr] = {}
-    items = section.items[2:]
-    if len(items) % 2:
-        raise PddlSyntaxError(f"{what}: expected ':keyword value' pairs", section.location)
-    for key_node, value in zip(items[::2], items[1::2], strict=True):
-        key = expect_symbol(key_node, "a keyword")
-        if key.text not in allowed:
-            raise UnknownKeywordError(
-                f"unknown keyword {key.text!r} in {what}; expected one of {', '.join(allowed)}",
-                key.location,
-            )
-        if key.text in options:
-            raise DuplicateError(f"{key.text} is given twice in {what}", key.location)
-        options[key.text] = value
-    return options
-
-
-def _action(section: SList, reader: FormulaReader, log: LeniencyLog) -> Action:
+def _action(section: SList, reader: FormulaReader, log: LeniencyLog) -> ActionSchema:
     if len(section.items) < 2:
         raise PddlSyntaxError("expected an action name after ':action'", section.location)
     name = expect_symbol(section.items[1], "an action name").text
     what = f"action {name!r}"
-    options = _options(section, (":parameters", ":precondition", ":effect"), what)
+    options = parse_options(section, (":parameters", ":precondition", ":effect"), what, 2)
     params = (
         reader.parameters(options[":parameters"], f"the parameters of {what}")
         if ":parameters" in options
@@ -334,7 +317,7 @@ def _action(section: SList, reader: FormulaReader, log: LeniencyLog) -> Action:
         else TRUE
     )
     effect = reader.effect(options[":effect"], scope) if ":effect" in options else AndEffect(())
-    return Action(name, params, precondition, effect, section.location)
+    return ActionSchema(name, params, precondition, effect, section.location)
 
 
 def _axiom(

@@ -31,6 +31,7 @@ from sdar_tamp.language.grammar import (
     expect_list,
     expect_symbol,
     parse_name_header,
+    parse_options,
 )
 from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, LeniencyLog, note_glued_variables
 from sdar_tamp.language.model import Atom, Domain, FunctionTerm, Rule, Stream, StreamFile
@@ -120,24 +121,6 @@ def _unique(name: str, names: set[str], location: SourceLocation) -> None:
     if name in names:
         raise DuplicateError(f"stream {name!r} is defined twice", location)
     names.add(name)
-
-
-def _options(section: SList, allowed: tuple[str, ...], what: str, start: int) -> dict[str, SExpr]:
-    items = section.items[start:]
-    if len(items) % 2:
-        raise PddlSyntaxError(f"{what}: expected ':keyword value' pairs", section.location)
-    options: dict[str, SExpr] = {}
-    for key_node, value in zip(items[::2], items[1::2], strict=True):
-        key = expect_symbol(key_node, "a keyword")
-        if key.text not in allowed:
-            raise UnknownKeywordError(
-                f"unknown keyword {key.text!r} in {what}; expected one of {', '.join(allowed)}",
-                key.location,
-            )
-        if key.text in options:
-            raise DuplicateError(f"{key.text} is given twice in {what}", key.location)
-        options[key.text] = value
-    return options
 
 
 def _declare_certified(
@@ -245,7 +228,7 @@ def _stream(section: SList, reader: FormulaReader) -> Stream:
         raise PddlSyntaxError("expected a stream name after ':stream'", section.location)
     name = expect_symbol(section.items[1], "a stream name").text
     what = f"stream {name!r}"
-    options = _options(section, STREAM_OPTIONS, what, 2)
+    options = parse_options(section, STREAM_OPTIONS, what, 2)
     empty = section.with_items(())
     inputs = _variables(options.get(":inputs", empty), f"the inputs of {what}")
     outputs = _variables(options.get(":outputs", empty), f"the outputs of {what}")
@@ -349,7 +332,7 @@ def _optional_domain(
 
 
 def _rule(section: SList, reader: FormulaReader) -> Rule:
-    options = _options(section, RULE_OPTIONS, "a rule", 1)
+    options = parse_options(section, RULE_OPTIONS, "a rule", 1)
     empty = section.with_items(())
     params_node = options.get(":inputs", options.get(":parameters", empty))
     params = _variables(params_node, "the parameters of a rule")

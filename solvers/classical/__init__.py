@@ -25,7 +25,7 @@ from solvers.classical.problem import (
     task_from_problem,
 )
 from solvers.classical.task import GroundTask
-from solvers.classical.validate import validate_plan
+from solvers.classical.validate import validated_plan_cost
 
 __all__ = [
     "HEURISTICS",
@@ -41,5 +41,5 @@ __all__ = [
     "ground",
     "plan",
     "task_from_problem",
-    "validate_plan",
+    "validated_plan_cost",
 ]

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from sdar_tamp.language.model import (
     EQUALITY,
     OBJECT_TYPE,
-    Action,
+    ActionSchema,
     AndEffect,
     Atom,
     Effect,
@@ -252,7 +252,7 @@ class _Normalizer:
             lits.append(Lit(atom.predicate, args))
         return lits
 
-    def action(self, action: Action) -> NormAction:
+    def action(self, action: ActionSchema) -> NormAction:
         context = {p.name: p.type for p in action.parameters}
         pre = [self.type_lit(p) for p in action.parameters]
         pre += self.conjunction(nnf(action.precondition), context)

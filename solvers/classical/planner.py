@@ -23,7 +23,7 @@ from solvers.classical.problem import (
 from solvers.classical.reachability import GroundingTimeout
 from solvers.classical.search import Evaluator, SearchOutcome, best_first_search
 from solvers.classical.task import GroundTask
-from solvers.classical.validate import validate_plan
+from solvers.classical.validate import validated_plan_cost
 
 SEARCHES = ("gbfs", "astar", "wastar", "lazy-gbfs")
 logger = get_logger(__name__)
@@ -97,7 +97,7 @@ def plan(
         return SearchResult(PlanStatus(outcome.status), None, 0.0, statistics)
     steps = tuple(ground_task.operators[i].action for i in outcome.operators)
     try:
-        cost = validate_plan(task, ground_task, steps)
+        cost = validated_plan_cost(task, steps)
     except PlanValidationError as error:  # a bug in the planner, never a user error
         raise PlanValidationError(f"planner bug: the plan found is invalid: {error}") from error
     return SearchResult(PlanStatus.SOLVED, steps, cost, statistics)

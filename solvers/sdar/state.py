@@ -1,45 +1,30 @@
 """A lifted state that applies a domain's actions one at a time (SDAR executes, not searches).
 
 Facts are atoms over object names: ``static`` ones (initial facts and stream certificates) and
-``fluents`` (the predicates some action changes). Preconditions are evaluated on the lifted
-formulas; a derived atom is evaluated on demand from its axiom's body. An existential
-quantifier is solved by matching a positive atom of its body against the facts (so it costs
-a scan of one predicate's atoms, not a product over typed objects); only when its body has no
-such atom does it range over the objects of the parameter's type.
+``fluents`` (the predicates some action changes). Conditions and effects mean what
+:mod:`sdar_tamp.language.semantics` says; this class keeps the facts, indexed by predicate, and
+changes them in place.
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
 
+from sdar_tamp.errors import ActionError
 from sdar_tamp.language.model import (
-    EQUALITY,
-    And,
-    AndEffect,
+    OBJECT_TYPE,
     Atom,
     Domain,
-    Effect,
-    Exists,
-    ForAll,
-    ForAllEffect,
     Formula,
     FunctionTerm,
-    Imply,
-    IncreaseCost,
-    Literal,
-    Not,
-    Or,
-    Parameter,
-    When,
     iter_effect_literals,
 )
+from sdar_tamp.language.semantics import Evaluator, bind, effect_changes
 
 Binding = Mapping[str, str]
 
-
-class ActionError(Exception):
-    """An action applied where its precondition does not hold (a solver bug, not user error)."""
+__all__ = ["ActionError", "Binding", "LiftedState", "fluent_predicates"]
 
 
 def fluent_predicates(domain: Domain) -> frozenset[str]:
@@ -52,7 +37,11 @@ def fluent_predicates(domain: Domain) -> frozenset[str]:
 
 
 class LiftedState:
-    """Static facts, the current fluents, and action application with costs."""
+    """Static facts, the current fluents, and action application with costs.
+
+    ``objects_of_type`` lists the objects of a type (quantifiers range over them); ``cost``
+    gives a ground cost term's value.
+    """
 
     def __init__(
         self,
@@ -64,19 +53,36 @@ class LiftedState:
     ) -> None:
         self.domain = domain
         self.fluent_names = fluent_predicates(domain)
-        self.axioms = {a.predicate: a for a in domain.axioms}
         self._by_predicate: dict[str, set[tuple[str, ...]]] = defaultdict(set)
         for atom in (*static, *fluents):
             self._by_predicate[atom.predicate].add(atom.args)
         self._of_type = objects_of_type
         self._cost = cost
+        self._evaluator: Evaluator | None = None
 
-    # -- facts ---------------------------------------------------------------------------------
+    # -- facts (the semantics' Facts and Objects) ----------------------------------------------
+    def __contains__(self, atom: object) -> bool:
+        return isinstance(atom, Atom) and atom.args in self._by_predicate.get(atom.predicate, ())
+
+    def args_of(self, predicate: str) -> Collection[tuple[str, ...]]:
+        return self._by_predicate.get(predicate, ())
+
+    def objects_of(self, type_name: str) -> Sequence[str]:
+        return self._of_type(type_name)
+
+    def has_type(self, name: str, type_name: str) -> bool:
+        return (
+            type_name == OBJECT_TYPE
+            or (name,) in self._by_predicate.get(type_name, ())
+            or name in self._of_type(type_name)
+        )
+
     def add_static(self, atoms: Iterable[Atom]) -> None:
         for atom in atoms:
             if atom.predicate in self.fluent_names:
                 raise ValueError(f"{atom} is a fluent; streams may not certify it")
             self._by_predicate[atom.predicate].add(atom.args)
+            self._evaluator = None
 
     def has(self, predicate: str, *args: str) -> bool:
         return args in self._by_predicate.get(predicate, ())
@@ -90,116 +96,31 @@ class LiftedState:
         )
 
     # -- evaluation ----------------------------------------------------------------------------
+    def evaluator(self) -> Evaluator:
+        """The evaluator of the current facts (a new one after every change)."""
+        if self._evaluator is None:
+            self._evaluator = Evaluator(self.domain, self, self)
+        return self._evaluator
+
     def holds(self, formula: Formula, binding: Binding) -> bool:
-        if isinstance(formula, Atom):
-            args = tuple(binding.get(a, a) for a in formula.args)
-            if formula.predicate == EQUALITY:
-                return len(set(args)) <= 1
-            axiom = self.axioms.get(formula.predicate)
-            if axiom is not None:
-                inner = {p.name: a for p, a in zip(axiom.parameters, args, strict=True)}
-                return self.holds(axiom.body, inner)
-            return args in self._by_predicate.get(formula.predicate, ())
-        if isinstance(formula, Not):
-            return not self.holds(formula.formula, binding)
-        if isinstance(formula, And):
-            return all(self.holds(p, binding) for p in formula.parts)
-        if isinstance(formula, Or):
-            return any(self.holds(p, binding) for p in formula.parts)
-        if isinstance(formula, Imply):
-            return not self.holds(formula.antecedent, binding) or self.holds(
-                formula.consequent, binding
-            )
-        if isinstance(formula, Exists):
-            return any(
-                self.holds(formula.body, b)
-                for b in self._candidates(formula.parameters, formula.body, binding)
-            )
-        assert isinstance(formula, ForAll)
-        return all(self.holds(formula.body, b) for b in self._typed(formula.parameters, binding))
-
-    def _candidates(
-        self, parameters: tuple[Parameter, ...], body: Formula, binding: Binding
-    ) -> Iterator[dict[str, str]]:
-        names = {p.name for p in parameters}
-        parts = body.parts if isinstance(body, And) else (body,)
-        anchors = [
-            p
-            for p in parts
-            if isinstance(p, Atom)
-            and p.predicate != EQUALITY
-            and p.predicate not in self.axioms
-            and names <= set(p.args)
-        ]
-        if not anchors:
-            yield from self._typed(parameters, binding)
-            return
-        anchor = min(anchors, key=lambda a: len(self._by_predicate.get(a.predicate, ())))
-        for args in sorted(self._by_predicate.get(anchor.predicate, ())):
-            b = dict(binding)
-            if all(_unify(t, v, b, names) for t, v in zip(anchor.args, args, strict=True)):
-                yield b
-
-    def _typed(self, parameters: tuple[Parameter, ...], binding: Binding) -> list[dict[str, str]]:
-        result = [dict(binding)]
-        for p in parameters:
-            result = [{**b, p.name: o} for b in result for o in self._of_type(p.type)]
-        return result
+        return self.evaluator().holds(formula, binding)
 
     # -- actions -------------------------------------------------------------------------------
     def applicable(self, name: str, args: Sequence[str]) -> bool:
         action = self.domain.action(name)
-        binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
-        return self.holds(action.precondition, binding)
+        return self.holds(action.precondition, bind(action, args))
 
     def apply(self, name: str, args: Sequence[str]) -> float:
         """Apply the action; returns its cost. Raises :class:`ActionError` if not applicable."""
         action = self.domain.action(name)
-        if len(args) != len(action.parameters):
-            raise ActionError(f"({name} {' '.join(args)}): wrong number of arguments")
-        binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
-        if not self.holds(action.precondition, binding):
+        binding = bind(action, args)
+        evaluator = self.evaluator()
+        if not evaluator.holds(action.precondition, binding):
             raise ActionError(f"({name} {' '.join(args)}): precondition does not hold")
-        adds: list[Atom] = []
-        deletes: list[Atom] = []
-        cost = self._effects(action.effect, binding, adds, deletes)
-        for atom in deletes:
+        changes = effect_changes(evaluator, action.effect, binding, self._cost)
+        for atom in changes.deletes:
             self._by_predicate[atom.predicate].discard(atom.args)
-        for atom in adds:
+        for atom in changes.adds:
             self._by_predicate[atom.predicate].add(atom.args)
-        return cost
-
-    def _effects(
-        self, effect: Effect, binding: Binding, adds: list[Atom], deletes: list[Atom]
-    ) -> float:
-        if isinstance(effect, Literal):
-            atom = Atom(effect.atom.predicate, tuple(binding.get(a, a) for a in effect.atom.args))
-            (deletes if effect.negated else adds).append(atom)
-            return 0.0
-        if isinstance(effect, AndEffect):
-            return sum(self._effects(p, binding, adds, deletes) for p in effect.parts)
-        if isinstance(effect, ForAllEffect):
-            return sum(
-                self._effects(effect.effect, b, adds, deletes)
-                for b in self._typed(effect.parameters, binding)
-            )
-        if isinstance(effect, When):
-            if self.holds(effect.condition, binding):
-                return self._effects(effect.effect, binding, adds, deletes)
-            return 0.0
-        assert isinstance(effect, IncreaseCost)
-        amount = effect.amount
-        if isinstance(amount, FunctionTerm):
-            return self._cost(
-                FunctionTerm(amount.name, tuple(binding.get(a, a) for a in amount.args))
-            )
-        return float(amount)
-
-
-def _unify(term: str, value: str, binding: dict[str, str], variables: set[str]) -> bool:
-    if term in variables:
-        if term in binding:
-            return binding[term] == value
-        binding[term] = value
-        return True
-    return binding.get(term, term) == value
+        self._evaluator = None
+        return changes.cost

@@ -30,16 +30,15 @@ from typing import Any
 
 from sdar_tamp.language.model import (
     And,
-    AndEffect,
     Atom,
     Domain,
     Formula,
     FunctionTerm,
-    IncreaseCost,
 )
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
+from sdar_tamp.language.semantics import ground_atom
 from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
@@ -59,7 +58,7 @@ from solvers.stream_planning.optimistic import (
     is_placeholder,
     negated_predicates,
 )
-from solvers.stream_planning.preimage import simulate
+from solvers.stream_planning.preimage import PlanCheck, simulate
 
 LOG = get_logger(__name__)
 ALGORITHMS = ("incremental", "focused", "binding", "adaptive")
@@ -242,19 +241,27 @@ class StreamSolver:
 
     def _real_check(
         self, actions: PlanSteps, trusted: frozenset[Atom] = frozenset()
-    ) -> tuple[bool, frozenset[Atom]]:
+    ) -> tuple[bool, PlanCheck]:
         """Is the plan valid on the real facts, each fact a fluent stream certified used only
-        in the state it was certified in (or ``trusted``: bound by the plan's skeleton)?"""
+        in the state it was certified in (or ``trusted``: bound by the plan's skeleton)? The
+        check also gives the facts it needs and its cost."""
         engine = self.engine
         facts = engine.store.levels
-        check = simulate(self.problem.domain, self._objects(facts), facts, actions, self.goal)
+        numeric = engine.numeric
+
+        def cost_of(term: FunctionTerm) -> float:
+            return numeric.get((term.name, term.args), 0.0)
+
+        check = simulate(
+            self.problem.domain, self._objects(facts), facts, actions, self.goal, cost_of
+        )  # fmt: skip
         if not check.valid or not engine.hidden:
-            return check.valid, check.needed
+            return check.valid, check
         for state, support in zip(check.states, check.supports, strict=True):
             hidden = (support & engine.hidden) - trusted
             if any(not engine.certified_in(a, state) for a in hidden):
-                return False, check.needed
-        return True, check.needed
+                return False, check
+        return True, check
 
     def _failed(self, state: InstanceState) -> None:
         """A call produced nothing: a fluent instance blocks its facts in states like its own
@@ -273,9 +280,11 @@ class StreamSolver:
             state.instance.disabled = False
         self.blocks.lift()
 
-    def _record(self, actions: PlanSteps, needed: frozenset[Atom]) -> bool:
-        """Keep a real plan if it is the best so far; True when it is good enough to stop."""
-        cost = plan_cost(self.problem.domain, actions, self.engine.numeric, self.options.unit_costs)
+    def _record(self, actions: PlanSteps, check: PlanCheck) -> bool:
+        """Keep a real plan if it is the best so far (its cost: its length with unit costs,
+        else the sum of its steps' costs); True when it is good enough to stop."""
+        cost = float(len(actions)) if self.options.unit_costs else check.cost
+        needed = check.needed
         if cost > self.options.max_cost:
             return False
         if self.best is None or cost < self.best[0]:
@@ -411,8 +420,8 @@ class StreamSolver:
             if not any(r.kind == "stream" for r in stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
             ):
-                valid, needed = self._real_check(actions)
-                if valid and self._record(actions, needed):
+                valid, check = self._real_check(actions)
+                if valid and self._record(actions, check):
                     return Status.SOLVED
                 if not valid:
                     LOG.debug("plan on real facts failed validation; raising complexity")
@@ -465,10 +474,7 @@ class StreamSolver:
             return self.engine.instance(name, inputs)
         fluents = tuple(
             sorted(
-                (
-                    Atom(a.predicate, tuple(bindings.get(n, n) for n in a.args))
-                    for a in skeleton.fluents[index]
-                ),
+                (ground_atom(a, bindings) for a in skeleton.fluents[index]),
                 key=str,
             )
         )
@@ -536,14 +542,14 @@ class StreamSolver:
         # a fluent result is certified for the state fluent_plan gave it (the state of its
         # first use when it cannot be split): its facts are trusted at the steps it serves
         trusted = frozenset(
-            Atom(a.predicate, tuple(bindings.get(n, n) for n in a.args))
+            ground_atom(a, bindings)
             for i, r in enumerate(skeleton.stream_plan)
             if i in skeleton.fluents
             for a in r.certified
         )
-        valid, needed = self._real_check(actions, trusted)
+        valid, check = self._real_check(actions, trusted)
         if valid:
-            return True if self._record(actions, needed) else None
+            return True if self._record(actions, check) else None
         return self._upstream_retry(skeleton, len(skeleton.stream_plan))
 
     def _take(self, skeleton: Skeleton, index: int, state: InstanceState) -> tuple[str, ...] | None:
@@ -692,7 +698,7 @@ class ActionEfforts:
 def positive_atoms(formula: Formula, binding: Mapping[str, str]) -> list[Atom]:
     """The atoms a formula needs true in every case: those under conjunctions only."""
     if isinstance(formula, Atom):
-        return [Atom(formula.predicate, tuple(binding.get(a, a) for a in formula.args))]
+        return [ground_atom(formula, binding)]
     if isinstance(formula, And):
         return [atom for part in formula.parts for atom in positive_atoms(part, binding)]
     return []
@@ -715,31 +721,3 @@ def extract_stream_plan(needed: Iterable[Atom], world: OptimisticWorld) -> list[
     for atom in sorted(needed, key=str):
         visit(atom)
     return order
-
-
-def plan_cost(
-    domain: Domain,
-    actions: PlanSteps,
-    numeric: Mapping[tuple[str, tuple[str, ...]], float],
-    unit_costs: bool,
-) -> float:
-    """The cost of a plan: its length with unit costs, else the sum of its top-level costs."""
-    if unit_costs:
-        return float(len(actions))
-    total = 0.0
-    for name, args in actions:
-        action = domain.action(name)
-        binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
-        stack = [action.effect]
-        while stack:
-            effect = stack.pop()
-            if isinstance(effect, AndEffect):
-                stack.extend(effect.parts)
-            elif isinstance(effect, IncreaseCost):
-                amount = effect.amount
-                if isinstance(amount, FunctionTerm):
-                    key = (amount.name, tuple(binding.get(a, a) for a in amount.args))
-                    total += numeric.get(key, 0.0)
-                else:
-                    total += amount
-    return total

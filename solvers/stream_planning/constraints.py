@@ -24,8 +24,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.model import Action as ActionSchema
 from sdar_tamp.language.model import (
+    ActionSchema,
     And,
     AndEffect,
     Atom,

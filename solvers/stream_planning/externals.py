@@ -26,6 +26,7 @@ from sdar_tamp.language.generators import (
 from sdar_tamp.language.model import Atom, Stream, StreamFunction, StreamPredicate
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
+from sdar_tamp.language.semantics import ground_atom
 from sdar_tamp.logs import get_logger
 from solvers.stream_planning.calls import CallRunner, CallTimeout
 
@@ -51,7 +52,7 @@ class Counters:
 
 
 def _bind(atoms: tuple[Atom, ...], mapping: Mapping[str, str]) -> tuple[Atom, ...]:
-    return tuple(Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in atoms)
+    return tuple(ground_atom(a, mapping) for a in atoms)
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from sdar_tamp.language.model import Atom
+from sdar_tamp.language.semantics import ground_atom
 from solvers.stream_planning.optimistic import OptResult, is_placeholder
 from solvers.stream_planning.preimage import PlanCheck
 
@@ -76,9 +77,7 @@ def fluent_plan(
         groups = _use_groups(i, stream_plan, check, wanted, actions)
         for fluents, group in groups[1:]:
             names = {o: f"{o}@{group[0]}" for o in result.outputs}
-            certified = tuple(
-                Atom(a.predicate, tuple(names.get(n, n) for n in a.args)) for a in result.certified
-            )
+            certified = tuple(ground_atom(a, names) for a in result.certified)
             for k in group:
                 renamed[k] = [names.get(n, n) for n in renamed[k]]
             facts[len(plan)] = fluents

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from typing import Any
 
@@ -9,6 +10,7 @@ import numpy as np
 import pytest
 
 from sdar_tamp.app import (
+    Rearrangement,
     plan_file_from_solution,
     rearrangement_problem,
     solve_rearrangement,
@@ -19,7 +21,7 @@ from sdar_tamp.replay import validate_plan
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.scene import Workspace
-from solvers.solution import Status
+from solvers.solution import Certificate, Solution, Status
 from solvers.solve import solve
 from streams.context import WorldContext
 from streams.motion import DualMotionPlanner
@@ -45,6 +47,24 @@ def _swap() -> Instance:
     return Instance("swap", WORKSPACE, (ObjectSpec("a", SIZE, a, b), ObjectSpec("b", SIZE, b, a)))
 
 
+@pytest.fixture(scope="module")
+def solved_three(ctx: WorldContext, planner: DualMotionPlanner) -> tuple[Rearrangement, Solution]:
+    """``_three`` (seed 0) solved once by ``solve_rearrangement`` for the tests that only read
+    the solution. With the default motion planner its options are ``SdarOptions(max_time)``
+    (the default quick attempts), so it is also the quick run of the motion-stream test."""
+    r = rearrangement_problem(_three(), ctx, planner=planner)
+    return r, solve_rearrangement(r, "sdar", 60.0)
+
+
+@pytest.fixture(scope="module")
+def solved_swap(ctx: WorldContext, planner: DualMotionPlanner) -> tuple[Rearrangement, Solution]:
+    """``_swap`` (seed 0) solved once, through the generic entry point
+    ``solve(algorithm="sdar")``; with the default motion planner ``solve_rearrangement`` runs
+    the same solver configuration (``test_both_entry_points_configure_sdar_alike``)."""
+    r = rearrangement_problem(_swap(), ctx, planner=planner)
+    return r, solve(r.problem, algorithm="sdar", max_time=60, verbose=False)
+
+
 def _three() -> Instance:
     """A chain c -> b (c's goal is b's start) and an independent object a."""
     return Instance(
@@ -59,10 +79,9 @@ def _three() -> Instance:
 
 
 def test_swap_is_one_synchronous_dual_arm_step(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, solved_swap: tuple[Rearrangement, Solution]
 ) -> None:
-    r = rearrangement_problem(_swap(), ctx, planner=planner)
-    solution = solve_rearrangement(r, "sdar", 60.0)
+    r, solution = solved_swap
     assert solution.status is Status.SOLVED
     names = [a.name for a in solution.plan or []]
     assert names == ["move", "pick-both", "move", "place-both"]
@@ -73,9 +92,10 @@ def test_swap_is_one_synchronous_dual_arm_step(
     assert report.ok, report.violation
 
 
-def test_plan_is_a_plan_of_the_domain(ctx: WorldContext, planner: DualMotionPlanner) -> None:
-    r = rearrangement_problem(_three(), ctx, planner=planner)
-    solution = solve_rearrangement(r, "sdar", 60.0)
+def test_plan_is_a_plan_of_the_domain(
+    ctx: WorldContext, solved_three: tuple[Rearrangement, Solution]
+) -> None:
+    r, solution = solved_three
     assert solution.status is Status.SOLVED and solution.plan is not None
     # Checked by code that shares nothing with SDAR: the timed plan is replayed by the
     # geometric validator (every object at its goal, no collision, limits), and the plan's
@@ -105,10 +125,30 @@ def test_baseline_task_planner_solves_too(ctx: WorldContext, planner: DualMotion
     assert sum(sum(t["to_buffer"]) for t in solution.trace) == 1
 
 
-def test_solve_entry_point_runs_sdar(ctx: WorldContext, planner: DualMotionPlanner) -> None:
-    r = rearrangement_problem(_swap(), ctx, planner=planner)
-    plan, cost, _ = solve(r.problem, algorithm="sdar", max_time=60, verbose=False)
+def test_solve_entry_point_runs_sdar(solved_swap: tuple[Rearrangement, Solution]) -> None:
+    plan, cost, _ = solved_swap[1]  # from solve(r.problem, algorithm="sdar")
     assert plan is not None and cost > 0
+
+
+def test_both_entry_points_configure_sdar_alike(
+    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With the default motion planner, ``solve_rearrangement`` and ``solve(algorithm="sdar")``
+    build the same solver (problem, task planner, options), so what the tests check of one
+    holds for the other."""
+    from solvers.sdar.solver import SdarSolver
+
+    built: list[tuple[Any, ...]] = []
+
+    def record(self: SdarSolver) -> Solution:
+        built.append((self.problem, type(self.planner), self.options))
+        return Solution(None, math.inf, Certificate((), ()))
+
+    monkeypatch.setattr(SdarSolver, "solve", record)
+    r = rearrangement_problem(_swap(), ctx, planner=planner)
+    solve(r.problem, algorithm="sdar", max_time=60, verbose=False)
+    solve_rearrangement(r, "sdar", 60.0)
+    assert len(built) == 2 and built[0] == built[1]
 
 
 def test_no_ik_gives_infeasible_with_a_diagnosis(
@@ -199,13 +239,13 @@ def test_unknown_task_planner_and_override_are_refused(ctx: WorldContext) -> Non
         rearrangement_problem(_swap(), ctx, motion="fast")
 
 
-def test_same_seed_gives_the_same_plan(ctx: WorldContext, planner: DualMotionPlanner) -> None:
-    plans = []
-    for _ in range(2):
-        r = rearrangement_problem(_three(), ctx, planner=planner, seed=7)
-        solution = solve_rearrangement(r, "sdar", 60.0)
-        plans.append(plan_file_from_solution(r, solution))
-    a, b = plans
+def test_same_seed_gives_the_same_plan(
+    ctx: WorldContext, planner: DualMotionPlanner, solved_three: tuple[Rearrangement, Solution]
+) -> None:
+    # a second, independent solve of the shared instance with the same seed (0)
+    r = rearrangement_problem(_three(), ctx, planner=planner, seed=0)
+    a = plan_file_from_solution(*solved_three)
+    b = plan_file_from_solution(r, solve_rearrangement(r, "sdar", 60.0))
     assert np.array_equal(a.q, b.q) and np.array_equal(a.t, b.t)
     assert [(e.t, e.arm, e.type, e.object) for e in a.events] == [
         (e.t, e.arm, e.type, e.object) for e in b.events
@@ -267,21 +307,25 @@ def test_colliding_first_grasps_widen_the_options(
 
 
 def test_motions_come_from_the_quick_stream_first(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: DualMotionPlanner, solved_three: tuple[Rearrangement, Solution]
 ) -> None:
     """Where optimisation alone finds the motions, the full motion planner (with its
     fallbacks) is never called; without quick attempts only the full planner is."""
     from solvers.sdar.planners import make_task_planner
     from solvers.sdar.solver import SdarOptions, SdarSolver
 
+    quick = SdarOptions.quick_attempts
+    r = rearrangement_problem(_three(), ctx, planner=planner)
+    options = SdarOptions(max_time=60.0, quick_attempts=0)
+    runs = {
+        quick: solved_three,
+        0: (r, SdarSolver(r.problem, make_task_planner("sdar"), options).solve()),
+    }
     calls: dict[int, dict[str, int]] = {}
-    for quick in (6, 0):
-        r = rearrangement_problem(_three(), ctx, planner=planner)
-        options = SdarOptions(max_time=60.0, quick_attempts=quick)
-        solution = SdarSolver(r.problem, make_task_planner("sdar"), options).solve()
+    for attempts, (r, solution) in runs.items():
         assert solution.status is Status.SOLVED
         assert validate_plan(r.instance, plan_file_from_solution(r, solution), ctx.scene).ok
-        calls[quick] = {k: s.calls for k, s in solution.streams.items() if "motion" in k}
+        calls[attempts] = {k: s.calls for k, s in solution.streams.items() if "motion" in k}
     motions = calls[0]["plan-dual-motion"]
     assert motions >= 3 and calls[0]["plan-dual-motion-quick"] == 0
-    assert calls[6] == {"plan-dual-motion": 0, "plan-dual-motion-quick": motions}
+    assert calls[quick] == {"plan-dual-motion": 0, "plan-dual-motion-quick": motions}

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from sdar_tamp.language import parse_domain, parse_problem
-from solvers.classical import PlanningTask, ground, plan, task_from_problem, validate_plan
+from solvers.classical import PlanningTask, ground, plan, task_from_problem, validated_plan_cost
 from solvers.classical import normalize as normalize_module
 from solvers.classical.join import (
     DEADLINE_STRIDE,
@@ -69,7 +69,7 @@ def test_both_compilations_agree(
     assert result.solved is solvable
     if solvable:
         assert result.plan is not None
-        assert validate_plan(task, grounded, result.plan) == 1
+        assert validated_plan_cost(task, result.plan) == 1
 
 
 def test_a_join_checks_the_deadline_while_it_runs() -> None:

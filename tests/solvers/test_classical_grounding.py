@@ -8,7 +8,7 @@ import pytest
 from classical_helpers import load, load_text
 
 from sdar_tamp.language.model import (
-    Action,
+    ActionSchema,
     And,
     Atom,
     Axiom,
@@ -58,7 +58,7 @@ def test_type_atoms_in_init_are_accepted_once() -> None:
 def test_type_names_work_as_unary_predicates() -> None:
     hierarchy = TypeHierarchy({"block": "object", "ball": "object"})
     # (grab ?x): any object that is a block by type-predicate, not by parameter type.
-    grab = Action(
+    grab = ActionSchema(
         "grab",
         (Parameter("?x"),),
         And((Atom("block", ("?x",)), Not(Atom("held", ("?x",))))),

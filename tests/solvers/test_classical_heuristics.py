@@ -7,7 +7,7 @@ import math
 import pytest
 
 from sdar_tamp.language.model import (
-    Action,
+    ActionSchema,
     And,
     AndEffect,
     Atom,
@@ -21,13 +21,13 @@ from solvers.classical.compiled import CompiledTask, mask
 from solvers.classical.heuristics import RelaxedHeuristic
 
 
-def _op(name: str, pre: list[str], add: list[str], cost: float) -> Action:
+def _op(name: str, pre: list[str], add: list[str], cost: float) -> ActionSchema:
     effects = [Literal(Atom(p)) for p in add] + [IncreaseCost(cost)]
-    return Action(name, (), And(tuple(Atom(p) for p in pre)), AndEffect(tuple(effects)))
+    return ActionSchema(name, (), And(tuple(Atom(p) for p in pre)), AndEffect(tuple(effects)))
 
 
 def _task(goal: list[str], with_noop: bool = True) -> PlanningTask:
-    spoil = Action("spoil", (), And(()), Literal(Atom("a"), negated=True))
+    spoil = ActionSchema("spoil", (), And(()), Literal(Atom("a"), negated=True))
     #   a --op1(2)--> b ;  a --op2(3)--> c ;  b,c --op3(1)--> g ;  b --op4(4)--> h
     actions = (
         _op("op1", ["a"], ["b"], 2.0),

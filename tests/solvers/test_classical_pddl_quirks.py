@@ -25,10 +25,9 @@ from solvers.classical import (
     GroundAction,
     GroundingError,
     PlanningTask,
-    ground,
     plan,
     task_from_problem,
-    validate_plan,
+    validated_plan_cost,
 )
 
 # Untyped STRIPS in upper case, a repeated variable in a declaration, '?' glued to names,
@@ -71,7 +70,7 @@ def _solve_and_validate(domain_text: str, problem_text: str) -> tuple[GroundActi
     task = task_from_problem(domain, parse_problem(problem_text, domain, "problem.pddl"))
     result = plan(task)
     assert result.solved and result.plan is not None
-    assert validate_plan(task, ground(task), result.plan) == len(result.plan)
+    assert validated_plan_cost(task, result.plan) == len(result.plan)
     return result.plan
 
 

@@ -5,14 +5,14 @@ from __future__ import annotations
 import pytest
 from classical_helpers import load
 
-from solvers.classical import GroundAction, PlanValidationError, ground, plan, validate_plan
+from solvers.classical import GroundAction, PlanValidationError, plan, validated_plan_cost
 
 
 def test_valid_plan_returns_its_cost() -> None:
     task = load("delivery_costs", "detour")
     result = plan(task, search="astar", heuristic="max")
     assert result.plan is not None
-    assert validate_plan(task, ground(task), result.plan) == 11.0
+    assert validated_plan_cost(task, result.plan) == 11.0
 
 
 @pytest.mark.parametrize(
@@ -30,9 +30,9 @@ def test_validator_rejects_corrupted_plans(corrupt, message: str) -> None:  # ty
     task = load("blocksworld", "sussman")
     result = plan(task)
     assert result.plan is not None
-    validate_plan(task, ground(task), result.plan)
+    validated_plan_cost(task, result.plan)
     with pytest.raises(PlanValidationError, match=message):
-        validate_plan(task, ground(task), corrupt(result.plan))
+        validated_plan_cost(task, corrupt(result.plan))
 
 
 def test_validator_simulates_conditional_effects_and_axioms() -> None:
@@ -40,8 +40,8 @@ def test_validator_simulates_conditional_effects_and_axioms() -> None:
     result = plan(task)
     assert result.plan is not None
     steps = list(result.plan)
-    validate_plan(task, ground(task), steps)
+    validated_plan_cost(task, steps)
     # dropping a take-out leaves a document in the case: the goal (not (in ...)) fails
     index = next(i for i, a in enumerate(steps) if a.name == "take-out" and a.args[0] == "letter")
     with pytest.raises(PlanValidationError):
-        validate_plan(task, ground(task), steps[:index] + steps[index + 1 :])
+        validated_plan_cost(task, steps[:index] + steps[index + 1 :])

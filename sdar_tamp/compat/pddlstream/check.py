@@ -1,7 +1,7 @@
 """Re-check a solution by simulation, independently of the solver that found it.
 
-The plan is run, with the classical validator (:func:`solvers.classical.validate_plan`), from
-the problem's initial facts plus every fact the solution's certificate says the streams
+The plan is run, with the classical validator (:func:`solvers.classical.validated_plan_cost`),
+from the problem's initial facts plus every fact the solution's certificate says the streams
 certified; every precondition must hold on the way and the goal at the end. Costs are not
 re-checked (the values of cost functions are not part of the certificate).
 """
@@ -12,7 +12,12 @@ from dataclasses import replace
 
 from sdar_tamp.language.model import OBJECT_TYPE, AndEffect, Atom, Domain, Effect, IncreaseCost
 from sdar_tamp.language.problem import PDDLProblem
-from solvers.classical import GroundAction, PlanningTask, PlanValidationError, ground, validate_plan
+from solvers.classical import (
+    GroundAction,
+    PlanningTask,
+    PlanValidationError,
+    validated_plan_cost,
+)
 from solvers.solution import Solution
 
 
@@ -55,7 +60,7 @@ def check_solution(problem: PDDLProblem, solution: Solution) -> str | None:
         use_costs=False,
     )
     try:
-        validate_plan(task, ground(task), steps)
+        validated_plan_cost(task, steps)
     except PlanValidationError as error:
         return str(error)
     return None

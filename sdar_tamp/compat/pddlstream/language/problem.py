@@ -26,7 +26,7 @@ from typing import Any
 
 from sdar_tamp.compat.pddlstream.language.object import DebugValue, SharedDebugValue
 from sdar_tamp.language.errors import StreamMapError
-from sdar_tamp.language.model import Domain, StreamFile
+from sdar_tamp.language.model import TOTAL_COST, Domain, StreamFile
 from sdar_tamp.language.pddl import parse_domain
 from sdar_tamp.language.problem import PDDLProblem as _CorePDDLProblem
 from sdar_tamp.language.streams import parse_stream_file
@@ -35,7 +35,6 @@ LOG = logging.getLogger(__name__)
 DEBUG = "debug"
 SHARED_DEBUG = "shared_debug"
 DEBUG_MODES = (DEBUG, SHARED_DEBUG)
-TOTAL_COST = "total-cost"
 
 
 def parse_stream_files(stream_pddl: Any, domain: Domain) -> StreamFile:
