@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -25,6 +26,7 @@ from sdar_tamp.textfile import read_text
 DEMO_DOMAIN = "dual_arm_rearrangement"
 DEMO_INSTANCE = "suites/paper/M1.yaml"
 _FORCE = "replace output files that exist (default: refuse)"
+_JSON = "print one JSON object (machine-readable) instead of the text summary"
 
 
 def _read(path: Path) -> str:
@@ -119,8 +121,11 @@ def cmd_demo(args: argparse.Namespace) -> int:
     from sdar_tamp.viewer import write_html, write_storyboard
 
     instance = domain_file(DEMO_DOMAIN, DEMO_INSTANCE)
-    out = output_folder(args.out or Path(tempfile.gettempdir()) / "sdar-demo", name="--out")
-    out.mkdir(parents=True, exist_ok=True)
+    if args.output is None:
+        out = Path(tempfile.mkdtemp(prefix="sdar-demo-"))  # a fresh folder per run
+    else:
+        out = output_folder(args.output, name="--output")
+        out.mkdir(parents=True, exist_ok=True)
     print(f"Solving the shipped mixed instance {DEMO_INSTANCE} (12 objects) with SDAR:")
     bar = ProgressBar(instance.stem)
     try:
@@ -149,7 +154,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
     if args.output is not None:
         output_file(args.output, suffixes=(".json",), force=args.force)
-    bar = ProgressBar(f"{args.instance.stem}") if not args.quiet else None
+    bar = ProgressBar(f"{args.instance.stem}") if not (args.quiet or args.json) else None
     try:
         config = PlannerConfig(
             task_planner=args.task_planner,
@@ -164,9 +169,18 @@ def cmd_solve(args: argparse.Namespace) -> int:
     finally:
         if bar is not None:
             bar.close()
-    print(format_summary(outcome))
+    written = None
     if outcome.plan is not None and args.output is not None:
-        print(f"wrote {save_plan(outcome.plan, args.output)}")
+        written = save_plan(outcome.plan, args.output)
+    if args.json:
+        from sdar_tamp.app.summary import summary_record
+
+        record = summary_record(outcome, plan_file=written)
+        print(json.dumps(record, sort_keys=True))
+    else:
+        print(format_summary(outcome))
+        if written is not None:
+            print(f"wrote {written}")
     return 0 if outcome.success else 1
 
 
@@ -214,7 +228,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     """Replay a plan file on an instance and check it independently of the planner."""
     from sdar_tamp.replay import run_validate
 
-    return run_validate(args.instance, args.plan)
+    return run_validate(args.instance, args.plan, as_json=args.json)
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
@@ -345,6 +359,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="sync: both arms on one synchronous timeline; async: each arm on its own, "
         "kept only when shorter and collision-free (default: sync)",
     )
+    solve.add_argument("--json", action="store_true", help=_JSON + " (implies -q)")
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     solve.set_defaults(func=cmd_solve)
 
@@ -376,6 +391,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     validate.add_argument("instance", type=Path, help="instance YAML")
     validate.add_argument("plan", type=Path, help="plan JSON")
+    validate.add_argument("--json", action="store_true", help=_JSON)
     validate.set_defaults(func=cmd_validate)
 
     bench = sub.add_parser(
@@ -411,17 +427,54 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument(
         "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="seconds (default: 60)"
     )
-    demo.add_argument("--out", type=Path, default=None, help="output folder (default: temp)")
+    demo.add_argument(
+        "-o",
+        "--output",
+        "--out",
+        dest="output",
+        type=Path,
+        default=None,
+        help="output folder (default: a new folder sdar-demo-* in the temporary directory)",
+    )
     demo.set_defaults(func=cmd_demo)
 
     add_export_parser(sub)  # sdar export, defined in sdar_tamp/export/command.py
+    for command in sub.choices.values():
+        _add_logging_options(command)
     return parser
+
+
+LOG_LEVELS = ("debug", "info", "warning", "error")
+
+
+def _add_logging_options(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_argument_group("logging")
+    group.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
+        help="more log lines on stderr: -v info, -vv debug (default: warnings only)",
+    )
+    group.add_argument(
+        "--log-level", choices=LOG_LEVELS, default=None, help="log level (overrides -v)"
+    )
+
+
+def _configure_logging(args: argparse.Namespace) -> None:
+    """The command line is a program: it owns the root handler and the package's level."""
+    import logging
+
+    name = args.log_level or ("warning", "info", "debug")[min(getattr(args, "verbose", 0), 2)]
+    logging.basicConfig(format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr)
+    logging.getLogger("sdar_tamp").setLevel(name.upper())
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
+    _configure_logging(args)
     try:
         return func(args)
     except SdarError as error:

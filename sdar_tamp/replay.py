@@ -30,6 +30,7 @@ The README section "What `sdar validate` checks" lists every rule with its toler
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -151,21 +152,33 @@ def validate_plan(
     return validator.validate(instance, plan)
 
 
-def run_validate(instance_path: Path, plan_path: Path) -> int:
-    """``sdar validate``: print the verdict; 0 when valid, 1 when not. Bad files raise."""
+def run_validate(instance_path: Path, plan_path: Path, *, as_json: bool = False) -> int:
+    """``sdar validate``: print the verdict (one JSON object with ``as_json``); 0 when valid,
+    1 when not. Bad files raise."""
     instance = load_instance(instance_path)
     plan = load_plan(plan_path)
     scene = load_scene(instance.scene_path(Path(instance_path)))
     report = validate_plan(instance, plan, scene)
-    if report.violation is None:
+    v = report.violation
+    if as_json:
+        record = {
+            "valid": v is None,
+            "instance": instance.name,
+            "plan": str(plan_path),
+            "events": len(plan.events),
+            "checks": report.checks,
+            "duration": plan.duration,
+            "violation": None if v is None else {"t": v.t, "kind": v.kind, "message": v.message},
+        }
+        print(json.dumps(record, sort_keys=True))
+    elif v is None:
         print(
             f"valid: {len(plan.events)} gripper events, {report.checks} collision checks, "
             f"duration {plan.duration:.2f} s"
         )
-        return 0
-    v = report.violation
-    print(f"invalid at t={v.t:.3f}s: {v.kind}: {v.message}")
-    return 1
+    else:
+        print(f"invalid at t={v.t:.3f}s: {v.kind}: {v.message}")
+    return 0 if v is None else 1
 
 
 def _pose_error(T_a: FloatArray, T_b: FloatArray) -> tuple[float, float]:

@@ -31,6 +31,33 @@ def format_summary(outcome: SolveOutcome) -> str:
     return "\n".join(lines)
 
 
+def summary_record(outcome: SolveOutcome, plan_file: Any = None) -> dict[str, Any]:
+    """The run as one JSON-ready object (``sdar solve --json``): status, validity, the plan's
+    metrics, the run's figures and, without a plan, the diagnosis."""
+    f = outcome.figures
+    record: dict[str, Any] = {
+        "instance": outcome.instance.name,
+        "status": outcome.status,
+        "valid": outcome.valid,
+        "violation": outcome.violation or None,
+        "plan_file": None if plan_file is None else str(plan_file),
+        "metrics": {} if outcome.plan is None else dict(outcome.plan.metrics),
+        "figures": {
+            "planning_time": f.planning_time,
+            "selection_time": f.selection_time,
+            "motion_time": f.motion_time,
+            "setup_time": f.setup_time,
+            "schedule_time": f.schedule_time,
+            "step_time_median": f.step_time_median,
+            "step_time_max": f.step_time_max,
+            "buffer_moves": f.buffer_moves,
+            "levels": dict(f.levels),
+        },
+        "diagnosis": list(outcome.diagnosis),
+    }
+    return record
+
+
 def _async_note(metrics: Any, schedule_time: float) -> str:
     """How the asynchronous schedule changed the execution time (empty for a sync run)."""
     if schedule_time <= 0.0:

@@ -45,9 +45,13 @@ def test_solve_writes_a_plan_that_validates(
 ) -> None:
     instance = domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml")
     plan = tmp_path / "S4.json"
-    assert main(["solve", str(instance), "-o", str(plan), "-q", "--seed", "3"]) == 0
-    out = capsys.readouterr().out
-    assert "S4: solved, plan valid" in out and "synchronous steps" in out
+    assert main(["solve", str(instance), "-o", str(plan), "--json", "--seed", "3"]) == 0
+    captured = capsys.readouterr()
+    record = json.loads(captured.out)  # --json: one object on stdout, no progress bar
+    assert captured.err == ""
+    assert (record["instance"], record["status"], record["valid"]) == ("S4", "solved", True)
+    assert record["plan_file"] == str(plan) and record["metrics"]["actions"] >= 4
+    assert record["figures"]["planning_time"] > 0 and record["violation"] is None
     assert main(["validate", str(instance), str(plan)]) == 0
     data = json.loads(plan.read_text())
     assert data["format"] == "sdar-plan" and data["metrics"]["task_planner"] == "sdar"
@@ -141,3 +145,51 @@ def test_generate_rejects_a_bad_object_count(
     assert main(["generate", "--family", "S", "--objects", "1", "-o", str(out)]) == 2
     assert "family S needs at least 2, got 1" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_demo_writes_a_fresh_folder_per_run(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without -o each demo run gets its own new folder under the temporary directory."""
+    import tempfile
+
+    import sdar_tamp.app.command as command
+    from sdar_tamp.app.records import RunFigures, SolveOutcome
+    from sdar_tamp.world.instance import load_instance
+
+    instance = load_instance(domain_file("dual_arm_rearrangement", "suites/paper/M1.yaml"))
+    figures = RunFigures("sdar", "sdar", 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    failed = SolveOutcome(instance, "timeout", None, False, "no plan", figures)
+    monkeypatch.setattr(command, "solve_instance", lambda *a, **k: failed)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    assert main(["demo"]) == 1 and main(["demo"]) == 1  # no plan: exit 1, folders made
+    folders = sorted(p.name for p in tmp_path.iterdir())
+    assert len(folders) == 2 and all(f.startswith("sdar-demo-") for f in folders)
+    assert "M1: timeout" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("flags", "level"),
+    [
+        ([], "WARNING"),
+        (["-v"], "INFO"),
+        (["-vv"], "DEBUG"),
+        (["-vvv", "--log-level", "error"], "ERROR"),
+    ],
+)
+def test_log_level_options_set_the_package_logger(
+    flags: list[str], level: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import logging
+
+    logger = logging.getLogger("sdar_tamp")
+    monkeypatch.setattr(logger, "level", logger.level)  # restored after the test
+    assert main(["check", str(domain_file("blocksworld")), *flags]) == 0
+    assert logging.getLevelName(logger.level) == level
+
+
+def test_an_unknown_log_level_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["check", str(domain_file("blocksworld")), "--log-level", "loud"])
+    assert info.value.code == 2
+    assert "argument --log-level: invalid choice: 'loud'" in capsys.readouterr().err

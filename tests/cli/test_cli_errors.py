@@ -189,7 +189,8 @@ def test_solve_checks_its_output_before_planning(
 def test_demo_output_folder_is_checked(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     afile = tmp_path / "f"
     afile.write_text("")
-    assert "--out: expected a folder" in refused(["demo", "--out", str(afile)], capsys)
+    assert "--output: expected a folder" in refused(["demo", "--out", str(afile)], capsys)
+    assert "--output: expected a folder" in refused(["demo", "-o", str(afile)], capsys)
 
 
 def test_a_failed_write_is_one_line(

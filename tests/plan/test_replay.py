@@ -7,6 +7,7 @@ the left arm picks o1 at its start, places it at its goal and returns home; o2 n
 from __future__ import annotations
 
 import dataclasses
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -328,6 +329,12 @@ def test_sdar_validate_exit_codes(
     assert main(["validate", str(instance), str(bad)]) == 1
     out = capsys.readouterr().out
     assert out.startswith("invalid at t=") and "s: final poses: o1 ends at" in out
+    assert main(["validate", str(instance), str(bad), "--json"]) == 1
+    record = json.loads(capsys.readouterr().out)
+    assert record["valid"] is False and record["violation"]["kind"] == "final poses"
+    assert main(["validate", str(instance), str(good), "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["valid"] is True and record["violation"] is None and record["checks"] > 0
     assert main(["validate", str(instance), str(tmp_path / "none.json")]) == 2
     assert "none.json: cannot read file" in capsys.readouterr().err
     broken = tmp_path / "broken.json"
