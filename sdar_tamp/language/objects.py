@@ -22,6 +22,11 @@ def _key(value: Any) -> tuple[str, Any]:
     return ("id", id(value))
 
 
+def keyed_by_identity(value: Any) -> bool:
+    """Is ``value`` named by identity (unhashable: it may change while it keeps its name)?"""
+    return _key(value)[0] == "id"
+
+
 class ObjectTable:
     """Assigns names to values and gives the values back."""
 

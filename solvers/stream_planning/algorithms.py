@@ -9,8 +9,11 @@
 - binding: as focused, but walk the whole stream plan, binding placeholders to the outputs of
   earlier calls, so one pass can turn an optimistic plan into a real one.
 - adaptive: binding with a queue of skeletons (optimistic plans) that are revisited; after each
-  search, each queued skeleton is worked on about ``search_sample_ratio`` times. The balance is
-  counted in visits, not measured in seconds, so a seeded run is reproducible.
+  search, each queued skeleton is worked on about ``search_sample_ratio`` times, and after a
+  search that found no new plan the queue may go on until its stream calls reach
+  ``search_sample_ratio`` times the facts that search planned over (the next search, at a
+  higher level, costs at least as much). The balance is counted in visits and calls, not
+  measured in seconds, so a seeded run is reproducible.
 
 A ``:fluents`` stream is called with the fluent facts of the state of the step that uses its
 certified facts (:mod:`.fluents`); what it certifies holds in that state only, so it never
@@ -140,6 +143,7 @@ class StreamSolver:
         self.use_costs = not options.unit_costs and has_costs(problem.domain)
         self.queue: list[Skeleton] = []
         self._order = 0
+        self._calls = 0  # stream calls made so far (the queue's work is counted in calls)
         self._unreachable = False  # the last plan search found the goal relaxed-unreachable
 
     # --- helpers --------------------------------------------------------------------------
@@ -235,6 +239,7 @@ class StreamSolver:
 
     def _sample_state(self, state: InstanceState) -> bool:
         start = time.perf_counter()
+        self._calls += 1
         produced = self.engine.sample(state)
         self.stats["sample_time"] += time.perf_counter() - start
         return produced
@@ -398,7 +403,7 @@ class StreamSolver:
             if found is None:
                 # no new plan: work on the queued skeletons, and raise the level (what they
                 # wait for may lie above it)
-                if self.queue and self._process_queue():
+                if self.queue and self._process_queue(searched=len(world.facts)):
                     return Status.SOLVED
                 if not self.queue and self._complete(world, lazy):
                     return Status.INFEASIBLE
@@ -482,15 +487,25 @@ class StreamSolver:
             return None
         return self.engine.fluent_instance(name, inputs, fluents)
 
-    def _process_queue(self) -> bool:
-        """Work on queued skeletons, ``search_sample_ratio`` visits each; True when solved."""
-        visits = max(1, math.ceil(self.options.search_sample_ratio * len(self.queue)))
-        for _ in range(visits):
-            if not self.queue:
-                break
+    def _process_queue(self, searched: int = 0) -> bool:
+        """Work on queued skeletons; True when solved.
+
+        Each skeleton gets about ``search_sample_ratio`` visits. After a search over
+        ``searched`` facts that found no new plan, the queue may go on until its stream calls
+        reach ``search_sample_ratio * searched``: the next search (at a higher level, over a
+        larger world) costs at least as much as this one did, so sampling gets a share that
+        grows with the search's (as PDDLStream's sample time follows its search time, here
+        counted, so a seeded run is reproducible). A visit counts at least one call.
+        """
+        ratio = self.options.search_sample_ratio
+        budget = max(ratio * len(self.queue), ratio * searched, 1.0)  # inf: until solved
+        spent = 0
+        while spent < budget and self.queue:
             self._check_time()
             skeleton = heapq.heappop(self.queue)
+            before = self._calls
             outcome = self._process(skeleton)
+            spent += max(1, self._calls - before)
             if outcome is True:
                 return True
             if outcome is False:  # still possible: requeue behind the others

@@ -9,6 +9,7 @@ or ``:predicate`` must answer with a bool (:func:`truth_value`). Calls go throug
 
 from __future__ import annotations
 
+import copy
 import itertools
 import time
 from collections.abc import Callable, Iterator, Mapping
@@ -24,7 +25,7 @@ from sdar_tamp.language.generators import (
     truth_value,
 )
 from sdar_tamp.language.model import Atom, Stream, StreamFunction, StreamPredicate
-from sdar_tamp.language.objects import ObjectTable
+from sdar_tamp.language.objects import ObjectTable, keyed_by_identity
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.semantics import ground_atom
 from sdar_tamp.logs import get_logger
@@ -220,8 +221,23 @@ class StreamInstance:
                     f"{self.describe(table)} must produce tuples of {len(decl.outputs)} value(s) "
                     f"({' '.join(decl.outputs) or 'none: it is a test'}), got {output!r}"
                 )
-            names.append(tuple(table.name(value) for value in output))
+            names.append(tuple(self._name(value, table) for value in output))
         return names, wild
+
+    def _name(self, value: Any, table: ObjectTable) -> str:
+        """The object name of an output value. A generator that yields again an unhashable
+        object it yielded before (a dict or array it changes between yields) gives a new value
+        each time: the value as yielded now is copied and named anew, so every call can add
+        a new object, as it would had the generator built a fresh one."""
+        name = table.name(value)
+        if not keyed_by_identity(value) or not any(name in r.outputs for r in self.results):
+            return name
+        try:
+            snapshot = copy.deepcopy(value)
+        except Exception:  # deepcopy is not available for every object
+            LOG.debug("%s yielded an object again that cannot be copied", self.external.name)
+            return name
+        return table.name(snapshot)
 
 
 @dataclass
