@@ -6,6 +6,7 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from operator import attrgetter
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.errors import (
@@ -40,6 +41,11 @@ from sdar_tamp.language.model import (
     When,
 )
 from sdar_tamp.language.sexpr import SExpr, SList, Symbol
+
+# heads that make a list something else than an atom in a formula
+_NOT_ATOMS = frozenset({EQUALITY, "and", "or", "not", "imply", "exists", "forall"})
+
+_TEXT = attrgetter("text")
 
 MAX_FORMULA_DEPTH = 100
 """Formulas and effects nested deeper than this are rejected with a located error (they are
@@ -113,10 +119,13 @@ def parse_typed_list(
     result: list[tuple[str, str, Symbol]] = []
     pending: list[Symbol] = []
     index = 0
-    while index < len(items):
-        token = expect_symbol(items[index], what)
+    count = len(items)
+    while index < count:
+        token = items[index]
+        if not isinstance(token, Symbol):
+            token = expect_symbol(token, what)  # the error, located
         if token.text == "-":
-            if index + 1 >= len(items):
+            if index + 1 >= count:
                 raise PddlSyntaxError(f"expected a type name after '-' in {what}", token.location)
             type_node = items[index + 1]
             if isinstance(type_node, SList):
@@ -131,7 +140,7 @@ def parse_typed_list(
             pending = []
             index += 2
             continue
-        if variables != token.text.startswith("?"):
+        if variables != (token.text[0] == "?"):
             expected = "a variable starting with '?'" if variables else "a name (no '?')"
             raise PddlSyntaxError(
                 f"expected {expected} in {what}, found {token.text!r}", token.location
@@ -139,6 +148,8 @@ def parse_typed_list(
         pending.append(token)
         index += 1
     result.extend((name.text, OBJECT_TYPE, name) for name in pending)
+    if len({name for name, _, _ in result}) == len(result):
+        return result  # no name appears twice
     seen: set[str] = set()
     for name, _, token in result:
         if name in seen:
@@ -273,6 +284,43 @@ class FormulaReader:
             )
         return Atom(name, args)
 
+    def plain_atoms(self, nodes: Sequence[SExpr], scope: Mapping[str, str]) -> list[Atom | None]:
+        """Each node as an atom when it plainly is one, else None.
+
+        Plainly: a list of symbols whose head is a declared predicate (not ``=`` nor a formula
+        keyword) with as many arguments as its arity, each a known object or a variable bound
+        in ``scope``. That is what large ``:init`` sections and goals are made of, and it is
+        checked here in a few lookups per node; for a None the caller takes the general path,
+        which gives the same atom or the located error.
+        """
+        arity = self.vocabulary.predicates.get
+        known = self.vocabulary.constants.__contains__
+        atoms: list[Atom | None] = []
+        append = atoms.append
+        for node in nodes:
+            atom = None
+            items = node.items if type(node) is SList else ()
+            head = items[0] if items else None
+            if type(head) is Symbol:
+                try:
+                    args = tuple(map(_TEXT, items[1:]))
+                except AttributeError:  # a list among the arguments
+                    args = None
+                if (
+                    args is not None
+                    and arity(head.text) == len(args)
+                    and head.text not in _NOT_ATOMS
+                    and (all(map(known, args)) or self._bound(args, scope))
+                ):
+                    atom = Atom(head.text, args)
+            append(atom)
+        return atoms
+
+    def _bound(self, names: Sequence[str], scope: Mapping[str, str]) -> bool:
+        """Whether every name is an object or a variable bound in ``scope``."""
+        constants = self.vocabulary.constants
+        return all(name in scope if name[0] == "?" else name in constants for name in names)
+
     # --- formulas -----------------------------------------------------------------------------
 
     def formula(self, node: SExpr, scope: Mapping[str, str]) -> Formula:
@@ -290,7 +338,17 @@ class FormulaReader:
         keyword = head.text if isinstance(head, Symbol) else ""
         rest = lst.items[1:]
         if keyword == "and":
-            return And(tuple(self.formula(part, scope) for part in rest))
+            if self._depth >= MAX_FORMULA_DEPTH:  # a part would be too deep: the error, located
+                return And(tuple(self.formula(part, scope) for part in rest))
+            atoms = self.plain_atoms(rest, scope)
+            return And(
+                tuple(
+                    [
+                        self.formula(part, scope) if atom is None else atom
+                        for atom, part in zip(atoms, rest, strict=True)
+                    ]
+                )
+            )
         if keyword == "or":
             return Or(tuple(self.formula(part, scope) for part in rest))
         if keyword == "not":

@@ -12,7 +12,7 @@ predicates used only in ``:init`` or the goal...) is accepted and noted as a
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.errors import (
@@ -60,7 +60,7 @@ from sdar_tamp.language.model import (
     Problem,
     TypeHierarchy,
 )
-from sdar_tamp.language.sexpr import SExpr, SList, Symbol, read_sexpr
+from sdar_tamp.language.sexpr import SExpr, SList, Symbol, collector_paused, read_sexpr
 
 REQUIREMENTS = frozenset(
     {
@@ -375,6 +375,11 @@ def parse_problem(
         PddlError: a subclass naming ``file:line:col`` and what was expected.
         StrictModeError: ``strict=True`` and the problem needs a leniency.
     """
+    with collector_paused():
+        return _parse_problem(text, domain, filename, strict)
+
+
+def _parse_problem(text: str, domain: Domain, filename: str | None, strict: bool) -> Problem:
     root = read_sexpr(text, filename)
     log = LeniencyLog(strict)
     note_glued_variables(root, log)
@@ -413,25 +418,26 @@ def parse_problem(
                     section.location,
                 )
         elif keyword == ":objects":
-            for obj, type_name, token in parse_typed_list(
-                section.items[1:], "the objects", types, variables=False
-            ):
-                if obj in own:
-                    raise DuplicateError(f"object {obj!r} is declared twice", token.location)
-                own[obj] = type_name
-                objects[obj] = type_name
+            # (a name declared twice is rejected there)
+            parsed = parse_typed_list(section.items[1:], "the objects", types, variables=False)
+            own = {obj: type_name for obj, type_name, _ in parsed}
+            objects.update(own)
     init: list[Atom] = []
     numeric: dict[tuple[str, tuple[str, ...]], float] = {}
     goal = TRUE
     minimize = False
-    located: list[tuple[Atom, SExpr]] = []
+    init_nodes: list[SExpr] = []  # where each initial fact is
     for keyword, section in sections:
         if keyword == ":init":
-            for node in section.items[1:]:
-                atom = _init_fact(node, reader, numeric)
+            nodes = section.items[1:]
+            derived = vocabulary.derived
+            plain_atoms = reader.plain_atoms(nodes, {})
+            for node, atom in zip(nodes, plain_atoms, strict=True):
+                if atom is None or atom.predicate in derived:
+                    atom = _init_fact(node, reader, numeric)  # the general case, or the error
                 if atom is not None:
-                    located.append((atom, node))
                     init.append(atom)
+                    init_nodes.append(node)
         elif keyword == ":goal":
             if len(section.items) != 2:
                 raise PddlSyntaxError("expected '(:goal formula)'", section.location)
@@ -442,7 +448,7 @@ def parse_problem(
         raise PddlSyntaxError(
             f"expected a '(:goal ...)' section in problem {name!r}", root.location
         )
-    _check_init_types(located, domain, objects, log)
+    _check_init_types(init, init_nodes, domain, objects, log)
     for predicate, location in (vocabulary.implicit_predicates or {}).items():
         log.add(
             IMPLICIT_PREDICATE,
@@ -497,43 +503,52 @@ def _init_fact(
 
 
 def _check_init_types(
-    facts: Iterable[tuple[Atom, SExpr]],
+    facts: Sequence[Atom],
+    nodes: Sequence[SExpr],
     domain: Domain,
     objects: Mapping[str, str],
     log: LeniencyLog,
 ) -> None:
-    """Note an argument whose type is not the predicate's parameter type.
+    """Note an argument whose type is not the predicate's parameter type (``nodes[i]`` is
+    where ``facts[i]`` is written).
 
     An object's type is its declared one, or a subtype given by a unary type fact in :init.
     """
-    facts = list(facts)
     hierarchy = domain.types
+    parents = hierarchy.parents
     types = dict(objects)
-    for atom, _ in facts:
-        if atom.predicate in hierarchy.parents and len(atom.args) == 1:
+    for atom in facts:
+        if atom.predicate in parents and len(atom.args) == 1:
             current = types.get(atom.args[0], OBJECT_TYPE)
             if hierarchy.is_subtype(atom.predicate, current):
                 types[atom.args[0]] = atom.predicate
-    subtype: dict[tuple[str, str], bool] = {}  # (type, expected type) -> is a subtype
-    for atom, node in facts:
-        declaration = domain.predicates.get(atom.predicate)
-        if declaration is None:
+    # (predicate, the types of its arguments) -> the arguments that do not fit, as (position,
+    # expected type): the facts are many, the combinations of types few
+    misfits: dict[tuple[str, ...], list[tuple[int, str]]] = {}
+    declarations = domain.predicates
+    type_of = types.get
+    untyped = itertools.repeat(OBJECT_TYPE)
+    for index, atom in enumerate(facts):
+        if atom.predicate not in declarations:
             continue
-        for position, (arg, parameter) in enumerate(
-            zip(atom.args, declaration.parameters, strict=True), 1
-        ):
-            own = types.get(arg, OBJECT_TYPE)
-            key = (own, parameter.type)
-            fits = subtype.get(key)
-            if fits is None:
-                fits = subtype[key] = hierarchy.is_subtype(own, parameter.type)
-            if not fits:
-                log.add(
-                    INIT_TYPE,
-                    f"argument {position} of {atom} is {arg!r} of type {own!r}, but "
-                    f"{atom.predicate!r} expects a {parameter.type!r}",
-                    node.location,  # worked out only for a fact that is noted
+        key = (atom.predicate, *map(type_of, atom.args, untyped))
+        found = misfits.get(key)
+        if found is None:
+            parameters = declarations[atom.predicate].parameters
+            found = misfits[key] = [
+                (position, parameter.type)
+                for position, (own, parameter) in enumerate(
+                    zip(key[1:], parameters, strict=True), 1
                 )
+                if not hierarchy.is_subtype(own, parameter.type)
+            ]
+        for position, expected in found:
+            log.add(
+                INIT_TYPE,
+                f"argument {position} of {atom} is {atom.args[position - 1]!r} of type "
+                f"{key[position]!r}, but {atom.predicate!r} expects a {expected!r}",
+                nodes[index].location,  # worked out only for a fact that is noted
+            )
 
 
 def _metric(section: SList) -> bool:

@@ -11,6 +11,8 @@ from __future__ import annotations
 import gc
 import re
 from bisect import bisect_right
+from collections.abc import Iterator
+from contextlib import contextmanager
 from itertools import accumulate
 from typing import NamedTuple, TypeAlias
 
@@ -24,6 +26,7 @@ from sdar_tamp.language.errors import PddlSyntaxError
 _SPLIT = re.compile(r"(;[^\n]*|[()]|[^ \t\r\n\f\v();][^ \t\r\n\f\v();?]*)")
 _SYMBOL = re.compile(r"[^ \t\r\n\f\v();][^ \t\r\n\f\v();?]*")
 _NEWLINE = re.compile(r"\n")
+_GLUE_BREAKS = frozenset(" \t\r\n\f\v()")  # a '?' after one of these starts a token anyway
 
 
 class SourceText:
@@ -126,6 +129,23 @@ class SList(NamedTuple):
 SExpr: TypeAlias = Symbol | SList
 
 
+@contextmanager
+def collector_paused() -> Iterator[None]:
+    """Pause Python's cyclic garbage collector meanwhile (and restore it as it was).
+
+    Parsing builds many objects and no reference cycles, so the collector can only waste time
+    on them (a third of the reading time on large files); memory is freed as usual, by
+    reference counting.
+    """
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if collecting:
+            gc.enable()
+
+
 def read_sexpr(text: str, filename: str | None = None) -> SList:
     """Read exactly one top-level list from ``text``.
 
@@ -133,15 +153,8 @@ def read_sexpr(text: str, filename: str | None = None) -> SList:
         PddlSyntaxError: unbalanced parentheses, an empty source or text after the list.
     """
     source = SourceText(text, filename)
-    # Building the tree creates no reference cycles, so the cyclic garbage collector can only
-    # waste time on it (a third of the reading time on large files): it is paused meanwhile.
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
+    with collector_paused():
         top, stack = _build(source)
-    finally:
-        if collecting:
-            gc.enable()
     _check_top(top, source)
     if stack:
         if top:
@@ -175,30 +188,28 @@ def _build(source: SourceText) -> tuple[list[SExpr], list[tuple[int, list[SExpr]
     stack: list[tuple[int, list[SExpr]]] = []
     items = top  # the items of the innermost open list
     glued = source.glued
-    after_symbol = False  # the token before this one is a symbol
-    for index in range(1, len(parts), 2):
-        token = parts[index]
-        first = token[0]
-        if first == "?" and after_symbol and not parts[index - 1]:
-            glued.append(ends[index - 1])
-        after_symbol = first not in "();"
-        if first == "(":
-            stack.append((ends[index - 1], items))
+    # parts[0::2] are the separators, so ends[0::2] are where the tokens start
+    for start, token in zip(ends[:-1:2], parts[1::2], strict=True):
+        if token == "(":
+            stack.append((start, items))
             items = []
-        elif first == ")":
+        elif token == ")":
             if not stack:
                 _check_top(top, source)
                 raise PddlSyntaxError(
-                    "unbalanced parentheses: ')' without a matching '('",
-                    source.location(ends[index - 1]),
+                    "unbalanced parentheses: ')' without a matching '('", source.location(start)
                 )
-            start, parent = stack.pop()
-            parent.append(new(SList, (tuple(items), start, source)))
+            begin, parent = stack.pop()
+            parent.append(new(SList, (tuple(items), begin, source)))
             items = parent
-        elif first != ";":
+        elif token[0] != ";":
+            # a '?' right after a symbol (no whitespace, no parenthesis, and a comment always
+            # ends before a line break) was split off it
+            if token[0] == "?" and start and text[start - 1] not in _GLUE_BREAKS:
+                glued.append(start)
             if not ascii_text:
                 token = token.lower()
-            items.append(new(Symbol, (token, ends[index - 1], source)))
+            items.append(new(Symbol, (token, start, source)))
     return top, stack
 
 
