@@ -195,6 +195,7 @@ class _Replay:
     ) -> None:
         self.instance, self.plan, self.scene, self.step = instance, plan, scene, step
         self.kins = kins
+        self.layout = scene.layout
         self.sizes = {o.name: o.size for o in instance.objects}
         self.rest = {o.name: o.start.as_tuple() for o in instance.objects}
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
@@ -209,8 +210,7 @@ class _Replay:
         return ObjectBox(pose_xyz_yaw(pose[0], pose[1], size[2] / 2.0, pose[2]), size)
 
     def arm_q(self, arm: str, q: FloatArray) -> FloatArray:
-        i = self.scene.arm_names.index(arm)
-        return q[6 * i : 6 * i + 6]
+        return self.layout.part(q, arm)
 
     def tcp(self, arm: str, q: FloatArray) -> FloatArray:
         return self.kins[arm].fk_tcp(self.arm_q(arm, q))
@@ -223,10 +223,10 @@ class _Replay:
         for arm, (_, q_event) in list(self.exempt.items()):
             if np.abs(self.arm_q(arm, q) - q_event).max() > STILL_TOL:
                 del self.exempt[arm]  # the arm has moved: contact counts again
-        if not self.world.in_collision(q[:6], q[6:]):
+        if not self.world.in_collision(q):
             self.free = q.copy()
             return None
-        pairs = [p for p in self.world.report(q[:6], q[6:]) if not self.allowed(p)]
+        pairs = [p for p in self.world.report(q) if not self.allowed(p)]
         if not pairs:
             return None
         text = ", ".join(f"{p.first} with {p.second}" for p in pairs[:3])
@@ -241,15 +241,16 @@ class _Replay:
         return False
 
     def tcp_positions(self, q: FloatArray) -> FloatArray:
-        """Both TCP positions ``(m, 2, 3)`` [m] for ``q`` ``(m, 12)`` (closed-form FK)."""
+        """Every arm's TCP position ``(m, arms, 3)`` [m] for ``q`` ``(m, dof)`` (closed-form
+        FK)."""
         out = []
-        for i, arm in enumerate(self.scene.arm_names):
+        for arm in self.layout:
             kin = self.kins[arm]
-            out.append((kin.fk_batch(q[:, 6 * i : 6 * i + 6]) @ kin.T_tool0_tcp)[:, :3, 3])
+            out.append((kin.fk_batch(self.layout.part(q, arm)) @ kin.T_tool0_tcp)[:, :3, 3])
         return np.stack(out, axis=1)
 
     def subdivisions(self, q: FloatArray) -> NDArray[np.int_]:
-        """Per interval of ``q`` ``(K, 12)``: the number of linear steps after which no TCP
+        """Per interval of ``q`` ``(K, dof)``: the number of linear steps after which no TCP
         has moved more than ``self.step`` [m] (refined until it holds)."""
         chord = np.linalg.norm(np.diff(self.tcp_positions(q), axis=0), axis=2).max(axis=1)
         n: NDArray[np.int_] = np.maximum(1, np.ceil(chord / self.step)).astype(int)
@@ -273,7 +274,8 @@ class _Replay:
         plan = self.plan
         knot_t = np.union1d(plan.t, [e.t for e in plan.events])
         knot_t = knot_t[: int(np.searchsorted(knot_t, t_stop)) + 1]  # the last one: to t_stop
-        knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in range(12)], axis=1)
+        columns = range(self.layout.dof)
+        knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in columns], axis=1)
         counts = self.subdivisions(knot_q) if len(knot_t) > 1 else np.zeros(0, dtype=int)
         pending = list(plan.events)
         for k, tk in enumerate(knot_t):
@@ -303,7 +305,7 @@ class _Replay:
         return self.final(float(knot_t[-1]))
 
     def apply(self, e: PlanEvent, q: FloatArray, t: float) -> Violation | None:
-        """Check and perform one gripper event at configuration ``q`` ``(12,)``."""
+        """Check and perform one gripper event at configuration ``q`` ``(dof,)``."""
         self.free = None  # the world changes
         T_world_tcp = self.tcp(e.arm, q)
         if e.type == "grasp":
