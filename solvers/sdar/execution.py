@@ -11,8 +11,9 @@ import time
 from collections.abc import Sequence
 
 from sdar_tamp.language.model import Atom
+from solvers.sdar.attempts import MotionMode
 from solvers.sdar.cache import StreamCache
-from solvers.sdar.grounding import Grounding, MotionMode
+from solvers.sdar.grounding import Grounding
 from solvers.sdar.report import Failures, TaskRecord
 
 

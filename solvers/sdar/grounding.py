@@ -5,17 +5,17 @@ For a candidate step and an assignment of arms, :class:`Grounder` asks the strea
 dual-arm configurations (or, for the one-arm-at-a-time motion planner, a sequence of gripper
 events with the other arm at home) and ranks the groundings by the task planner's rank and
 then by the estimated motion time. Groundings that failed before are skipped (see
-:class:`TabuLists`).
+:class:`~solvers.sdar.attempts.TabuLists`).
 """
 
 from __future__ import annotations
 
-import enum
 import itertools
 from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.report import Failures
@@ -23,13 +23,6 @@ from solvers.sdar.tasks import Move, Step
 
 if TYPE_CHECKING:
     from solvers.sdar.solver import SdarOptions
-
-
-class MotionMode(enum.Enum):
-    """Which motion stream an attempt uses: the quick one (no fallbacks) or the full one."""
-
-    QUICK = "quick"
-    FULL = "full"
 
 
 @dataclass(frozen=True)
@@ -62,21 +55,6 @@ class Grounding:
     d_place: str
     estimate: float
     sequence: tuple[Event, ...] = ()  # one arm at a time only
-
-
-class TabuLists:
-    """Groundings that failed: with the full motion stream (never tried again) and with the
-    quick one (not tried again with the quick stream)."""
-
-    def __init__(self) -> None:
-        self._full: set[Hashable] = set()
-        self._quick: set[Hashable] = set()
-
-    def blocked(self, key: Hashable, mode: MotionMode) -> bool:
-        return key in self._full or (mode is MotionMode.QUICK and key in self._quick)
-
-    def add(self, key: Hashable, mode: MotionMode) -> None:
-        (self._quick if mode is MotionMode.QUICK else self._full).add(key)
 
 
 class Grounder:

@@ -17,9 +17,10 @@ Every applied action is checked against the domain's lifted precondition
 
 The parts, around one :class:`~solvers.sdar.cache.StreamCache` (streams bound once, their
 outputs and the lifted state): :mod:`~solvers.sdar.grounding` (options, dual-arm
-configurations, tabu lists), :mod:`~solvers.sdar.execution` (motions and actions),
+configurations), :mod:`~solvers.sdar.execution` (motions and actions),
 :mod:`~solvers.sdar.recovery` (evictions) and :mod:`~solvers.sdar.report` (records, the
-solution). This module holds the decision loop and the quick-stream ladder.
+solution), with :mod:`~solvers.sdar.attempts` (the motion mode of an attempt, the tabu lists and
+the quick-stream ladder). This module holds the decision loop.
 """
 
 from __future__ import annotations
@@ -34,10 +35,11 @@ from sdar_tamp.graph import DependencyGraph
 from sdar_tamp.language.model import And, Atom
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
+from solvers.sdar.attempts import MotionMode, QuickLadder, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.execution import Executor
-from solvers.sdar.grounding import Grounder, MotionMode, TabuLists
+from solvers.sdar.grounding import Grounder
 from solvers.sdar.recovery import Recovery
 from solvers.sdar.report import Failures, RunSummary, TaskRecord, build_solution
 from solvers.sdar.tasks import Step, TaskPlanner, TaskView
@@ -70,19 +72,6 @@ class Decision:
 
     start: float  # [s] (time.perf_counter)
     motion_time: float  # [s]
-
-
-@dataclass
-class QuickLadder:
-    """The groundings of the best rank tried with the quick motion stream first: ``left``
-    attempts remain; ``best_rank`` is the rank of the first grounding found with it."""
-
-    left: int
-    best_rank: int | None = None
-
-    @property
-    def mode(self) -> MotionMode:
-        return MotionMode.QUICK if self.left > 0 else MotionMode.FULL
 
 
 class SdarSolver:

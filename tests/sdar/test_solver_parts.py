@@ -3,10 +3,9 @@ deadline and the failure record."""
 
 from __future__ import annotations
 
+from solvers.sdar.attempts import MotionMode, QuickLadder, TabuLists
 from solvers.sdar.budget import Deadline
-from solvers.sdar.grounding import MotionMode, TabuLists
 from solvers.sdar.report import Failures
-from solvers.sdar.solver import QuickLadder
 from solvers.sdar.tasks import Move, Step
 
 
