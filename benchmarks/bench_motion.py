@@ -105,7 +105,7 @@ def hard_set(instance: str, seed: int, count: int) -> None:
             continue
         q0 = np.concatenate([qs[0][0], qs[1][0]])
         q1 = np.concatenate([qs[0][1], qs[1][1]])
-        if world.in_collision(q0[:6], q0[6:]) or world.in_collision(q1[:6], q1[6:]):
+        if world.in_collision(q0) or world.in_collision(q1):
             continue
         moving = (True, kind == "both_arms")
         request = MotionRequest(q0, q1, objects, retreat=moving, approach=moving)

@@ -59,8 +59,8 @@ def realistic_configurations(
 
 def bench_collision(world: CollisionWorld, Q: FloatArray) -> tuple[float, float]:
     """Dual-arm checks per second and the fraction found colliding."""
-    hits = [world.in_collision(q[:6], q[6:]) for q in Q]
-    rate = _best_rate(lambda: [world.in_collision(q[:6], q[6:]) for q in Q], len(Q), 3)
+    hits = [world.in_collision(q) for q in Q]
+    rate = _best_rate(lambda: [world.in_collision(q) for q in Q], len(Q), 3)
     return rate, float(np.mean(hits))
 
 

@@ -34,6 +34,7 @@ import numpy as np
 
 from sdar_tamp.errors import ParameterError, SdarError, SourceLocation
 from sdar_tamp.textfile import read_text
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
 
@@ -46,6 +47,9 @@ MAX_DEPTH = 64  #: deepest nesting of JSON lists and objects a plan file may hav
 #: After its gripper event an arm stands still this long [s] (the gripper closes or opens;
 #: the 2F-85 takes about half a second). :func:`build_plan_file` keeps both arms still.
 GRIPPER_DWELL = 0.5
+#: Arms of a version-1 plan file, and joints per arm (the in-memory plan goes by its layout).
+FILE_ARMS = 2
+FILE_ARM_JOINTS = 6
 
 
 def plan_joint_names(arm: str, robot_joints: Sequence[str]) -> tuple[str, ...]:
@@ -70,7 +74,8 @@ def readonly(value: Any) -> FloatArray:
 
 @dataclass(frozen=True, eq=False)
 class ArmInfo:
-    """One arm: name, joint names, base and tool frames ``(4, 4)``, home ``(6,)`` [rad]."""
+    """One arm: name, joint names, base and tool frames ``(4, 4)``, home ``(joints,)``
+    [rad]."""
 
     name: str
     joints: tuple[str, ...]
@@ -112,11 +117,12 @@ class StepRecord:
 
 @dataclass(frozen=True, eq=False)
 class PlanFile:
-    """A timed plan: samples ``q`` ``(n, 12)`` [rad] at ``t`` ``(n,)`` [s], gripper events,
-    final object poses ``name -> (x, y, yaw)`` [m, m, rad] and metrics."""
+    """A timed plan: samples ``q`` ``(n, layout.dof)`` [rad] at ``t`` ``(n,)`` [s] (the arms'
+    joints in ``arms`` order), gripper events, final object poses ``name -> (x, y, yaw)``
+    [m, m, rad] and metrics."""
 
     instance: str
-    arms: tuple[ArmInfo, ArmInfo]
+    arms: tuple[ArmInfo, ...]
     t: FloatArray
     q: FloatArray
     events: tuple[PlanEvent, ...]
@@ -134,8 +140,14 @@ class PlanFile:
         return float(self.t[-1])
 
     @property
-    def arm_names(self) -> tuple[str, str]:
-        return self.arms[0].name, self.arms[1].name
+    def arm_names(self) -> tuple[str, ...]:
+        return tuple(a.name for a in self.arms)
+
+    @property
+    def layout(self) -> ArmLayout:
+        """The arms' joints in ``q``, each arm as many as its home configuration has (raises
+        :class:`ArmLayoutError` for repeated names)."""
+        return ArmLayout(self.arm_names, tuple(len(a.home) for a in self.arms))
 
 
 # -- writing ----------------------------------------------------------------------------------
@@ -322,11 +334,14 @@ def plan_from_dict(data: Any, source: str = "<plan>") -> PlanFile:
         raise r.fail("version", f"expected {VERSION} (this reader), got {_show(top['version'])}")
     if top["units"] != UNITS:
         raise r.fail("units", f"expected {json.dumps(UNITS)}, got {_show(top['units'])}")
-    arms = tuple(_arm(r, a, f"arms[{i}]") for i, a in enumerate(r.items(top["arms"], "arms", 2)))
-    if arms[0].name == arms[1].name:
-        raise r.fail("arms[1].name", f"expected a name different from {arms[0].name!r}")
-    t, q = _trajectory(r, top["trajectory"])
-    events = _events(r, top["events"], (arms[0].name, arms[1].name), float(t[-1]))
+    items = r.items(top["arms"], "arms", FILE_ARMS)
+    arms = tuple(_arm(r, a, f"arms[{i}]") for i, a in enumerate(items))
+    for i, arm in enumerate(arms):
+        if arm.name in (a.name for a in arms[:i]):
+            raise r.fail(f"arms[{i}].name", f"expected a name different from {arm.name!r}")
+    layout = ArmLayout(tuple(a.name for a in arms), tuple(len(a.home) for a in arms))
+    t, q = _trajectory(r, top["trajectory"], layout.dof)
+    events = _events(r, top["events"], layout.names, float(t[-1]))
     final: dict[str, tuple[float, float, float]] = {}
     for name, pose in r.mapping(top["final_poses"], "final_poses", "object poses").items():
         x, y, yaw = r.vec(pose, f"final_poses.{name}", 3)
@@ -339,22 +354,22 @@ def plan_from_dict(data: Any, source: str = "<plan>") -> PlanFile:
         _step(r, s, f"steps[{i}]") for i, s in enumerate(r.items(top.get("steps", []), "steps"))
     )
     instance = r.text(top["instance"], "instance")
-    return PlanFile(instance, (arms[0], arms[1]), t, q, events, final, metrics, steps)
+    return PlanFile(instance, arms, t, q, events, final, metrics, steps)
 
 
 def _arm(r: _Reader, v: Any, key: str) -> ArmInfo:
     a = r.obj(v, key, ["name", "joints", "T_world_base", "T_tool0_tcp", "home"])
-    joints = r.items(a["joints"], f"{key}.joints", 6, "joint names")
+    joints = r.items(a["joints"], f"{key}.joints", FILE_ARM_JOINTS, "joint names")
     return ArmInfo(
         r.text(a["name"], f"{key}.name"),
         tuple(r.text(j, f"{key}.joints[{i}]") for i, j in enumerate(joints)),
         r.pose(a["T_world_base"], f"{key}.T_world_base"),
         r.pose(a["T_tool0_tcp"], f"{key}.T_tool0_tcp"),
-        r.vec(a["home"], f"{key}.home", 6),
+        r.vec(a["home"], f"{key}.home", len(joints)),
     )
 
 
-def _trajectory(r: _Reader, v: Any) -> tuple[FloatArray, FloatArray]:
+def _trajectory(r: _Reader, v: Any, dof: int) -> tuple[FloatArray, FloatArray]:
     traj = r.obj(v, "trajectory", ["t", "q"])
     t = np.array(
         [
@@ -365,7 +380,7 @@ def _trajectory(r: _Reader, v: Any) -> tuple[FloatArray, FloatArray]:
     if len(t) == 0:
         raise r.fail("trajectory.t", "expected at least one time, got an empty list")
     rows = r.items(traj["q"], "trajectory.q", len(t), "rows (one per time in trajectory.t)")
-    q = np.stack([r.vec(row, f"trajectory.q[{i}]", 12) for i, row in enumerate(rows)])
+    q = np.stack([r.vec(row, f"trajectory.q[{i}]", dof) for i, row in enumerate(rows)])
     if t[0] != 0.0:
         raise r.fail("trajectory.t[0]", f"expected 0, got {t[0]!r}")
     for i in range(1, len(t)):
@@ -380,7 +395,7 @@ def _trajectory(r: _Reader, v: Any) -> tuple[FloatArray, FloatArray]:
     return t, q
 
 
-def _events(r: _Reader, v: Any, arms: tuple[str, str], t_end: float) -> tuple[PlanEvent, ...]:
+def _events(r: _Reader, v: Any, arms: tuple[str, ...], t_end: float) -> tuple[PlanEvent, ...]:
     out: list[PlanEvent] = []
     for i, item in enumerate(r.items(v, "events", what="events")):
         key = f"events[{i}]"
@@ -427,7 +442,8 @@ def _step(r: _Reader, v: Any, key: str) -> StepRecord:
 # -- building a plan from segments and gripper events ---------------------------------------
 @dataclass(frozen=True, eq=False)
 class MotionSegment:
-    """One synchronous motion: samples ``q`` ``(m, 12)`` [rad] at ``t`` ``(m,)`` [s] from 0."""
+    """One synchronous motion: samples ``q`` ``(m, dof)`` [rad] (every arm, in the scene's
+    layout) at ``t`` ``(m,)`` [s] from 0."""
 
     t: FloatArray
     q: FloatArray
@@ -472,7 +488,7 @@ def build_plan_file(
     ``start_poses`` (``sizes`` must name the same objects), updated at every release from the
     tool pose (``T_world_tcp @ T_tcp_object`` projected on the table). Metrics: see
     :data:`COMPUTED_METRICS`; other entries of ``metrics`` are passed through. The timeline
-    starts at ``q_start`` ``(12,)``, else at the first segment's start, else at home.
+    starts at ``q_start`` ``(dof,)``, else at the first segment's start, else at home.
     """
     from sdar_tamp.world.kinematics import ArmKinematics  # pinocchio: imported on use
 
@@ -482,10 +498,11 @@ def build_plan_file(
         )
     if gripper_time < 0.0 or dt <= 0.0:
         raise ParameterError(f"gripper_time >= 0 and dt > 0 expected [s], got {gripper_time}, {dt}")
-    names = scene.arm_names
+    layout = scene.layout
+    names = layout.names
     kins = {a: ArmKinematics.from_scene(scene, a) for a in names}
     first = next((i for i in items if isinstance(i, MotionSegment)), None)
-    home = np.concatenate([np.array(a.home) for a in scene.arms])
+    home = scene.home
     q_now = np.array(q_start if q_start is not None else first.q[0] if first else home, float)
     ts, qs = [np.zeros(1)], [q_now[None]]
     now, dwell = 0.0, False
@@ -509,7 +526,7 @@ def build_plan_file(
                 held[item.arm] = item.object
                 continue
             actions += held.pop(item.arm, None) == item.object
-            q_arm = q_now[6 * names.index(item.arm) :][:6]
+            q_arm = layout.part(q_now, item.arm)
             T = kins[item.arm].fk_tcp(q_arm) @ np.asarray(item.T_tcp_object)
             final[item.object] = (float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0]))
             continue
@@ -519,9 +536,10 @@ def build_plan_file(
             qs.append(q_now[None])
         dwell = False
         t, q = np.asarray(item.t, dtype=np.float64), np.asarray(item.q, dtype=np.float64)
-        if t.ndim != 1 or q.shape != (len(t), 12) or len(t) == 0 or t[0] != 0.0:
+        if t.ndim != 1 or q.shape != (len(t), layout.dof) or len(t) == 0 or t[0] != 0.0:
             raise ParameterError(
-                f"items[{n}]: expected t (m,) from 0 and q (m, 12), got {t.shape} and {q.shape}"
+                f"items[{n}]: expected t (m,) from 0 and q (m, {layout.dof}), got {t.shape} and "
+                f"{q.shape}"
             )
         if np.any(np.diff(t) <= 0.0):
             raise ParameterError(f"items[{n}].t: expected strictly increasing times")
@@ -530,8 +548,9 @@ def build_plan_file(
             raise ParameterError(
                 f"items[{n}]: the segment starts {jump:.3g} rad away from where the timeline stands"
             )
-        moving = np.abs(np.diff(q, axis=0)) > 1e-9  # both arms moving at once
-        dual += bool(np.any(moving[:, :6].any(axis=1) & moving[:, 6:].any(axis=1)))
+        moving = np.abs(np.diff(q, axis=0)) > 1e-9
+        arms_moving = np.stack([moving[:, s].any(axis=1) for s in layout.slices], axis=1)
+        dual += bool(np.any(arms_moving.sum(axis=1) >= 2))  # two arms or more at once
         steps.append(StepRecord(now, now + float(t[-1]), item.level, item.objects, item.kind))
         ts.append(now + t[1:])
         qs.append(q[1:])
@@ -555,9 +574,7 @@ def build_plan_file(
         )
         for a in scene.arms
     )
-    return PlanFile(
-        instance_name, (arms[0], arms[1]), t_all, q_all, tuple(events), final, out, tuple(steps)
-    )
+    return PlanFile(instance_name, arms, t_all, q_all, tuple(events), final, out, tuple(steps))
 
 
 def resample(t: FloatArray, q: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sdar_tamp.plan_file import EVENT_TYPES, GRIPPER_DWELL, MAX_DT, PlanFile, plan_joint_names
+from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import JOINT_KEYS, Scene
 from sdar_tamp.world.transforms import FloatArray, translation
@@ -68,8 +69,12 @@ def check_format(plan: PlanFile) -> Violation | None:
 
     if t.ndim != 1 or len(t) == 0:
         return bad("trajectory.t", f"expected a non-empty list of times, got shape {t.shape}")
-    if q.shape != (len(t), 12):
-        return bad("trajectory.q", f"expected shape ({len(t)}, 12), got {q.shape}")
+    try:
+        dof = plan.layout.dof
+    except ArmLayoutError as err:
+        return bad("arms", str(err))
+    if q.shape != (len(t), dof):
+        return bad("trajectory.q", f"expected shape ({len(t)}, {dof}), got {q.shape}")
     for name, values in (("trajectory.t", t[:, None]), ("trajectory.q", q)):
         if not _finite(values):
             i = int(np.argwhere(~np.isfinite(values))[0, 0])
@@ -183,12 +188,12 @@ def check_timeline(
 
 
 def _joint(scene: Scene, j: int) -> str:
-    return f"{scene.arms[j // 6].name} {JOINT_KEYS[j % 6]}"
+    arm, k = scene.layout.locate(j)
+    return f"{arm} {JOINT_KEYS[k]}"
 
 
 def _joint_limits(plan: PlanFile, scene: Scene) -> Violation | None:
-    lo = np.concatenate([a.lower for a in scene.arms])
-    hi = np.concatenate([a.upper for a in scene.arms])
+    lo, hi = scene.joint_array("lower"), scene.joint_array("upper")
     t, q = plan.t, plan.q
     bad = (q < lo - JOINT_TOL) | (q > hi + JOINT_TOL)
     if not bad.any():
@@ -199,7 +204,7 @@ def _joint_limits(plan: PlanFile, scene: Scene) -> Violation | None:
 
 
 def _velocity(plan: PlanFile, scene: Scene, tol: float) -> Violation | None:
-    v_max = np.concatenate([a.velocity_limit for a in scene.arms])
+    v_max = scene.joint_array("velocity_limit")
     t = plan.t
     if len(t) < 2:
         return None
@@ -217,7 +222,7 @@ def _velocity(plan: PlanFile, scene: Scene, tol: float) -> Violation | None:
 
 
 def _acceleration(plan: PlanFile, scene: Scene, tol: float) -> Violation | None:
-    a_max = np.concatenate([a.acceleration_limit for a in scene.arms])
+    a_max = scene.joint_array("acceleration_limit")
     t = plan.t
     if len(t) < 2:
         return None
@@ -246,7 +251,7 @@ def _acceleration(plan: PlanFile, scene: Scene, tol: float) -> Violation | None:
 
 
 def _at(plan: PlanFile, t: float) -> FloatArray:
-    """Configuration ``(12,)`` at time ``t`` [s] (linear between samples)."""
+    """Configuration ``(dof,)`` at time ``t`` [s] (linear between samples)."""
     return np.array([np.interp(t, plan.t, plan.q[:, j]) for j in range(plan.q.shape[1])])
 
 
@@ -277,7 +282,7 @@ def _dwell(plan: PlanFile, scene: Scene, dwell: float) -> Violation | None:
                 f"still for {dwell} s after a gripper event",
             )
         arms = [i for i, name in enumerate(plan.arm_names) if any(e.arm == name for e in group)]
-        cols = np.concatenate([np.arange(6 * i, 6 * i + 6) for i in arms])
+        cols = np.concatenate([np.arange(plan.layout.dof)[plan.layout.slice(i)] for i in arms])
         q_e = _at(plan, t_e)[cols]
         inside = (t > t_e) & (t < end)
         times = np.concatenate([t[inside], [end]])

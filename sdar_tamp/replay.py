@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -54,6 +54,7 @@ from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
 from sdar_tamp.world.instance import Instance, load_instance
 from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
@@ -196,30 +197,30 @@ def _planar_error(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, fl
 
 
 def tcp_positions(
-    q: FloatArray, kins: Mapping[str, ArmKinematics], arm_names: Sequence[str]
+    q: FloatArray, kins: Mapping[str, ArmKinematics], layout: ArmLayout
 ) -> FloatArray:
-    """Both TCP positions ``(m, 2, 3)`` [m] for ``q`` ``(m, 12)`` (closed-form FK)."""
+    """Every arm's TCP position ``(m, arms, 3)`` [m] for ``q`` ``(m, dof)`` (closed-form FK)."""
     out = []
-    for i, arm in enumerate(arm_names):
+    for arm in layout:
         kin = kins[arm]
-        out.append((kin.fk_batch(q[:, 6 * i : 6 * i + 6]) @ kin.T_tool0_tcp)[:, :3, 3])
+        out.append((kin.fk_batch(layout.part(q, arm)) @ kin.T_tool0_tcp)[:, :3, 3])
     return np.stack(out, axis=1)
 
 
 def tcp_subdivisions(
-    q: FloatArray, kins: Mapping[str, ArmKinematics], arm_names: Sequence[str], step: float
+    q: FloatArray, kins: Mapping[str, ArmKinematics], layout: ArmLayout, step: float
 ) -> NDArray[np.int_]:
-    """Per interval of ``q`` ``(K, 12)``: the number of linear steps after which no TCP has
+    """Per interval of ``q`` ``(K, dof)``: the number of linear steps after which no TCP has
     moved more than ``step`` [m] (refined until it holds). Each interval's count depends on its
     two ends only, so a plan and any stretch of it agree on the points the replay checks."""
-    chord = np.linalg.norm(np.diff(tcp_positions(q, kins, arm_names), axis=0), axis=2).max(axis=1)
+    chord = np.linalg.norm(np.diff(tcp_positions(q, kins, layout), axis=0), axis=2).max(axis=1)
     n: NDArray[np.int_] = np.maximum(1, np.ceil(chord / step)).astype(int)
     for _ in range(30):
         off = np.cumsum(n + 1) - (n + 1)  # first dense point of every interval
         idx = np.repeat(np.arange(len(n)), n + 1)
         frac = (np.arange(len(idx)) - np.repeat(off, n + 1)) / np.repeat(n, n + 1)
         dense = q[idx] + frac[:, None] * (q[idx + 1] - q[idx])
-        d = np.linalg.norm(np.diff(tcp_positions(dense, kins, arm_names), axis=0), axis=2)
+        d = np.linalg.norm(np.diff(tcp_positions(dense, kins, layout), axis=0), axis=2)
         d = d.max(axis=1)
         d[off[1:] - 1] = 0.0  # steps across intervals
         worst = np.maximum.reduceat(np.append(d, 0.0), off)
@@ -244,6 +245,7 @@ class _Replay:
     ) -> None:
         self.instance, self.plan, self.scene, self.step = instance, plan, scene, step
         self.kins = kins
+        self.layout = scene.layout
         self.sizes = {o.name: o.size for o in instance.objects}
         self.rest = {o.name: o.start.as_tuple() for o in instance.objects}
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
@@ -258,8 +260,7 @@ class _Replay:
         return ObjectBox(pose_xyz_yaw(pose[0], pose[1], size[2] / 2.0, pose[2]), size)
 
     def arm_q(self, arm: str, q: FloatArray) -> FloatArray:
-        i = self.scene.arm_names.index(arm)
-        return q[6 * i : 6 * i + 6]
+        return self.layout.part(q, arm)
 
     def tcp(self, arm: str, q: FloatArray) -> FloatArray:
         return self.kins[arm].fk_tcp(self.arm_q(arm, q))
@@ -272,10 +273,10 @@ class _Replay:
         for arm, (_, q_event) in list(self.exempt.items()):
             if np.abs(self.arm_q(arm, q) - q_event).max() > STILL_TOL:
                 del self.exempt[arm]  # the arm has moved: contact counts again
-        if not self.world.in_collision(q[:6], q[6:]):
+        if not self.world.in_collision(q):
             self.free = q.copy()
             return None
-        pairs = [p for p in self.world.report(q[:6], q[6:]) if not self.allowed(p)]
+        pairs = [p for p in self.world.report(q) if not self.allowed(p)]
         if not pairs:
             return None
         text = ", ".join(f"{p.first} with {p.second}" for p in pairs[:3])
@@ -291,7 +292,7 @@ class _Replay:
 
     def subdivisions(self, q: FloatArray) -> NDArray[np.int_]:
         """See :func:`tcp_subdivisions`."""
-        return tcp_subdivisions(q, self.kins, self.scene.arm_names, self.step)
+        return tcp_subdivisions(q, self.kins, self.layout, self.step)
 
     # -- the walk -------------------------------------------------------------------------------
     def walk(self, t_stop: float) -> Violation | None:
@@ -299,7 +300,8 @@ class _Replay:
         plan = self.plan
         knot_t = np.union1d(plan.t, [e.t for e in plan.events])
         knot_t = knot_t[: int(np.searchsorted(knot_t, t_stop)) + 1]  # the last one: to t_stop
-        knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in range(12)], axis=1)
+        columns = range(self.layout.dof)
+        knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in columns], axis=1)
         counts = self.subdivisions(knot_q) if len(knot_t) > 1 else np.zeros(0, dtype=int)
         pending = list(plan.events)
         for k, tk in enumerate(knot_t):
@@ -329,7 +331,7 @@ class _Replay:
         return self.final(float(knot_t[-1]))
 
     def apply(self, e: PlanEvent, q: FloatArray, t: float) -> Violation | None:
-        """Check and perform one gripper event at configuration ``q`` ``(12,)``."""
+        """Check and perform one gripper event at configuration ``q`` ``(dof,)``."""
         self.free = None  # the world changes
         T_world_tcp = self.tcp(e.arm, q)
         if e.type == "grasp":

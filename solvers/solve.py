@@ -31,7 +31,7 @@ from solvers.stream_planning.algorithms import ALGORITHMS, StreamOptions, Stream
 from solvers.stream_planning.constraints import compile_constraints
 
 if TYPE_CHECKING:
-    from solvers.sdar.solver import SdarOptions
+    from solvers.sdar.options import SdarOptions
 
 LOG = get_logger(__name__)
 INF = math.inf
@@ -149,7 +149,7 @@ def solve(
         task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``
             (default: the problem's ``solve_defaults``, else ``sdar``).
         sdar_options: with ``algorithm="sdar"``: SDAR-M's budgets and switches
-            (:class:`solvers.sdar.solver.SdarOptions`; its ``max_time`` is replaced by
+            (:class:`solvers.sdar.options.SdarOptions`; its ``max_time`` is replaced by
             ``max_time``; default: the problem's ``solve_defaults``, else the defaults). A
             rearrangement built by :mod:`sdar_tamp.app` carries its ``PlannerConfig``'s
             task planner and options in ``solve_defaults``, so ``solve(r.problem,
@@ -298,8 +298,9 @@ def _solve_sdar(
     verbose: bool,
     sdar_options: SdarOptions | None,
 ) -> Solution:
+    from solvers.sdar.options import SdarOptions
     from solvers.sdar.planners import make_task_planner
-    from solvers.sdar.solver import SdarOptions, SdarSolver
+    from solvers.sdar.solver import SdarSolver
 
     planner = make_task_planner(task_planner)
     if sdar_options is not None and not isinstance(sdar_options, SdarOptions):

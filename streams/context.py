@@ -1,14 +1,17 @@
-"""The world context the streams share: scene, both arms' kinematics and symbolic FK."""
+"""The world context the streams share: scene, every arm's kinematics and symbolic FK."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import FloatArray
 from streams.fk_casadi import ArmFK
@@ -16,7 +19,7 @@ from streams.fk_casadi import ArmFK
 
 @dataclass(frozen=True)
 class WorldContext:
-    """Static facts about the dual-arm world. Arms are in the scene's order (left first)."""
+    """Static facts about the world. Arms are in the scene's order (its :class:`ArmLayout`)."""
 
     scene: Scene
     kinematics: dict[str, ArmKinematics]
@@ -32,14 +35,22 @@ class WorldContext:
             {a: ArmFK.from_scene(sc, a) for a in names},
         )
 
+    @cached_property
+    def layout(self) -> ArmLayout:
+        """The arms' joints in a configuration vector."""
+        return self.scene.layout
+
     @property
-    def arm_names(self) -> tuple[str, str]:
-        a, b = self.scene.arm_names
-        return a, b
+    def arm_names(self) -> tuple[str, ...]:
+        return self.layout.names
 
     def other(self, arm: str) -> str:
-        a, b = self.arm_names
-        return b if arm == a else a
+        """The other arm of a two-arm world."""
+        self.layout.index(arm)  # an arm of the layout
+        others = [a for a in self.layout if a != arm]
+        if len(others) != 1:
+            raise ParameterError(f"other: defined for two arms, the scene has {len(self.layout)}")
+        return others[0]
 
     def home(self, arm: str) -> FloatArray:
         return np.array(self.scene.arm(arm).home, dtype=np.float64)
@@ -50,10 +61,9 @@ class WorldContext:
         return CollisionWorld(self.scene, tolerance=-margin)
 
     def split(self, q: FloatArray) -> dict[str, FloatArray]:
-        """A dual-arm configuration ``(12,)`` as ``arm -> (6,)``."""
-        a, b = self.arm_names
-        return {a: np.asarray(q[:6], dtype=np.float64), b: np.asarray(q[6:], dtype=np.float64)}
+        """A configuration ``(layout.dof,)`` as ``arm -> (arm dof,)``."""
+        return self.layout.split(q)
 
     def join(self, q: dict[str, FloatArray]) -> FloatArray:
-        a, b = self.arm_names
-        return np.concatenate([q[a], q[b]])
+        """Every arm's joints ``arm -> (arm dof,)`` as one configuration ``(layout.dof,)``."""
+        return self.layout.join(q)

@@ -122,10 +122,7 @@ def _collides(
     q: FloatArray,
 ) -> bool:
     """Collision of ``arm`` at ``q``, except its gripper touching the object it grasps."""
-    left, right = ctx.arm_names
-    q_left = q if arm == left else park[left]
-    q_right = q if arm == right else park[right]
-    if not world.in_collision(q_left, q_right):
+    if not world.in_collision(ctx.layout.join({**park, arm: q})):
         return False
     target = f"object:{obj}"
     return any(not _is_gripper_contact(p.first, p.second, arm, target) for p in world.report())
@@ -222,7 +219,7 @@ def compatible_pairs(
 def _pair_collides(
     world: CollisionWorld, a: IKCandidate, b: IKCandidate, qa: FloatArray, qb: FloatArray
 ) -> bool:
-    if not world.in_collision(qa, qb):
+    if not world.in_collision(world.layout.join({a.arm: qa, b.arm: qb})):
         return False
     allowed = {(a.arm, f"object:{a.obj}"), (b.arm, f"object:{b.obj}")}
     return any(

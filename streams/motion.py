@@ -1,6 +1,6 @@
 """SDAR-M synchronous dual-arm motion with fallbacks (the paper's Alg. 2).
 
-A synchronous segment takes both arms from ``q_start`` to ``q_goal`` (``(12,)`` [rad]) with
+A synchronous segment takes the arms from ``q_start`` to ``q_goal`` (``(dof,)`` [rad]) with
 the held objects fixed for the whole segment (gripper actions happen between segments):
 
 1. retreat: arms flagged ``retreat`` first move their tool ``lift`` [m] straight back along
@@ -65,14 +65,15 @@ DIRECT_SAMPLES = 16
 
 @dataclass(frozen=True)
 class MotionRequest:
-    """One synchronous segment. Arms are in the scene's order (left first)."""
+    """One synchronous segment. Arms are in the scene's order (its layout); ``retreat`` and
+    ``approach`` say per arm whether it leaves or reaches a grasp (missing entries: no)."""
 
-    q_start: FloatArray  # (12,) [rad]
-    q_goal: FloatArray  # (12,) [rad]
+    q_start: FloatArray  # (dof,) [rad]
+    q_goal: FloatArray  # (dof,) [rad]
     objects: Mapping[str, ObjectBox]  # resting objects
     held: Mapping[str, HeldObject] = field(default_factory=dict)  # arm -> held object
-    retreat: tuple[bool, bool] = (False, False)
-    approach: tuple[bool, bool] = (False, False)
+    retreat: tuple[bool, ...] = ()
+    approach: tuple[bool, ...] = ()
     lift: float = 0.08  # [m]
 
 
@@ -97,14 +98,14 @@ class MotionResult:
 class TransferProblem:
     """The transfer between the lifted configurations, with everything a strategy needs."""
 
-    q_from: FloatArray  # (12,)
-    q_to: FloatArray  # (12,)
-    held: tuple[HeldSpheres, HeldSpheres]
+    q_from: FloatArray  # (dof,)
+    q_to: FloatArray  # (dof,)
+    held: tuple[HeldSpheres, ...]  # per arm
     obstacles: tuple[FloatArray, FloatArray]
 
 
 class TransferStrategy(Protocol):
-    """Produces the transfer as a list of stages (each a ``(k, 12)`` path) or None."""
+    """Produces the transfer as a list of stages (each a ``(k, dof)`` path) or None."""
 
     @property
     def name(self) -> str: ...
@@ -153,8 +154,8 @@ class DualMotionPlanner:
         self.margin_world = ctx.new_world(margin=direct_margin)
         self.direct = direct
         self.direct_lifts = tuple(float(h) for h in direct_lifts)
-        self._v = np.concatenate([ctx.scene.arm(a).velocity_limit for a in ctx.arm_names])
-        self._a = np.concatenate([ctx.scene.arm(a).acceleration_limit for a in ctx.arm_names])
+        self._v = ctx.scene.joint_array("velocity_limit")
+        self._a = ctx.scene.joint_array("acceleration_limit")
         self.optimisation_time = 0.0  # reset per plan_dual_motion call
         self.ipopt_solves = 0
         self.direct_paths = 0  # transfers taken without optimisation, per plan_dual_motion call
@@ -173,7 +174,7 @@ class DualMotionPlanner:
 
     @property
     def limits(self) -> tuple[FloatArray, FloatArray]:
-        """Joint velocity [rad/s] and acceleration [rad/s^2] limits ``(12,)`` each."""
+        """Joint velocity [rad/s] and acceleration [rad/s^2] limits ``(dof,)`` each."""
         return self._v, self._a
 
     @property
@@ -194,16 +195,17 @@ class DualMotionPlanner:
         q_a: FloatArray,
         q_b: FloatArray,
         warm_start: FloatArray | None = None,
-        fixed: tuple[bool, bool] = (False, False),
+        fixed: tuple[bool, ...] = (),
     ) -> FloatArray | None:
         """One optimised transfer from ``q_a`` to ``q_b`` (sphere model), or None.
 
-        An arm whose two end configurations are equal waits: its joints are held fixed.
+        ``fixed``: per arm, whether it waits (missing entries: no). An arm whose two end
+        configurations are equal waits too: its joints are held fixed.
         """
         if np.allclose(q_a, q_b):
             return np.stack([q_a, q_b])
-        still = [bool(np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6])) for i in (0, 1)]
-        fixed = (fixed[0] or still[0], fixed[1] or still[1])
+        still = self._still(q_a, q_b)
+        fixed = tuple(_flag(fixed, i) or still[i] for i in range(len(still)))
         if warm_start is None and self.direct:
             direct = self.direct_path(q_a, q_b, fixed)
             if direct is not None:
@@ -217,26 +219,27 @@ class DualMotionPlanner:
         self.ipopt_solves += int(result.rounds > 0)
         return result.path if result.success else None
 
+    def _still(self, q_a: FloatArray, q_b: FloatArray) -> list[bool]:
+        """Per arm: its joints are the same at ``q_a`` and ``q_b``."""
+        return [bool(np.allclose(q_a[sl], q_b[sl])) for sl in self.ctx.layout.slices]
+
     def direct_path(
-        self, q_a: FloatArray, q_b: FloatArray, fixed: tuple[bool, bool] = (False, False)
+        self, q_a: FloatArray, q_b: FloatArray, fixed: tuple[bool, ...] = ()
     ) -> FloatArray | None:
         """The straight joint-space line from ``q_a`` to ``q_b``, else a lightly bent path
-        through a lifted via configuration (:data:`DIRECT_LIFTS`), as waypoints ``(k, 12)``,
+        through a lifted via configuration (:data:`DIRECT_LIFTS`), as waypoints ``(k, dof)``,
         if the curve the time parameterisation follows through them passes the exact check
         in ``margin_world`` (configured like ``world``); else None. Arms that wait stay put."""
-        still = [
-            fixed[i] or bool(np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6]))
-            for i in (0, 1)
-        ]
-        if any(f and not np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6])
-               for i, f in enumerate(fixed)):  # fmt: skip
+        equal = self._still(q_a, q_b)
+        if any(_flag(fixed, i) and not equal[i] for i in range(len(equal))):
             return None
+        still = [_flag(fixed, i) or equal[i] for i in range(len(equal))]
         candidates = [np.stack([q_a, q_b])]
         for height in self.direct_lifts:
             via = self.lifted_via(q_a, q_b, height, knots=3)[1]
-            for i in (0, 1):
-                if still[i]:
-                    via[6 * i : 6 * i + 6] = q_a[6 * i : 6 * i + 6]
+            for sl, waits in zip(self.ctx.layout.slices, still, strict=True):
+                if waits:
+                    via[sl] = q_a[sl]
             candidates.append(np.stack([q_a, via, q_b]))
         for waypoints in candidates:
             curve = spline_curve(waypoints, DIRECT_SAMPLES)
@@ -249,7 +252,7 @@ class DualMotionPlanner:
         problem: TransferProblem,
         q_a: FloatArray,
         q_b: FloatArray,
-        fixed: tuple[bool, bool] = (False, False),
+        fixed: tuple[bool, ...] = (),
     ) -> FloatArray | None:
         """:meth:`optimise` from the straight line, then from a lifted via-point."""
         path = self.optimise(problem, q_a, q_b, fixed=fixed)
@@ -260,15 +263,15 @@ class DualMotionPlanner:
     def lifted_via(
         self, q_a: FloatArray, q_b: FloatArray, height: float = 0.15, knots: int | None = None
     ) -> FloatArray:
-        """A warm start ``(K, 12)`` (``knots``, default the optimiser's) through a via
+        """A warm start ``(K, dof)`` (``knots``, default the optimiser's) through a via
         configuration whose TCPs are ``height`` [m] above the higher end, half-way between
         the two."""
         K = knots if knots is not None else self._build.options.knots
         mid = 0.5 * (q_a + q_b)
         via = mid.copy()
-        for i, arm in enumerate(self.ctx.arm_names):
+        for arm in self.ctx.arm_names:
             kin = self.ctx.kinematics[arm]
-            sl = slice(6 * i, 6 * i + 6)
+            sl = self.ctx.layout.slice(arm)
             Ta, Tb = kin.fk_tcp(q_a[sl]), kin.fk_tcp(q_b[sl])
             T = Tb.copy()
             T[:3, 3] = 0.5 * (Ta[:3, 3] + Tb[:3, 3])
@@ -295,11 +298,11 @@ class DualMotionPlanner:
         return tool_pose_ik(kin, T, q_goal_arm)
 
     def depth(self, q: FloatArray) -> FloatArray:
-        """``(2,)``: how far [m] each arm's TCP reaches past the table centre line towards
-        the other arm's base."""
-        out = np.zeros(2)
+        """``(arms,)``: how far [m] each arm's TCP reaches past the table centre line, away
+        from its own base."""
+        out = np.zeros(len(self.ctx.layout))
         for i, arm in enumerate(self.ctx.arm_names):
-            p = self.ctx.kinematics[arm].fk_tcp(q[6 * i : 6 * i + 6])[:3, 3]
+            p = self.ctx.kinematics[arm].fk_tcp(self.ctx.layout.part(q, arm))[:3, 3]
             out[i] = p[0] * np.sign(-self.ctx.scene.arm(arm).base_xyz[0])
         return out
 
@@ -307,17 +310,16 @@ class DualMotionPlanner:
     def phases(
         self, request: MotionRequest, one_at_a_time: bool = False
     ) -> tuple[list[FloatArray], list[FloatArray]] | None:
-        """Retreat and approach as lists of paths ``(n, 12)``: one synchronised (padded) path
-        each, or, with ``one_at_a_time``, the left arm's then the right arm's; None if a
-        straight tool move is unreachable."""
+        """Retreat and approach as lists of paths ``(n, dof)``: one synchronised (padded) path
+        each, or, with ``one_at_a_time``, one arm's after the other's (layout order); None if
+        a straight tool move is unreachable."""
         ret, app = [], []
         for i, arm in enumerate(self.ctx.arm_names):
             kin = self.ctx.kinematics[arm]
-            sl = slice(6 * i, 6 * i + 6)
-            r = straight_tool_move(kin, request.q_start[sl], -request.lift) if request.retreat[
-                i] else request.q_start[sl][None]  # fmt: skip
-            a = straight_tool_move(kin, request.q_goal[sl], -request.lift) if request.approach[
-                i] else request.q_goal[sl][None]  # fmt: skip
+            sl = self.ctx.layout.slice(arm)
+            q0, q1, lift = request.q_start[sl], request.q_goal[sl], -request.lift
+            r = straight_tool_move(kin, q0, lift) if _flag(request.retreat, i) else q0[None]
+            a = straight_tool_move(kin, q1, lift) if _flag(request.approach, i) else q1[None]
             if r is None or a is None:
                 return None
             ret.append(r)
@@ -346,7 +348,7 @@ class DualMotionPlanner:
         obstacles = (
             (np.concatenate(cs), np.concatenate(rs)) if cs else (np.zeros((0, 3)), np.zeros(0))
         )
-        return TransferProblem(q_from, q_to, (held[0], held[1]), obstacles)
+        return TransferProblem(q_from, q_to, tuple(held), obstacles)
 
     def assemble(
         self,
@@ -361,20 +363,34 @@ class DualMotionPlanner:
         return traj
 
 
+def _flag(flags: tuple[bool, ...], i: int) -> bool:
+    """Entry ``i`` of a per-arm flag tuple (missing entries are False)."""
+    return i < len(flags) and flags[i]
+
+
+def _only(i: int, n: int) -> tuple[bool, ...]:
+    """Per-arm ``fixed`` flags with every arm but ``i`` waiting."""
+    return tuple(k != i for k in range(n))
+
+
 def _sync(paths: list[FloatArray]) -> FloatArray:
-    """Two arm paths ``(n_i, 6)`` as one ``(max n, 12)`` path (the shorter one waits)."""
+    """Per-arm paths ``(n_i, arm dof)`` as one ``(max n, dof)`` path (shorter ones wait)."""
     n = max(len(p) for p in paths)
     padded = [np.concatenate([p, np.repeat(p[-1:], n - len(p), axis=0)]) for p in paths]
     return np.concatenate(padded, axis=1)
 
 
 def _chain(paths: list[FloatArray]) -> list[FloatArray]:
-    """Two arm paths ``(n_i, 6)`` as two ``(n_i, 12)`` paths: the left arm moves while the
-    right waits at its start, then the right arm moves (each timed rest to rest)."""
-    left, right = paths
-    first = np.concatenate([left, np.repeat(right[:1], len(left), axis=0)], axis=1)
-    second = np.concatenate([np.repeat(left[-1:], len(right), axis=0), right], axis=1)
-    return [first, second]
+    """Per-arm paths ``(n_i, arm dof)`` as one ``(n_i, dof)`` path per arm: the arms move one
+    after the other in layout order, the others waiting where they are (each timed rest to
+    rest)."""
+    out = []
+    for k, path in enumerate(paths):
+        n = len(path)
+        done = [np.repeat(p[-1:], n, axis=0) for p in paths[:k]]
+        waiting = [np.repeat(p[:1], n, axis=0) for p in paths[k + 1 :]]
+        out.append(np.concatenate([*done, path, *waiting], axis=1))
+    return out
 
 
 # -- strategies ---------------------------------------------------------------------------
@@ -407,9 +423,10 @@ class UntangleStrategy:
     ) -> list[FloatArray] | None:
         ctx = planner.ctx
         order = np.argsort(-planner.depth(problem.q_from))
-        for y in (int(order[0]), int(order[1])):
+        n = len(ctx.layout)
+        for y in (int(k) for k in order):
             arm = ctx.arm_names[y]
-            sl = slice(6 * y, 6 * y + 6)
+            sl = ctx.layout.slice(y)
             park = planner.park(arm, problem.q_to[sl], self.park_height)
             if park is None:
                 continue
@@ -418,8 +435,7 @@ class UntangleStrategy:
             first = planner.optimise_or_lift(problem, problem.q_from, q_mid)
             if first is None:
                 continue
-            fixed = (y != 0, y != 1)
-            second = planner.optimise(problem, q_mid, problem.q_to, fixed=fixed)
+            second = planner.optimise(problem, q_mid, problem.q_to, fixed=_only(y, n))
             if second is not None:
                 return [first, second]
         return None
@@ -427,7 +443,7 @@ class UntangleStrategy:
 
 @dataclass(frozen=True)
 class SequentialStrategy:
-    """One arm at a time: retract the first to home, move the second, move the first."""
+    """One arm at a time: retract the first to home, move the others, move the first."""
 
     name: str = "sequential"
 
@@ -435,17 +451,17 @@ class SequentialStrategy:
         self, planner: DualMotionPlanner, problem: TransferProblem
     ) -> list[FloatArray] | None:
         ctx = planner.ctx
+        layout = ctx.layout
+        n = len(layout)
         order = np.argsort(-planner.depth(problem.q_from))
-        for f in (int(order[0]), int(order[1])):
-            s = 1 - f
-            sf, ss = slice(6 * f, 6 * f + 6), slice(6 * s, 6 * s + 6)
-            q1 = problem.q_from.copy()
-            q1[sf] = ctx.home(ctx.arm_names[f])
-            q2 = q1.copy()
-            q2[ss] = problem.q_to[ss]
+        for f in (int(k) for k in order):
+            first, others = _only(f, n), tuple(k == f for k in range(n))
+            q1 = layout.replace(problem.q_from, f, ctx.home(ctx.arm_names[f]))
+            q2 = layout.replace(problem.q_to, f, q1[layout.slice(f)])
             stages = []
-            for qa, qb, moving in ((problem.q_from, q1, f), (q1, q2, s), (q2, problem.q_to, f)):
-                path = planner.optimise_or_lift(problem, qa, qb, (moving != 0, moving != 1))
+            for qa, qb, fixed in ((problem.q_from, q1, first), (q1, q2, others),
+                                  (q2, problem.q_to, first)):  # fmt: skip
+                path = planner.optimise_or_lift(problem, qa, qb, fixed)
                 if path is None:
                     break
                 stages.append(path)
@@ -466,23 +482,24 @@ class OneArmStrategy:
         self, planner: DualMotionPlanner, problem: TransferProblem
     ) -> list[FloatArray] | None:
         ctx = planner.ctx
+        layout = ctx.layout
+        n = len(layout)
         moving = [
             i
-            for i in (0, 1)
-            if not np.allclose(problem.q_from[6 * i : 6 * i + 6], problem.q_to[6 * i : 6 * i + 6])
+            for i in range(n)
+            if not np.allclose(layout.part(problem.q_from, i), layout.part(problem.q_to, i))
         ]
         depth = planner.depth(problem.q_from)
         homeward = {
-            i: bool(np.allclose(problem.q_to[6 * i : 6 * i + 6], ctx.home(ctx.arm_names[i])))
+            i: bool(np.allclose(layout.part(problem.q_to, i), ctx.home(ctx.arm_names[i])))
             for i in moving
         }
         moving.sort(key=lambda i: (not homeward[i], -depth[i]))
         stages: list[FloatArray] = []
         q = problem.q_from.copy()
         for i in moving:
-            q_next = q.copy()
-            q_next[6 * i : 6 * i + 6] = problem.q_to[6 * i : 6 * i + 6]
-            path = planner.optimise_or_lift(problem, q, q_next, (i != 0, i != 1))
+            q_next = layout.replace(q, i, layout.part(problem.q_to, i))
+            path = planner.optimise_or_lift(problem, q, q_next, _only(i, n))
             if path is None:
                 return None
             stages.append(path)

@@ -1,4 +1,4 @@
-"""Sampling-based synchronous dual-arm transfers: OMPL's RRTConnect in the 12-D joint space.
+"""Sampling-based synchronous dual-arm transfers: OMPL's RRTConnect in the joint space of every arm.
 
 An optional extra (``pip install sdar-tamp[ompl]``). The planner samples both arms' joints
 within their limits; a state is valid when the planner's ``margin_world`` (resting and held
@@ -96,7 +96,7 @@ def sample_path(
     q_b: FloatArray,
     options: SamplingOptions | None = None,
 ) -> FloatArray | None:
-    """Collision-free waypoints ``(k, 12)`` from ``q_a`` to ``q_b`` (``planner.margin_world``
+    """Collision-free waypoints ``(k, dof)`` from ``q_a`` to ``q_b`` (``planner.margin_world``
     configured for the segment), shortcut; None when the budget runs out."""
     o = options or SamplingOptions()
     ob, og, ou = _ompl()
@@ -105,15 +105,14 @@ def sample_path(
             ou.RNG.setSeed(o.seed + 1)  # OMPL refuses 0
             _SEEDED.append(o.seed)
     ctx, world = planner.ctx, planner.margin_world
-    lo = np.concatenate([ctx.scene.arm(a).lower_array for a in ctx.arm_names])
-    hi = np.concatenate([ctx.scene.arm(a).upper_array for a in ctx.arm_names])
+    lo, hi = ctx.scene.joint_array("lower"), ctx.scene.joint_array("upper")
     q_a, q_b = np.asarray(q_a, dtype=np.float64), np.asarray(q_b, dtype=np.float64)
     # arms that do not move are pinned: zero-width bounds keep them at their start
-    still = [bool(np.allclose(q_a[6 * i : 6 * i + 6], q_b[6 * i : 6 * i + 6])) for i in (0, 1)]
+    still = [bool(np.allclose(q_a[sl], q_b[sl])) for sl in ctx.layout.slices]
     lo, hi = np.minimum(lo, np.minimum(q_a, q_b)), np.maximum(hi, np.maximum(q_a, q_b))
-    for i in (0, 1):
-        if still[i]:
-            lo[6 * i : 6 * i + 6] = hi[6 * i : 6 * i + 6] = q_a[6 * i : 6 * i + 6]
+    for sl, pinned in zip(ctx.layout.slices, still, strict=True):
+        if pinned:
+            lo[sl] = hi[sl] = q_a[sl]
     free = np.flatnonzero(hi > lo)
     if len(free) == 0:
         return np.stack([q_a, q_b])
@@ -155,7 +154,7 @@ def _plan(
     def valid(state: Any) -> bool:
         checks[0] += 1
         x = full(state)
-        return not world.in_collision(x[:6], x[6:])
+        return not world.in_collision(x)
 
     if not valid(_state(space, q_a, free)) or not valid(_state(space, q_b, free)):
         return None  # RRTConnect would wait for a valid start or goal

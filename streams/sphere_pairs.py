@@ -38,10 +38,9 @@ class PathSpheres:
     coarse_radii: tuple[FloatArray, FloatArray]
 
 
-def path_spheres(
-    ctx: WorldContext, path: FloatArray, held: tuple[HeldSpheres, HeldSpheres]
-) -> PathSpheres:
-    """Centres of every arm and held sphere at each configuration of ``path`` ``(s, 12)``."""
+def path_spheres(ctx: WorldContext, path: FloatArray, held: tuple[HeldSpheres, ...]) -> PathSpheres:
+    """Centres of every arm and held sphere at each configuration of ``path`` ``(s, dof)``;
+    ``held``: per arm, in the layout's order."""
     cs: list[FloatArray] = []
     rs: list[FloatArray] = []
     ms: list[FloatArray] = []
@@ -49,7 +48,7 @@ def path_spheres(
     crs: list[FloatArray] = []
     for i, arm in enumerate(ctx.arm_names):
         fk = ctx.fk[arm]
-        q = path[:, 6 * i : 6 * i + 6]
+        q = ctx.layout.part(path, arm)
         c, cc = fk.centres(q), fk.centres(q, coarse=True)
         h = held[i]
         if len(h.radius):

@@ -65,16 +65,28 @@ class ArmConf:
     pre: tuple[float, ...] | None = None  # the pre-grasp configuration, if any
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class DualConf:
-    """Both arms, scene order."""
+    """A configuration of every arm, in the scene's arm order: ``DualConf(first, second)``."""
 
-    left: ArmConf
-    right: ArmConf
+    arms: tuple[ArmConf, ...]
+
+    def __init__(self, *arms: ArmConf) -> None:
+        if not arms:
+            raise ParameterError("DualConf: expected one ArmConf per arm, got none")
+        object.__setattr__(self, "arms", tuple(arms))
 
     @property
     def q(self) -> FloatArray:
-        return np.array(self.left.q + self.right.q)
+        """Every arm's joints ``(dof,)`` [rad], in the scene's layout."""
+        return np.concatenate([np.asarray(a.q, dtype=np.float64) for a in self.arms])
+
+    def arm(self, name: str) -> ArmConf:
+        """The configuration of arm ``name``."""
+        for a in self.arms:
+            if a.arm == name:
+                return a
+        raise ParameterError(f"arm must be one of {[a.arm for a in self.arms]}; got {name!r}")
 
 
 #: Collision worlds kept for IK queries, one per object arrangement (a step of SDAR-M asks
@@ -190,11 +202,11 @@ class DualArmStreams:
     def combine_confs(
         self, a1: str, q1: ArmConf, a2: str, q2: ArmConf
     ) -> Iterator[tuple[DualConf]]:
-        left = self.ctx.arm_names[0]
         if a1 == a2:
             return
-        conf = DualConf(q1, q2) if a1 == left else DualConf(q2, q1)
-        if not self._arms_only.in_collision(np.array(conf.left.q), np.array(conf.right.q)):
+        by_arm = {a1: q1, a2: q2}
+        conf = DualConf(*(by_arm[a] for a in self.ctx.arm_names))
+        if not self._arms_only.in_collision(conf.q):
             yield (conf,)
 
     def plan_dual_motion(
@@ -222,8 +234,8 @@ class DualArmStreams:
                 T_tool0_tcp = self.ctx.kinematics[arm].T_tool0_tcp
                 T_tool0_obj = T_tool0_tcp @ inverse(g.T_object_tcp)
                 held[arm] = HeldObject(obj, self.size(obj), T_tool0_obj)
-        retreat = (q1.left.pre is not None, q1.right.pre is not None)
-        approach = (q2.left.pre is not None, q2.right.pre is not None)
+        retreat = tuple(a.pre is not None for a in q1.arms)
+        approach = tuple(a.pre is not None for a in q2.arms)
         request = MotionRequest(q1.q, q2.q, objects, held, retreat, approach)
         strategies = None
         if self.motion == "ompl":
@@ -270,10 +282,8 @@ class DualArmStreams:
 
     @property
     def _limits(self) -> tuple[FloatArray, FloatArray]:
-        arms = [self.ctx.scene.arm(a) for a in self.ctx.arm_names]
-        v = np.concatenate([np.asarray(s.velocity_limit) for s in arms])
-        a = np.concatenate([np.asarray(s.acceleration_limit) for s in arms])
-        return v, a
+        scene = self.ctx.scene
+        return scene.joint_array("velocity_limit"), scene.joint_array("acceleration_limit")
 
 
 def make_stream_map(

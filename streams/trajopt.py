@@ -1,6 +1,6 @@
 """Synchronous dual-arm trajectory optimisation (CasADi + IPOPT), built once per shape.
 
-Decision variables: the interior knots of a path ``q_0 .. q_{K-1}`` over both arms (12 joints);
+Decision variables: the interior knots of a path ``q_0 .. q_{K-1}`` over every arm (``dof`` joints);
 ``q_0`` and ``q_{K-1}`` are parameters. Cost: squared second differences (smoothness) plus a
 small weight on squared first differences (length). Constraints at every interior knot:
 
@@ -68,20 +68,20 @@ class TrajOptOptions:
 
 @dataclass(frozen=True)
 class TransferQuery:
-    """One transfer: end configurations ``(12,)`` [rad], held spheres per arm (scene order),
+    """One transfer: end configurations ``(dof,)`` [rad], held spheres per arm (scene order),
     obstacle spheres ``(m, 3)``, ``(m,)`` [m] and the nominal duration ``T`` [s]."""
 
     q_start: FloatArray
     q_goal: FloatArray
-    held: tuple[HeldSpheres, HeldSpheres]
+    held: tuple[HeldSpheres, ...]
     obstacles: tuple[FloatArray, FloatArray]
     duration: float
-    fixed: tuple[bool, bool] = (False, False)  # an arm that must wait at its start
+    fixed: tuple[bool, ...] = ()  # per arm (scene order): it must wait at its start
 
 
 @dataclass(frozen=True)
 class TrajOptResult:
-    """The optimised knots ``(K, 12)``; ``success`` means IPOPT converged (or stopped at a
+    """The optimised knots ``(K, dof)``; ``success`` means IPOPT converged (or stopped at a
     feasible point) and every sphere pair keeps its clearance on a dense check of the path."""
 
     path: FloatArray
@@ -120,12 +120,14 @@ class DualArmTrajOpt:
         self.ctx = ctx
         self.options = o = options or TrajOptOptions()
         arms = ctx.arm_names
+        self._arms = self.ctx.layout
+        dof = self._arms.dof
         self._n_arm = [len(ctx.fk[a].spheres) + o.held_slots for a in arms]
         self._n_coarse = [len(ctx.fk[a].coarse) + o.held_slots for a in arms]
         lay = _Layout()
-        lay.add("q0", 1, 12)
-        lay.add("q1", 1, 12)
-        for i in range(2):
+        lay.add("q0", 1, dof)
+        lay.add("q1", 1, dof)
+        for i in range(len(self._arms)):
             lay.add(f"held{i}", o.held_slots, 4)
             lay.add(f"aa_sel{i}", o.arm_arm_slots, self._n_coarse[i])
             lay.add(f"ao_sel{i}", o.obstacle_slots, self._n_arm[i])
@@ -152,10 +154,11 @@ class DualArmTrajOpt:
 
     def _build(self) -> None:
         o, lay, K = self.options, self._lay, self.options.knots
-        x = sx_sym("x", (K - 2) * 12)
+        arms, dof = self._arms, self._arms.dof
+        x = sx_sym("x", (K - 2) * dof)
         p = sx_sym("p", lay.size)
         q0, q1 = lay.sym(p, "q0").T, lay.sym(p, "q1").T
-        Q = [q0] + [x[12 * k : 12 * k + 12] for k in range(K - 2)] + [q1]
+        Q = [q0] + [x[dof * k : dof * (k + 1)] for k in range(K - 2)] + [q1]
         m = lay.sym(p, "margin")
         cost = 0
         for k in range(K - 1):
@@ -165,16 +168,16 @@ class DualArmTrajOpt:
         g: list[Any] = []
         sel = {name: lay.sym(p, name) for name in lay.blocks if "sel" in name or "obs" in name}
         for k in range(1, K - 1):
-            CR = [self._arm_spheres_sx(i, Q[k][6 * i : 6 * i + 6], p) for i in range(2)]
+            CR = [self._arm_spheres_sx(i, Q[k][sl], p) for i, sl in enumerate(arms.slices)]
             cl, cr = sel["aa_sel0"] @ CR[0][2], sel["aa_sel1"] @ CR[1][2]
             rl, rr = sel["aa_sel0"] @ CR[0][3], sel["aa_sel1"] @ CR[1][3]
             g.append(ca.sum2((cl - cr) ** 2) - (rl + rr + m) ** 2)
-            for i in range(2):
+            for i in range(len(arms)):
                 C, R = CR[i][0], CR[i][1]
                 obs = sel[f"ao_obs{i}"]
                 c, r = sel[f"ao_sel{i}"] @ C, sel[f"ao_sel{i}"] @ R
                 g.append(ca.sum2((c - obs[:, :3]) ** 2) - (r + obs[:, 3] + m) ** 2)
-            for i in range(2):
+            for i in range(len(arms)):
                 C, R = CR[i][0], CR[i][1]
                 g.append(sel[f"t_sel{i}"] @ C[:, 2] - sel[f"t_sel{i}"] @ R - m)
         self._n_collision = sum(int(e.shape[0]) for e in g)
@@ -195,18 +198,17 @@ class DualArmTrajOpt:
         }
         self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", nlp, opts)
         self._g_fn = ca.Function("g", [x, p], [nlp["g"]])
-        lo = np.concatenate([self.ctx.scene.arm(a).lower_array for a in self.ctx.arm_names])
-        hi = np.concatenate([self.ctx.scene.arm(a).upper_array for a in self.ctx.arm_names])
+        scene = self.ctx.scene
+        lo, hi = scene.joint_array("lower"), scene.joint_array("upper")
         self._lbx, self._ubx = np.tile(lo, K - 2), np.tile(hi, K - 2)
-        v = np.concatenate([self.ctx.scene.arm(a).velocity_limit for a in self.ctx.arm_names])
-        acc = np.concatenate([self.ctx.scene.arm(a).acceleration_limit for a in self.ctx.arm_names])
-        self._vmax, self._amax = np.array(v), np.array(acc)
+        self._vmax = scene.joint_array("velocity_limit")
+        self._amax = scene.joint_array("acceleration_limit")
 
     # -- solving -----------------------------------------------------------------------
     def solve(self, query: TransferQuery, warm_start: FloatArray | None = None) -> TrajOptResult:
-        """Optimise the transfer; ``warm_start`` ``(K, 12)`` (default: the straight line)."""
+        """Optimise the transfer; ``warm_start`` ``(K, dof)`` (default: the straight line)."""
         t0 = time.perf_counter()
-        o, K = self.options, self.options.knots
+        o, K, dof = self.options, self.options.knots, self._arms.dof
         q_a, q_b = np.asarray(query.q_start), np.asarray(query.q_goal)
         straight = warm_start is None
         if warm_start is None:
@@ -222,12 +224,12 @@ class DualArmTrajOpt:
             p, lbg, ubg = self._parameters(query, selection)
             lbx = np.minimum(self._lbx, path[1:-1].reshape(-1))
             ubx = np.maximum(self._ubx, path[1:-1].reshape(-1))
-            for i, fixed in enumerate(query.fixed):
+            for sl, fixed in zip(self._arms.slices, query.fixed, strict=False):
                 if fixed:
-                    hold = np.tile(q_a[6 * i : 6 * i + 6], (K - 2, 1))
-                    path[1:-1, 6 * i : 6 * i + 6] = hold
-                    lbx.reshape(K - 2, 12)[:, 6 * i : 6 * i + 6] = hold
-                    ubx.reshape(K - 2, 12)[:, 6 * i : 6 * i + 6] = hold
+                    hold = np.tile(q_a[sl], (K - 2, 1))
+                    path[1:-1, sl] = hold
+                    lbx.reshape(K - 2, dof)[:, sl] = hold
+                    ubx.reshape(K - 2, dof)[:, sl] = hold
             if straight and rounds == 1 and self._straight_is_optimal(path, p, lbg, ubg):
                 worst, violators = _violations(dense, ends, query, selection)
                 if not violators.any_left():
@@ -238,7 +240,7 @@ class DualArmTrajOpt:
             stats = self._solver.stats()
             status, iters = str(stats["return_status"]), iters + int(stats["iter_count"])
             path = path.copy()
-            path[1:-1] = to_array(sol["x"]).reshape(K - 2, 12)
+            path[1:-1] = to_array(sol["x"]).reshape(K - 2, dof)
             g = to_array(self._g_fn(path[1:-1].reshape(-1), p)).reshape(-1)
             feasible = bool(np.all(g >= lbg - 1e-4) and np.all(g <= ubg + 1e-4))
             dense = path_spheres(self.ctx, densify(path, 3), query.held)
@@ -270,7 +272,7 @@ class DualArmTrajOpt:
         lay.put(p, "q0", query.q_start)
         lay.put(p, "q1", query.q_goal)
         lay.put(p, "margin", np.array([o.margin]))
-        for i in range(2):
+        for i in range(len(self._arms)):
             held = np.zeros((o.held_slots, 4))
             h = query.held[i]
             held[: len(h.radius), :3] = h.centre
@@ -286,8 +288,8 @@ class DualArmTrajOpt:
             lay.put(p, f"t_sel{i}", _one_hot(s.table[i], o.table_slots, self._n_arm[i]))
         per_knot = np.concatenate(
             [_slot_lb(s.aa_lb, o.arm_arm_slots)]
-            + [_slot_lb(s.ao_lb[i], o.obstacle_slots) for i in range(2)]
-            + [_slot_lb(s.table_lb[i], o.table_slots) for i in range(2)]
+            + [_slot_lb(lb, o.obstacle_slots) for lb in s.ao_lb]
+            + [_slot_lb(lb, o.table_slots) for lb in s.table_lb]
         )
         dt = query.duration / (K - 1)
         lbg = np.concatenate(
@@ -409,21 +411,21 @@ class _Selection:
     obstacle sphere); ``table[i]`` ``(n,)``; and each slot's constraint lower bound."""
 
     aa: Any
-    ao: tuple[Any, Any]
-    table: tuple[Any, Any]
+    ao: tuple[Any, ...]  # per arm
+    table: tuple[Any, ...]  # per arm
     aa_lb: FloatArray
-    ao_lb: tuple[FloatArray, FloatArray]
-    table_lb: tuple[FloatArray, FloatArray]
+    ao_lb: tuple[FloatArray, ...]  # per arm
+    table_lb: tuple[FloatArray, ...]  # per arm
 
 
 @dataclass(frozen=True)
 class _Violators:
     aa: set[tuple[int, int]]
-    ao: tuple[set[tuple[int, int]], set[tuple[int, int]]]
-    table: tuple[set[int], set[int]]
+    ao: tuple[set[tuple[int, int]], ...]  # per arm
+    table: tuple[set[int], ...]  # per arm
 
     def any_left(self) -> bool:
-        return bool(self.aa or self.ao[0] or self.ao[1] or self.table[0] or self.table[1])
+        return bool(self.aa or any(self.ao) or any(self.table))
 
     def merged(self, other: _Selection | None) -> _Selection:
         def pairs(base: Any, extra: set[tuple[int, int]]) -> Any:
@@ -437,9 +439,11 @@ class _Violators:
         empty1 = np.zeros(0, dtype=np.int64)
         nolb = np.zeros(0)
         aa = pairs(other.aa if other else empty2, self.aa)
-        ao = tuple(pairs(other.ao[i] if other else empty2, self.ao[i]) for i in range(2))
-        tb = tuple(singles(other.table[i] if other else empty1, self.table[i]) for i in range(2))
-        return _Selection(aa, (ao[0], ao[1]), (tb[0], tb[1]), nolb, (nolb, nolb), (nolb, nolb))
+        arms = range(len(self.ao))
+        ao = tuple(pairs(other.ao[i] if other else empty2, self.ao[i]) for i in arms)
+        tb = tuple(singles(other.table[i] if other else empty1, self.table[i]) for i in arms)
+        nolbs = tuple(nolb for _ in arms)
+        return _Selection(aa, ao, tb, nolb, nolbs, nolbs)
 
 
 def _pick(clear: FloatArray, slots: int, limit: float, forced: Any) -> Any:
@@ -470,7 +474,7 @@ def _select(
     aa_lb = _lb_sq(aa_end, rl + rr, o.margin)
     ao, ao_lb, tb, tb_lb = [], [], [], []
     oc, orad = query.obstacles
-    for i in range(2):
+    for i in range(len(query.held)):
         if len(orad):
             c = obstacle_clearance(dense, i, oc, orad).min(axis=0)
             sel = _pick(c, o.obstacle_slots, o.select_distance, forced.ao[i] if forced else None)
@@ -487,8 +491,7 @@ def _select(
         tend = table_clearance(ends, i)[:, tsel].min(axis=0)
         tb.append(tsel)
         tb_lb.append(np.minimum(0.0, tend - o.margin) - 1e-6)
-    return _Selection(aa, (ao[0], ao[1]), (tb[0], tb[1]), aa_lb, (ao_lb[0], ao_lb[1]),
-                      (tb_lb[0], tb_lb[1]))  # fmt: skip
+    return _Selection(aa, tuple(ao), tuple(tb), aa_lb, tuple(ao_lb), tuple(tb_lb))
 
 
 def _lb_sq(end_clearance: FloatArray, rsum: FloatArray, margin: float) -> FloatArray:
@@ -512,7 +515,7 @@ def _violations(
     ao: list[set[tuple[int, int]]] = []
     tb: list[set[int]] = []
     oc, orad = query.obstacles
-    for i in range(2):
+    for i in range(len(query.held)):
         if len(orad):
             c = obstacle_clearance(dense, i, oc, orad).min(axis=0)
             ce = obstacle_clearance(ends, i, oc, orad).min(axis=0)
@@ -526,4 +529,4 @@ def _violations(
         bad_t = {int(a) for a in np.flatnonzero(t < np.minimum(0.0, te) + tol)}
         tb.append(bad_t - {int(a) for a in selection.table[i]})
         worst = min(worst, float(t.min()))
-    return worst, _Violators(bad_aa, (ao[0], ao[1]), (tb[0], tb[1]))
+    return worst, _Violators(bad_aa, tuple(ao), tuple(tb))

@@ -47,7 +47,7 @@ def configure_world(
     held: Mapping[str, HeldObject],
     q: FloatArray,
 ) -> None:
-    """Put ``objects`` on the table and ``held`` objects in the hands at ``q`` ``(12,)``."""
+    """Put ``objects`` on the table and ``held`` objects in the hands at ``q`` ``(dof,)``."""
     for arm in ctx.arm_names:
         if world.held_by(arm) is not None:
             world.detach(arm)
@@ -61,12 +61,12 @@ def configure_world(
 
 
 def interpolate_by_tcp(ctx: WorldContext, q: FloatArray, max_tcp_step: float) -> FloatArray:
-    """Samples ``q`` ``(m, 12)`` refined so no TCP moves more than ``max_tcp_step`` [m]."""
+    """Samples ``q`` ``(m, dof)`` refined so no TCP moves more than ``max_tcp_step`` [m]."""
     if len(q) < 2:
         return np.asarray(q, dtype=np.float64)
     steps = []
-    for i, arm in enumerate(ctx.arm_names):
-        p = ctx.fk[arm].tcp_positions(q[:, 6 * i : 6 * i + 6])
+    for arm in ctx.arm_names:
+        p = ctx.fk[arm].tcp_positions(ctx.layout.part(q, arm))
         steps.append(np.linalg.norm(np.diff(p, axis=0), axis=1))
     # joint-space chords bend the TCP path; 1.5x covers the curvature between samples
     n = np.maximum(1, np.ceil(1.5 * np.max(steps, axis=0) / max_tcp_step)).astype(int)
@@ -85,17 +85,16 @@ def validate_trajectory(
     max_tcp_step: float = 0.005,
     limit_tolerance: float = 1e-3,
 ) -> ValidationReport:
-    """Check samples ``q`` ``(m, 12)`` (at times ``t`` ``(m,)`` [s] if given) against the
+    """Check samples ``q`` ``(m, dof)`` (at times ``t`` ``(m,)`` [s] if given) against the
     world as configured (see :func:`configure_world`)."""
     q = np.asarray(q, dtype=np.float64)
-    lo = np.concatenate([ctx.scene.arm(a).lower_array for a in ctx.arm_names])
-    hi = np.concatenate([ctx.scene.arm(a).upper_array for a in ctx.arm_names])
+    lo, hi = ctx.scene.joint_array("lower"), ctx.scene.joint_array("upper")
     bad = np.flatnonzero(np.any((q < lo - 1e-9) | (q > hi + 1e-9), axis=1))
     if len(bad):
         return ValidationReport(False, "joint limits", int(bad[0]))
     if t is not None and len(q) > 2:
-        v = np.concatenate([ctx.scene.arm(a).velocity_limit for a in ctx.arm_names])
-        a = np.concatenate([ctx.scene.arm(a).acceleration_limit for a in ctx.arm_names])
+        v = ctx.scene.joint_array("velocity_limit")
+        a = ctx.scene.joint_array("acceleration_limit")
         dt = np.diff(t)
         vel = np.diff(q, axis=0) / dt[:, None]
         acc = np.diff(vel, axis=0) / (0.5 * (dt[1:] + dt[:-1]))[:, None]
@@ -105,6 +104,6 @@ def validate_trajectory(
             return ValidationReport(False, "acceleration limit", int(np.argmax(np.abs(acc).max(1))))
     dense = interpolate_by_tcp(ctx, q, max_tcp_step)
     for i, qi in enumerate(dense):
-        if world.in_collision(qi[:6], qi[6:]):
-            return ValidationReport(False, "collision", i, world.report(qi[:6], qi[6:]), i + 1)
+        if world.in_collision(qi):
+            return ValidationReport(False, "collision", i, world.report(qi), i + 1)
     return ValidationReport(True, checks=len(dense))

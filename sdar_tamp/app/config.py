@@ -10,7 +10,7 @@ sdar_options=config.sdar_options())`` all read it, so every entry point plans al
   its own timeline, :mod:`sdar_tamp.schedule`; the synchronous plan is kept when the
   schedule is not shorter);
 - ``grasps``: the grasp set (:class:`streams.grasps.GraspOptions`);
-- ``sdar``: SDAR-M's budgets (:class:`solvers.sdar.solver.SdarOptions`: candidates, grasps
+- ``sdar``: SDAR-M's budgets (:class:`solvers.sdar.options.SdarOptions`: candidates, grasps
   tried per object, buffers, ...). The fields that follow from the motion planner
   (``one_arm_at_a_time``, and ``quick_attempts`` which only the ``sdar`` motion planner uses)
   and the run's ``max_time`` and ``progress`` are set by :meth:`PlannerConfig.sdar_options`;
@@ -29,7 +29,7 @@ from typing import Any
 from sdar_tamp.arguments import MAX_TIME, SEED, Real
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import GRIPPER_DWELL
-from solvers.sdar.solver import SdarOptions
+from solvers.sdar.options import SdarOptions
 from streams.grasps import DEFAULT_GRASPS, GraspOptions
 from streams.trajopt import TrajOptOptions
 

@@ -28,10 +28,9 @@ from sdar_tamp.world.transforms import BoolArray, FloatArray, inverse
 TIME_TOL = 1e-9  #: [s] an event this close before a sample time counts at that time
 
 
-def arm_columns(plan: PlanFile) -> tuple[slice, slice]:
-    """The columns of ``plan.q`` of each arm, in the plan's arm order (from ``arms[].joints``)."""
-    first = len(plan.arms[0].joints)
-    return slice(0, first), slice(first, first + len(plan.arms[1].joints))
+def arm_columns(plan: PlanFile) -> tuple[slice, ...]:
+    """The columns of ``plan.q`` of each arm, in the plan's arm order (its layout)."""
+    return plan.layout.slices
 
 
 def sample_derivatives(t: FloatArray, q: FloatArray) -> tuple[FloatArray, FloatArray]:

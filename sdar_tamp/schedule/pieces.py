@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sdar_tamp.plan_file import PlanEvent, PlanFile, StepRecord
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.plan_file import FILE_ARM_JOINTS, FILE_ARMS, PlanEvent, PlanFile, StepRecord
 from sdar_tamp.plan_rules import STILL_TOL
 from sdar_tamp.schedule.spline import retime
 from sdar_tamp.world.scene import Scene
@@ -25,8 +26,11 @@ STEP_TOL = 1e-9  #: [s] two sampling steps closer than this belong to one unifor
 
 
 def arm_columns(arm: int) -> slice:
-    """The columns of arm ``arm`` (scene order) in a plan's ``q`` ``(n, 12)``."""
-    return slice(6 * arm, 6 * arm + 6)
+    """The columns of arm ``arm`` (scene order) in a plan file's ``q`` (the file format holds
+    ``FILE_ARMS`` arms of ``FILE_ARM_JOINTS`` joints each)."""
+    if not 0 <= arm < FILE_ARMS:
+        raise ParameterError(f"arm: expected an index in [0, {FILE_ARMS}), got {arm!r}")
+    return slice(FILE_ARM_JOINTS * arm, FILE_ARM_JOINTS * (arm + 1))
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,6 +1,6 @@
 """Replaying a stretch of a timeline against the world, as the plan validator does.
 
-:class:`WorldSweep` checks configurations ``(m, 12)`` one tick apart, with the gripper events
+:class:`WorldSweep` checks configurations ``(m, dof)`` one tick apart, with the gripper events
 inside the stretch, against the collision world in the state the earlier events left it: the
 same points as the replay of :mod:`sdar_tamp.replay` (its subdivision of every interval, which
 depends only on the interval's ends), the same contact rule at grasps and releases, and the
@@ -51,6 +51,7 @@ class WorldSweep:
     def __init__(self, instance: Instance, scene: Scene, max_tcp_step: float) -> None:
         self.scene, self.step = scene, max_tcp_step
         self.names = scene.arm_names
+        self.scene_layout = scene.layout
         self.kins = {a: ArmKinematics.from_scene(scene, a) for a in self.names}
         self.sizes = {o.name: o.size for o in instance.objects}
         self.start = {o.name: o.start.as_tuple() for o in instance.objects}
@@ -77,9 +78,11 @@ class WorldSweep:
             self.exempt[e.event.arm] = (e.event.object, e.q_arm)
 
     def run(self, k0: int, q: FloatArray, events: Sequence[TimedEvent]) -> Conflict | None:
-        """Check the configurations ``q`` ``(m, 12)`` at ticks ``k0 .. k0 + m - 1`` and the
+        """Check the configurations ``q`` ``(m, dof)`` at ticks ``k0 .. k0 + m - 1`` and the
         ``events`` among them (in time order); the first conflict, or None."""
-        counts = tcp_subdivisions(q, self.kins, self.names, self.step) if len(q) > 1 else None
+        counts = (
+            tcp_subdivisions(q, self.kins, self.scene_layout, self.step) if len(q) > 1 else None
+        )
         pending = list(events)
         for k in range(len(q)):
             group = [e for e in pending if e.tick <= k0 + k]
@@ -104,12 +107,11 @@ class WorldSweep:
     def collide(self, q: FloatArray, tick: int) -> Conflict | None:
         self.checks += 1
         for arm, (_, q_event) in list(self.exempt.items()):
-            i = self.names.index(arm)
-            if np.abs(q[6 * i : 6 * i + 6] - q_event).max() > STILL_TOL:
+            if np.abs(self.scene_layout.part(q, arm) - q_event).max() > STILL_TOL:
                 del self.exempt[arm]
-        if not self.world.in_collision(q[:6], q[6:]):
+        if not self.world.in_collision(q):
             return None
-        pairs = [p for p in self.world.report(q[:6], q[6:]) if not self.allowed(p)]
+        pairs = [p for p in self.world.report(q) if not self.allowed(p)]
         if not pairs:
             return None
         return Conflict(tick, "collision", ", ".join(f"{p.first} with {p.second}" for p in pairs))

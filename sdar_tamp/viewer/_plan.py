@@ -54,7 +54,8 @@ class StepLike(Protocol):
 
 
 class PlanLike(Protocol):
-    """A timed dual-arm plan: ``t`` ``(n,)`` [s], ``q`` ``(n, 12)`` [rad] (arm 1 then arm 2)."""
+    """A timed plan: ``t`` ``(n,)`` [s], ``q`` ``(n, dof)`` [rad] (the arms' joints in
+    ``arms`` order)."""
 
     @property
     def instance(self) -> str: ...

@@ -18,7 +18,9 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.viewer._geometry import ArmDrawing
 from sdar_tamp.viewer._plan import PlanLike, StepLike
 from sdar_tamp.world._pin import PinRobot
+from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
 
@@ -51,9 +53,10 @@ class Timeline:
     """A plan (or, without one, the arms at home) replayable at any time."""
 
     instance: Instance
-    arms: tuple[ArmDrawing, ArmDrawing]
+    arms: tuple[ArmDrawing, ...]
+    layout: ArmLayout  # the arms' joints in q
     t: FloatArray  # (n,) [s]
-    q: FloatArray  # (n, 12) [rad]
+    q: FloatArray  # (n, layout.dof) [rad]
     plan: PlanLike | None = field(default=None, repr=False)
     holds: dict[str, tuple[_Hold, ...]] = field(default_factory=dict, repr=False)
 
@@ -65,12 +68,17 @@ class Timeline:
                 ArmDrawing.build(a.name, robot, a.T_world_base, _tcp_offset(scene))
                 for a in scene.arms
             )
-            q = np.concatenate([np.asarray(a.home, dtype=np.float64) for a in scene.arms])
-            return Timeline(instance, _pair(drawings), np.zeros(1), q[None])
+            return Timeline(instance, drawings, scene.layout, np.zeros(1), scene.home[None])
         if plan.instance != instance.name:
             _log.warning("plan for instance %r drawn on instance %r", plan.instance, instance.name)
-        if len(plan.arms) != 2:
-            raise ParameterError(f"plan.arms: expected 2 arms, got {len(plan.arms)}")
+        if len(plan.arms) != len(scene.arms):
+            raise ParameterError(
+                f"plan.arms: expected {len(scene.arms)} arms (the scene's), got {len(plan.arms)}"
+            )
+        try:
+            layout = ArmLayout.uniform([a.name for a in plan.arms], robot.nq)
+        except ArmLayoutError as e:
+            raise ParameterError(f"plan.arms: {e}") from None
         drawings = tuple(
             ArmDrawing.build(
                 a.name,
@@ -82,13 +90,13 @@ class Timeline:
         )
         t = np.asarray(plan.t, dtype=np.float64).reshape(-1)
         q = np.asarray(plan.q, dtype=np.float64)
-        if len(t) == 0 or q.shape != (len(t), 12) or np.any(np.diff(t) < 0):
+        if len(t) == 0 or q.shape != (len(t), layout.dof) or np.any(np.diff(t) < 0):
             raise ParameterError(
-                f"plan: expected increasing times (n,) and configurations (n, 12), got "
-                f"t {t.shape} and q {q.shape}"
+                f"plan: expected increasing times (n,) and configurations (n, {layout.dof}), "
+                f"got t {t.shape} and q {q.shape}"
             )
-        timeline = Timeline(instance, _pair(drawings), t, q, plan)
-        return Timeline(instance, timeline.arms, t, q, plan, timeline._holds(plan))
+        timeline = Timeline(instance, drawings, layout, t, q, plan)
+        return Timeline(instance, drawings, layout, t, q, plan, timeline._holds(plan))
 
     # -- sampling ------------------------------------------------------------------------------
     @property
@@ -110,22 +118,23 @@ class Timeline:
         return times
 
     def q_at(self, times: FloatArray) -> FloatArray:
-        """Configurations ``(k, 12)`` [rad] at ``times`` ``(k,)``, linearly interpolated."""
+        """Configurations ``(k, layout.dof)`` [rad] at ``times`` ``(k,)``, linearly interpolated."""
         ts = np.atleast_1d(np.asarray(times, dtype=np.float64))
         if len(self.t) == 1:
             return np.repeat(self.q, len(ts), axis=0)
-        return np.column_stack([np.interp(ts, self.t, self.q[:, j]) for j in range(12)])
+        columns = range(self.layout.dof)
+        return np.column_stack([np.interp(ts, self.t, self.q[:, j]) for j in columns])
 
     def arm_q(self, q: FloatArray, arm: int) -> FloatArray:
-        out: FloatArray = q[:, 6 * arm : 6 * arm + 6]
-        return out
+        """The joints ``(k, arm dof)`` of arm number ``arm`` in ``q`` ``(k, layout.dof)``."""
+        return self.layout.part(q, arm)
 
     def object_poses(self, times: FloatArray) -> tuple[FloatArray, IntArray]:
         """World poses ``(k, n_obj, 4, 4)`` of every object at ``times`` ``(k,)``, and who holds
         it ``(k, n_obj)``: the arm index, or -1 when it rests."""
         ts = np.atleast_1d(np.asarray(times, dtype=np.float64))
         q = self.q_at(ts)
-        tcp = [self.arms[a].tcp_poses(self.arm_q(q, a)) for a in range(2)]
+        tcp = [self.arms[a].tcp_poses(self.arm_q(q, a)) for a in range(len(self.arms))]
         n_obj = len(self.instance.objects)
         poses = np.empty((len(ts), n_obj, 4, 4))
         holder = np.full((len(ts), n_obj), -1, dtype=np.int64)
@@ -211,10 +220,6 @@ def _step_label(step: StepLike) -> str:
     parts += [f"level {step.level}"] if step.level != "" else []
     parts += [", ".join(step.objects)] if len(step.objects) > 0 else []
     return ", ".join(parts)
-
-
-def _pair(drawings: tuple[ArmDrawing, ...]) -> tuple[ArmDrawing, ArmDrawing]:
-    return drawings[0], drawings[1]
 
 
 def _tcp_offset(scene: Scene) -> FloatArray:

@@ -7,6 +7,7 @@ Light modules are re-exported here; the pinocchio/coal ones are imported from th
 
 from sdar_tamp.world.dependency import DependencyGraph, Structure, instance_dependency_graph
 from sdar_tamp.world.errors import (
+    ArmLayoutError,
     CollisionModelError,
     GenerationError,
     InstanceError,
@@ -27,12 +28,15 @@ from sdar_tamp.world.instance import (
     save_instance,
     validate_instance,
 )
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import ArmSpec, Gripper, Scene, Table, Workspace, load_scene
 from sdar_tamp.world.suites import SUITES, build_suite, generate_suite, load_suite
 
 __all__ = [
     "FAMILIES",
     "SUITES",
+    "ArmLayout",
+    "ArmLayoutError",
     "ArmSpec",
     "CollisionModelError",
     "DependencyGraph",

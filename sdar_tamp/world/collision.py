@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sdar_tamp.world import collision_model as cm
-from sdar_tamp.world.errors import CollisionModelError
+from sdar_tamp.world.errors import ArmLayoutError, CollisionModelError
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse
 
@@ -57,7 +57,8 @@ class Clearance:
 class CollisionWorld:
     """Both arms, the table, resting and held objects; answers collision queries.
 
-    Arm configurations are given in the scene's arm order (``q_left`` is ``scene.arms[0]``).
+    Configurations ``q`` ``(layout.dof,)`` hold every arm's joints in the scene's
+    :class:`~sdar_tamp.world.layout.ArmLayout` (``scene.layout``).
     Changing objects or grasps rebuilds the geometry lazily (about a millisecond); queries at
     a fixed object set are the fast path.
     """
@@ -68,7 +69,8 @@ class CollisionWorld:
         self._arms = cm.build_dual_arm(scene)
         self._resting: dict[str, ObjectBox] = {}
         self._held: dict[str, tuple[str, FloatArray, ObjectBox]] = {}
-        self._q = np.concatenate([np.array(a.home) for a in scene.arms])
+        self.layout = scene.layout
+        self._q = scene.home
         self._geometry: cm.SceneGeometry | None = None
 
     # -- objects and grasps ---------------------------------------------------------------
@@ -123,49 +125,43 @@ class CollisionWorld:
         return placed
 
     # -- configurations -------------------------------------------------------------------
-    def set_configuration(self, q_left: FloatArray, q_right: FloatArray) -> None:
-        self._q[:6] = q_left
-        self._q[6:] = q_right
+    def set_configuration(self, q: FloatArray) -> None:
+        """Set every arm's joints: ``q`` ``(layout.dof,)`` [rad]."""
+        self._set(q)
 
     @property
-    def configuration(self) -> tuple[FloatArray, FloatArray]:
-        return self._q[:6].copy(), self._q[6:].copy()
+    def configuration(self) -> FloatArray:
+        """The current configuration ``(layout.dof,)`` (a copy)."""
+        return self._q.copy()
 
     def tool0_pose(self, arm: str, q_arm: FloatArray | None = None) -> FloatArray:
         """``T_world_tool0`` of ``arm`` at ``q_arm`` (default: current configuration)."""
-        q = self._q.copy()
-        if q_arm is not None:
-            q[self._arm(arm)] = q_arm
-        else:
-            self._arm(arm)
+        self._arm(arm)
+        q = self._q if q_arm is None else self.layout.replace(self._q, arm, q_arm)
         return cm.tool0_pose(self._arms, q, arm)
 
     # -- queries --------------------------------------------------------------------------
-    def in_collision(
-        self, q_left: FloatArray | None = None, q_right: FloatArray | None = None
-    ) -> bool:
-        """True if any checked pair collides at ``(q_left, q_right)`` (default: current)."""
+    def in_collision(self, q: FloatArray | None = None) -> bool:
+        """True if any checked pair collides at ``q`` ``(layout.dof,)`` (default: current)."""
         geometry = self._geometry or self._scene_geometry()
-        self._set(q_left, q_right)
+        self._set(q)
         return cm.any_collision(self._arms, geometry, self._q)
 
-    def report(
-        self, q_left: FloatArray | None = None, q_right: FloatArray | None = None
-    ) -> tuple[CollisionPair, ...]:
-        """Every colliding pair, by shape names (empty when collision-free)."""
+    def report(self, q: FloatArray | None = None) -> tuple[CollisionPair, ...]:
+        """Every colliding pair at ``q`` (default: current), by shape names (empty when
+        collision-free)."""
         geometry = self._scene_geometry()
-        self._set(q_left, q_right)
+        self._set(q)
         return tuple(
             CollisionPair(*geometry.pair_names[i])
             for i in cm.colliding_pairs(self._arms, geometry, self._q)
         )
 
-    def min_distance(
-        self, q_left: FloatArray | None = None, q_right: FloatArray | None = None
-    ) -> Clearance:
-        """Smallest signed distance over every checked pair [m] (negative: penetration)."""
+    def min_distance(self, q: FloatArray | None = None) -> Clearance:
+        """Smallest signed distance over every checked pair at ``q`` (default: current) [m]
+        (negative: penetration)."""
         geometry = self._scene_geometry()
-        self._set(q_left, q_right)
+        self._set(q)
         d = cm.pair_distances(self._arms, geometry, self._q)
         if d.size == 0:
             return Clearance(float("inf"), None)
@@ -173,18 +169,19 @@ class CollisionWorld:
         return Clearance(float(d[i]), CollisionPair(*geometry.pair_names[i]))
 
     # -- internals ------------------------------------------------------------------------
-    def _set(self, q_left: FloatArray | None, q_right: FloatArray | None) -> None:
-        if q_left is not None:
-            self._q[:6] = q_left
-        if q_right is not None:
-            self._q[6:] = q_right
+    def _set(self, q: FloatArray | None) -> None:
+        if q is not None:
+            if np.shape(q) != self._q.shape:
+                raise ArmLayoutError(
+                    f"q: expected shape ({self.layout.dof},) for arms {list(self.layout.names)}, "
+                    f"got {np.shape(q)}"
+                )
+            self._q[:] = q
 
     def _arm(self, arm: str) -> slice:
-        if arm not in self._arms.arm_names:
-            raise CollisionModelError(
-                f"unknown arm {arm!r}; expected one of {self._arms.arm_names}"
-            )
-        return self._arms.q_slice(arm)
+        if arm not in self.layout:
+            raise CollisionModelError(f"unknown arm {arm!r}; expected one of {self.layout.names}")
+        return self.layout.slice(arm)
 
     def _shrunk(self, box: ObjectBox) -> FloatArray:
         return np.maximum(np.array(box.size) - 2.0 * self._tolerance, 1e-6)

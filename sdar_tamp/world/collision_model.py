@@ -1,9 +1,9 @@
 """Typed adapter building the pinocchio model of both arms and the scene geometry.
 
-The two arms are one 12-DoF pinocchio model (left joints first). Scene geometry is added as
-pinocchio geometry objects: the table and resting objects on the universe joint, held objects
-on the wrist_3 joint of the arm holding them. Collision pairs encode the filtering rules of
-:class:`sdar_tamp.world.collision.CollisionWorld`.
+The arms are one pinocchio model whose joints follow the scene's :class:`ArmLayout`. Scene
+geometry is added as pinocchio geometry objects: the table and resting objects on the
+universe joint, held objects on the wrist_3 joint of the arm holding them. Collision pairs
+encode the filtering rules of :class:`sdar_tamp.world.collision.CollisionWorld`.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from sdar_tamp.world import _coal
 from sdar_tamp.world._pin import array_to_se3, se3_to_array
 from sdar_tamp.world._yaml import file_error
 from sdar_tamp.world.errors import SceneError
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
 
@@ -42,14 +43,14 @@ class DualArmModel:
     data: Any = field(repr=False)
     arm_geometry: Any = field(repr=False)  # pin.GeometryModel holding the arm shapes only
     shapes: tuple[ArmGeometry, ...]
-    arm_names: tuple[str, ...]
+    layout: ArmLayout
     wrist_joint: dict[str, int]  # arm -> joint id of wrist_3
     tool0_frame: dict[str, int]  # arm -> frame id of tool0
     T_wrist_tool0: FloatArray  # tool0 in the wrist_3 joint frame
 
-    def q_slice(self, arm: str) -> slice:
-        i = self.arm_names.index(arm)
-        return slice(6 * i, 6 * i + 6)
+    @property
+    def arm_names(self) -> tuple[str, ...]:
+        return self.layout.names
 
 
 def _prefixed_urdf(text: str, prefix: str) -> str:
@@ -81,12 +82,18 @@ def build_dual_arm(scene: Scene) -> DualArmModel:
             shapes.append(ArmGeometry(str(obj.name), spec.name, link, gi))
     tool0 = {a.name: int(model.getFrameId(f"{a.name}_tool0")) for a in scene.arms}
     T_wrist_tool0 = se3_to_array(model.frames[tool0[scene.arms[0].name]].placement)
+    layout = scene.layout
+    if model.nq != layout.dof:
+        raise SceneError(
+            f"{scene.file}: the robot description has {model.nq // len(layout)} joints per arm; "
+            f"the scene's arms have {list(layout.dofs)}"
+        )
     return DualArmModel(
         model,
         model.createData(),
         geometry,
         tuple(shapes),
-        scene.arm_names,
+        layout,
         wrist,
         tool0,
         T_wrist_tool0,
@@ -94,7 +101,7 @@ def build_dual_arm(scene: Scene) -> DualArmModel:
 
 
 def tool0_pose(arms: DualArmModel, q: FloatArray, arm: str) -> FloatArray:
-    """``T_world_tool0`` of ``arm`` at the dual-arm configuration ``q`` ``(12,)``."""
+    """``T_world_tool0`` of ``arm`` at the configuration ``q`` ``(layout.dof,)``."""
     pin.framesForwardKinematics(arms.model, arms.data, q)
     return se3_to_array(arms.data.oMf[arms.tool0_frame[arm]])
 
@@ -170,7 +177,7 @@ def pair_distances(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> F
 
 
 def link_poses(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> dict[str, FloatArray]:
-    """World pose of every geometry ``name -> (4, 4)`` at ``q`` ``(12,)``."""
+    """World pose of every geometry ``name -> (4, 4)`` at ``q`` ``(layout.dof,)``."""
     pin.updateGeometryPlacements(arms.model, arms.data, scene.geometry, scene.data, q)
     return {
         str(obj.name): se3_to_array(scene.data.oMg[i])

@@ -41,3 +41,8 @@ class CollisionModelError(WorldError):
 
 class GenerationError(WorldError):
     """A seeded generator could not build the structure it promises within its retry budget."""
+
+
+class ArmLayoutError(WorldError, ValueError):
+    """A bad arm layout (no arms, repeated names, a non-positive DoF) or a configuration
+    whose shape does not match the layout, or an arm the layout does not have."""

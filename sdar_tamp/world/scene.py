@@ -1,4 +1,4 @@
-"""The dual-arm scene: table, two arms, workspace, default object, gripper.
+"""The dual-arm scene: table, arms (two, for now), workspace, default object, gripper.
 
 Loaded from ``scene.yaml`` (the shipped one lives in ``domains/dual_arm_rearrangement``) into
 frozen dataclasses. World frame: table centre at the origin, z up, table top at z = 0.
@@ -14,6 +14,7 @@ import numpy as np
 
 from sdar_tamp.world._yaml import Node, read_yaml
 from sdar_tamp.world.errors import SceneError
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.transforms import BoolArray, FloatArray, pose_xyz_yaw
 
 #: Joint keys of ``joint_limits`` in the scene file, in joint order.
@@ -115,11 +116,31 @@ class Scene:
     def arm_names(self) -> tuple[str, ...]:
         return tuple(a.name for a in self.arms)
 
+    @property
+    def layout(self) -> ArmLayout:
+        """The arms' joints in a configuration vector, in the scene's arm order."""
+        return ArmLayout(self.arm_names, tuple(len(a.home) for a in self.arms))
+
+    @property
+    def home(self) -> FloatArray:
+        """Every arm at its home configuration ``(layout.dof,)`` [rad]."""
+        return self.layout.join([a.home for a in self.arms])
+
+    def joint_array(self, field: str) -> FloatArray:
+        """A per-joint property of every arm (``lower``, ``upper``, ``velocity_limit``,
+        ``acceleration_limit`` or ``home``) as one vector ``(layout.dof,)``."""
+        if field not in _JOINT_FIELDS:
+            raise SceneError(f"field must be one of {', '.join(_JOINT_FIELDS)}; got {field!r}")
+        return self.layout.join([getattr(a, field) for a in self.arms])
+
     def arm(self, name: str) -> ArmSpec:
         for a in self.arms:
             if a.name == name:
                 return a
         raise SceneError(f"unknown arm {name!r}; the scene has {list(self.arm_names)}")
+
+
+_JOINT_FIELDS = ("lower", "upper", "velocity_limit", "acceleration_limit", "home")
 
 
 def load_scene(path: Path | None = None) -> Scene:

@@ -228,3 +228,20 @@ def test_resample_inserts_linear_samples() -> None:
     t, q = resample(np.array([0.0, 0.05, 0.06]), np.array([[0.0], [1.0], [3.0]]), 0.02)
     np.testing.assert_allclose(t, [0.0, 0.05 / 3, 0.1 / 3, 0.05, 0.06])
     np.testing.assert_allclose(q[:, 0], [0.0, 1 / 3, 2 / 3, 1.0, 3.0])
+
+
+def test_the_plan_layout_follows_its_arms(plan: PlanFile, scene: Scene) -> None:
+    assert plan.layout == scene.layout
+    assert plan.q.shape[1] == plan.layout.dof
+
+
+def test_repeated_arm_names_in_memory_are_a_format_violation(plan: PlanFile) -> None:
+    import dataclasses
+
+    from sdar_tamp.plan_rules import check_format
+
+    twins = dataclasses.replace(plan, arms=(plan.arms[0], plan.arms[0]))
+    found = check_format(twins)
+    assert found is not None and found.kind == "format"
+    assert found.message == "arms: arm layout: arm names must differ, got ['left'] twice"
+    assert check_format(plan) is None

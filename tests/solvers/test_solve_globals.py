@@ -102,7 +102,6 @@ _ALLOWED = {
     ("sdar_tamp/cli.py", "basicConfig"),  # the sdar program: -v / --log-level
     ("sdar_tamp/cli.py", "setLevel"),
     ("sdar_tamp/logs.py", "getLogger"),  # the one place that names loggers
-    ("solvers/sdar/solver.py", "getLogger"),  # named f"sdar_tamp.{__name__}"
 }
 
 

@@ -34,7 +34,7 @@ def test_candidates_reproduce_the_grasp_pose_and_are_ranked(
         # the pre-grasp never collides with anything
         other = ctx.other(c.arm)
         qs = {c.arm: c.q_pre, other: ctx.home(other)}
-        assert not world.in_collision(qs["left"], qs["right"])
+        assert not world.in_collision(ctx.layout.join(qs))
 
 
 def test_ranking_for_two_arms_two_objects_six_grasps_is_repeatable(
@@ -69,7 +69,7 @@ def test_compatible_pairs_are_jointly_collision_free(
     assert pairs
     for a, b in pairs:
         assert a.arm == "left" and b.arm == "right"
-        assert not world.in_collision(a.q_pre, b.q_pre)
+        assert not world.in_collision(ctx.layout.join({a.arm: a.q_pre, b.arm: b.q_pre}))
 
 
 def test_scene_cache_keeps_one_world_per_arrangement(

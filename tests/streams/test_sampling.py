@@ -51,16 +51,15 @@ def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
     assert W is not None and len(W) >= 3
     np.testing.assert_allclose(W[[0, -1]], np.stack([q_a, q_b]))
     for k in range(len(W)):  # every waypoint is clear, with the margin
-        assert not planner.margin_world.in_collision(W[k, :6], W[k, 6:])
+        assert not planner.margin_world.in_collision(W[k])
     # a waiting arm stays where it is
-    q_b2 = q_b.copy()
-    q_b2[:6] = q_a[:6]
+    layout = ctx.layout
+    q_b2 = layout.replace(q_b, "left", layout.part(q_a, "left"))
     W2 = sample_path(planner, q_a, q_b2)
-    assert W2 is not None and np.allclose(W2[:, :6], q_a[:6])
+    assert W2 is not None and np.allclose(layout.part(W2, "left"), layout.part(q_a, "left"))
     # a goal in collision ends at once (RRTConnect alone would wait for a valid goal)
-    q_bad = q_b.copy()
-    q_bad[6:] = q_a[6:]
-    assert planner.margin_world.in_collision(q_bad[:6], q_bad[6:])
+    q_bad = layout.replace(q_b, "right", layout.part(q_a, "right"))
+    assert planner.margin_world.in_collision(q_bad)
     assert sample_path(planner, q_a, q_bad) is None
 
 

@@ -1,3 +1,4 @@
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -6,6 +7,7 @@ import pytest
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.pddl import parse_domain
 from sdar_tamp.language.streams import parse_stream_file
+from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance, Pose2D
 from streams.context import WorldContext
 from streams.motion import DualMotionPlanner
@@ -96,7 +98,7 @@ def test_combine_confs_rejects_arms_in_collision(ctx: WorldContext) -> None:
     assert not list(sm["combine-confs"]("left", home["left"], "left", home["left"]))
     # a left configuration whose gripper touches the right arm's gripper at home
     crossing = ArmConf("left", (-2.781, -3.068, 0.89, 2.288, -0.423, 0.863))
-    pairs = ctx.new_world().report(np.array(crossing.q), ctx.home("right"))
+    pairs = ctx.new_world().report(DualConf(crossing, home["right"]).q)
     assert any(p.first.startswith("left") and p.second.startswith("right") for p in pairs)
     assert not list(sm["combine-confs"]("left", crossing, "right", home["right"]))
 
@@ -136,3 +138,28 @@ def test_ik_queries_of_one_arrangement_share_one_collision_world(
     list(sm_obj.inverse_kinematics("left", o.name, o.goal, grasps[0], after))
     list(sm_obj.inverse_kinematics("right", o.name, o.goal, grasps[0], after))
     assert sm_obj.scenes.builds == 2 and sm_obj.scenes.hits == 16
+
+
+def test_dual_conf_holds_every_arm_in_layout_order(ctx: WorldContext) -> None:
+    home = {a: ArmConf(a, tuple(ctx.home(a))) for a in ctx.arm_names}
+    d = DualConf(*(home[a] for a in ctx.arm_names))
+    assert d.arms == (home["left"], home["right"]) and d.arm("right") is home["right"]
+    np.testing.assert_array_equal(d.q, ctx.scene.home)
+    combine = make_stream_map(ctx)["combine-confs"]
+    ((combined,),) = list(combine("right", home["right"], "left", home["left"]))
+    assert combined == d  # arms in layout order whatever order the stream got them in
+    with pytest.raises(ParameterError, match="DualConf: expected one ArmConf per arm, got none"):
+        DualConf()
+    with pytest.raises(ParameterError, match=r"arm must be one of \['left', 'right'\]; got 'up'"):
+        d.arm("up")
+
+
+def test_other_arm_needs_two_arms(ctx: WorldContext) -> None:
+    assert ctx.other("left") == "right" and ctx.other("right") == "left"
+    with pytest.raises(ArmLayoutError, match="unknown arm 'up'"):
+        ctx.other("up")
+    third = dataclasses.replace(ctx.scene.arms[0], name="middle")
+    three = WorldContext(dataclasses.replace(ctx.scene, arms=(*ctx.scene.arms, third)), {}, {})
+    with pytest.raises(ParameterError, match="other: defined for two arms, the scene has 3"):
+        three.other("left")
+    assert three.split(np.arange(18.0))["middle"].tolist() == list(range(12, 18))

@@ -29,7 +29,7 @@ def test_a_pass_through_an_object_is_caught(ctx: WorldContext) -> None:
     q_end = home.copy()
     q_end[1] += 1.0
     traj = np.stack([home, q_end])  # the coarse samples themselves are free
-    assert not world.in_collision(home[:6], home[6:]) and T.shape == (4, 4)
+    assert not world.in_collision(home) and T.shape == (4, 4)
     report = validate_trajectory(ctx, world, traj)
     assert not report.ok and report.reason == "collision"
     assert any("object:o" in (c.first, c.second) for c in report.pairs)

@@ -172,6 +172,22 @@ def test_unknown_event_object_is_named(instance: Instance, plan: PlanFile) -> No
         Timeline.build(instance, bad, load_scene())
 
 
+def test_plan_arms_must_match_the_scene(instance: Instance, plan: PlanFile) -> None:
+    twins = dataclasses.replace(plan, arms=(plan.arms[0], plan.arms[0]))
+    with pytest.raises(ParameterError, match=r"plan.arms: arm layout: arm names must differ"):
+        Timeline.build(instance, twins, load_scene())
+    one = dataclasses.replace(plan, arms=plan.arms[:1])
+    with pytest.raises(ParameterError, match=r"plan.arms: expected 2 arms \(the scene's\), got 1"):
+        Timeline.build(instance, one, load_scene())
+
+
+def test_arm_joints_come_from_the_layout(instance: Instance, plan: PlanFile) -> None:
+    timeline = Timeline.build(instance, plan, load_scene())
+    assert timeline.layout == plan.layout
+    q = timeline.q_at(np.array([0.0, plan.duration]))
+    np.testing.assert_array_equal(timeline.arm_q(q, 1), q[:, timeline.layout.slice("right")])
+
+
 # -- the HTML page ------------------------------------------------------------------------------
 def _frames(html: str) -> list[dict[str, object]]:
     m = re.search(r"Plotly\.addFrames\('sdar-viewer', ", html)

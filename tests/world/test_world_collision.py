@@ -4,12 +4,14 @@ import numpy as np
 import pytest
 
 from sdar_tamp.world.collision import CollisionWorld, ObjectBox
-from sdar_tamp.world.errors import CollisionModelError
+from sdar_tamp.world.errors import ArmLayoutError, CollisionModelError
 from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import pose_xyz_yaw, top_down_pose
 
 SIZE = (0.08, 0.04, 0.05)
+LAYOUT = ArmLayout(("left", "right"), (6, 6))  # the shipped scene's
 
 
 @pytest.fixture(scope="module")
@@ -28,35 +30,40 @@ def _reach(kin: ArmKinematics, x: float, y: float, z: float, yaw: float = 0.0) -
     return q[0]
 
 
+def _q(q_left: np.ndarray, q_right: np.ndarray) -> np.ndarray:
+    """Both arms' joints as one configuration, in the scene's layout."""
+    return LAYOUT.join({"left": q_left, "right": q_right})
+
+
 def _box(x: float, y: float, yaw: float = 0.0) -> ObjectBox:
     return ObjectBox(pose_xyz_yaw(x, y, SIZE[2] / 2, yaw), SIZE)
 
 
 def test_home_configurations_are_free(world: CollisionWorld, scene: Scene) -> None:
     home = np.array(scene.arms[0].home)
-    assert not world.in_collision(home, home)
-    assert world.report(home, home) == ()
-    assert world.min_distance(home, home).distance > 0.0
+    assert not world.in_collision(_q(home, home))
+    assert world.report(_q(home, home)) == ()
+    assert world.min_distance(_q(home, home)).distance > 0.0
 
 
 def test_arms_driven_into_each_other_collide(world: CollisionWorld, kins: dict) -> None:
     q_l = _reach(kins["left"], 0.0, 0.0, 0.15)
     q_r = _reach(kins["right"], 0.0, 0.0, 0.15)
     home = np.array(kins["right"].spec.home)
-    assert not world.in_collision(q_l, home)
-    assert world.in_collision(q_l, q_r)
-    pairs = world.report(q_l, q_r)
+    assert not world.in_collision(_q(q_l, home))
+    assert world.in_collision(_q(q_l, q_r))
+    pairs = world.report(_q(q_l, q_r))
     assert any(p.first.startswith("left_") and p.second.startswith("right_") for p in pairs)
-    assert world.min_distance(q_l, q_r).distance < 0.0
+    assert world.min_distance(_q(q_l, q_r)).distance < 0.0
 
 
 def test_arm_into_the_table_collides(world: CollisionWorld, kins: dict) -> None:
     home = np.array(kins["right"].spec.home)
     q_l = _reach(kins["left"], 0.0, 0.0, 0.05)  # fingertips 0.017 m below the TCP: free
-    assert not world.in_collision(q_l, home)
+    assert not world.in_collision(_q(q_l, home))
     q_l = _reach(kins["left"], 0.0, 0.0, 0.0)
-    assert world.in_collision(q_l, home)
-    assert any(p.second == "table" for p in world.report(q_l, home))
+    assert world.in_collision(_q(q_l, home))
+    assert any(p.second == "table" for p in world.report(_q(q_l, home)))
 
 
 def test_object_under_the_gripper_collides_until_held(world: CollisionWorld, kins: dict) -> None:
@@ -65,24 +72,24 @@ def test_object_under_the_gripper_collides_until_held(world: CollisionWorld, kin
     above = _reach(kins["left"], 0.0, 0.1, 0.2)
     grasp = _reach(kins["left"], 0.0, 0.1, SIZE[2] / 2)  # fingers close along world y
     off = _reach(kins["left"], 0.0, 0.13, SIZE[2] / 2)  # a finger lands in the object
-    assert not world.in_collision(above, home)
-    assert not world.in_collision(grasp, home)  # open fingers straddle the 0.04 m side
-    assert world.in_collision(off, home)
-    pairs = {(p.first, p.second) for p in world.report(off, home)}
+    assert not world.in_collision(_q(above, home))
+    assert not world.in_collision(_q(grasp, home))  # open fingers straddle the 0.04 m side
+    assert world.in_collision(_q(off, home))
+    pairs = {(p.first, p.second) for p in world.report(_q(off, home))}
     assert ("left_gripper_left_finger_0", "object:o0") in pairs
     # turned by 90 deg the 0.08 m side would lie between the fingers: wider than the 0.060 m
     # pre-grasp opening, so a finger lands in the object
     across = _reach(kins["left"], 0.0, 0.1, SIZE[2] / 2, yaw=np.pi / 2)
-    assert world.in_collision(across, home)
+    assert world.in_collision(_q(across, home))
     world.attach("left", "o0", grasp)
     assert world.held_by("left") == "o0"
-    assert not world.in_collision(grasp, home)  # the held object never hits its own gripper
+    assert not world.in_collision(_q(grasp, home))  # the held object never hits its own gripper
     lifted = _reach(kins["left"], 0.0, 0.1, 0.2)
-    assert not world.in_collision(lifted, home)
-    assert world.in_collision(off, home) is False  # held: moves with the gripper
+    assert not world.in_collision(_q(lifted, home))
+    assert world.in_collision(_q(off, home)) is False  # held: moves with the gripper
     placed = world.detach("left", grasp)
     np.testing.assert_allclose(placed.T_world_obj, _box(0.0, 0.1).T_world_obj, atol=1e-9)
-    assert world.in_collision(off, home)
+    assert world.in_collision(_q(off, home))
 
 
 def test_held_object_against_table_objects_and_other_held(
@@ -93,17 +100,17 @@ def test_held_object_against_table_objects_and_other_held(
     q_r = _reach(kins["right"], 0.1, 0.0, SIZE[2] / 2)
     world.attach("left", "a", q_l)
     world.attach("right", "b", q_r)
-    assert not world.in_collision(q_l, q_r)
+    assert not world.in_collision(_q(q_l, q_r))
     # held object pushed into the table
     low = _reach(kins["left"], -0.1, 0.0, 0.0)
-    assert ("held:a", "table") in {(p.first, p.second) for p in world.report(low, q_r)}
+    assert ("held:a", "table") in {(p.first, p.second) for p in world.report(_q(low, q_r))}
     # held object lowered onto a resting one
     onto = _reach(kins["left"], 0.0, 0.2, SIZE[2] / 2 + 0.03)
-    assert any({p.first, p.second} == {"held:a", "object:c"} for p in world.report(onto, q_r))
+    assert any({p.first, p.second} == {"held:a", "object:c"} for p in world.report(_q(onto, q_r)))
     # both held objects brought together high above the table
     q_l2 = _reach(kins["left"], -0.03, 0.0, 0.35)
     q_r2 = _reach(kins["right"], 0.03, 0.0, 0.35)
-    assert any({p.first, p.second} == {"held:a", "held:b"} for p in world.report(q_l2, q_r2))
+    assert any({p.first, p.second} == {"held:a", "held:b"} for p in world.report(_q(q_l2, q_r2)))
 
 
 def test_bad_requests_raise(world: CollisionWorld) -> None:
@@ -124,9 +131,10 @@ def test_bad_requests_raise(world: CollisionWorld) -> None:
 def test_configuration_is_stored(world: CollisionWorld, kins: dict) -> None:
     q_l = _reach(kins["left"], 0.0, 0.0, 0.15)
     q_r = _reach(kins["right"], 0.0, 0.0, 0.15)
-    world.set_configuration(q_l, q_r)
+    world.set_configuration(_q(q_l, q_r))
     assert world.in_collision()
-    np.testing.assert_allclose(world.configuration[0], q_l)
+    np.testing.assert_allclose(world.layout.part(world.configuration, "left"), q_l)
+    np.testing.assert_allclose(world.configuration, _q(q_l, q_r))
     np.testing.assert_allclose(world.tool0_pose("left"), kins["left"].fk_tool0(q_l), atol=1e-12)
 
 
@@ -138,3 +146,15 @@ def test_coal_adapter_distance_between_boxes() -> None:
     assert d == pytest.approx(0.10, abs=1e-9)
     d = shape_distance(a, _box(0.0, 0.0).T_world_obj, b, _box(0.07, 0.0).T_world_obj)
     assert d == pytest.approx(-0.01, abs=1e-6)
+
+
+def test_configuration_of_the_wrong_shape_is_refused(world: CollisionWorld, scene: Scene) -> None:
+    assert world.layout == scene.layout == LAYOUT
+    home = np.array(scene.arms[0].home)
+    with pytest.raises(
+        ArmLayoutError, match=r"expected shape \(12,\) for arms \['left', 'right'\]"
+    ):
+        world.in_collision(home)  # one arm only
+    with pytest.raises(ArmLayoutError, match="got \\(13,\\)"):
+        world.set_configuration(np.zeros(13))
+    np.testing.assert_allclose(world.configuration, scene.home)  # unchanged

@@ -1,0 +1,240 @@
+"""Grounding of candidate steps: grasps, IK at both ends, buffers and dual-arm configurations.
+
+For a candidate step and an assignment of arms, :class:`Grounder` asks the streams for a few
+(grasp, pick IK, target, place IK) options per move, combines them into collision-free
+dual-arm configurations (or, for the one-arm-at-a-time motion planner, a sequence of gripper
+events with the other arm at home) and ranks the groundings by the task planner's rank and
+then by the estimated motion time. Groundings that failed before are skipped (see
+:class:`~solvers.sdar.attempts.TabuLists`).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Hashable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from solvers.sdar.attempts import MotionMode, TabuLists
+from solvers.sdar.budget import Deadline
+from solvers.sdar.cache import StreamCache
+from solvers.sdar.report import Failures
+from solvers.sdar.tasks import Move, Step
+
+if TYPE_CHECKING:
+    from solvers.sdar.options import SdarOptions
+
+
+@dataclass(frozen=True)
+class Option:
+    grasp: str
+    pick: str  # arm configuration at the current pose
+    target: str  # pose
+    place: str  # arm configuration at the target
+
+
+@dataclass(frozen=True)
+class Event:
+    """One gripper action of a one-arm-at-a-time execution, at ``conf``: the acting arm at
+    its pick or place configuration, the other arm at home."""
+
+    index: int  # into the step's moves
+    pick: bool
+    conf: str  # dual-arm configuration
+
+
+@dataclass(frozen=True)
+class Grounding:
+    """A step with arms and options; ``d_pick`` / ``d_place``: the dual-arm configurations of
+    the first and of the last gripper action."""
+
+    step: Step
+    arms: tuple[str, ...]
+    options: tuple[Option, ...]
+    d_pick: str
+    d_place: str
+    estimate: float
+    sequence: tuple[Event, ...] = ()  # one arm at a time only
+
+
+class Grounder:
+    """Grounds candidate steps in the current arrangement of ``cache``."""
+
+    def __init__(
+        self,
+        cache: StreamCache,
+        options: SdarOptions,
+        goals: Mapping[str, str],
+        home: Mapping[str, str],
+        tabu: TabuLists,
+        failures: Failures,
+        deadline: Deadline,
+    ) -> None:
+        self.cache = cache
+        self.options = options
+        self.goals = goals
+        self.home = home
+        self.tabu = tabu
+        self.failures = failures
+        self.deadline = deadline
+
+    def key(self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...]) -> Hashable:
+        """The tabu key of a grounding in the current arrangement."""
+        return (self.cache.fluents(self.cache.voc.atpose), step.moves, arms, combo)
+
+    def select(self, candidates: Sequence[Step], mode: MotionMode) -> list[Grounding]:
+        """Feasible groundings, best first: task-planner rank, then estimated motion time."""
+        found: list[Grounding] = []
+        for index, step in enumerate(candidates):
+            if self.deadline.passed():
+                break
+            if found and (
+                step.rank > found[0].step.rank
+                or (index >= self.options.candidates and len(found) >= 1)
+                or len(found) >= self.options.choose_among
+            ):
+                break
+            for arms in self._assignments(step):
+                found.extend(self._ground(step, arms, mode))
+            found.sort(key=lambda g: (g.step.rank, g.estimate))
+        return found
+
+    def _assignments(self, step: Step) -> list[tuple[str, ...]]:
+        return list(itertools.permutations(sorted(self.home), len(step.moves)))
+
+    def _ground(self, step: Step, arms: tuple[str, ...], mode: MotionMode) -> list[Grounding]:
+        """Every grounding of ``step`` with ``arms`` not yet tried, cheapest estimate first:
+        from ``options_per_move`` options per move, or from ``more_options`` when none of
+        those combinations works (two arms reaching for neighbouring objects often collide
+        with the first grasps and not with tilted ones)."""
+        lifted = frozenset(step.objects)
+        opt = self.options
+        limits = [opt.options_per_move]
+        if step.kind in opt.expand_kinds and opt.more_options > opt.options_per_move:
+            limits.append(opt.more_options)
+        for limit in limits:
+            per_move = [
+                self._move_options(a, m, lifted, limit)
+                for a, m in zip(arms, step.moves, strict=True)
+            ]
+            for a, m, options in zip(arms, step.moves, per_move, strict=True):
+                if not options:
+                    target = "a buffer" if m.to_buffer else "its goal"
+                    show = self.cache.show
+                    self.failures.why(step, arms, f"no grasp with IK for {show(a)} at "
+                                      f"{show(m.obj)} and at {target}")  # fmt: skip
+                    return []
+            found = self._combinations(step, arms, per_move, mode)
+            if found or all(len(options) < limit for options in per_move):
+                break
+        if not found:
+            self.failures.why(step, arms, "the arms' configurations collide (or were tried)")
+        return sorted(found, key=lambda g: g.estimate)
+
+    def _move_options(
+        self, arm: str, move: Move, lifted: frozenset[str], limit: int
+    ) -> list[Option]:
+        cache, voc, opt = self.cache, self.cache.voc, self.options
+        p = cache.current_poses()[move.obj]
+        resting = cache.fluents(voc.atpose)
+        if move.to_buffer:
+            targets = [out[0] for out in cache.outputs(voc.buffer, (move.obj,), opt.buffers,
+                                                         resting)]  # fmt: skip
+        else:
+            targets = [self.goals[move.obj]]
+        after = cache.fluents(voc.atpose, without=lifted)
+        found: list[Option] = []
+        for (g,) in cache.outputs(voc.grasp, (move.obj,), opt.grasps):
+            picks = cache.outputs(voc.ik, (arm, move.obj, p, g), 1, resting)
+            if not picks:
+                continue
+            for t in targets:
+                places = cache.outputs(voc.ik, (arm, move.obj, t, g), 1, after)
+                if places:
+                    found.append(Option(g, picks[0][0], t, places[0][0]))
+                    break
+            if len(found) >= limit:
+                break
+        return found
+
+    def _combinations(
+        self,
+        step: Step,
+        arms: tuple[str, ...],
+        per_move: Sequence[Sequence[Option]],
+        mode: MotionMode,
+    ) -> list[Grounding]:
+        """The groundings of every combination of the moves' options not yet tried whose
+        dual-arm configurations are collision-free."""
+        idle = [a for a in self.home if a not in arms]
+        current = self.cache.current_dualconf()
+        found: list[Grounding] = []
+        for combo in _product(per_move):
+            if self.tabu.blocked(self.key(step, arms, combo), mode):
+                continue
+            if self.options.one_arm_at_a_time:
+                one = self._ground_one_arm(step, arms, combo, current)
+                if one is not None:
+                    found.append(one)
+                continue
+            pick = {a: o.pick for a, o in zip(arms, combo, strict=True)}
+            place = {a: o.place for a, o in zip(arms, combo, strict=True)}
+            for a in idle:  # the idle arm waits at its retract (home) configuration
+                pick[a] = place[a] = self.home[a]
+            d_pick, d_place = self._combine(pick), self._combine(place)
+            if d_pick is None or d_place is None:
+                continue
+            distance = self.cache.distance
+            estimate = distance(current, d_pick) + distance(d_pick, d_place)
+            found.append(Grounding(step, arms, combo, d_pick, d_place, estimate))
+        return found
+
+    def _combine(self, confs: Mapping[str, str]) -> str | None:
+        (a1, q1), (a2, q2) = sorted(confs.items())
+        out = self.cache.outputs(self.cache.voc.combine, (a1, q1, a2, q2), 1)
+        return out[0][0] if out else None
+
+    def _ground_one_arm(
+        self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...], current: str
+    ) -> Grounding | None:
+        """The baseline motion planner's grounding: every gripper action happens with the
+        acting arm at its configuration and the other arm at home (its retract pose)."""
+        sequence: list[Event] = []
+        for index, pick in self._one_arm_order(step, [o.target for o in combo]):
+            arm = arms[index]
+            option = combo[index]
+            confs = dict(self.home)
+            confs[arm] = option.pick if pick else option.place
+            d = self._combine(confs)
+            if d is None:
+                return None
+            sequence.append(Event(index, pick, d))
+        estimate, d0 = 0.0, current
+        for event in sequence:
+            estimate += self.cache.distance(d0, event.conf)
+            d0 = event.conf
+        first, last = sequence[0].conf, sequence[-1].conf
+        return Grounding(step, arms, combo, first, last, estimate, tuple(sequence))
+
+    def _one_arm_order(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
+        """``(move index, pick?)`` in execution order. A move whose target is clear of every
+        other resting object goes first, alone, then the other; otherwise (a swap) the first
+        arm picks and waits at home holding its object while the second arm works."""
+        if len(step.moves) == 1:
+            return [(0, True), (0, False)]
+        current = self.cache.current_poses()
+        for k, (obj, target) in enumerate(zip(step.objects, targets, strict=True)):
+            if all(
+                self.cache.test(self.cache.voc.cfree, (obj, target, other, pose))
+                for other, pose in current.items()
+                if other != obj
+            ):
+                return [(k, True), (k, False), (1 - k, True), (1 - k, False)]
+        return [(0, True), (1, True), (1, False), (0, False)]
+
+
+def _product(options: Sequence[Sequence[Option]]) -> list[tuple[Option, ...]]:
+    combos: list[tuple[Option, ...]] = [()]
+    for choices in options:
+        combos = [(*c, o) for c in combos for o in choices]
+    return combos

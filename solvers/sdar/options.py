@@ -1,0 +1,28 @@
+"""SDAR-M's budgets and switches (:class:`SdarOptions`), apart so that every part of the solver
+can read them without importing the decision loop."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from solvers.sdar.vocabulary import SdarVocabulary
+
+
+@dataclass(frozen=True)
+class SdarOptions:
+    """Budgets of SDAR-M (see the module docstring)."""
+
+    max_time: float = math.inf  # [s]
+    candidates: int = 8  # candidate steps grounded per decision (more if none works)
+    choose_among: int = 3  # feasible groundings compared by estimated motion time
+    grasps: int = 6  # grasps tried per object
+    options_per_move: int = 2  # (grasp, pick IK, place IK) options kept per arm and move
+    more_options: int = 6  # kept instead when every pair of the first ones makes the arms collide
+    expand_kinds: tuple[str, ...] = ("pair", "swap", "chain", "cycle")  # two-move steps
+    buffers: int = 4  # buffer poses tried per buffer move
+    one_arm_at_a_time: bool = False  # the baseline motion planner (one arm moves at a time)
+    quick_attempts: int = 6  # best-ranked groundings tried with the quick motion stream first
+    progress: Callable[[int, int], None] | None = None  # (objects at goal, objects) per step
+    vocabulary: SdarVocabulary = field(default_factory=SdarVocabulary)
