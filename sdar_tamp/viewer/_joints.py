@@ -27,7 +27,8 @@ def joint_figure(
     steps: Sequence[tuple[float, float]],
     violation_t: float | None,
 ) -> JSON:
-    """The panel as a plotly figure: four stacked plots (q then q-dot, first arm then second)."""
+    """The panel as a plotly figure: four stacked plots (q then q-dot, first arm then second);
+    ``x`` holds the times of every curve (a typed-array spec), which the curves leave out."""
     rows = [(a, kind) for a in range(2) for kind in ("q", "qd")]
     n = len(rows)
     gap = 0.035
@@ -66,7 +67,6 @@ def joint_figure(
                     "name": joint.replace("_", " "),
                     "legendgroup": joint,
                     "showlegend": k == 0,
-                    "x": t,
                     "y": typed_array(values[:, j]),
                     "xaxis": f"x{suffix}",
                     "yaxis": f"y{suffix}",
@@ -124,7 +124,8 @@ def joint_figure(
                 }
             )
     layout["shapes"] = shapes
-    return {"data": data, "layout": layout}
+    # the times are sent once (``x``); the page gives them to every curve
+    return {"data": data, "layout": layout, "x": t}
 
 
 def _vline(t: float, colour: str, dash: str, width: float) -> JSON:

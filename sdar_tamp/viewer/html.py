@@ -31,6 +31,7 @@ from sdar_tamp.viewer._plan import PlanLike, StepLike
 from sdar_tamp.viewer._plotly import JSON, typed_array
 from sdar_tamp.viewer._story import Grip, grips, joint_curves, link_poses, object_holds, pose7
 from sdar_tamp.viewer._timeline import Segment, Timeline
+from sdar_tamp.viewer.errors import require
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import FloatArray
@@ -67,6 +68,7 @@ def write_html(
     them). ``validate``: replay a :class:`~sdar_tamp.plan_file.PlanFile` with the validator of
     ``sdar validate`` and show its first violation (other plan objects are not validated).
     """
+    require("plotly.offline", "the interactive viewer")  # before any work
     scene = scene if scene is not None else load_scene()
     timeline = Timeline.build(instance, plan, scene)
     times = timeline.sample_times(fps) if plan is not None else timeline.t
@@ -384,7 +386,7 @@ def _layout(scene: Scene, z_top: float) -> JSON:
             "aspectmode": "manual",
             "aspectratio": {"x": 1.0, "y": (yr[1] - yr[0]) / span, "z": (zr[1] - zr[0]) / span},
             "camera": {
-                "eye": {"x": 0.25, "y": -0.95, "z": 0.55},
+                "eye": {"x": 0.28, "y": -1.08, "z": 0.62},
                 "center": {"x": 0, "y": 0, "z": -0.12},
             },
             "domain": {"x": [0, 1], "y": [0, 1]},

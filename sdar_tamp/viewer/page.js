@@ -119,8 +119,9 @@
         for (var v = 0; v < 8; v++) place(m, objLocal, 8 * b + v, OX, OY, OZ, 8 * b + v);
         if (h[1] >= 0) holding[h[1]].push(obj.name);
         if (h[1] >= 0 || moving.indexOf(obj.name) >= 0) {
-          lx.push(pose[0]); ly.push(pose[1]);  // held: under the object, clear of the gripper
-          lz.push(pose[2] + (h[1] >= 0 ? -1 : 1) * (obj.size[2] / 2 + 0.03));
+          var r = Math.max(obj.size[0], obj.size[1]) / 2 + 0.1;  // held: in front, clear of the gripper
+          lx.push(pose[0]); ly.push(pose[1] - (h[1] >= 0 ? r : 0));
+          lz.push(pose[2] + (h[1] >= 0 ? -0.04 : obj.size[2] / 2 + 0.03));
           lt.push(h[1] >= 0 ? '<b>' + obj.name + '</b> (' + arms[h[1]].name + ')' : obj.name);
         }
       });
@@ -323,6 +324,8 @@
     var config = { displaylogo: false, responsive: true };
     var ready = [Plotly.newPlot(gd, data, layout, config)];
     if (D.joints) {
+      var xs = decode(D.joints.x);
+      D.joints.data.forEach(function (trace) { trace.x = xs; });
       ready.push(Plotly.newPlot(gj, D.joints.data, D.joints.layout,
         { displaylogo: false, responsive: true, displayModeBar: false }));
     }
