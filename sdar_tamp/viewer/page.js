@@ -164,6 +164,11 @@
       render(t).then(pump, function (e) { busy = false; console.error(e); });
     }
     function request(t) { wanted = t; if (!busy) pump(); }
+    function whenDrawn() {  // resolves once every requested time is drawn
+      return new Promise(function (resolve) {
+        (function wait() { if (busy || wanted !== null) setTimeout(wait, 5); else resolve(); })();
+      });
+    }
 
     function publish() {
       document.body.setAttribute('data-sdar-t', state.t.toFixed(3));
@@ -317,7 +322,7 @@
       get speed() { return state.speed; },
       steps: steps, events: events, violation: D.violation,
       setTime: setTime, play: play, pause: pause, nextStep: nextStep, prevStep: prevStep,
-      setSpeed: setSpeed
+      setSpeed: setSpeed, whenDrawn: whenDrawn
     };
     verdict();
     $('sdar-joints-pane').hidden = !D.joints;
@@ -333,9 +338,7 @@
       if (D.joints) gj.on('plotly_click', function (ev) { if (ev.points.length) setTime(ev.points[0].x); });
       if (T.length > 1) timeline();
       setTime(initial());
-      return new Promise(function (resolve) {
-        (function wait() { if (busy) setTimeout(wait, 10); else resolve(); })();
-      });
+      return whenDrawn();
     }).then(function () {
       document.body.setAttribute('data-sdar-ready', String(T.length));
       window.dispatchEvent(new Event('sdar-ready'));

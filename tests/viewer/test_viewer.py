@@ -528,6 +528,22 @@ def test_banner_shows_the_first_violation(
     assert red.mean() > 0.5, red.mean()
 
 
+@needs_chromium
+def test_a_browser_that_cannot_unpack_the_page_is_told(
+    instance: Instance, plan: PlanFile, tmp_path: Path
+) -> None:
+    page = write_html(instance, plan, tmp_path / "replay.html", fps=5)
+    old = page.with_name("old.html")
+    html = page.read_text(encoding="utf-8")
+    old.write_text(html.replace("<body>", "<body><script>window.DecompressionStream = undefined;"
+                                "</script>", 1), encoding="utf-8")  # fmt: skip
+    run = _chromium(old.resolve().as_uri(), tmp_path, "--dump-dom")
+    banner = re.search(r'<div id="sdar-banner"([^>]*)>(.*?)</div>', run.stdout, re.S)
+    assert banner is not None and "hidden" not in banner.group(1)
+    assert "cannot unpack the page" in banner.group(2)
+    assert "data-sdar-ready" not in _body(run.stdout)  # never drawn
+
+
 def _near(pixels: np.ndarray, rgb: tuple[int, int, int], tol: int = 60) -> int:
     """Pixels within ``tol`` of the hue family of ``rgb`` (shading changes the brightness)."""
     p = pixels.astype(float)
