@@ -1,4 +1,5 @@
-"""Typed adapter over plotly: a figure given as plain dicts -> one self-contained HTML page.
+"""Typed adapter over plotly: typed-array specs for figures given as plain dicts, and the
+plotly.js bundle to embed in a page.
 
 plotly ships without type stubs and is an optional dependency (the ``viz`` extra); this module is
 the only place that imports it. Arrays are passed as plotly.js typed-array specs (base64 of
@@ -25,21 +26,8 @@ def typed_array(values: ArrayLike, dtype: str = "f4") -> JSON:
     return {"dtype": dtype, "bdata": base64.b64encode(data.tobytes()).decode("ascii")}
 
 
-def figure_html(figure: JSON, div_id: str, post_script: str | None = None) -> str:
-    """The full HTML page of ``figure`` (``data``, ``layout``, ``frames``) with plotly.js
-    embedded, so it works offline. ``post_script`` runs once the plot is drawn."""
-    pio = require("plotly.io", "the interactive viewer")
-    html: str = pio.to_html(
-        figure,
-        config={"displaylogo": False, "responsive": True},
-        auto_play=False,
-        include_plotlyjs=True,
-        include_mathjax=False,
-        full_html=True,
-        post_script=post_script,
-        default_width="100%",
-        default_height="100vh",
-        validate=False,
-        div_id=div_id,
-    )
-    return html
+def plotly_js() -> str:
+    """The source of plotly.js (minified) shipped with the installed plotly package."""
+    offline = require("plotly.offline", "the interactive viewer")
+    source: str = offline.get_plotlyjs()
+    return source

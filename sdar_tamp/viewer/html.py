@@ -1,27 +1,42 @@
-"""An interactive 3-D replay of a plan as one self-contained HTML page (plotly, offline).
+"""An interactive 3-D page that explains a plan: one self-contained HTML file (plotly, offline).
 
 The page shows the table with the workspace outline, each object's goal as a flat outline in the
-object's colour, the objects as boxes, and both arms as meshes of their collision shapes (links
-and gripper). Play/pause buttons and a time slider drive the animation; the page address may end
-in ``#t=12.5`` to open at that time [s]. The arms, drawn from the plan's joint trajectory by
-forward kinematics, and the objects are sampled at ``fps`` frames per second of plan time.
+object's colour, the objects as boxes and both arms as meshes of their collision shapes; the
+fingers close on a grasped object. Under the view, a time slider shows the plan's steps (bands
+named by kind, level and objects) and its grasp and release events; buttons play, pause and jump
+to the previous or next step, and a menu sets the playback speed. A heads-up line names the
+current step and what each arm holds; moving objects are labelled in the view. Beside it, a
+joint-space panel draws q and q-dot of each arm against the scene's limits. When the plan breaks
+a rule of ``sdar validate``, a banner names the first violation and the slider marks its time.
+
+The page address may end in ``#t=12.5`` (open at 12.5 s) or ``#step=3`` (at the start of the third
+step). Arms are sent as link poses per frame (``fps`` frames per second of plan time, interpolated
+in the browser) and drawn from one copy of their geometry; plotly.js is embedded gzip-compressed.
 """
 
 from __future__ import annotations
 
-import json
+import logging
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_rules import Violation
 from sdar_tamp.viewer._geometry import ArmDrawing, box_mesh
-from sdar_tamp.viewer._plan import PlanLike
-from sdar_tamp.viewer._plotly import JSON, figure_html, typed_array
-from sdar_tamp.viewer._timeline import Timeline
+from sdar_tamp.viewer._joints import joint_figure
+from sdar_tamp.viewer._page import page_html
+from sdar_tamp.viewer._plan import PlanLike, StepLike
+from sdar_tamp.viewer._plotly import JSON, typed_array
+from sdar_tamp.viewer._story import Grip, grips, joint_curves, link_poses, object_holds, pose7
+from sdar_tamp.viewer._timeline import Segment, Timeline
+from sdar_tamp.viewer.errors import require
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import FloatArray
+
+_log = logging.getLogger(__name__)
 
 #: Object colours, in instance order (matplotlib's tab10).
 OBJECT_COLOURS = (
@@ -43,35 +58,57 @@ def write_html(
     path: Path,
     scene: Scene | None = None,
     fps: float = 10.0,
+    validate: bool = True,
 ) -> Path:
-    """Write the replay of ``plan`` on ``instance`` to ``path`` (HTML) and return the path.
+    """Write the page explaining ``plan`` on ``instance`` to ``path`` (HTML); return the path.
 
     ``plan`` None draws the scene at the start: objects at their start poses, arms at home.
-    ``scene`` gives the robot, table and workspace (default: the shipped scene). ``fps``
-    [1/s] is the number of animation frames per second of plan time.
+    ``scene`` gives the robot, table, workspace and joint limits (default: the shipped scene).
+    ``fps`` [1/s]: animation frames per second of plan time (the browser interpolates between
+    them). ``validate``: replay a :class:`~sdar_tamp.plan_file.PlanFile` with the validator of
+    ``sdar validate`` and show its first violation (other plan objects are not validated).
     """
+    require("plotly.offline", "the interactive viewer")  # before any work
     scene = scene if scene is not None else load_scene()
     timeline = Timeline.build(instance, plan, scene)
     times = timeline.sample_times(fps) if plan is not None else timeline.t
-    figure = build_figure(timeline, scene, times, fps)
+    violation: Violation | None = None
+    validated = validate and isinstance(plan, PlanFile)
+    if validated and isinstance(plan, PlanFile):
+        from sdar_tamp.replay import validate_plan
+
+        violation = validate_plan(instance, plan, scene).violation
+        if violation is not None:
+            _log.warning(
+                "plan invalid at t=%.3f s: %s: %s (marked in the page)",
+                violation.t,
+                violation.kind,
+                violation.message,
+            )
+    data = page_data(timeline, scene, times, violation, validated)
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(figure_html(figure, _DIV, _post_script(times)), encoding="utf-8")
+    out.write_text(page_html(str(data["title"]), data), encoding="utf-8")
     return out
 
 
-def build_figure(timeline: Timeline, scene: Scene, times: FloatArray, fps: float) -> JSON:
-    """The plotly figure (plain dicts) with one animation frame per entry of ``times`` [s]."""
-    instance = timeline.instance
+def page_data(
+    timeline: Timeline,
+    scene: Scene,
+    times: FloatArray,
+    violation: Violation | None = None,
+    validated: bool = False,
+) -> JSON:
+    """Everything the page needs, as JSON-ready values: the 3-D figure at the first frame, the
+    joint panel, link poses per frame, holds, steps, events and the verdict of the validator."""
+    instance, plan = timeline.instance, timeline.plan
     q = timeline.q_at(times)
-    # the bases never move: drawn once, outside the animation frames
+    grip = grips(timeline, times)
+    # the bases never move: drawn once; the rest of each arm moves by its link poses
     bases = [a.select(_STATIC) for a in timeline.arms]
     moving = [a.select(_STATIC, keep=False) for a in timeline.arms]
-    arm_vertices = [a.mesh_vertices(timeline.arm_q(q, i)) for i, a in enumerate(moving)]
-    obj_poses, _ = timeline.object_poses(times)
-    obj_local, obj_faces, obj_colours = _object_mesh(instance)
-    obj_vertices = np.einsum("kbij,bvj->kbvi", obj_poses[..., :3, :3], obj_local)
-    obj_vertices = (obj_vertices + obj_poses[:, :, None, :3, 3]).reshape(len(times), -1, 3)
+    poses = [link_poses(a, timeline.arm_q(q, i), grip[i]) for i, a in enumerate(moving)]
+    tcps = [a.tcp_poses(timeline.arm_q(q, i)) for i, a in enumerate(timeline.arms)]
 
     static = [_table(scene), _workspace(scene), *_goal_outlines(instance), _goal_labels(instance)]
     static += [
@@ -79,37 +116,126 @@ def build_figure(timeline: Timeline, scene: Scene, times: FloatArray, fps: float
         for i, b in enumerate(bases)
     ]
     arms = [
-        _arm_trace(a, f"arm {a.name}", arm_vertices[i][0], ARM_COLOURS[i % 2])
+        _arm_trace(a, f"arm {a.name}", _posed(a, poses[i][0]), ARM_COLOURS[i % 2])
         for i, a in enumerate(moving)
     ]
-    names = [o.name for o in instance.objects for _ in range(8)]
+    obj_poses, _ = timeline.object_poses(times[:1])
+    obj_local, obj_faces, obj_colours = _object_mesh(instance)
+    obj_vertices = np.einsum("bij,bvj->bvi", obj_poses[0, :, :3, :3], obj_local)
+    obj_vertices = (obj_vertices + obj_poses[0, :, None, :3, 3]).reshape(-1, 3)
     objects: JSON = {
         "type": "mesh3d",
         "name": "objects",
-        **_xyz(obj_vertices[0]),
+        **_xyz(obj_vertices),
         **_ijk(obj_faces),
         "facecolor": obj_colours,
         "flatshading": True,
-        "text": names,
+        "text": [o.name for o in instance.objects for _ in range(8)],
         "hoverinfo": "text",
         "lighting": {"ambient": 0.55, "diffuse": 0.7, "specular": 0.1},
     }
-    data = [*static, *arms, objects]
-    dynamic = [len(static), len(static) + 1, len(static) + 2]
-    frames = [
-        {
-            "name": str(k),
-            "traces": dynamic,
-            "data": [_xyz(arm_vertices[0][k]), _xyz(arm_vertices[1][k]), _xyz(obj_vertices[k])],
-        }
-        for k in range(len(times))
-    ]
-    z_top = max(float(v[..., 2].max()) for v in arm_vertices) + 0.05
-    layout = _layout(timeline, scene, times, fps, z_top)
-    figure: JSON = {"data": data, "layout": layout}
-    if len(times) > 1:
-        figure["frames"] = frames
-    return figure
+    labels: JSON = {
+        "type": "scatter3d",
+        "mode": "text",
+        "name": "labels",
+        "x": [],
+        "y": [],
+        "z": [],
+        "text": [],
+        "textfont": {"size": 13, "color": "#111111"},
+        "hoverinfo": "skip",
+        "showlegend": False,
+    }
+    z_top = max(float(p[..., 2, 3].max()) for p in poses) + 0.12
+    figure: JSON = {
+        "data": [*static, *arms, objects, labels],
+        "layout": _layout(scene, z_top),
+    }
+    n = len(static)
+    steps = timeline.segments() if plan is not None else ()
+    names = [a.name for a in timeline.arms]
+    return {
+        "title": _title(timeline),
+        "t0": timeline.t_start,
+        "t1": timeline.t_end,
+        "times": [round(float(t), 4) for t in times],
+        "figure": figure,
+        "traces": {"arms": [n, n + 1], "objects": n + 2, "labels": n + 3},
+        "arms": [_arm_data(a, poses[i], tcps[i], grip[i], i) for i, a in enumerate(moving)],
+        "objects": [
+            {
+                "name": o.name,
+                "colour": OBJECT_COLOURS[i % len(OBJECT_COLOURS)],
+                "size": list(o.size),
+                "holds": [
+                    [None if not np.isfinite(t) else round(float(t), 6), arm, _r(pose7(T))]
+                    for t, arm, T in holds
+                ],
+            }
+            for i, (o, holds) in enumerate(
+                zip(instance.objects, object_holds(timeline), strict=True)
+            )
+        ],
+        "objectLocal": typed_array(obj_local),
+        "steps": [
+            _step_data(s, plan.steps[k] if plan is not None and k < len(plan.steps) else None)
+            for k, s in enumerate(steps)
+        ],
+        "events": [
+            {"t": float(e.t), "arm": names.index(e.arm), "type": e.type, "object": e.object}
+            for e in (plan.events if plan is not None else ())
+        ],
+        "joints": (
+            joint_figure(
+                joint_curves(timeline, scene),
+                names,
+                [(s.t_start, s.t_end) for s in steps],
+                violation.t if violation is not None else None,
+            )
+            if plan is not None
+            else None
+        ),
+        "validated": validated,
+        "violation": (
+            {"t": violation.t, "kind": violation.kind, "message": violation.message}
+            if violation is not None
+            else None
+        ),
+    }
+
+
+def _step_data(segment: Segment, step: StepLike | None) -> JSON:
+    return {
+        "t_start": segment.t_start,
+        "t_end": segment.t_end,
+        "label": segment.label,
+        "kind": str(step.kind) if step is not None else "",
+        "objects": list(step.objects) if step is not None else [],
+    }
+
+
+def _r(values: FloatArray) -> list[float]:
+    return [round(float(v), 6) for v in np.asarray(values).reshape(-1)]
+
+
+def _posed(arm: ArmDrawing, T: FloatArray) -> FloatArray:
+    """World vertices ``(m, 3)`` of ``arm``'s mesh with its links at ``T`` ``(L, 4, 4)``."""
+    Tv = T[arm.vertex_link]
+    out: FloatArray = np.einsum("mij,mj->mi", Tv[:, :3, :3], arm.vertices) + Tv[:, :3, 3]
+    return out
+
+
+def _arm_data(arm: ArmDrawing, poses: FloatArray, tcp: FloatArray, grip: Grip, i: int) -> JSON:
+    return {
+        "name": arm.name,
+        "colour": ARM_COLOURS[i % 2],
+        "links": list(arm.links),
+        "local": typed_array(arm.vertices),
+        "vlink": typed_array(arm.vertex_link, "i4"),
+        "poses": typed_array(pose7(poses)),  # (k, L, 7)
+        "tcp": typed_array(pose7(tcp)),  # (k, 7)
+        "closure": typed_array(grip.closure),  # (k,)
+    }
 
 
 # -- traces -----------------------------------------------------------------------------------
@@ -233,7 +359,7 @@ def _title(timeline: Timeline) -> str:
     return ", ".join(parts)
 
 
-def _layout(timeline: Timeline, scene: Scene, times: FloatArray, fps: float, z_top: float) -> JSON:
+def _layout(scene: Scene, z_top: float) -> JSON:
     sx, sy, _ = scene.table.size
     xr, yr, zr = (-sx / 2 - 0.05, sx / 2 + 0.05), (-sy / 2 - 0.05, sy / 2 + 0.05), (-0.06, z_top)
     span = xr[1] - xr[0]
@@ -248,9 +374,8 @@ def _layout(timeline: Timeline, scene: Scene, times: FloatArray, fps: float, z_t
             "zeroline": False,
         }
 
-    layout: JSON = {
-        "title": {"text": _title(timeline), "x": 0.02, "font": {"size": 16}},
-        "margin": {"l": 0, "r": 0, "t": 40, "b": 0},
+    return {
+        "margin": {"l": 0, "r": 0, "t": 0, "b": 0},
         "paper_bgcolor": "white",
         "showlegend": False,
         "uirevision": "sdar",
@@ -261,77 +386,9 @@ def _layout(timeline: Timeline, scene: Scene, times: FloatArray, fps: float, z_t
             "aspectmode": "manual",
             "aspectratio": {"x": 1.0, "y": (yr[1] - yr[0]) / span, "z": (zr[1] - zr[0]) / span},
             "camera": {
-                "eye": {"x": 0.3, "y": -1.0, "z": 0.6},
-                "center": {"x": 0, "y": 0, "z": -0.15},
+                "eye": {"x": 0.28, "y": -1.08, "z": 0.62},
+                "center": {"x": 0, "y": 0, "z": -0.12},
             },
-            "domain": {"x": [0, 1], "y": [0.09 if len(times) > 1 else 0.0, 1]},
+            "domain": {"x": [0, 1], "y": [0, 1]},
         },
     }
-    if len(times) > 1:
-        layout["updatemenus"] = [_buttons(fps)]
-        layout["sliders"] = [_slider(times)]
-    return layout
-
-
-def _animate(frames: list[str | None] | None, duration: float, redraw: bool = True) -> list[Any]:
-    return [
-        frames,
-        {
-            "mode": "immediate",
-            "fromcurrent": True,
-            "frame": {"duration": duration, "redraw": redraw},
-            "transition": {"duration": 0},
-        },
-    ]
-
-
-def _buttons(fps: float) -> JSON:
-    return {
-        "type": "buttons",
-        "direction": "left",
-        "showactive": False,
-        "x": 0.01,
-        "y": 0.01,
-        "xanchor": "left",
-        "yanchor": "bottom",
-        "pad": {"r": 8},
-        "buttons": [
-            {"label": "▶ Play", "method": "animate", "args": _animate(None, 1000.0 / fps)},
-            {"label": "❚❚ Pause", "method": "animate", "args": _animate([None], 0, False)},
-        ],
-    }
-
-
-def _slider(times: FloatArray) -> JSON:
-    return {
-        "active": 0,
-        "x": 0.17,
-        "len": 0.81,
-        "y": 0.0,
-        "yanchor": "bottom",
-        "pad": {"t": 0, "b": 4},
-        "ticklen": 0,
-        "minorticklen": 0,
-        "font": {"color": "rgba(0,0,0,0)"},
-        "currentvalue": {"prefix": "t = ", "suffix": " s", "font": {"size": 14, "color": "#222"}},
-        "steps": [
-            {"label": f"{t:.2f}", "method": "animate", "args": _animate([str(k)], 0)}
-            for k, t in enumerate(times)
-        ],
-    }
-
-
-def _post_script(times: FloatArray) -> str:
-    """Open at ``#t=<seconds>`` when the address asks for it; mark the page as drawn."""
-    return (
-        "(function(){var gd=document.getElementById('" + _DIV + "');"
-        "var times=" + json.dumps([round(float(t), 3) for t in times]) + ";"
-        "function done(){document.body.setAttribute('data-sdar-ready',String(times.length));}"
-        "var m=/[#&]t=([-0-9.eE]+)/.exec(window.location.hash);"
-        "if(!m||times.length<2){done();return;}"
-        "var t=parseFloat(m[1]),best=0;"
-        "for(var k=1;k<times.length;k++){if(Math.abs(times[k]-t)<Math.abs(times[best]-t))best=k;}"
-        "Plotly.animate(gd,[String(best)],{mode:'immediate',frame:{duration:0,redraw:true},"
-        "transition:{duration:0}}).then(function(){"
-        "document.body.setAttribute('data-sdar-frame',String(best));done();});})();"
-    )
