@@ -504,7 +504,8 @@ def build_plan_file(
     first = next((i for i in items if isinstance(i, MotionSegment)), None)
     home = scene.home
     q_now = np.array(q_start if q_start is not None else first.q[0] if first else home, float)
-    ts, qs = [np.zeros(1)], [q_now[None]]
+    ts: list[FloatArray] = [np.zeros(1)]
+    qs: list[FloatArray] = [q_now[None]]
     now, dwell = 0.0, False
     events: list[PlanEvent] = []
     steps: list[StepRecord] = []

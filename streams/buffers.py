@@ -69,7 +69,7 @@ def sample_buffers(
         raise ValueError(f"k must be >= 0, got {k}")
     ws = workspace or ctx.scene.workspace
     rng = np.random.default_rng(seed)
-    taken = np.asarray(occupied, dtype=np.float64).reshape(-1, 4, 2)
+    taken: FloatArray = np.asarray(occupied, dtype=np.float64).reshape(-1, 4, 2)
     grown = np.array([size[0] + 2 * margin, size[1] + 2 * margin])
     out: list[Pose2D] = []
     for _ in range(max_batches):

@@ -173,7 +173,7 @@ def time_parameterize(
     tg = np.concatenate([[0.0], np.cumsum(step)])
     T = float(tg[-1])
     n_samples = max(1, int(np.ceil(T / dt)))
-    t = np.linspace(0.0, T, n_samples + 1)
+    t = np.linspace(0.0, T, n_samples + 1).astype(np.float64)
     k = np.clip(np.searchsorted(tg, t, side="right") - 1, 0, n_grid - 2)
     tau = t - tg[k]
     s_t = np.clip(sg[k] + sq[k] * tau + 0.5 * u[k] * tau * tau, 0.0, s[-1])

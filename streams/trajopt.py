@@ -451,7 +451,7 @@ def _pick(clear: FloatArray, slots: int, limit: float, forced: Any) -> Any:
     forced ones first."""
     flat = clear.reshape(-1)
     forced_flat = (
-        np.ravel_multi_index(np.asarray(forced).T, clear.shape)
+        np.ravel_multi_index(tuple(np.asarray(forced, dtype=np.int64).T), clear.shape)
         if forced is not None and np.asarray(forced).size
         else np.zeros(0, dtype=np.int64)
     )

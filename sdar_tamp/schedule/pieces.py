@@ -14,6 +14,7 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import FILE_ARM_JOINTS, FILE_ARMS, PlanEvent, PlanFile, StepRecord
@@ -67,7 +68,7 @@ def _step_at(plan: PlanFile, t: float) -> StepRecord | None:
     return next((s for s in plan.steps if s.t_start - 1e-9 <= t <= s.t_end + 1e-9), None)
 
 
-def _runs(moving: np.ndarray) -> list[tuple[int, int]]:
+def _runs(moving: NDArray[np.bool_]) -> list[tuple[int, int]]:
     """Maximal runs ``[i, j)`` of True in ``moving`` (intervals of the timeline)."""
     edges = np.diff(np.concatenate([[0], moving.astype(int), [0]]))
     return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True))

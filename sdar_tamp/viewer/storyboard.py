@@ -204,7 +204,7 @@ def _update(view: _Artists, timeline: Timeline, t: float) -> None:
 
 
 def _tcp_paths(ax: Any, timeline: Timeline, seg: Segment) -> None:
-    times = np.linspace(seg.t_start, seg.t_end, 60)
+    times = np.linspace(seg.t_start, seg.t_end, 60).astype(np.float64)
     q = timeline.q_at(times)
     for a, arm in enumerate(timeline.arms):
         tcp = arm.tcp_poses(timeline.arm_q(q, a))[:, :2, 3]
