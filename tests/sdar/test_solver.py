@@ -141,7 +141,7 @@ def test_both_entry_points_configure_sdar_alike(
     built: list[tuple[Any, ...]] = []
 
     def record(self: SdarSolver) -> Solution:
-        built.append((self.problem, type(self.planner), self.options))
+        built.append((self.cache.problem, type(self.planner), self.options))
         return Solution(None, math.inf, Certificate((), ()))
 
     monkeypatch.setattr(SdarSolver, "solve", record)
