@@ -166,26 +166,36 @@ class _Checker:
         return StuckObject(obj, others, "table" in hit, "self" in hit, bool(self.candidates[obj]))
 
 
-def removal_remainder(
+@dataclass(frozen=True)
+class Removal:
+    """The outcome of taking objects away: the objects taken away in each round (every one
+    with a clear grasp at once), and those that remain with what their grasps hit."""
+
+    rounds: tuple[tuple[str, ...], ...]
+    stuck: tuple[StuckObject, ...]
+
+
+def remove_graspable(
     ctx: WorldContext,
     boxes: Mapping[str, ObjectBox],
     grasps: Mapping[str, tuple[Grasp, ...]],
     lift: float = PREGRASP_LIFT,
-) -> tuple[StuckObject, ...]:
-    """The objects left after repeatedly taking away every object with a clear grasp (see the
-    module docstring), each with what its grasps hit; empty when all can be taken away."""
+) -> Removal:
+    """Repeatedly take away every object of ``boxes`` (resting, name -> box) that has a clear
+    grasp of ``grasps`` (name -> grasp set), see the module docstring."""
     checker = _Checker(ctx, boxes, grasps, lift)
     remaining = list(boxes)
+    rounds: list[tuple[str, ...]] = []
     while remaining:
         checker.rest(remaining)
-        free = [o for o in remaining if checker.graspable(o)]
+        free = tuple(o for o in remaining if checker.graspable(o))
         if not free:
             break
+        rounds.append(free)
         remaining = [o for o in remaining if o not in free]
-    if not remaining:
-        return ()
-    checker.rest(remaining)
-    return tuple(checker.explain(o) for o in remaining)
+    if remaining:
+        checker.rest(remaining)
+    return Removal(tuple(rounds), tuple(checker.explain(o) for o in remaining))
 
 
 def _box(pose: Pose2D, size: tuple[float, float, float]) -> ObjectBox:
@@ -216,7 +226,23 @@ def prove_infeasible(
         boxes = {
             o.name: _box(o.start if phase == "start" else o.goal, o.size) for o in instance.objects
         }
-        stuck = removal_remainder(ctx, boxes, sets, lift)
+        stuck = remove_graspable(ctx, boxes, sets, lift).stuck
         if any(s.name in moving for s in stuck):
             return InfeasibilityProof(phase, stuck)
     return None
+
+
+class ProofCheck:
+    """The generators' acceptance test (:data:`sdar_tamp.world.generators.Acceptance`): the
+    reason an instance is proven unsolvable, or ``None``. The world (default: the shipped
+    scene) is loaded on first use."""
+
+    def __init__(self, ctx: WorldContext | None = None, grasps: GraspOptions = DEFAULT_GRASPS):
+        self._ctx = ctx
+        self.grasps = grasps
+
+    def __call__(self, instance: Instance) -> str | None:
+        if self._ctx is None:
+            self._ctx = WorldContext.load()
+        proof = prove_infeasible(self._ctx, instance, self.grasps)
+        return None if proof is None else "; ".join(proof.lines())
