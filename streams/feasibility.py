@@ -123,8 +123,10 @@ class _Checker:
             )
             n = len(grasps)
             ok = both.valid[:n] & both.valid[n:]
+            rows, branches = np.nonzero(ok)
             out.extend(
-                _Candidate(arm, both.q[gi, b], both.q[n + gi, b]) for gi, b in zip(*np.nonzero(ok))
+                _Candidate(arm, both.q[gi, b], both.q[n + gi, b])
+                for gi, b in zip(rows, branches, strict=True)
             )
         return out
 

@@ -12,8 +12,8 @@ File shape::
 
 Rules checked by :func:`validate_instance` (each error names the object): unique names, a
 graspable size (a horizontal side the fingers close on and a height they can hold above the
-table, :mod:`sdar_tamp.world.graspability`), footprints inside the workspace, and no two overlapping footprints at start or
-at goal (touching is allowed).
+table, :mod:`sdar_tamp.world.graspability`), footprints inside the workspace, and no two
+overlapping footprints at start or at goal (touching is allowed).
 """
 
 from __future__ import annotations

@@ -75,9 +75,7 @@ def build_suite(suite: str, accept: Acceptance | None = None) -> tuple[Instance,
     )
 
 
-def generate_suite(
-    suite: str, out_dir: Path, accept: Acceptance | None = None
-) -> list[Path]:
+def generate_suite(suite: str, out_dir: Path, accept: Acceptance | None = None) -> list[Path]:
     """Write a suite as ``out_dir/<name>.yaml`` files; returns the paths in suite order."""
     out = Path(out_dir)
     return [save_instance(i, out / f"{i.name}.yaml") for i in build_suite(suite, accept)]

@@ -57,10 +57,10 @@ def test_boxed_in_objects_that_never_need_to_move_prove_nothing(ctx: WorldContex
 def test_a_dense_scene_freed_in_order_is_not_refused(ctx: WorldContext) -> None:
     """o0 is boxed in by o1 standing 5 mm beside it, across its closing axis; o1 (turned a
     quarter) closes along x and is free: taking o1 away first frees o0."""
-    from streams.feasibility import remove_graspable
-    from streams.grasps import sample_grasps
     from sdar_tamp.world.collision import ObjectBox
     from sdar_tamp.world.transforms import pose_xyz_yaw
+    from streams.feasibility import remove_graspable
+    from streams.grasps import sample_grasps
 
     starts = (Pose2D(0.0, 0.0, 0.0), Pose2D(0.0, 0.065, math.pi / 2))
     goals = (Pose2D(0.0, -0.2, 0.0), Pose2D(0.15, 0.2, 0.0))
