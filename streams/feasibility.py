@@ -16,9 +16,11 @@ its start), no plan exists.
 to be placed is released while the rest of the remainder already rests at its goals.
 
 Both tests are necessary conditions only: an instance that passes them may still be
-unsolvable; an instance they reject is unsolvable for any planner using the grasp set.
-Collisions use the replay validator's tolerance (objects shrunk by 1 mm), more lenient than
-the planner's IK margin.
+unsolvable. ``margin`` [m] is the clearance asked between the arm and the other objects:
+with :data:`VALIDATOR_MARGIN` (objects shrunk by 1 mm, as the replay validator checks) a
+rejected instance has no valid plan at all with the grasp set; with the IK streams'
+:data:`~streams.stream_map.IK_MARGIN` (3 mm) it has none the planner can find, since every
+pick and place it plans passes through those IK checks.
 """
 
 from __future__ import annotations
@@ -34,11 +36,14 @@ from sdar_tamp.world.instance import Instance, Pose2D
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, pregrasp_offset, sample_grasps
+from streams.stream_map import IK_MARGIN
 
 #: Pre-grasp distance along the approach [m] (as the IK stream's).
 PREGRASP_LIFT = 0.08
-#: Object shrink per face [m] in the collision checks (the replay validator's).
-PROOF_TOLERANCE = 1e-3
+#: Clearance [m] of the replay validator (negative: objects shrunk by 1 mm per face).
+VALIDATOR_MARGIN = -1e-3
+#: Clearance [m] of the planner's IK checks.
+PLANNER_MARGIN = IK_MARGIN
 _OBJECT = "object:"
 
 
@@ -71,6 +76,7 @@ class InfeasibilityProof:
 
     phase: str
     stuck: tuple[StuckObject, ...]
+    margin: float = VALIDATOR_MARGIN  # [m], see the module docstring
 
     @property
     def objects(self) -> tuple[str, ...]:
@@ -78,9 +84,14 @@ class InfeasibilityProof:
 
     def summary(self) -> str:
         what = "picked first" if self.phase == "start" else "placed last"
+        scope = (
+            ""
+            if self.margin <= VALIDATOR_MARGIN
+            else f" with the planner's {self.margin * 1000:g} mm grasp clearance"
+        )
         return (
             f"infeasible: with every object at its {self.phase}, none of "
-            f"{', '.join(self.objects)} can ever be {what}"
+            f"{', '.join(self.objects)} can ever be {what}{scope}"
         )
 
     def lines(self) -> tuple[str, ...]:
@@ -105,10 +116,11 @@ class _Checker:
         boxes: Mapping[str, ObjectBox],
         grasps: Mapping[str, tuple[Grasp, ...]],
         lift: float,
+        margin: float,
     ) -> None:
         self.ctx = ctx
         self.boxes = dict(boxes)
-        self.world = CollisionWorld(ctx.scene, tolerance=PROOF_TOLERANCE)
+        self.world = CollisionWorld(ctx.scene, tolerance=-margin)
         self.home = {a: ctx.home(a) for a in ctx.arm_names}
         self.candidates = {o: self._candidates(o, grasps[o], lift) for o in boxes}
 
@@ -182,10 +194,12 @@ def remove_graspable(
     boxes: Mapping[str, ObjectBox],
     grasps: Mapping[str, tuple[Grasp, ...]],
     lift: float = PREGRASP_LIFT,
+    margin: float = VALIDATOR_MARGIN,
 ) -> Removal:
     """Repeatedly take away every object of ``boxes`` (resting, name -> box) that has a clear
-    grasp of ``grasps`` (name -> grasp set), see the module docstring."""
-    checker = _Checker(ctx, boxes, grasps, lift)
+    grasp of ``grasps`` (name -> grasp set) with clearance ``margin`` [m], see the module
+    docstring."""
+    checker = _Checker(ctx, boxes, grasps, lift, margin)
     remaining = list(boxes)
     rounds: list[tuple[str, ...]] = []
     while remaining:
@@ -215,9 +229,11 @@ def prove_infeasible(
     instance: Instance,
     grasps: GraspOptions = DEFAULT_GRASPS,
     lift: float = PREGRASP_LIFT,
+    margin: float = VALIDATOR_MARGIN,
 ) -> InfeasibilityProof | None:
-    """A proof that ``instance`` cannot be solved with the grasp set ``grasps`` (first picks,
-    then last placements), or ``None`` when these tests find none."""
+    """A proof that ``instance`` cannot be solved with the grasp set ``grasps`` and the
+    clearance ``margin`` [m] (first picks, then last placements), or ``None`` when these
+    tests find none."""
     width = ctx.scene.gripper.max_graspable_width
     sets = {
         o.name: sample_grasps(o.size, width, grasps.tilts, grasps.symmetric)
@@ -228,15 +244,28 @@ def prove_infeasible(
         boxes = {
             o.name: _box(o.start if phase == "start" else o.goal, o.size) for o in instance.objects
         }
-        stuck = remove_graspable(ctx, boxes, sets, lift).stuck
+        stuck = remove_graspable(ctx, boxes, sets, lift, margin).stuck
         if any(s.name in moving for s in stuck):
-            return InfeasibilityProof(phase, stuck)
+            return InfeasibilityProof(phase, stuck, margin)
     return None
+
+
+def prove_unplannable(
+    ctx: WorldContext, instance: Instance, grasps: GraspOptions = DEFAULT_GRASPS
+) -> InfeasibilityProof | None:
+    """A proof that the planner cannot solve ``instance`` (its IK clearance,
+    :data:`PLANNER_MARGIN`); when one is found, the stronger proof that no valid plan exists
+    (:data:`VALIDATOR_MARGIN`) is returned instead if it holds too."""
+    proof = prove_infeasible(ctx, instance, grasps, margin=PLANNER_MARGIN)
+    if proof is None:
+        return None
+    return prove_infeasible(ctx, instance, grasps, margin=VALIDATOR_MARGIN) or proof
 
 
 class ProofCheck:
     """The generators' acceptance test (:data:`sdar_tamp.world.generators.Acceptance`): the
-    reason an instance is proven unsolvable, or ``None``. The world (default: the shipped
+    reason an instance is proven unsolvable by the planner (:func:`prove_unplannable`), or
+    ``None``. The world (default: the shipped
     scene) is loaded on first use."""
 
     def __init__(self, ctx: WorldContext | None = None, grasps: GraspOptions = DEFAULT_GRASPS):
@@ -246,5 +275,5 @@ class ProofCheck:
     def __call__(self, instance: Instance) -> str | None:
         if self._ctx is None:
             self._ctx = WorldContext.load()
-        proof = prove_infeasible(self._ctx, instance, self.grasps)
+        proof = prove_unplannable(self._ctx, instance, self.grasps)
         return None if proof is None else "; ".join(proof.lines())

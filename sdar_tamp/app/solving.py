@@ -5,7 +5,8 @@
 so both entry points plan alike; before it, the quick infeasibility proofs of
 :mod:`streams.feasibility` run (well under a second for 24 objects): when they prove the
 instance unsolvable, the solution says ``infeasible`` at once, naming the stuck objects and
-what their grasps hit.
+what their grasps hit (at the planner's IK clearance; the diagnosis says when no valid plan
+exists at all).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from sdar_tamp.app.problem import Rearrangement
 from sdar_tamp.arguments import MAX_TIME
 from solvers.solution import Solution, Status
 from solvers.solve import solve
-from streams.feasibility import prove_infeasible
+from streams.feasibility import prove_unplannable
 
 
 def solve_rearrangement(
@@ -53,7 +54,7 @@ def solve_rearrangement(
     )
     started = time.perf_counter()
     proof = (
-        prove_infeasible(rearrangement.ctx, rearrangement.instance, run.grasps) if prove else None
+        prove_unplannable(rearrangement.ctx, rearrangement.instance, run.grasps) if prove else None
     )
     proof_time = time.perf_counter() - started if prove else 0.0
     if proof is not None:

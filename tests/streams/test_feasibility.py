@@ -12,7 +12,14 @@ from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.suites import load_suite, suite_members
 from streams.context import WorldContext
-from streams.feasibility import ProofCheck, prove_infeasible
+from streams.feasibility import (
+    PLANNER_MARGIN,
+    VALIDATOR_MARGIN,
+    ProofCheck,
+    prove_infeasible,
+    prove_unplannable,
+)
+from streams.stream_map import IK_MARGIN
 
 SIZE = (0.08, 0.04, 0.05)  # closes along y only (0.08 m is wider than the gripper opens)
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
@@ -87,7 +94,7 @@ def test_an_object_out_of_reach_is_named(ctx: WorldContext) -> None:
 @pytest.mark.parametrize("name", ["R12", "S12", "D12", "M1", "M5", "M10"])
 def test_solvable_paper_instances_are_not_refused(ctx: WorldContext, name: str) -> None:
     (inst,) = [i for i in load_suite("paper") if i.name == name]
-    assert prove_infeasible(ctx, inst) is None
+    assert prove_unplannable(ctx, inst) is None
 
 
 def test_the_stress_suite_is_generated_without_provably_unsolvable_instances(
@@ -103,3 +110,21 @@ def test_the_stress_suite_is_generated_without_provably_unsolvable_instances(
     assert reason is not None and "picked first" in reason and "o22" in reason
     accepted = generate_instance(m.family, m.n_objects, m.seed, options, m.name, accept=check)
     assert accepted == shipped[[i.name for i in shipped].index("D24")]
+
+
+def test_too_little_room_for_the_planner_is_told_apart_from_no_plan_at_all(
+    ctx: WorldContext,
+) -> None:
+    """2.3 cm between neighbours: a finger (2.2 cm beside the object) fits within the
+    validator's tolerance, not within the planner's 3 mm IK clearance."""
+    trio = tuple(Pose2D(0.0, k * 0.063, 0.0) for k in (-1, 0, 1))
+    inst = _instance(trio, SPREAD)
+    assert prove_infeasible(ctx, inst, margin=VALIDATOR_MARGIN) is None
+    proof = prove_unplannable(ctx, inst)
+    assert proof is not None and proof.margin == PLANNER_MARGIN == IK_MARGIN
+    assert "with the planner's 3 mm grasp clearance" in proof.summary()
+    assert "o1" in proof.objects
+    # boxed in for any plan: the stronger proof is the one returned
+    strict = prove_unplannable(ctx, _instance(TRIO, SPREAD))
+    assert strict is not None and strict.margin == VALIDATOR_MARGIN
+    assert "clearance" not in strict.summary()
