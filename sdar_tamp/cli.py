@@ -187,6 +187,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 def cmd_generate(args: argparse.Namespace) -> int:
     """Generate a rearrangement instance (one family) or a whole suite of instance files."""
     from sdar_tamp.world.commands import generate, generate_suite, suite_files
+    from streams.feasibility import ProofCheck  # refuses samples proven unsolvable
 
     if args.suite is not None:
         if args.family is not None or args.objects is not None:
@@ -198,13 +199,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
                 f"--output: {len(taken)} instance file(s) of suite {args.suite!r} exist in "
                 f"{str(args.output)!r} (e.g. {taken[0].name}); pass --force to replace them"
             )
-        paths = generate_suite(args.suite, args.output)
+        paths = generate_suite(args.suite, args.output, ProofCheck())
         print(f"wrote {len(paths)} instances of suite {args.suite!r} to {args.output}")
         return 0
     if args.family is None or args.objects is None:
         raise SdarError("sdar generate needs --family and --objects, or --suite")
     output_file(args.output, suffixes=(".yaml", ".yml"), force=args.force)
-    path = generate(args.family, args.objects, args.seed, args.output)
+    path = generate(args.family, args.objects, args.seed, args.output, ProofCheck())
     print(f"wrote {path}")
     return 0
 

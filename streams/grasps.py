@@ -2,12 +2,16 @@
 
 Tool frame convention (the scene's ``tcp``): the gripper approaches along its z axis and the
 fingers close along its y axis. A grasp is the pose of the tool centre point in the object
-frame, ``T_object_tcp``; the TCP sits at the object's centre.
+frame, ``T_object_tcp``; the TCP sits at the object's centre, raised for a short object so
+that the fingertips stay clear of the table (:mod:`sdar_tamp.world.graspability`, which the
+instance loader shares: an object it accepts has a top-down grasp).
 
 Order (the paper's expanding grasp angles): every top-down grasp first, then tilted grasps
 with growing approach angles ``+t, -t`` for ``t`` in ``tilts``. The tilt turns the tool about
 its closing axis, i.e. in the plane perpendicular to the closing axis. Closing axes are tried
-short side first; a side wider than the gripper's graspable width is rejected. With
+short side first; a side wider than the gripper's graspable width is rejected (up to
+:data:`~sdar_tamp.world.graspability.WIDTH_TOLERANCE`), and so is a tilt that would leave
+the fingers too little of a short object to hold. With
 ``symmetric=True`` both 180-degree variants (tool turned by pi about its approach axis) are
 returned; they are distinct wrist configurations of the same physical grasp.
 """
@@ -20,6 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.world.graspability import (
+    MIN_FINGER_CONTACT,
+    WIDTH_TOLERANCE,
+    finger_contact,
+    fits_between_fingers,
+    grasp_height,
+)
 from sdar_tamp.world.transforms import FloatArray
 
 #: The paper's grasp set: top-down, then 45 degrees either way.
@@ -100,16 +111,23 @@ def sample_grasps(
     """
     if any(t <= 0.0 or t >= np.pi / 2 for t in tilts):
         raise ValueError(f"tilts must lie in (0, pi/2) [rad], got {list(tilts)}")
-    axes = [a for a in sorted((0, 1), key=lambda a: size[a]) if min_width <= size[a] <= max_width]
+    axes = [
+        a
+        for a in sorted((0, 1), key=lambda a: size[a])
+        if min_width - WIDTH_TOLERANCE <= size[a] and fits_between_fingers(size[a], max_width)
+    ]
     angles = [0.0] + [s * t for t in sorted(tilts) for s in (1.0, -1.0)]
     flips = (False, True) if symmetric else (False,)
     out: list[Grasp] = []
     for tilt in angles:
+        if finger_contact(size[2], tilt) < MIN_FINGER_CONTACT - WIDTH_TOLERANCE:
+            continue  # too little of a short object would be left between the fingers
         for axis in axes:
             for flip in flips:
                 R = grasp_rotation(axis, tilt, flip)
                 T = np.eye(4)
                 T[:3, :3] = R
+                T[2, 3] = grasp_height(size[2], tilt) - 0.5 * size[2]
                 out.append(Grasp(len(out), T, float(size[axis]), R[:, 2].copy(), tilt, axis, flip))
     return tuple(out)
 

@@ -8,20 +8,23 @@ from __future__ import annotations
 from pathlib import Path
 
 from sdar_tamp.world.draw import draw_instance
-from sdar_tamp.world.generators import generate_instance
+from sdar_tamp.world.generators import Acceptance, generate_instance
 from sdar_tamp.world.instance import load_instance, save_instance
 from sdar_tamp.world.suites import generate_suite as _generate_suite
 from sdar_tamp.world.suites import suite_members
 
 
-def generate(family: str, objects: int, seed: int, out: Path) -> Path:
-    """Generate one instance of ``family`` (R, S, D, M) and write it to ``out`` (YAML)."""
-    return save_instance(generate_instance(family, objects, seed), Path(out))
+def generate(
+    family: str, objects: int, seed: int, out: Path, accept: Acceptance | None = None
+) -> Path:
+    """Generate one instance of ``family`` (R, S, D, M) and write it to ``out`` (YAML);
+    ``accept``: the generator's acceptance test."""
+    return save_instance(generate_instance(family, objects, seed, accept=accept), Path(out))
 
 
-def generate_suite(suite: str, out_dir: Path) -> list[Path]:
+def generate_suite(suite: str, out_dir: Path, accept: Acceptance | None = None) -> list[Path]:
     """Write the named suite (``paper`` or ``stress``) into ``out_dir``."""
-    return _generate_suite(suite, Path(out_dir))
+    return _generate_suite(suite, Path(out_dir), accept)
 
 
 def suite_files(suite: str, out_dir: Path) -> list[Path]:

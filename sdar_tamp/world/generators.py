@@ -12,6 +12,9 @@ the dependency graph has exactly the edges ``i -> j``; objects without successor
 overlapping no other object's start. Each instance is verified with
 :mod:`sdar_tamp.world.dependency`; failures are retried with the same generator, bounded.
 Every random choice comes from ``numpy.random.default_rng(seed)``: same seed, same instance.
+An optional acceptance test (``accept``: instance -> the reason it is refused, or ``None``)
+rejects further samples, e.g. those the infeasibility proofs of :mod:`streams.feasibility`
+show unsolvable (the command line passes them); a refused sample is retried like any other.
 
 Requests that cannot be met are refused early: :func:`max_objects` is a sound area bound (more
 objects than it allows cannot be placed with the clearance, whatever the placement), checked
@@ -42,6 +45,8 @@ FAMILIES = ("R", "S", "D", "M")
 DEFAULT_SIZE = (0.08, 0.04, 0.05)
 DEFAULT_WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 _LENGTH = Real(0.0, closed=True, unit="m")
+#: An acceptance test of generated instances: the reason one is refused, or ``None``.
+Acceptance = Callable[[Instance], str | None]
 _SIDE = Real(0.0, unit="m")
 
 
@@ -86,8 +91,10 @@ def generate_instance(
     seed: int,
     options: GeneratorOptions | None = None,
     name: str | None = None,
+    accept: Acceptance | None = None,
 ) -> Instance:
-    """One instance of ``family`` with ``n_objects`` objects; deterministic in ``seed``."""
+    """One instance of ``family`` with ``n_objects`` objects; deterministic in ``seed`` (and
+    in ``accept``, which refuses a sample by returning why, see the module docstring)."""
     if family not in FAMILIES:
         raise ParameterError(f"family: expected one of {list(FAMILIES)}, got {family!r}")
     n_objects = COUNT.check("objects", n_objects)
@@ -105,7 +112,8 @@ def generate_instance(
             f"{_table_area(opts):.3f} m^2); got {n_objects}"
         )
     rng = np.random.default_rng(seed)
-    crowded = most = full = 0
+    crowded = most = full = refused = 0
+    reason = ""
     for _ in range(opts.attempts):
         inst = _attempt(family, n_objects, rng, opts, name or f"{family}{n_objects}", seed)
         if isinstance(inst, int):
@@ -121,10 +129,15 @@ def generate_instance(
         crowded = 0
         if inst is not None and _verified(family, inst):
             validate_instance(inst)
-            return inst
+            why = accept(inst) if accept is not None else None
+            if why is None:
+                return inst
+            refused, reason = refused + 1, why
     crowding = (
         f" (in {full} of them no room was found for more than {most} objects)" if full else ""
     )
+    if refused:
+        crowding += f" ({refused} refused by the acceptance test, the last one: {reason})"
     raise GenerationError(
         f"family {family} with {n_objects} objects (seed {seed}): no instance with the promised "
         f"structure after {opts.attempts} attempts{crowding}; try fewer objects or a larger "

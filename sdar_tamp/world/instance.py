@@ -11,8 +11,9 @@ File shape::
     seed: 7                  # optional
 
 Rules checked by :func:`validate_instance` (each error names the object): unique names, a
-graspable size, footprints inside the workspace, and no two overlapping footprints at start or
-at goal (touching is allowed).
+graspable size (a horizontal side the fingers close on and a height they can hold above the
+table, :mod:`sdar_tamp.world.graspability`), footprints inside the workspace, and no two
+overlapping footprints at start or at goal (touching is allowed).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from sdar_tamp.errors import SourceLocation
 from sdar_tamp.world._yaml import Node, parse_yaml, read_yaml
 from sdar_tamp.world.errors import InstanceError
 from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
+from sdar_tamp.world.graspability import grasp_problem
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.transforms import FloatArray
 
@@ -110,10 +112,10 @@ def validate_instance(
         if o.name in seen:
             raise InstanceError(f"object {o.name!r}: duplicate name", loc.get(o.name))
         seen.add(o.name)
-        if min(o.size[0], o.size[1]) > max_grasp_width:
+        problem = grasp_problem(o.size, max_grasp_width)
+        if problem is not None:
             raise InstanceError(
-                f"object {o.name!r}: size {list(o.size)} cannot be grasped; expected a "
-                f"horizontal side <= {max_grasp_width} m (gripper opening minus margin)",
+                f"object {o.name!r}: size {list(o.size)} cannot be grasped: {problem}",
                 loc.get(o.name),
             )
     ws = instance.workspace

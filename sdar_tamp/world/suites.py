@@ -16,7 +16,7 @@ from importlib.resources import files
 from pathlib import Path
 
 from sdar_tamp.world.errors import SuiteError
-from sdar_tamp.world.generators import GeneratorOptions, generate_instance
+from sdar_tamp.world.generators import Acceptance, GeneratorOptions, generate_instance
 from sdar_tamp.world.instance import Instance, load_instance, save_instance
 
 SUITES = ("paper", "stress")
@@ -59,8 +59,9 @@ def suite_members(suite: str) -> tuple[SuiteMember, ...]:
     raise SuiteError(f"unknown suite {suite!r}; expected one of {list(SUITES)}")
 
 
-def build_suite(suite: str) -> tuple[Instance, ...]:
-    """Generate every instance of a suite in memory."""
+def build_suite(suite: str, accept: Acceptance | None = None) -> tuple[Instance, ...]:
+    """Generate every instance of a suite in memory (``accept``: the generator's acceptance
+    test, see :func:`~sdar_tamp.world.generators.generate_instance`)."""
     return tuple(
         generate_instance(
             m.family,
@@ -68,15 +69,16 @@ def build_suite(suite: str) -> tuple[Instance, ...]:
             m.seed,
             GeneratorOptions() if m.gap is None else GeneratorOptions(gap=m.gap),
             name=m.name,
+            accept=accept,
         )
         for m in suite_members(suite)
     )
 
 
-def generate_suite(suite: str, out_dir: Path) -> list[Path]:
+def generate_suite(suite: str, out_dir: Path, accept: Acceptance | None = None) -> list[Path]:
     """Write a suite as ``out_dir/<name>.yaml`` files; returns the paths in suite order."""
     out = Path(out_dir)
-    return [save_instance(inst, out / f"{inst.name}.yaml") for inst in build_suite(suite)]
+    return [save_instance(i, out / f"{i.name}.yaml") for i in build_suite(suite, accept)]
 
 
 def shipped_suite_dir(suite: str) -> Path:

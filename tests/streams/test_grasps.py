@@ -1,7 +1,12 @@
 import numpy as np
 import pytest
 
+from sdar_tamp.world.collision import ObjectBox
+from sdar_tamp.world.graspability import FINGER_DEPTH, TABLE_CLEARANCE, fingertip_drop
+from sdar_tamp.world.transforms import pose_xyz_yaw
+from streams.context import WorldContext
 from streams.grasps import pregrasp_offset, sample_grasps
+from streams.ik import IKRequest, solve_ik_candidates
 
 
 def test_default_object_gives_the_six_grasp_set_top_down_first() -> None:
@@ -40,3 +45,42 @@ def test_pregrasp_backs_off_along_the_approach() -> None:
     g = sample_grasps((0.08, 0.04, 0.05), 0.075)[2]
     pre = pregrasp_offset(g.T_object_tcp, 0.08)
     np.testing.assert_allclose(pre[:3, 3] - g.T_object_tcp[:3, 3], -0.08 * g.approach)
+
+
+def test_a_side_equal_to_the_graspable_width_is_graspable(ctx: WorldContext) -> None:
+    """0.06 - 0.01 is 0.049999999999999996: a 0.05 m cube still fits (one shared tolerance)."""
+    width = ctx.scene.gripper.max_graspable_width
+    assert width < 0.05
+    assert len(sample_grasps((0.05, 0.05, 0.05), width)) == 12
+    assert sample_grasps((0.0501, 0.0501, 0.05), width) == ()
+
+
+def test_a_short_bar_is_held_above_the_table(ctx: WorldContext) -> None:
+    """A 3 cm tall bar: the TCP rises so that the fingertips keep the table clearance; the
+    grasp is reachable without touching the table, and the fingertips are the closest to it."""
+    size = (0.08, 0.04, 0.03)
+    grasps = sample_grasps(size, ctx.scene.gripper.max_graspable_width)
+    top = [g for g in grasps if g.is_top_down]
+    assert len(top) == 2
+    z_tcp = size[2] / 2 + top[0].T_object_tcp[2, 3]  # above the table [m]
+    assert z_tcp == pytest.approx(FINGER_DEPTH + TABLE_CLEARANCE)
+    box = ObjectBox(pose_xyz_yaw(0.0, 0.1, size[2] / 2, 0.0), size)
+    world = ctx.new_world(margin=0.0)
+    home = {a: ctx.home(a) for a in ctx.arm_names}
+    cands = solve_ik_candidates(
+        ctx, world, {"bar": box}, [IKRequest("left", "bar", box, tuple(top))], home
+    )
+    assert cands
+    world.set_objects({})
+    clearance = world.min_distance(ctx.layout.join({**home, "left": cands[0].q}))
+    assert clearance.pair is not None and "table" in (clearance.pair.first, clearance.pair.second)
+    assert clearance.distance == pytest.approx(TABLE_CLEARANCE, abs=2e-4)
+    # tilted grasps rise further (the tilted finger reaches lower) or are left out
+    for g in grasps:
+        assert (
+            g.T_object_tcp[2, 3] + size[2] / 2 >= fingertip_drop(g.tilt) + TABLE_CLEARANCE - 1e-12
+        )
+
+
+def test_a_bar_too_short_to_hold_gets_no_grasp() -> None:
+    assert sample_grasps((0.08, 0.04, 0.01), 0.05) == ()

@@ -11,7 +11,7 @@ from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError, SuiteError
 from sdar_tamp.world.footprint import corners, inflate, overlap_matrix
 from sdar_tamp.world.generators import GeneratorOptions, generate_instance, max_objects
-from sdar_tamp.world.instance import load_instance, validate_instance
+from sdar_tamp.world.instance import Instance, load_instance, validate_instance
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.suites import build_suite, load_suite, suite_members
 
@@ -200,3 +200,23 @@ def test_generate_suite_writes_loadable_files(
     paths = generate_suite("paper", tmp_path)
     assert [p.name for p in paths] == ["R4.yaml", "R5.yaml"]
     assert load_suite("paper", tmp_path) == build_suite("paper")
+
+
+def test_refused_samples_are_replaced_by_later_ones() -> None:
+    seen: list[Instance] = []
+
+    def refuse_two(inst: Instance) -> str | None:
+        seen.append(inst)
+        return "refused" if len(seen) <= 2 else None
+
+    plain = generate_instance("S", 6, 11)
+    accepted = generate_instance("S", 6, 11, accept=refuse_two)
+    assert seen[0] == plain and len(seen) == 3 and accepted == seen[2] != plain
+
+
+def test_an_acceptance_test_refusing_everything_ends_with_its_reason() -> None:
+    with pytest.raises(GenerationError, match=r"3 refused by the acceptance test, the last "
+                       r"one: o0 is boxed in"):  # fmt: skip
+        generate_instance(
+            "R", 4, 5, GeneratorOptions(attempts=3), accept=lambda inst: "o0 is boxed in"
+        )

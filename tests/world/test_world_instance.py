@@ -14,7 +14,7 @@ from sdar_tamp.world.instance import (
     parse_instance,
     save_instance,
 )
-from sdar_tamp.world.scene import Workspace
+from sdar_tamp.world.scene import Scene, Workspace
 
 HEAD = "name: T\nworkspace: {x: [-0.25, 0.25], y: [-0.3, 0.3]}\nobjects:\n"
 
@@ -88,6 +88,29 @@ def test_ungraspable_size() -> None:
     text = HEAD + _obj("big", "[0, 0, 0]", "[0, 0, 0]", size="[0.1, 0.09, 0.05]")
     with pytest.raises(InstanceError, match=r"object 'big': size .* cannot be grasped"):
         parse_instance(text, "inst.yaml")
+
+
+def test_an_object_too_short_to_hold_is_refused_with_its_place_and_reason() -> None:
+    text = (
+        HEAD
+        + _obj("ok", "[0, 0.2, 0]", "[0, 0.2, 0]")
+        + _obj("flat", "[0, 0, 0]", "[0, 0, 0]", size="[0.08, 0.04, 0.008]")
+    )
+    with pytest.raises(
+        InstanceError,
+        match=r"inst.yaml:5:\d+: object 'flat': size .* cannot be grasped: height 0.008 m is too "
+        r"short: .* expected a height >= 0.013 m",
+    ):
+        parse_instance(text, "inst.yaml")
+
+
+def test_a_cube_as_wide_as_the_gripper_allows_and_a_short_bar_load(scene: Scene) -> None:
+    """The loader and the grasp sampler share one width tolerance: the scene's graspable
+    width (0.06 - 0.01, a hair under 0.05 m) accepts a 0.05 m cube."""
+    width = scene.gripper.max_graspable_width
+    text = HEAD + _obj("cube", "[0, 0, 0]", "[0, 0.2, 0]", size="[0.05, 0.05, 0.05]")
+    text += _obj("bar", "[0.15, 0, 0]", "[0.15, 0.2, 0]", size="[0.08, 0.04, 0.03]")
+    assert parse_instance(text, "inst.yaml", max_grasp_width=width).names == ("cube", "bar")
 
 
 def test_duplicate_names() -> None:
