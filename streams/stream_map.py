@@ -2,7 +2,8 @@
 
 Generators (``sample-grasp``, ``inverse-kinematics``, ``sample-buffer``, ``combine-confs``,
 ``plan-dual-motion``) yield one output tuple per call of ``next``; tests (``test-overlap``,
-``test-cfree``) return a bool; the function ``Duration`` returns a number [s].
+``test-cfree``, ``test-blocks-grasps``, ``test-grasp-cfree``) return a bool; the function
+``Duration`` returns a number [s].
 :data:`STREAM_KINDS` says which is which, so the wiring layer can wrap them (e.g.
 ``from_gen_fn`` / ``from_test`` / ``from_fn``). Replace any entry of the returned dict by
 another callable with the same signature to swap a stream.
@@ -28,6 +29,7 @@ from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
+from streams.blocking import GraspBlocking, gripper_boxes
 from streams.buffers import sample_buffers
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, sample_grasps
@@ -50,6 +52,8 @@ STREAM_KINDS: Mapping[str, str] = MappingProxyType(
         "plan-dual-motion-quick": "gen",
         "test-overlap": "test",
         "test-cfree": "test",
+        "test-blocks-grasps": "test",
+        "test-grasp-cfree": "test",
         "Duration": "function",
         "Distance": "function",
     }
@@ -135,6 +139,14 @@ class DualArmStreams:
         self.grasp_options = grasps
         self._grasps: dict[str, tuple[Grasp, ...]] = {}
         self._buffer_calls = 0
+        self._blocking: GraspBlocking | None = None
+
+    @property
+    def blocking(self) -> GraspBlocking:
+        """The grasp-blocking tests of the scene's gripper (built on first use)."""
+        if self._blocking is None:
+            self._blocking = GraspBlocking(gripper_boxes(self.ctx.scene.robot_urdf), IK_MARGIN)
+        return self._blocking
 
     def size(self, obj: str) -> Size:
         return self.sizes.get(obj, self.ctx.scene.object_size)
@@ -266,6 +278,20 @@ class DualArmStreams:
         """Footprints of ``o`` at ``p`` and ``o2`` at ``p2`` are clear of each other."""
         return o != o2 and not self.test_overlap(o, p, o2, p2)
 
+    def test_blocks_grasps(self, o: str, p: Pose2D, o2: str, p2: Pose2D) -> bool:
+        """``o`` at ``p`` leaves no grasp of ``o2`` at ``p2`` (every grasp of the grasp set
+        puts a gripper box into ``o``'s box): a dependency edge that footprints miss."""
+        if o == o2:
+            return False
+        return self.blocking.blocks_all(self.grasps(o2), self.box(o2, p2), self.box(o, p))
+
+    def test_grasp_cfree(self, o: str, p: Pose2D, g: Grasp, o2: str, p2: Pose2D) -> bool:
+        """The gripper holding ``o`` at ``p`` with ``g`` is clear of ``o2`` at ``p2`` (two
+        grippers placing two neighbouring objects at once)."""
+        if o == o2:
+            return False
+        return not bool(self.blocking.blocked((g,), self.box(o, p), self.box(o2, p2))[0])
+
     @staticmethod
     def duration(t: MotionResult) -> float:
         """Execution time [s] of a planned motion."""
@@ -315,6 +341,8 @@ def make_stream_map(
         "plan-dual-motion-quick": s.plan_dual_motion_quick,
         "test-overlap": s.test_overlap,
         "test-cfree": s.test_cfree,
+        "test-blocks-grasps": s.test_blocks_grasps,
+        "test-grasp-cfree": s.test_grasp_cfree,
         "Duration": s.duration,
         "Distance": s.distance,
     }

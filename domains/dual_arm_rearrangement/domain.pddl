@@ -28,6 +28,8 @@
     (motion ?d1 - dualconf ?t - traj ?d2 - dualconf)
     (overlaps ?o - obj ?p - pose ?o2 - obj ?p2 - pose)
     (cfree ?o - obj ?p - pose ?o2 - obj ?p2 - pose)
+    (blocksgrasps ?o - obj ?p - pose ?o2 - obj ?p2 - pose)  ; ?o at ?p leaves ?o2 no grasp
+    (graspcfree ?o - obj ?p - pose ?g - grasp ?o2 - obj ?p2 - pose)
     ; fluents
     (atpose ?o - obj ?p - pose)
     (holding ?a - arm ?o - obj ?g - grasp)

@@ -42,6 +42,15 @@
   (:stream test-cfree
     :inputs (?o ?p ?o2 ?p2) :domain (and (objpose ?o ?p) (objpose ?o2 ?p2))
     :certified (cfree ?o ?p ?o2 ?p2))
+  ; ?o at ?p leaves no grasp of ?o2 at ?p2 (a gripper box of every grasp meets ?o): an edge
+  ; of the dependency graph that footprints miss (a finger needs room beside an object)
+  (:stream test-blocks-grasps
+    :inputs (?o ?p ?o2 ?p2) :domain (and (objpose ?o ?p) (objpose ?o2 ?p2))
+    :certified (blocksgrasps ?o ?p ?o2 ?p2))
+  ; the gripper holding ?o at ?p with ?g is clear of ?o2 at ?p2 (two objects placed at once)
+  (:stream test-grasp-cfree
+    :inputs (?o ?p ?g ?o2 ?p2) :domain (and (objpose ?o ?p) (graspof ?o ?g) (objpose ?o2 ?p2))
+    :certified (graspcfree ?o ?p ?g ?o2 ?p2))
   ; the execution time [s] of a motion
   (:function (Duration ?t) (traj ?t))
   ; an estimate [s] of the synchronous motion between two dual-arm configurations

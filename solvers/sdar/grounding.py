@@ -106,15 +106,20 @@ class Grounder:
         """Every grounding of ``step`` with ``arms`` not yet tried, cheapest estimate first:
         from ``options_per_move`` options per move, or from ``more_options`` when none of
         those combinations works (two arms reaching for neighbouring objects often collide
-        with the first grasps and not with tilted ones)."""
+        with the first grasps and not with tilted ones), and for a two-move step at last
+        from every grasp of the grasp set (two grippers placing touching objects at once
+        need a compatible pair, often two grasps tilted away from each other; ``pair_kinds``)."""
         lifted = frozenset(step.objects)
         opt = self.options
-        limits = [opt.options_per_move]
+        stages = [(opt.options_per_move, opt.grasps)]
         if step.kind in opt.expand_kinds and opt.more_options > opt.options_per_move:
-            limits.append(opt.more_options)
-        for limit in limits:
+            stages.append((opt.more_options, opt.grasps))
+        if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps:
+            stages.append((opt.pair_grasps, opt.pair_grasps))
+        found: list[Grounding] = []
+        for limit, grasps in stages:
             per_move = [
-                self._move_options(a, m, lifted, limit)
+                self._move_options(a, m, lifted, limit, grasps)
                 for a, m in zip(arms, step.moves, strict=True)
             ]
             for a, m, options in zip(arms, step.moves, per_move, strict=True):
@@ -132,7 +137,7 @@ class Grounder:
         return sorted(found, key=lambda g: g.estimate)
 
     def _move_options(
-        self, arm: str, move: Move, lifted: frozenset[str], limit: int
+        self, arm: str, move: Move, lifted: frozenset[str], limit: int, grasps: int
     ) -> list[Option]:
         cache, voc, opt = self.cache, self.cache.voc, self.options
         p = cache.current_poses()[move.obj]
@@ -144,7 +149,7 @@ class Grounder:
             targets = [self.goals[move.obj]]
         after = cache.fluents(voc.atpose, without=lifted)
         found: list[Option] = []
-        for (g,) in cache.outputs(voc.grasp, (move.obj,), opt.grasps):
+        for (g,) in cache.outputs(voc.grasp, (move.obj,), grasps):
             picks = cache.outputs(voc.ik, (arm, move.obj, p, g), 1, resting)
             if not picks:
                 continue
@@ -172,6 +177,8 @@ class Grounder:
         for combo in _product(per_move):
             if self.tabu.blocked(self.key(step, arms, combo), mode):
                 continue
+            if not self.options.one_arm_at_a_time and not self._grippers_clear(step, combo):
+                continue
             if self.options.one_arm_at_a_time:
                 one = self._ground_one_arm(step, arms, combo, current)
                 if one is not None:
@@ -188,6 +195,18 @@ class Grounder:
             estimate = distance(current, d_pick) + distance(d_pick, d_place)
             found.append(Grounding(step, arms, combo, d_pick, d_place, estimate))
         return found
+
+    def _grippers_clear(self, step: Step, combo: tuple[Option, ...]) -> bool:
+        """Two objects placed at once: each gripper is clear of the other object at its
+        target (the domain's gripper test, when it has one; the IK of a placement sees only
+        the objects that stay)."""
+        test = self.cache.voc.grasp_cfree
+        if len(combo) != 2 or test not in self.cache.streams:
+            return True
+        (a, b), (oa, ob) = step.objects, combo
+        return self.cache.test(test, (a, oa.target, oa.grasp, b, ob.target)) and self.cache.test(
+            test, (b, ob.target, ob.grasp, a, oa.target)
+        )
 
     def _combine(self, confs: Mapping[str, str]) -> str | None:
         (a1, q1), (a2, q2) = sorted(confs.items())

@@ -23,6 +23,14 @@ whose current poses block the goal of ``x``. Rank classes (lower is better):
 7. ``cycle``: as 2-3, for an ``x`` known to cost an extra buffer move (a detour).
 8. ``buffer``: one object to a buffer; objects already on a buffer only if nothing else is
    possible (no ping-pong).
+9. any of the above that brings an object to its goal while that goal would leave another
+   object still to be placed no grasp at its own goal (:meth:`TaskView.must_wait`): last
+   resorts, since the other object could then never be placed.
+
+Edges of the view's graph come from footprints and from grasps alike: ``i -> j`` also when
+``i`` at its goal leaves ``j`` no grasp where ``j`` rests, or ``j`` where it rests leaves ``i``
+no grasp (at its goal, or where ``i`` rests). Moves are ordered and cycles broken over all of
+them.
 
 Choosing ``x``: the objects that belong to a minimum *buffer set* of the current graph (the
 fewest objects whose removal leaves components of at most two objects, see
@@ -47,7 +55,8 @@ from solvers.sdar.tasks import Move, Step, TaskView
 
 _Edges = tuple[tuple[int, int], ...]
 _DOUBLE_FIRSTS = 3  # double buffer moves are sought for the best three first objects
-LAST, GOAL_PAIR, CYCLE, CYCLE_FREE, CYCLE_DOUBLE, CYCLE_ALONE, SINGLE, DETOUR, BUFFER = range(9)
+(LAST, GOAL_PAIR, CYCLE, CYCLE_FREE, CYCLE_DOUBLE, CYCLE_ALONE, SINGLE, DETOUR, BUFFER,
+ WAIT) = range(10)  # fmt: skip
 
 _Key = tuple[int, ...]
 _Ranked = list[tuple[_Key, Step]]
@@ -112,8 +121,19 @@ class SdarTaskPlanner:
             if (Move(x, to_buffer=True),) not in proposed:
                 key = (BUFFER, scene.order[x])
                 kept.append((key, Step((Move(x, to_buffer=True),), "buffer", BUFFER)))
+        if view.waits:
+            kept = [self._wait(item, view) for item in kept]
         kept.sort(key=lambda item: item[0])
         return [step for _, step in kept]
+
+    @staticmethod
+    def _wait(item: tuple[_Key, Step], view: TaskView) -> tuple[_Key, Step]:
+        """Class 9 for a step placing an object whose goal would leave another object still to
+        be placed (the other object of a pair too: both are placed at once) no grasp."""
+        key, step = item
+        if not any(not m.to_buffer and view.must_wait(m.obj) for m in step.moves):
+            return item
+        return (WAIT, *key), Step(step.moves, step.kind, WAIT)
 
     def _goal_pairs(self, scene: _Scene) -> _Ranked:
         """Class 1: both objects to their goals."""

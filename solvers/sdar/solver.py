@@ -111,24 +111,38 @@ class SdarSolver:
         )
 
     def view(self) -> TaskView:
-        """The dependency graph of the objects not at their goals (overlap test stream)."""
-        cache = self.cache
+        """The dependency graph of the objects not at their goals: footprint overlap (the
+        overlap test stream) and, when the domain has the grasp-blocking test, objects that
+        leave one another no grasp (see :class:`~solvers.sdar.tasks.TaskView`)."""
+        cache, voc = self.cache, self.voc
         current = cache.current_poses()
         remaining = tuple(sorted(o for o, g in self.goals.items() if current.get(o) != g))
+        blocks = voc.blocks_grasps if voc.blocks_grasps in cache.streams else None
         edges = []
+        waits: set[tuple[str, str]] = set()
         for i, a in enumerate(remaining):
+            goal = self.goals[a]
             for j, b in enumerate(remaining):
-                if (
-                    i != j
-                    and b in current
-                    and cache.test(self.voc.overlap, (a, self.goals[a], b, current[b]))
+                if i == j or b not in current:
+                    continue
+                here = current[b]
+                if cache.test(voc.overlap, (a, goal, b, here)) or (
+                    blocks is not None
+                    and (
+                        cache.test(blocks, (a, goal, b, here))  # b could not be picked
+                        or cache.test(blocks, (b, here, a, goal))  # a could not be placed
+                        or (a in current and cache.test(blocks, (b, here, a, current[a])))
+                    )
                 ):
                     edges.append((i, j))
+                if blocks is not None and cache.test(blocks, (a, goal, b, self.goals[b])):
+                    waits.add((a, b))
         buffered = frozenset(
             o for o, p in current.items() if cache.state.has(self.voc.buffer_pose, p)
         )
         done = frozenset(o for o, g in self.goals.items() if current.get(o) == g)
-        return TaskView(DependencyGraph(remaining, tuple(edges)), done, buffered)
+        graph = DependencyGraph(remaining, tuple(edges))
+        return TaskView(graph, done, buffered, frozenset(waits))
 
     # -- the loop ----------------------------------------------------------------------------
     def solve(self) -> Solution:

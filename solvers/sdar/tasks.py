@@ -55,14 +55,18 @@ class Step:
 class TaskView:
     """The current arrangement as a task planner sees it.
 
-    ``graph`` is the dependency graph over the objects not at their goals (``i -> j``: the goal
-    of ``i`` overlaps the current pose of ``j``); ``done`` are the objects at their goals;
-    ``in_buffer`` the objects resting on a buffer.
+    ``graph`` is the dependency graph over the objects not at their goals (``i -> j``: ``i``
+    cannot go to its goal while ``j`` rests where it does: the goal of ``i`` overlaps the
+    current pose of ``j``, or one of them leaves the other no grasp); ``done`` are the objects
+    at their goals; ``in_buffer`` the objects resting on a buffer; ``waits`` pairs ``(i, j)``:
+    ``i`` at its goal would leave ``j`` no grasp at the goal of ``j``, so ``i`` goes to its
+    goal after ``j``.
     """
 
     graph: DependencyGraph
     done: frozenset[str]
     in_buffer: frozenset[str]
+    waits: frozenset[tuple[str, str]] = frozenset()
 
     @property
     def remaining(self) -> tuple[str, ...]:
@@ -72,6 +76,11 @@ class TaskView:
         """The objects whose current poses overlap the goal of ``obj``."""
         i = self.graph.names.index(obj)
         return frozenset(self.graph.names[j] for j in self.graph.successors(i))
+
+    def must_wait(self, obj: str) -> bool:
+        """``obj`` at its goal would leave an object still to be placed no grasp at its goal."""
+        remaining = set(self.graph.names)
+        return any(i == obj and j in remaining and j != obj for i, j in self.waits)
 
     def goal_free_after(self, obj: str, lifted: frozenset[str]) -> bool:
         """The goal of ``obj`` is free once the objects in ``lifted`` are picked up."""

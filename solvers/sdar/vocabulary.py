@@ -29,6 +29,10 @@ class SdarVocabulary:
     motion: str = "plan-dual-motion"  # (?d1 ?d2) -> ?t, fluents atpose holding
     quick_motion: str = "plan-dual-motion-quick"  # the same, cheaper and weaker (optional)
     distance: str = "distance"  # function (?d1 ?d2): estimated motion time (optional)
+    blocks_grasps: str = "test-blocks-grasps"  # (?o ?p ?o2 ?p2): o at p leaves o2 no grasp
+    # at p2 (optional: dependency edges beyond footprint overlap)
+    grasp_cfree: str = "test-grasp-cfree"  # (?o ?p ?g ?o2 ?p2): the gripper holding o at p
+    # with g is clear of o2 at p2 (optional: two objects placed at once)
     # predicates and types
     atpose: str = "atpose"
     holding: str = "holding"

@@ -297,7 +297,7 @@ def test_colliding_first_grasps_widen_the_options(
     buffered: dict[int, int] = {}
     for more in (2, 6):
         r = rearrangement_problem(instance, ctx, planner=planner)
-        options = SdarOptions(max_time=60.0, more_options=more)
+        options = SdarOptions(max_time=60.0, more_options=more, pair_grasps=0)
         solution = SdarSolver(r.problem, make_task_planner("sdar"), options).solve()
         assert solution.status is Status.SOLVED
         kinds[more] = [t["kind"] for t in solution.trace]
