@@ -145,6 +145,9 @@ STRAIGHT_ANGLE_TOL = np.radians(2.0)
 DIRECT_MARGIN = 0.005
 #: TCP lifts [m] of the lightly bent paths tried when the straight line is not clear.
 DIRECT_LIFTS = (0.05, 0.12)
+#: Largest joint distance [rad] of a bent path's via configuration from the mid-point of its
+#: ends (farther: another IK branch, not a light bend).
+DIRECT_VIA_SPREAD = 1.0
 
 
 class DualMotionPlanner:
@@ -269,6 +272,8 @@ class DualMotionPlanner:
             for sl, waits in zip(self.ctx.layout.slices, still, strict=True):
                 if waits:
                     via[sl] = q_a[sl]
+            if np.abs(via - 0.5 * (q_a + q_b)).max() > DIRECT_VIA_SPREAD:
+                continue  # another IK branch (a wrist turned round): a long, slow detour
             candidates.append(np.stack([q_a, via, q_b]))
         for waypoints in candidates:
             curve = spline_curve(waypoints, DIRECT_SAMPLES)
