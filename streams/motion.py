@@ -3,14 +3,20 @@
 A synchronous segment takes the arms from ``q_start`` to ``q_goal`` (``(dof,)`` [rad]) with
 the held objects fixed for the whole segment (gripper actions happen between segments):
 
-1. retreat: arms flagged ``retreat`` first move their tool ``lift`` [m] straight back along
-   the tool axis (IK interpolation), both arms at once;
+1. retreat: arms flagged ``retreat`` first move their tool straight back along the tool axis
+   (IK interpolation), both arms at once, by a lift [m] chosen per grasp from the clearance
+   of its neighbours (:func:`streams.shape.clearance_lift`; or the request's fixed ``lift``);
 2. transfer: between the two lifted (pre-grasp) configurations, produced by a *strategy*;
-3. approach: arms flagged ``approach`` move ``lift`` straight down the tool axis to the goal.
+3. approach: arms flagged ``approach`` move straight down the tool axis to the goal.
 
-Every phase and stage is timed rest to rest (:mod:`streams.timing`), the whole trajectory is
-then checked exactly with coal (:mod:`streams.validate`), and only a trajectory that passes
-is returned as a success. Strategies, tried in order until one passes:
+The motion is first shaped as one blended path (:mod:`streams.shape`): only the first and
+last ``straight`` centimetres stay straight, the corners at the lifted configurations are
+rounded into the transfer, and the path is timed as one, without stopping at the pre-grasp
+points. If that path leaves the straight tool axis or fails the exact check, the unblended
+motion is used: every phase and stage timed rest to rest (:mod:`streams.timing`). Either way
+the whole trajectory is checked exactly with coal (:mod:`streams.validate`), and only a
+trajectory that passes is returned as a success. Strategies, tried in order until one
+passes:
 
 * ``plain`` (:class:`PlainStrategy`): one synchronous optimisation, warm-started from the
   straight line, then from a lifted via-point;
@@ -38,9 +44,18 @@ import numpy as np
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
+from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.transforms import FloatArray
 from streams.cartesian import straight_tool_move, tool_pose_ik
 from streams.context import WorldContext
+from streams.shape import (
+    ShapeOptions,
+    arc_length,
+    clearance_lift,
+    round_corner,
+    straight_end_deviation,
+    straight_prefix,
+)
 from streams.sphere_pairs import HeldSpheres
 from streams.spheres import object_spheres
 from streams.timing import TimedTrajectory, spline_curve, time_parameterize
@@ -74,7 +89,7 @@ class MotionRequest:
     held: Mapping[str, HeldObject] = field(default_factory=dict)  # arm -> held object
     retreat: tuple[bool, ...] = ()
     approach: tuple[bool, ...] = ()
-    lift: float = 0.08  # [m]
+    lift: float | None = None  # [m] fixed for every grasp; None: per grasp from clearance
 
 
 @dataclass(frozen=True)
@@ -89,6 +104,7 @@ class MotionResult:
     attempts: tuple[str, ...]  # "level: outcome" for every strategy tried
     validation: ValidationReport | None = None
     reason: str = ""
+    blended: bool = False  # retreat, transfer and approach timed as one blended path
     ipopt_solves: int = 0  # optimiser calls that ran IPOPT (a feasible straight line needs none)
     direct_paths: int = 0  # transfers (or stages) taken straight or lightly bent, not optimised
     sampled_paths: int = 0  # transfers found by the sampling-based planner (OMPL)
@@ -115,11 +131,23 @@ class TransferStrategy(Protocol):
     ) -> list[FloatArray] | None: ...
 
 
+#: Joint-space spacing [rad] of the transfer curve's samples in a blended path.
+BLEND_SPACING = 0.05
+#: Share of a single transfer's length either corner of a blended path may cut.
+BLEND_SHARE = 0.45
+#: Largest distance [m] of the TCP from the grasp's tool axis, and angle [rad] of the tool
+#: from the grasp's orientation, on the straight part of a blended retreat or approach.
+STRAIGHT_TOL = 0.002
+STRAIGHT_ANGLE_TOL = np.radians(2.0)
+
 #: Clearance [m] a transfer taken without optimisation keeps from resting and held objects
 #: on the exact check (the optimiser's sphere model asks 15 mm of its spheres).
 DIRECT_MARGIN = 0.005
 #: TCP lifts [m] of the lightly bent paths tried when the straight line is not clear.
 DIRECT_LIFTS = (0.05, 0.12)
+#: Largest joint distance [rad] of a bent path's via configuration from the mid-point of its
+#: ends (farther: another IK branch, not a light bend).
+DIRECT_VIA_SPREAD = 1.0
 
 
 class DualMotionPlanner:
@@ -132,7 +160,8 @@ class DualMotionPlanner:
 
     ``direct_lifts``: TCP lifts [m] of the bent paths tried after the straight line (empty:
     the straight line only); ``direct=False`` always optimises (the sphere model's own
-    straight-line test still applies)."""
+    straight-line test still applies); ``shape``: lift heights and blending
+    (:mod:`streams.shape`). Trajectories use the scene's ``velocity_safety``."""
 
     def __init__(
         self,
@@ -143,6 +172,7 @@ class DualMotionPlanner:
         direct_margin: float = DIRECT_MARGIN,
         direct_lifts: Sequence[float] = DIRECT_LIFTS,
         optimisers: OptimiserCache | None = OPTIMISERS,
+        shape: ShapeOptions | None = None,
     ) -> None:
         if direct_margin < 0.0:
             raise ParameterError(f"direct_margin must be >= 0 [m], got {direct_margin}")
@@ -156,6 +186,8 @@ class DualMotionPlanner:
         self.direct_lifts = tuple(float(h) for h in direct_lifts)
         self._v = ctx.scene.joint_array("velocity_limit")
         self._a = ctx.scene.joint_array("acceleration_limit")
+        self.safety = ctx.scene.velocity_safety
+        self.shape = shape if shape is not None else ShapeOptions()
         self.optimisation_time = 0.0  # reset per plan_dual_motion call
         self.ipopt_solves = 0
         self.direct_paths = 0  # transfers taken without optimisation, per plan_dual_motion call
@@ -240,6 +272,8 @@ class DualMotionPlanner:
             for sl, waits in zip(self.ctx.layout.slices, still, strict=True):
                 if waits:
                     via[sl] = q_a[sl]
+            if np.abs(via - 0.5 * (q_a + q_b)).max() > DIRECT_VIA_SPREAD:
+                continue  # another IK branch (a wrist turned round): a long, slow detour
             candidates.append(np.stack([q_a, via, q_b]))
         for waypoints in candidates:
             curve = spline_curve(waypoints, DIRECT_SAMPLES)
@@ -307,19 +341,53 @@ class DualMotionPlanner:
         return out
 
     # -- assembling ------------------------------------------------------------------------
+    def lifts(
+        self, request: MotionRequest, fixed: float | None = None
+    ) -> tuple[list[float], list[float]]:
+        """Per arm, the lift [m] of its retreat and of its approach: ``fixed`` (default the
+        request's ``lift``) for every grasp, or, when both are None, from the clearance of
+        each grasp's neighbours (the shape's default lift where that is unusable)."""
+        lift = fixed if fixed is not None else request.lift
+        n = len(self.ctx.layout)
+        if lift is not None:
+            return [lift] * n, [lift] * n
+        out: tuple[list[float], list[float]] = ([], [])
+        for arm in self.ctx.arm_names:
+            kin = self.ctx.kinematics[arm]
+            sl = self.ctx.layout.slice(arm)
+            h = request.held.get(arm)
+            ends = (request.q_start[sl], request.q_goal[sl])
+            xy = [kin.fk_tcp(q)[:2, 3] for q in ends]
+            for side, q in enumerate(ends):
+                held = None
+                if h is not None:
+                    held = ObjectBox(kin.fk_tool0(q) @ h.T_tool0_obj, h.size)
+                found = clearance_lift(
+                    kin.fk_tcp(q), request.objects, held, self.shape, xy[1 - side]
+                )
+                out[side].append(found if found is not None else self.shape.default_lift)
+        return out
+
     def phases(
-        self, request: MotionRequest, one_at_a_time: bool = False
+        self, request: MotionRequest, one_at_a_time: bool = False, lift: float | None = None
     ) -> tuple[list[FloatArray], list[FloatArray]] | None:
         """Retreat and approach as lists of paths ``(n, dof)``: one synchronised (padded) path
         each, or, with ``one_at_a_time``, one arm's after the other's (layout order); None if
-        a straight tool move is unreachable."""
+        a straight tool move is unreachable. ``lift`` [m]: fixed for every grasp (default:
+        :meth:`lifts`)."""
         ret, app = [], []
+        up, down = self.lifts(request, lift)
+        step = self.shape.step
         for i, arm in enumerate(self.ctx.arm_names):
             kin = self.ctx.kinematics[arm]
             sl = self.ctx.layout.slice(arm)
-            q0, q1, lift = request.q_start[sl], request.q_goal[sl], -request.lift
-            r = straight_tool_move(kin, q0, lift) if _flag(request.retreat, i) else q0[None]
-            a = straight_tool_move(kin, q1, lift) if _flag(request.approach, i) else q1[None]
+            q0, q1 = request.q_start[sl], request.q_goal[sl]
+            r = straight_tool_move(kin, q0, -up[i], step) if _flag(request.retreat, i) else q0[None]
+            a = (
+                straight_tool_move(kin, q1, -down[i], step)
+                if _flag(request.approach, i)
+                else q1[None]
+            )
             if r is None or a is None:
                 return None
             ret.append(r)
@@ -357,10 +425,93 @@ class DualMotionPlanner:
         approach: Sequence[FloatArray],
     ) -> TimedTrajectory:
         """The paths in order, each timed rest to rest."""
-        traj = time_parameterize(retreat[0], self._v, self._a)
+        traj = self.timed(retreat[0])
         for path in (*retreat[1:], *stages, *approach):
-            traj = traj.then(time_parameterize(path, self._v, self._a))
+            traj = traj.then(self.timed(path))
         return traj
+
+    def timed(self, path: FloatArray, path_speed: FloatArray | None = None) -> TimedTrajectory:
+        """``path`` ``(n, dof)`` timed rest to rest at the scene's ``velocity_safety``."""
+        return time_parameterize(path, self._v, self._a, safety=self.safety, path_speed=path_speed)
+
+    def blend(
+        self,
+        request: MotionRequest,
+        retreat: Sequence[FloatArray],
+        stages: Sequence[FloatArray],
+        approach: Sequence[FloatArray],
+    ) -> TimedTrajectory | None:
+        """The motion with the corners at the lifted configurations rounded into the transfer
+        (see :mod:`streams.shape`), the first and last stage timed each as one path with
+        the retreat and approach, or None when neither end can blend (a chained retreat or
+        approach, or one no longer than the straight part) or the blended path leaves the
+        straight tool axis at a grasp."""
+        if not self.shape.blend:
+            return None
+        straight = self.shape.straight
+        ctx = self.ctx
+        kins = {i: (ctx.kinematics[a], ctx.layout.slice(a)) for i, a in enumerate(ctx.arm_names)}
+        up = {i: kins[i] for i in kins if _flag(request.retreat, i)}
+        down = {i: kins[i] for i in kins if _flag(request.approach, i)}
+        r_keep = straight_prefix(up, retreat[0], straight) if up and len(retreat) == 1 else None
+        a_path = approach[-1][::-1]
+        a_keep = straight_prefix(down, a_path, straight) if down and len(approach) == 1 else None
+        if r_keep is None and a_keep is None:
+            return None
+        curves = [self._dense(stage) for stage in stages]
+        share = BLEND_SHARE if len(curves) == 1 else 1.0
+        first_len, last_len = (float(arc_length(curves[k])[-1]) for k in (0, -1))
+        if a_keep is not None:
+            curves[-1] = round_corner(
+                a_path, a_keep, curves[-1][::-1], share * last_len, self.shape.reach
+            )[::-1]
+        if r_keep is not None:
+            curves[0] = round_corner(
+                retreat[0], r_keep, curves[0], share * first_len, self.shape.reach
+            )
+        caps = [np.full(len(c), np.inf) for c in curves]
+        if r_keep is not None:
+            caps[0][: r_keep + 1] = self._tcp_cap(retreat[0][: r_keep + 1], up)
+        if a_keep is not None:
+            tail = self._tcp_cap(a_path[: a_keep + 1], down)[::-1]
+            caps[-1][-(a_keep + 1) :] = np.minimum(caps[-1][-(a_keep + 1) :], tail)
+        pieces: list[TimedTrajectory] = []
+        if r_keep is None:
+            pieces.extend(self.timed(p) for p in retreat)
+        pieces.extend(self.timed(c, cap) for c, cap in zip(curves, caps, strict=True))
+        if a_keep is None:
+            pieces.extend(self.timed(p) for p in approach)
+        traj = pieces[0]
+        for piece in pieces[1:]:
+            traj = traj.then(piece)
+        for flags, q_grasp, q in ((up, request.q_start, traj.q), (down, request.q_goal,
+                                                                   traj.q[::-1])):  # fmt: skip
+            for kin, sl in flags.values():
+                lateral, angle = straight_end_deviation(kin, q[:, sl], q_grasp[sl], straight)
+                if lateral > STRAIGHT_TOL or angle > STRAIGHT_ANGLE_TOL:
+                    return None
+        return traj
+
+    def _dense(self, stage: FloatArray) -> FloatArray:
+        """The curve the timing follows through ``stage``'s waypoints, densely sampled."""
+        length = float(np.linalg.norm(np.diff(stage, axis=0), axis=1).sum())
+        return spline_curve(stage, max(DIRECT_SAMPLES, int(np.ceil(length / BLEND_SPACING)) + 1))
+
+    def _tcp_cap(self, path: FloatArray, arms: Mapping[int, tuple[ArmKinematics, slice]]
+                 ) -> FloatArray:  # fmt: skip
+        """Per waypoint of ``path`` ``(m, dof)``: the path speed [rad/s] at which no TCP of
+        ``arms`` moves faster than the shape's ``grasp_speed`` (the steeper adjacent chord)."""
+        dq = np.linalg.norm(np.diff(path, axis=0), axis=1)
+        ratio = np.zeros(len(dq))
+        for kin, sl in arms.values():
+            p = np.stack([kin.fk_tcp(q)[:3, 3] for q in path[:, sl]])
+            dp = np.linalg.norm(np.diff(p, axis=0), axis=1)
+            ratio = np.maximum(ratio, dp / np.maximum(dq, 1e-12))
+        chord = self.shape.grasp_speed / np.maximum(ratio, 1e-12)
+        out = np.full(len(path), np.inf)
+        out[:-1] = chord
+        out[1:] = np.minimum(out[1:], chord)
+        return out
 
 
 def _flag(flags: tuple[bool, ...], i: int) -> bool:
@@ -374,10 +525,18 @@ def _only(i: int, n: int) -> tuple[bool, ...]:
 
 
 def _sync(paths: list[FloatArray]) -> FloatArray:
-    """Per-arm paths ``(n_i, arm dof)`` as one ``(max n, dof)`` path (shorter ones wait)."""
+    """Per-arm paths ``(n_i, arm dof)`` as one ``(max n, dof)`` path: shorter ones are
+    resampled (linearly between their waypoints), so every arm starts and ends together."""
     n = max(len(p) for p in paths)
-    padded = [np.concatenate([p, np.repeat(p[-1:], n - len(p), axis=0)]) for p in paths]
-    return np.concatenate(padded, axis=1)
+    x = np.linspace(0.0, 1.0, n)
+    out = []
+    for p in paths:
+        if len(p) == 1:
+            out.append(np.repeat(p, n, axis=0))
+            continue
+        xp = np.linspace(0.0, 1.0, len(p))
+        out.append(np.stack([np.interp(x, xp, p[:, j]) for j in range(p.shape[1])], axis=1))
+    return np.concatenate(out, axis=1)
 
 
 def _chain(paths: list[FloatArray]) -> list[FloatArray]:
@@ -526,17 +685,19 @@ def _clear_phases(
     """Retreat and approach that are collision-free on their own (every strategy shares
     them): synchronised, else one arm after the other; or why there are none."""
     reason = "approach or retreat unreachable"
-    for chained in dict.fromkeys((one_at_a_time, True)):
-        phases = planner.phases(request, one_at_a_time=chained)
-        if phases is None:
-            return reason
-        for label, paths in zip(("retreat", "approach"), phases, strict=True):
-            report = validate_trajectory(planner.ctx, planner.world, np.concatenate(paths))
-            if not report.ok:
-                reason = f"{label} collides ({report.reason})"
+    lifts = (None,) if request.lift is not None else (None, planner.shape.default_lift)
+    for lift in lifts:  # the clearance lifts, then the fixed default
+        for chained in dict.fromkeys((one_at_a_time, True)):
+            phases = planner.phases(request, one_at_a_time=chained, lift=lift)
+            if phases is None:
                 break
-        else:
-            return phases
+            for label, paths in zip(("retreat", "approach"), phases, strict=True):
+                report = validate_trajectory(planner.ctx, planner.world, np.concatenate(paths))
+                if not report.ok:
+                    reason = f"{label} collides ({report.reason})"
+                    break
+            else:
+                return phases
     return reason
 
 
@@ -572,6 +733,17 @@ def plan_dual_motion(
         if stages is None:
             attempts.append(f"{strategy.name}: optimisation failed")
             continue
+        blended = planner.blend(request, retreat, stages, approach)
+        if blended is not None:
+            report = validate_trajectory(ctx, planner.world, blended.q, blended.t)
+            if report.ok:
+                attempts.append(f"{strategy.name}: ok (blended)")
+                return MotionResult(True, strategy.name, blended, planner.optimisation_time,
+                                    time.perf_counter() - t0, tuple(attempts), report,
+                                    ipopt_solves=planner.ipopt_solves,
+                                    direct_paths=planner.direct_paths,
+                                    sampled_paths=planner.sampled_paths,
+                                    blended=True)  # fmt: skip
         traj = planner.assemble(retreat, stages, approach)
         report = validate_trajectory(ctx, planner.world, traj.q, traj.t)
         if report.ok:

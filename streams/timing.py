@@ -10,8 +10,17 @@ points and the constraints
 
 at both ends of every grid step. The backward pass solves a two-variable linear programme per
 grid point by enumerating the vertices of its polygon. Limits are scaled by ``safety``
-(default 0.95) to absorb the discretisation. The motion starts and ends at rest; the result
-is resampled at a uniform step of at most ``dt``.
+(default 0.95; the scene's ``velocity_safety``); an optional cap on the path speed per
+waypoint slows chosen parts (a grasp's straight approach). The motion starts and ends at rest;
+the result is resampled at a uniform step of at most ``dt``.
+
+The samples are then checked with the measures a plan validator uses: the velocity of every
+interval, the second divided difference at every interior sample, and at both ends half the
+acceleration limit for the robot at rest one step away (so two rest-to-rest trajectories
+joined end to start, each sampled at its own step, stay within the limit at the junction).
+Where the discretisation breaks one of them, the whole profile is slowed uniformly (time
+scaled by the smallest factor that restores every limit) and sampled again; with
+``safety=1`` this is what keeps the result valid.
 """
 
 from __future__ import annotations
@@ -20,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.transforms import FloatArray
 
 
@@ -126,6 +136,30 @@ def _u_range(rows: FloatArray, a2: FloatArray, x: float) -> tuple[float, float]:
     return lo, hi
 
 
+def sample_limit_ratio(
+    t: FloatArray, q: FloatArray, v_max: FloatArray, a_max: FloatArray
+) -> tuple[float, float]:
+    """Largest ratios (velocity, acceleration) of the samples' divided differences to the
+    limits: interval velocities, interior second differences, and at both ends the
+    acceleration from (and to) rest one step away against half the limit (see the module
+    docstring). Both ``<= 1``: the samples keep the limits."""
+    if len(t) < 2:
+        return 0.0, 0.0
+    h = np.diff(t)
+    vel = np.diff(q, axis=0) / h[:, None]
+    rv = float(np.max(np.abs(vel) / v_max))
+    ends = np.stack([np.abs(vel[0]) / h[0], np.abs(vel[-1]) / h[-1]]) / (0.5 * a_max)
+    ra = float(ends.max())
+    if len(vel) > 1:
+        acc = np.diff(vel, axis=0) / (0.5 * (h[1:] + h[:-1]))[:, None]
+        ra = max(ra, float(np.max(np.abs(acc) / a_max)))
+    return rv, ra
+
+
+#: Rounds of uniform slowing after the first sampling (each scales time by the ratio found).
+_SLOWDOWN_ROUNDS = 6
+
+
 def time_parameterize(
     waypoints: FloatArray,
     v_max: FloatArray,
@@ -134,18 +168,26 @@ def time_parameterize(
     grid_step: float = 0.02,
     safety: float = 0.95,
     max_grid: int = 150,
+    path_speed: FloatArray | None = None,
 ) -> TimedTrajectory:
     """A rest-to-rest trajectory through ``waypoints`` ``(N, n)`` [rad] within ``v_max``
     [rad/s] and ``a_max`` [rad/s^2] ``(n,)``, sampled every ``<= dt`` [s].
 
     The speed grid has a spacing of ``grid_step`` [rad] of path length, at most ``max_grid``
-    points."""
+    points. ``safety`` in (0, 1] scales the limits of the profile; the samples keep the
+    unscaled limits in any case (see the module docstring). ``path_speed`` ``(N,)``: a cap
+    on the path speed [rad/s of chord length] at each waypoint (``inf``: none); between two
+    waypoints the smaller of their caps applies."""
+    if not 0.0 < safety <= 1.0:
+        raise ParameterError(f"safety must lie in (0, 1], got {safety}")
     W = np.asarray(waypoints, dtype=np.float64)
     keep = np.concatenate([[True], np.linalg.norm(np.diff(W, axis=0), axis=1) > 1e-9])
     W = W[keep]
+    cap = None if path_speed is None else np.asarray(path_speed, dtype=np.float64)[keep]
     if len(W) < 2:
         return TimedTrajectory(np.zeros(1), W[:1].copy())
-    v, a = safety * np.asarray(v_max, dtype=np.float64), safety * np.asarray(a_max)
+    v_true, a_true = np.asarray(v_max, dtype=np.float64), np.asarray(a_max, dtype=np.float64)
+    v, a = safety * v_true, safety * a_true
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(W, axis=0), axis=1))])
     M = natural_spline(s, W)
     n_grid = int(np.clip(np.ceil(s[-1] / grid_step) + 1, 8, max_grid))
@@ -154,6 +196,8 @@ def time_parameterize(
     _, dq, ddq = spline_eval(s, W, M, sg)
     with np.errstate(divide="ignore"):
         xv = np.min(np.where(np.abs(dq) > 1e-12, (v / np.abs(dq)) ** 2, np.inf), axis=1)
+    if cap is not None:
+        xv = np.minimum(xv, _grid_cap(s, cap, sg) ** 2)
     a2 = np.concatenate([a, a])
     rows = [_accel_rows(dq[i], ddq[i], dq[i + 1], ddq[i + 1], ds) for i in range(n_grid - 1)]
     xmax = np.zeros(n_grid)
@@ -171,12 +215,28 @@ def time_parameterize(
     sq = np.sqrt(x)
     step = 2 * ds / np.maximum(sq[:-1] + sq[1:], 1e-12)
     tg = np.concatenate([[0.0], np.cumsum(step)])
-    T = float(tg[-1])
-    n_samples = max(1, int(np.ceil(T / dt)))
-    t = np.linspace(0.0, T, n_samples + 1).astype(np.float64)
-    k = np.clip(np.searchsorted(tg, t, side="right") - 1, 0, n_grid - 2)
-    tau = t - tg[k]
-    s_t = np.clip(sg[k] + sq[k] * tau + 0.5 * u[k] * tau * tau, 0.0, s[-1])
-    s_t[-1] = s[-1]
-    q, _, _ = spline_eval(s, W, M, s_t)
+    scale = 1.0
+    for _ in range(_SLOWDOWN_ROUNDS + 1):
+        T = scale * float(tg[-1])
+        n_samples = max(1, int(np.ceil(T / dt)))
+        t = np.linspace(0.0, T, n_samples + 1).astype(np.float64)
+        tp = t / scale  # the profile's own time
+        k = np.clip(np.searchsorted(tg, tp, side="right") - 1, 0, n_grid - 2)
+        tau = tp - tg[k]
+        s_t = np.clip(sg[k] + sq[k] * tau + 0.5 * u[k] * tau * tau, 0.0, s[-1])
+        s_t[-1] = s[-1]
+        q, _, _ = spline_eval(s, W, M, s_t)
+        rv, ra = sample_limit_ratio(t, q, v_true, a_true)
+        worst = max(rv, float(np.sqrt(ra)))
+        if worst <= 1.0:
+            break
+        scale *= worst * (1.0 + 1e-4)
     return TimedTrajectory(t, q)
+
+
+def _grid_cap(s: FloatArray, cap: FloatArray, sg: FloatArray) -> FloatArray:
+    """Per grid point ``sg``: the smaller cap of the two waypoints around it."""
+    i = np.clip(np.searchsorted(s, sg, side="right") - 1, 0, len(s) - 2)
+    on = np.isclose(sg, s[i + 1])
+    return np.where(on, np.minimum(cap[i + 1], cap[np.minimum(i + 2, len(s) - 1)]),
+                    np.minimum(cap[i], cap[i + 1]))  # fmt: skip

@@ -20,6 +20,9 @@ from sdar_tamp.world.transforms import BoolArray, FloatArray, pose_xyz_yaw
 #: Joint keys of ``joint_limits`` in the scene file, in joint order.
 JOINT_KEYS = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
 Vec6 = tuple[float, float, float, float, float, float]
+#: Default ``velocity_safety``: the full limits (the time parameterisation slows a profile
+#: whose samples would break them, so the validator's numerical tolerance suffices).
+DEFAULT_VELOCITY_SAFETY = 1.0
 
 
 def domain_path(name: str) -> Path:
@@ -111,6 +114,9 @@ class Scene:
     object_size: tuple[float, float, float]  # default cuboid lx, ly, lz [m]
     gripper: Gripper
     arms: tuple[ArmSpec, ...]
+    #: Fraction in (0, 1] of the velocity and acceleration limits a trajectory's time-optimal
+    #: profile may use (the sampled trajectory keeps the full limits in any case).
+    velocity_safety: float = DEFAULT_VELOCITY_SAFETY
 
     @property
     def arm_names(self) -> tuple[str, ...]:
@@ -147,7 +153,9 @@ def load_scene(path: Path | None = None) -> Scene:
     """Load a scene file (default: the shipped ``scene.yaml``)."""
     path = default_scene_path() if path is None else Path(path)
     root = read_yaml(path, SceneError)
-    keys = root.mapping(["robot", "table", "workspace", "object_size", "gripper", "arms"])
+    keys = root.mapping(
+        ["robot", "table", "workspace", "object_size", "gripper", "arms"], ["velocity_safety"]
+    )
     robot = path.parent / keys["robot"].as_str()
     if not robot.is_file():
         raise keys["robot"].error("a robot description file next to the scene file")
@@ -170,7 +178,14 @@ def load_scene(path: Path | None = None) -> Scene:
     arms = tuple(_arm(node) for node in arm_nodes)
     if arms[0].name == arms[1].name:
         raise arm_nodes[1].mapping(_ARM_KEYS)["name"].error("a name different from arms[0].name")
-    return Scene(str(path), robot, table, workspace, size, gripper, arms)  # type: ignore[arg-type]
+    safety = DEFAULT_VELOCITY_SAFETY
+    if "velocity_safety" in keys:
+        node = keys["velocity_safety"]
+        safety = node.as_float()
+        if not 0.0 < safety <= 1.0:
+            raise node.error("a number in (0, 1], the share of the joint limits a motion uses")
+    return Scene(str(path), robot, table, workspace, size, gripper, arms,  # type: ignore[arg-type]
+                 safety)  # fmt: skip
 
 
 _ARM_KEYS = ["name", "base", "joint_limits", "velocity_limit", "acceleration_limit", "home"]

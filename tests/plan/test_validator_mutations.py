@@ -46,6 +46,7 @@ from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, solve_ik_candidates
 from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
+from streams.shape import ShapeOptions
 from streams.validate import HeldObject
 
 INSTANCE = """name: D3
@@ -126,7 +127,14 @@ def base(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Base:
         MotionRequest(q_pick, q_place, {"o3": start["o3"]}, held, both, both),
         MotionRequest(q_place, h12, goal, retreat=both),
     ]
-    a, b, c = (plan_dual_motion(motion_planner, r) for r in requests)
+    # the carrying motion is not blended: it passes through rest at its lifted points, where
+    # the "drop" mutants pause; the others are blended (no stop at the pre-grasp points)
+    unblended = DualMotionPlanner(ctx, shape=ShapeOptions(blend=False))
+    a, b, c = (
+        plan_dual_motion(p, r)
+        for p, r in zip((motion_planner, unblended, motion_planner), requests, strict=True)
+    )
+    assert a.blended and c.blended and not b.blended
     items: list[MotionSegment | GripperEvent] = [
         _segment(a, "pick"),
         *(GripperEvent(arm, "grasp", name, T_tcp_obj[arm]) for arm, name in ARMS.items()),

@@ -8,6 +8,7 @@ import pytest
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from streams import trajopt
+from streams.cartesian import tool_pose_ik
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
@@ -20,6 +21,7 @@ from streams.motion import (
     default_strategies,
     plan_dual_motion,
 )
+from streams.shape import ShapeOptions, straight_end_deviation
 from streams.timing import spline_curve
 from streams.trajopt import OptimiserCache, TrajOptOptions, TransferQuery, straight_line
 from streams.validate import configure_world, validate_trajectory
@@ -254,3 +256,61 @@ def test_optimisers_are_built_once_per_scene_and_options(
     broken = cache.get(ctx, TrajOptOptions(knots=3))
     with pytest.raises(ParameterError, match="no NLP with 3 knots"):
         broken.get()
+
+
+def test_blended_pick_motion_is_valid_and_ends_straight(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    names = list(objects)
+    q_goal = _pick_goal(ctx, objects, names[0], names[5])
+    request = MotionRequest(_home12(ctx), q_goal, objects, approach=(True, True))
+    result = plan_dual_motion(planner, request)
+    assert result.success and result.blended and result.trajectory is not None
+    traj = result.trajectory
+    _check(ctx, traj.t, traj.q, request)
+    unblended = DualMotionPlanner(ctx, shape=ShapeOptions(blend=False))
+    slow = plan_dual_motion(unblended, request)
+    assert slow.success and not slow.blended and slow.trajectory is not None
+    assert traj.duration < slow.trajectory.duration  # no stop at the pre-grasp points
+    # one rest-to-rest piece: the robot is at rest only at its two ends
+    speed = np.abs(np.diff(traj.q, axis=0)).max(axis=1) / np.diff(traj.t)
+    assert speed[1:-1].min() > 1e-3
+    straight = planner.shape.straight
+    for arm in ctx.arm_names:
+        kin, sl = ctx.kinematics[arm], ctx.layout.slice(arm)
+        lateral, angle = straight_end_deviation(kin, traj.q[::-1, sl], q_goal[sl], straight)
+        assert lateral <= 0.002 and angle <= np.radians(2.0)
+        # TCP speed on the final straight centimetres within the shape's grasp speed
+        p = np.stack([kin.fk_tcp(q)[:3, 3] for q in traj.q[:, sl]])
+        near = np.linalg.norm(p[1:] - p[-1], axis=1) < straight - 1e-3
+        v = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(traj.t)
+        assert v[near].max() <= planner.shape.grasp_speed * 1.05
+        # a mutant that cuts the final straight approach: in from the side (3 cm along the
+        # tool's x axis, 3 cm back), straight in joint space, is caught by the check
+        T = kin.fk_tcp(q_goal[sl])
+        T[:3, 3] += 0.03 * T[:3, 0] - 0.03 * T[:3, 2]
+        q_side = tool_pose_ik(kin, T, q_goal[sl])
+        assert q_side is not None
+        mutant = np.linspace(q_side, q_goal[sl], 30)
+        bad_lateral, bad_angle = straight_end_deviation(kin, mutant[::-1], q_goal[sl], straight)
+        assert bad_lateral > 0.002 or bad_angle > np.radians(2.0)
+
+
+def test_lift_follows_clearance(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    names = list(objects)
+    q_goal = _pick_goal(ctx, objects, names[0], names[5])
+    request = MotionRequest(_home12(ctx), q_goal, objects, approach=(True, True))
+    _, down = planner.lifts(request)
+    # a tall object next to the left arm's grasp raises its lift (and only its)
+    kin, sl = ctx.kinematics["left"], ctx.layout.slice("left")
+    x, y = kin.fk_tcp(q_goal[sl])[:2, 3]
+    tall = ObjectBox(objects[names[0]].T_world_obj.copy(), (0.04, 0.04, 0.14))
+    tall.T_world_obj[:3, 3] = [x, y + 0.07, 0.07]
+    _, raised = planner.lifts(MotionRequest(_home12(ctx), q_goal, {**objects, "tall": tall},
+                                            approach=(True, True)))  # fmt: skip
+    assert raised[0] == pytest.approx(min(0.14 + planner.shape.lift_margin - 0.008,
+                                          planner.shape.max_lift), abs=2e-3)  # fmt: skip
+    assert raised[0] > down[0] and raised[1] == down[1]
+    assert planner.lifts(request, 0.08) == ([0.08, 0.08], [0.08, 0.08])

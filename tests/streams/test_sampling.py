@@ -31,8 +31,9 @@ needs_ompl = pytest.mark.skipif(not sampling.ompl_available(), reason="OMPL not 
 
 
 def _blocked(objects: dict[str, ObjectBox]) -> MotionRequest:
+    # the fixed 8 cm lift the blocked configurations were found with
     return MotionRequest(BLOCKED_START, BLOCKED_GOAL, objects, retreat=(True, True),
-                         approach=(True, True))  # fmt: skip
+                         approach=(True, True), lift=0.08)  # fmt: skip
 
 
 @needs_ompl

@@ -1,7 +1,14 @@
 import numpy as np
 import pytest
 
-from streams.timing import natural_spline, spline_curve, spline_eval, time_parameterize
+from sdar_tamp.errors import ParameterError
+from streams.timing import (
+    natural_spline,
+    sample_limit_ratio,
+    spline_curve,
+    spline_eval,
+    time_parameterize,
+)
 
 V = np.full(12, np.pi)
 A = np.full(12, 5.0)
@@ -64,3 +71,41 @@ def test_spline_curve_is_the_path_the_parameterisation_follows() -> None:
     # every timed sample lies on the curve
     dist = np.linalg.norm(traj.q[:, None] - curve[None], axis=2).min(axis=1)
     assert dist.max() < 0.03
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_full_limits_keep_every_sample_within_them(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    W = np.cumsum(rng.normal(0.0, 0.2, (8, 12)), axis=0)
+    fast = time_parameterize(W, V, A, safety=1.0)
+    rv, ra = sample_limit_ratio(fast.t, fast.q, V, A)
+    assert rv <= 1.0 and ra <= 1.0  # interval velocities, second differences, ends from rest
+    assert fast.duration < time_parameterize(W, V, A, safety=0.95).duration
+
+
+def test_coarse_profile_is_slowed_until_the_samples_keep_the_limits() -> None:
+    rng = np.random.default_rng(4)
+    W = np.cumsum(rng.normal(0.0, 0.3, (6, 12)), axis=0)
+    # a grid far too coarse for the curve: the profile alone would break the limits
+    traj = time_parameterize(W, V, A, safety=1.0, grid_step=1.0, max_grid=8)
+    rv, ra = sample_limit_ratio(traj.t, traj.q, V, A)
+    assert rv <= 1.0 and ra <= 1.0
+
+
+@pytest.mark.parametrize("safety", [0.0, -0.1, 1.2, float("nan")])
+def test_safety_out_of_range(safety: float) -> None:
+    with pytest.raises(ParameterError, match=r"safety must lie in \(0, 1\]"):
+        time_parameterize(np.stack([np.zeros(12), np.ones(12)]), V, A, safety=safety)
+
+
+def test_path_speed_cap_slows_the_capped_part_only() -> None:
+    W = np.zeros((5, 12))
+    W[:, 0] = np.linspace(0.0, 2.0, 5)
+    free = time_parameterize(W, V, A, safety=1.0)
+    cap = np.array([0.2, 0.2, np.inf, np.inf, np.inf])  # [rad/s] on the first half rad
+    capped = time_parameterize(W, V, A, safety=1.0, path_speed=cap)
+    assert capped.duration > free.duration
+    vel = np.diff(capped.q[:, 0]) / np.diff(capped.t)
+    first = capped.q[1:, 0] <= 0.5
+    assert np.abs(vel[first]).max() <= 0.2 * 1.01
+    assert np.abs(vel).max() > 1.0  # the rest is not capped
