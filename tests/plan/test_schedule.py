@@ -50,9 +50,10 @@ def _solve(ctx: WorldContext, planner: DualMotionPlanner, instance: Instance) ->
 
 
 @pytest.fixture(scope="module")
-def r4(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
-    """Four objects of the paper suite: the arms' motions differ in length."""
-    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "R4.yaml"))
+def uneven(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
+    """Four objects of the paper suite (one through a buffer): the arms' motions differ in
+    length, so running each arm on its own timeline saves time."""
+    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "D4.yaml"))
 
 
 @pytest.fixture(scope="module")
@@ -73,36 +74,36 @@ def _dwell_overlaps(plan: PlanFile) -> int:
 
 
 # -- the schedule -----------------------------------------------------------------------------
-def test_an_async_plan_validates_and_is_shorter(r4: Solved, tmp_path: Path) -> None:
-    s = schedule_async(r4.plan, r4.instance, r4.ctx.scene)
+def test_an_async_plan_validates_and_is_shorter(uneven: Solved, tmp_path: Path) -> None:
+    s = schedule_async(uneven.plan, uneven.instance, uneven.ctx.scene)
     assert s.asynchronous, s.reason
     assert s.async_duration is not None and s.async_duration < s.sync_duration
     assert s.plan.duration == pytest.approx(s.async_duration)
     assert s.plan.metrics["execution"] == "async"
     assert s.plan.metrics["execution_time"] == pytest.approx(s.plan.duration)
     assert _dwell_overlaps(s.plan) >= 1  # one arm moves while the other's gripper acts
-    assert _dwell_overlaps(r4.plan) == 0
+    assert _dwell_overlaps(uneven.plan) == 0
     # the same events per object, in the same order per object
-    for name in r4.instance.names:
-        sync = [(e.arm, e.type) for e in r4.plan.events if e.object == name]
+    for name in uneven.instance.names:
+        sync = [(e.arm, e.type) for e in uneven.plan.events if e.object == name]
         assert [(e.arm, e.type) for e in s.plan.events if e.object == name] == sync
-    report = validate_plan(r4.instance, s.plan, r4.ctx.scene)
+    report = validate_plan(uneven.instance, s.plan, uneven.ctx.scene)
     assert report.ok, report.violation
     path = save_plan(s.plan, tmp_path / "async.json")  # the file format round trip
-    assert validate_plan(r4.instance, load_plan(path), r4.ctx.scene).ok
+    assert validate_plan(uneven.instance, load_plan(path), uneven.ctx.scene).ok
 
 
-def test_the_synchronous_pace_and_every_ordering_validate(r4: Solved) -> None:
+def test_the_synchronous_pace_and_every_ordering_validate(uneven: Solved) -> None:
     for options in (
         ScheduleOptions(retime=False),
         ScheduleOptions(orders=("events",)),
         ScheduleOptions(orders=("objects",)),
     ):
-        s = schedule_async(r4.plan, r4.instance, r4.ctx.scene, options)
-        assert s.plan.duration <= r4.plan.duration
+        s = schedule_async(uneven.plan, uneven.instance, uneven.ctx.scene, options)
+        assert s.plan.duration <= uneven.plan.duration
         if s.asynchronous:
             assert s.order in options.orders
-            report = validate_plan(r4.instance, s.plan, r4.ctx.scene)
+            report = validate_plan(uneven.instance, s.plan, uneven.ctx.scene)
             assert report.ok, (options, report.violation)
 
 
@@ -133,8 +134,8 @@ def test_without_the_separation_the_validator_rejects_the_schedule(swap: Solved)
     assert "left" in names and "right" in names  # the two arms (or what they hold) touch
 
 
-def test_a_per_arm_dwell_violation_is_rejected(r4: Solved) -> None:
-    plan = schedule_async(r4.plan, r4.instance, r4.ctx.scene).plan
+def test_a_per_arm_dwell_violation_is_rejected(uneven: Solved) -> None:
+    plan = schedule_async(uneven.plan, uneven.instance, uneven.ctx.scene).plan
     e = next(
         e
         for e in plan.events
@@ -153,10 +154,10 @@ def test_a_per_arm_dwell_violation_is_rejected(r4: Solved) -> None:
     q = np.array(plan.q)
     bump = 1e-4 * np.sin(np.linspace(0.0, np.pi, 26)) ** 2
     q[k : k + 26, mine.start] += bump  # the arm of the event moves during its dwell
-    report = validate_plan(r4.instance, dataclasses.replace(plan, q=q), r4.ctx.scene)
+    report = validate_plan(uneven.instance, dataclasses.replace(plan, q=q), uneven.ctx.scene)
     assert not report.ok and report.violation is not None
     assert report.violation.kind == "dwell" and e.arm in report.violation.message
-    assert validate_plan(r4.instance, plan, r4.ctx.scene).ok  # the other arm moving is fine
+    assert validate_plan(uneven.instance, plan, uneven.ctx.scene).ok  # the other arm moving is fine
 
 
 # -- the parts --------------------------------------------------------------------------------
