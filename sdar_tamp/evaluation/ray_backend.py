@@ -12,8 +12,10 @@ backend starts; this module is its typed adapter (Ray is used as an untyped modu
 - Each task is a generator: it reports that it started, then its answer. The hard limit
   counts from the start, like the process backend's, and an overrunning task is cancelled
   with ``ray.cancel(force=True)`` (its worker process is killed).
-- A task whose node died is reported as ``external`` (not the run's fault: a rerun runs it);
-  every other Ray error is a failure of that run.
+- A task whose node died, or that failed before it started, is reported as ``external`` (not
+  the run's fault: a rerun runs it); every other Ray error is a failure of that run. A task
+  that cannot even be unpacked on its node (``sdar_tamp`` missing there) stops the sweep with
+  :class:`BackendError`: the cluster needs fixing, not thousands of error rows.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import importlib
 import logging
 import math
 import os
+import re
 import signal
 import socket
 import threading
@@ -44,6 +47,7 @@ log = logging.getLogger(__name__)
 
 PROBE_TIMEOUT = 5.0  # [s] to open a TCP connection to the cluster's address
 _EXTERNAL_ERRORS = ("NodeDiedError", "LocalRayletDiedError", "OwnerDiedError")
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 
 class BackendError(SdarError):
@@ -101,10 +105,25 @@ def _call(fn: Callable[[Any], Any], task: Any) -> Iterator[tuple[str, Any]]:
         yield "ok", answer
 
 
+def describe(error: BaseException) -> str:
+    """``Name: first line`` of the innermost exception a Ray error wraps."""
+    inner = error
+    for _ in range(8):
+        cause = getattr(inner, "cause", None)
+        if not isinstance(cause, BaseException) and inner.args:
+            cause = inner.args[0]
+        if not isinstance(cause, BaseException) or cause is inner:
+            break
+        inner = cause
+    lines = _ANSI.sub("", str(inner)).strip().splitlines()
+    return f"{type(inner).__name__}: {lines[0]}" if lines else type(inner).__name__
+
+
 @dataclass
 class _Job(Generic[T]):
     task: T
     deadline: float  # [s] on the monotonic clock
+    started: bool = False
 
 
 class _Working:
@@ -160,7 +179,7 @@ class RayBackend(Generic[T, R]):
                 ray.init(address="local", num_cpus=self.workers, include_dashboard=False, **options)
             else:
                 ray.init(address=self.address, **options)
-        except (ConnectionError, RuntimeError, ValueError) as error:
+        except Exception as error:  # Ray raises many kinds here; all mean "no cluster"
             where = self.address or "a local Ray"
             raise BackendError(f"cannot start Ray on {where}: {error}") from None
         finally:
@@ -236,11 +255,16 @@ class RayBackend(Generic[T, R]):
             except StopIteration:
                 return WorkerFailure("the Ray task ended without an answer")
             except ray.exceptions.RayError as error:
-                name = type(error).__name__
-                text = str(error).strip().splitlines()
-                detail = f"{name}: {text[0]}" if text else name
-                return WorkerFailure(f"Ray task failed: {detail}", name in _EXTERNAL_ERRORS)
+                if not job.started and isinstance(error, ray.exceptions.RayTaskError):
+                    raise BackendError(
+                        f"a Ray task could not start on its node ({describe(error)}); every "
+                        "node needs the same sdar-tamp and ray versions as this machine "
+                        "(pip install 'sdar-tamp[cluster]')"
+                    ) from None
+                external = not job.started or type(error).__name__ in _EXTERNAL_ERRORS
+                return WorkerFailure(f"Ray task failed: {describe(error)}", external)
             if kind == "started":
+                job.started = True
                 job.deadline = self._deadline()
                 continue
             if kind == "ok":

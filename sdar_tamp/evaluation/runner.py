@@ -300,7 +300,6 @@ def run_bench(
     if isinstance(shard, str):
         shard = parse_shard(shard)
     entries = suite_entries(suite, instances, max_objects)
-    carried = {e.name: pack(e.path) for e in entries} if backend == "ray" else {}
     runs = open_backend(backend, _run_task, workers, hard_limit=hard_limit, address=address)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -316,12 +315,17 @@ def run_bench(
     )  # fmt: skip
     write_settings(out, reconcile(out, wanted, load_results(out)))
     done = finished_pairs(out)
-    tasks = [
-        _Task(e, c, time_limit, seed, carried.get(e.name))
+    pending = [
+        (e, c)
         for e in entries
         for c in chosen
         if (e.name, c.id) not in done and (shard is None or shard.takes(e.name, c.id))
     ]
+    carried: dict[str, InstanceFiles] = {}  # the instances as text, for Ray nodes
+    for e, _ in pending if backend == "ray" else []:
+        if e.name not in carried:
+            carried[e.name] = pack(e.path)
+    tasks = [_Task(e, c, time_limit, seed, carried.get(e.name)) for e, c in pending]
     if not tasks:
         return out / RESULTS
     bar = tqdm(total=len(tasks), desc="bench", unit="run", file=sys.stderr, disable=not progress)

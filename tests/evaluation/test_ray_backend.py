@@ -150,3 +150,18 @@ def test_overrun_is_recorded_as_timeout_row(tmp_path: Path, local_ray: None) -> 
     assert "hard limit of 1 s: Ray task killed" in row["diagnosis"]
     assert not plan_path(tmp_path, "R4", "sdar").exists()
     assert ray.is_initialized()  # a Ray the caller started stays up
+
+
+def test_a_node_without_the_code_stops_the_sweep(
+    tmp_path: Path, local_ray: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The task's function cannot be unpacked on the node: one clear error, not error rows."""
+    (tmp_path / "only_on_the_driver.py").write_text("def run(task):\n    return task\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import only_on_the_driver  # type: ignore[import-not-found]
+
+    missing = r"\(ModuleNotFoundError: No module named 'only_on_the_driver'\)"
+    backend = RayBackend(only_on_the_driver.run, workers=1, hard_limit=60.0)
+    expected = f"could not start on its node {missing}; every node"
+    with pytest.raises(BackendError, match=expected), backend:
+        list(backend.run([1, 2]))
