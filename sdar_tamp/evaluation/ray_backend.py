@@ -11,7 +11,8 @@ backend starts; this module is its typed adapter (Ray is used as an untyped modu
 - At most ``workers`` tasks at once (default: the cluster's CPUs), one CPU each.
 - Each task is a generator: it reports that it started, then its answer. The hard limit
   counts from the start, like the process backend's, and an overrunning task is cancelled
-  with ``ray.cancel(force=True)`` (its worker process is killed).
+  with ``ray.cancel(force=True)`` (its worker process is killed). A task that has not started
+  after the hard limit (at least :data:`STARTUP_LIMIT`) is cancelled too, not recorded.
 - A task whose node died, or that failed before it started, is reported as ``external`` (not
   the run's fault: a rerun runs it); every other Ray error is a failure of that run. A task
   that cannot even be unpacked on its node (``sdar_tamp`` missing there) stops the sweep with
@@ -273,6 +274,9 @@ class RayBackend(Generic[T, R]):
             return WorkerFailure(str(value))
         if time.monotonic() > job.deadline:
             self._cancel(ray, gen)
+            if not job.started:  # queued all along (a busy or shrunk cluster): not its fault
+                waited = max(self.hard_limit or 0.0, STARTUP_LIMIT)
+                return WorkerFailure(f"the Ray task did not start within {waited:g} s", True)
             return WorkerFailure(
                 f"no answer within the hard limit of {self.hard_limit:g} s: Ray task killed",
                 timed_out=True,

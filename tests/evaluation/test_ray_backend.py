@@ -165,3 +165,22 @@ def test_a_node_without_the_code_stops_the_sweep(
     expected = f"could not start on its node {missing}; every node"
     with pytest.raises(BackendError, match=expected), backend:
         list(backend.run([1, 2]))
+
+
+def test_a_task_that_never_starts_is_not_recorded(
+    tmp_path: Path, local_ray: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """One CPU, two tasks at once: the second waits in Ray's queue past the limit, so it is
+    cancelled as not started (``external``: a rerun runs it), not as a timeout."""
+    import sdar_tamp.evaluation.ray_backend as ray_backend
+
+    monkeypatch.setattr(ray_backend, "STARTUP_LIMIT", 0.5)
+    files = [str(tmp_path / "first"), str(tmp_path / "second")]
+    with RayBackend(_stuck, workers=2, hard_limit=5.0, poll=0.1) as backend:  # 5 s to start
+        answers = dict(backend.run(files))
+    failures = [a for a in answers.values() if isinstance(a, WorkerFailure)]
+    assert len(failures) == 2
+    started = [a for a in failures if a.timed_out]
+    queued = [a for a in failures if a.external]
+    assert len(started) == 1 and not started[0].external
+    assert len(queued) == 1 and "did not start within 5 s" in queued[0].reason
