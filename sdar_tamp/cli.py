@@ -406,7 +406,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="all, or some of sdar,baseline,baseline-tp+sdar-m,sdar-t+baseline-mp,"
         "sdar-t+plain,baseline-tp+plain (default: all)",
     )
-    bench.add_argument("--workers", type=COUNT.parse, default=1, help="processes (default: 1)")
+    bench.add_argument(
+        "--workers",
+        type=COUNT.parse,
+        default=None,
+        help="runs at once (default: 1 process; with --backend ray, one per cluster CPU)",
+    )
     bench.add_argument(
         "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="s per run (default: 60)"
     )
@@ -421,6 +426,35 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="discard the runs already in --out (needed to change seed, time limit, workers "
         "or suite there; without it such a rerun is refused)",
+    )
+    bench.add_argument(
+        "--backend",
+        choices=("process", "ray"),
+        default="process",
+        help="process: worker processes here (default); ray: Ray tasks on a cluster, or on a "
+        "local Ray (pip install 'sdar-tamp[cluster]')",
+    )
+    bench.add_argument(
+        "--address",
+        default=None,
+        help="with --backend ray: the cluster's head, host:port (default: $RAY_ADDRESS, else "
+        "a local Ray)",
+    )
+    bench.add_argument(
+        "--shard",
+        default=None,
+        metavar="I/N",
+        help="run only shard I of N (1 <= I <= N) of the (instance, combination) pairs, for "
+        "batch schedulers; each shard into its own --out, joined with --merge",
+    )
+    bench.add_argument(
+        "--merge",
+        nargs="+",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="join the folders of finished shards into --out (a new folder) and write its "
+        "report; runs nothing, the other options are ignored",
     )
     bench.set_defaults(func=cmd_bench)
 

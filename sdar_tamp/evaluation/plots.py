@@ -96,9 +96,17 @@ def plot_action_ratio(rows: Sequence[Row], path: Path) -> Path:
     return _save(fig, path)
 
 
+#: Instances up to which the execution times are one bar per instance; beyond (a sweep), one
+#: box per family and combination.
+MAX_BARS = 60
+
+
 def plot_execution_times(rows: Sequence[Row], path: Path) -> Path:
-    """Execution time per instance and combination; a missing bar is a failure."""
+    """Execution time per instance and combination; a missing bar is a failure. Over
+    :data:`MAX_BARS` instances: the distribution per family and combination instead."""
     combos, names = combinations_in(rows), instances_in(rows)
+    if len(names) > MAX_BARS:
+        return _plot_execution_boxes(rows, len(names), path)
     fig = Figure(figsize=(max(8.0, 0.7 * len(names) + 2), 4.0))
     ax = fig.subplots()
     width = 0.8 / max(1, len(combos))
@@ -120,6 +128,47 @@ def plot_execution_times(rows: Sequence[Row], path: Path) -> Path:
     ax.set_ylabel("execution time [s]")
     ax.set_title("Execution time (missing bar: no valid plan)")
     ax.legend(fontsize="small", ncols=min(3, len(combos)))
+    return _save(fig, path)
+
+
+def _plot_execution_boxes(rows: Sequence[Row], instances: int, path: Path) -> Path:
+    """Execution times of the successful runs: one box per family and combination."""
+    combos = combinations_in(rows)
+    families = sorted({r["family"] for r in rows}, key=lambda f: instance_sort_key(f + "0"))
+    fig = Figure(figsize=(max(8.0, 0.5 * len(families) * len(combos) + 2), 4.0))
+    ax = fig.subplots()
+    width = 0.8 / max(1, len(combos))
+    handles, labels = [], []
+    for k, c in enumerate(combos):
+        found = [
+            (i, [t for r in rows if r["family"] == f and r["combination"] == c.id
+                 and succeeded(r) and (t := num(r, "execution_time_s")) is not None])
+            for i, f in enumerate(families)
+        ]  # fmt: skip
+        found = [(i, times) for i, times in found if times]
+        if not found:
+            continue
+        boxes = ax.boxplot(
+            [times for _, times in found],
+            positions=[i + (k - (len(combos) - 1) / 2) * width for i, _ in found],
+            widths=0.9 * width,
+            patch_artist=True,
+            showfliers=False,
+            manage_ticks=False,
+            medianprops={"color": "black"},
+        )
+        for box in boxes["boxes"]:
+            box.set_facecolor(f"C{k}")
+        handles.append(boxes["boxes"][0])
+        labels.append(c.label)
+    if not handles:
+        _empty(ax, "no successful run")
+        return _save(fig, path)
+    ax.set_xticks(range(len(families)), families)
+    ax.set_xlabel("family")
+    ax.set_ylabel("execution time [s]")
+    ax.set_title(f"Execution time of the successful runs ({instances} instances)")
+    ax.legend(handles, labels, fontsize="small", ncols=min(3, len(combos)))
     return _save(fig, path)
 
 

@@ -103,16 +103,20 @@ class ActionCounts:
 
 def action_counts(rows: Sequence[Row]) -> list[ActionCounts]:
     pairs = by_pair(rows)
+    first: dict[tuple[str, str], Row] = {}  # (task planner, instance) -> its first counted row
+    for r in rows:
+        if r["abstract_actions"]:
+            first.setdefault((r["task_planner"], r["instance"]), r)
 
     def abstract(planner: str, name: str) -> tuple[int, int, int] | None:
-        for r in rows:
-            if r["instance"] == name and r["task_planner"] == planner and r["abstract_actions"]:
-                return (
-                    int(r["abstract_actions"]),
-                    int(r["abstract_buffer_moves"]),
-                    int(r["abstract_steps"]),
-                )
-        return None
+        r = first.get((planner, name))
+        if r is None:
+            return None
+        return (
+            int(r["abstract_actions"]),
+            int(r["abstract_buffer_moves"]),
+            int(r["abstract_steps"]),
+        )
 
     def real(name: str, combo: str) -> int | None:
         r = pairs.get((name, combo))

@@ -22,6 +22,7 @@ Row = dict[str, str]
 
 RESULTS = "results.csv"
 STEPS = "steps.csv"
+PLANS = "plans"
 COLUMNS = (
     "instance", "family", "objects", "combination", "task_planner", "motion_planner", "seed",
     "time_limit_s", "success", "status", "valid", "actions", "steps", "dual_arm_steps",
@@ -120,6 +121,11 @@ def read_rows(path: Path, columns: Sequence[str]) -> list[dict[str, str]]:
             f"{path}: unexpected columns (written by another version?); use a new folder"
         )
     return [dict(zip(columns, r, strict=True)) for r in reader if len(r) == len(columns)]
+
+
+def plan_path(out_dir: Path, instance: str, combination: str) -> Path:
+    """Where a benchmark folder keeps the plan file of a run."""
+    return Path(out_dir) / PLANS / f"{instance}__{combination}.json"
 
 
 def load_results(out_dir: Path) -> list[dict[str, str]]:

@@ -8,14 +8,22 @@ Output folder:
   pair again).
 - ``steps.csv``: planning time [s] of every synchronous step of every solved run, split into
   plan selection (IK, grasps, buffers, ranking) and motion generation (:data:`STEP_COLUMNS`).
-- ``settings.json``: what the rows depend on (seed, time limit, workers, suite, instance file
-  hashes, version; :mod:`sdar_tamp.evaluation.settings`). A rerun with other settings is
-  refused instead of mixing their rows; ``restart=True`` discards the old rows.
+- ``plans/INSTANCE__COMBINATION.json``: the plan file of every run that produced a plan
+  (:mod:`sdar_tamp.plan_file`; ``sdar validate`` and ``sdar show`` read it), written before
+  its row.
+- ``settings.json``: what the rows depend on (seed, time limit, workers, backend, shard,
+  suite, instance file hashes, version; :mod:`sdar_tamp.evaluation.settings`). A rerun with
+  other settings is refused instead of mixing their rows; ``restart=True`` discards the old
+  rows.
 
-Each run is solved in a worker process (:class:`~sdar_tamp.evaluation.workers.WorkerPool`):
-a run that overruns a hard limit (by default ``2 * time_limit + 120`` s: set-up, abstract run
-and replay come on top of the time limit) or whose worker crashes is recorded as an ``error``
-row, and no worker outlives the benchmark, even if it is killed.
+Each run is solved by a backend (:mod:`sdar_tamp.evaluation.backends`): a worker process on
+this machine (:class:`~sdar_tamp.evaluation.workers.WorkerPool`), or a Ray task on a cluster
+(:mod:`sdar_tamp.evaluation.ray_backend`) that carries the instance as text
+(:mod:`sdar_tamp.evaluation.payload`). Only this process writes the folder. A run that
+overruns a hard limit (by default ``2 * time_limit + 120`` s: set-up, abstract run and replay
+come on top of the time limit) is killed and recorded as a ``timeout`` row, one whose worker
+crashes as an ``error`` row, and no worker outlives the benchmark, even if it is killed.
+``shard`` (:mod:`sdar_tamp.evaluation.shards`) keeps one of N disjoint parts of the pairs.
 
 A run succeeds when it is solved *and* its plan passes the independent replay. Each row also
 holds the task planner's geometry-free action count (:mod:`sdar_tamp.app.abstract`), which
@@ -32,6 +40,7 @@ import functools
 import logging
 import re
 import shlex
+import shutil
 import signal
 import sys
 import threading
@@ -45,9 +54,12 @@ from typing import TYPE_CHECKING, Any
 from sdar_tamp import __version__
 from sdar_tamp.arguments import COUNT, SEED, TIME_LIMIT
 from sdar_tamp.errors import ParameterError, SdarError
+from sdar_tamp.evaluation.backends import check_backend, open_backend
+from sdar_tamp.evaluation.payload import InstanceFiles, pack, unpack
 from sdar_tamp.evaluation.results import (
     COLUMNS,
     COMBINATIONS,
+    PLANS,
     RESULTS,
     STEP_COLUMNS,
     STEPS,
@@ -56,6 +68,7 @@ from sdar_tamp.evaluation.results import (
     instance_sort_key,
     load_results,
     parse_combos,
+    plan_path,
     read_rows,
 )
 from sdar_tamp.evaluation.settings import (
@@ -66,11 +79,13 @@ from sdar_tamp.evaluation.settings import (
     reconcile,
     write_settings,
 )
-from sdar_tamp.evaluation.workers import WorkerFailure, WorkerPool
+from sdar_tamp.evaluation.shards import Shard, parse_shard
+from sdar_tamp.evaluation.workers import WorkerFailure
 from sdar_tamp.textfile import read_text
 
 if TYPE_CHECKING:
     from sdar_tamp.app.cache import PlannerCache
+    from sdar_tamp.plan_file import PlanFile
 
 log = logging.getLogger(__name__)
 
@@ -135,6 +150,10 @@ class _Task:
     combo: Combination
     time_limit: float
     seed: int
+    files: InstanceFiles | None = None  # the instance as text, for a machine without the suite
+
+
+Answer = tuple[dict[str, Any], list[tuple[float, float]], "PlanFile | None"]
 
 
 @functools.cache
@@ -168,24 +187,25 @@ def _task_row(task: _Task) -> dict[str, Any]:
     )  # fmt: skip
 
 
-def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
-    """One solve in a worker process: the CSV row and the per-step planning times."""
+def _run_task(task: _Task) -> Answer:
+    """One solve in a worker: the CSV row, the per-step planning times and the plan."""
     from sdar_tamp.app.command import solve_instance
 
     e, c = task.entry, task.combo
+    path = e.path if task.files is None else unpack(task.files)
     row = _task_row(task)
-    row.update(_abstract_figures(e.path, c.task_planner))
+    row.update(_abstract_figures(path, c.task_planner))
     start = time.perf_counter()
     try:
         outcome = solve_instance(
-            e.path, time_limit=task.time_limit, seed=task.seed, task_planner=c.task_planner,
+            path, time_limit=task.time_limit, seed=task.seed, task_planner=c.task_planner,
             motion_planner=c.motion_planner, cache=_worker_cache(),
         )  # fmt: skip
     except Exception as error:  # one broken run is recorded as such, not the end of the bench
         log.exception("%s with %s raised", e.name, c.id)
         row.update(status="error", success=False, valid=False, diagnosis=repr(error))
         row["wall_time_s"] = time.perf_counter() - start
-        return row, []
+        return row, [], None
     f = outcome.figures
     row.update(
         status=outcome.status, success=outcome.success, valid=outcome.valid,
@@ -195,14 +215,14 @@ def _run_task(task: _Task) -> tuple[dict[str, Any], list[tuple[float, float]]]:
         wall_time_s=time.perf_counter() - start,
     )  # fmt: skip
     if outcome.plan is None:
-        return row, []
+        return row, [], None
     m = outcome.plan.metrics
     row.update(
         actions=m["actions"], steps=m["steps"], dual_arm_steps=m["dual_arm_steps"],
         execution_time_s=m["execution_time"], buffer_moves=f.buffer_moves,
         step_time_median_s=f.step_time_median,
     )  # fmt: skip
-    return row, [(step.selection, step.motion) for step in f.step_times]
+    return row, [(step.selection, step.motion) for step in f.step_times], outcome.plan
 
 
 def finished_pairs(out_dir: Path) -> set[tuple[str, str]]:
@@ -240,7 +260,7 @@ def run_bench(
     out_dir: str | Path,
     combos: str | Sequence[str] = "all",
     *,
-    workers: int = 1,
+    workers: int | None = None,
     time_limit: float = 60.0,
     instances: Sequence[str] | None = None,
     max_objects: int | None = None,
@@ -248,19 +268,28 @@ def run_bench(
     progress: bool = True,
     restart: bool = False,
     hard_limit: float | None = None,
+    backend: str = "process",
+    address: str | None = None,
+    shard: Shard | str | None = None,
 ) -> Path:
     """Solve every (instance, combination) of ``suite`` not yet in ``out_dir/results.csv``
-    with ``workers`` processes and ``time_limit`` [s] per run; returns the results file.
+    with ``time_limit`` [s] per run; returns the results file.
 
-    Rows already in the folder are reused only if they were made with the same settings
-    (:mod:`sdar_tamp.evaluation.settings`); otherwise :class:`SettingsMismatch` is raised
-    before anything runs, unless ``restart`` discards them first. ``hard_limit`` [s] (default
-    :func:`default_hard_limit`) bounds one run's worker. An exception (``KeyboardInterrupt``)
-    kills the workers and leaves every finished row in place."""
+    ``backend``: ``process`` (``workers`` processes here, default 1) or ``ray`` (at most
+    ``workers`` Ray tasks at once, default one per cluster CPU; ``address``: the cluster,
+    default ``$RAY_ADDRESS`` or a local Ray). ``shard`` (``"i/N"`` or a :class:`Shard`):
+    only the pairs of that shard. Rows already in the folder are reused only if they were
+    made with the same settings (:mod:`sdar_tamp.evaluation.settings`); otherwise
+    :class:`SettingsMismatch` is raised before anything runs, unless ``restart`` discards
+    them first. ``hard_limit`` [s] (default :func:`default_hard_limit`) bounds one run. An
+    exception (``KeyboardInterrupt``) kills the runs in progress and leaves every finished
+    row in place."""
     from tqdm import tqdm
 
     chosen = parse_combos(combos)
-    workers = COUNT.check("workers", workers)
+    backend = check_backend(backend, address)
+    if workers is not None:
+        workers = COUNT.check("workers", workers)
     time_limit = TIME_LIMIT.check("time_limit", time_limit)
     seed = SEED.check("seed", seed)
     if max_objects is not None:
@@ -268,43 +297,44 @@ def run_bench(
     if hard_limit is None:
         hard_limit = default_hard_limit(time_limit)
     hard_limit = TIME_LIMIT.check("hard_limit", hard_limit)
+    if isinstance(shard, str):
+        shard = parse_shard(shard)
     entries = suite_entries(suite, instances, max_objects)
+    runs = open_backend(backend, _run_task, workers, hard_limit=hard_limit, address=address)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if restart:
         for name in (RESULTS, STEPS, SETTINGS):
             (out / name).unlink(missing_ok=True)
+        shutil.rmtree(out / PLANS, ignore_errors=True)
+    recorded_workers = workers if workers is not None else (1 if backend == "process" else 0)
     wanted = BenchSettings(
         version=__version__, suite=suite_label(suite), seed=seed, time_limit_s=time_limit,
-        workers=workers, instances={e.name: file_digest(e.path) for e in entries},
+        workers=recorded_workers, instances={e.name: file_digest(e.path) for e in entries},
+        backend=backend, shard=str(shard) if shard is not None else "",
     )  # fmt: skip
     write_settings(out, reconcile(out, wanted, load_results(out)))
     done = finished_pairs(out)
-    tasks = [
-        _Task(e, c, time_limit, seed) for e in entries for c in chosen if (e.name, c.id) not in done
+    pending = [
+        (e, c)
+        for e in entries
+        for c in chosen
+        if (e.name, c.id) not in done and (shard is None or shard.takes(e.name, c.id))
     ]
+    carried: dict[str, InstanceFiles] = {}  # the instances as text, for Ray nodes
+    for e, _ in pending if backend == "ray" else []:
+        if e.name not in carried:
+            carried[e.name] = pack(e.path)
+    tasks = [_Task(e, c, time_limit, seed, carried.get(e.name)) for e, c in pending]
     if not tasks:
         return out / RESULTS
     bar = tqdm(total=len(tasks), desc="bench", unit="run", file=sys.stderr, disable=not progress)
-    pool = WorkerPool(_run_task, min(workers, len(tasks)), hard_limit=hard_limit)
     try:
-        with pool:
-            for task, answer in pool.run(tasks):
-                steps: list[tuple[float, float]]
-                if isinstance(answer, WorkerFailure):
-                    failed = _failed_row(task, answer)
-                    if failed is None:
-                        continue
-                    row, steps = failed, []
-                else:
-                    row, steps = answer
-                step_rows = [
-                    dict(instance=row["instance"], combination=row["combination"], step=i,
-                         selection_s=s, motion_s=m)
-                    for i, (s, m) in enumerate(steps)
-                ]  # fmt: skip
-                append_rows(out / STEPS, STEP_COLUMNS, step_rows)  # first: see finished_pairs
-                append_rows(out / RESULTS, COLUMNS, [row])
+        with runs:
+            for task, answer in runs.run(tasks):
+                row = _record(out, task, answer)
+                if row is None:
+                    continue
                 bar.set_postfix_str(f"{row['instance']} {row['combination']}: {row['status']}")
                 bar.update(1)
     finally:
@@ -312,16 +342,42 @@ def run_bench(
     return out / RESULTS
 
 
+def _record(out: Path, task: _Task, answer: Answer | WorkerFailure) -> dict[str, Any] | None:
+    """Write a run's plan, steps and row (in this order: see :func:`finished_pairs`); returns
+    the row, ``None`` for a run not to record."""
+    steps: list[tuple[float, float]] = []
+    if isinstance(answer, WorkerFailure):
+        row = _failed_row(task, answer)
+        if row is None:
+            return None
+    else:
+        row, steps, plan = answer
+        if plan is not None:
+            from sdar_tamp.plan_file import save_plan
+
+            save_plan(plan, plan_path(out, row["instance"], row["combination"]))
+    step_rows = [
+        dict(instance=row["instance"], combination=row["combination"], step=i, selection_s=s,
+             motion_s=m)
+        for i, (s, m) in enumerate(steps)
+    ]  # fmt: skip
+    append_rows(out / STEPS, STEP_COLUMNS, step_rows)
+    append_rows(out / RESULTS, COLUMNS, [row])
+    return row
+
+
 def _failed_row(task: _Task, failure: WorkerFailure) -> dict[str, Any] | None:
-    """The ``error`` row of a run without an answer; ``None`` (no row: a rerun runs it again)
-    when its worker was terminated from outside."""
+    """The row of a run without an answer: ``timeout`` when it overran the hard limit, else
+    ``error``; ``None`` (no row: a rerun runs it again) when its worker was terminated from
+    outside."""
     name = f"{task.entry.name} with {task.combo.id}"
     if failure.external:
         log.warning("%s not recorded: %s", name, failure.reason)
         return None
     log.error("%s: %s", name, failure.reason)
     row = _task_row(task)
-    row.update(status="error", success=False, valid=False, diagnosis=failure.reason)
+    status = "timeout" if failure.timed_out else "error"
+    row.update(status=status, success=False, valid=False, diagnosis=failure.reason)
     return row
 
 
@@ -330,7 +386,10 @@ def bench_commands(
     suite_names: Iterable[str],
 ) -> list[str]:  # fmt: skip
     """The ``sdar bench`` commands that made ``rows`` under ``settings`` (rerun: resumes, then
-    redraws): one per group of instances run with the same combinations."""
+    redraws): one per group of instances run with the same combinations; for a shard, one
+    command (a shard holds some combinations of each instance)."""
+    if settings.shard:
+        return [_shard_command(out, settings, rows, suite_names)]
     by_instance: dict[str, set[str]] = {}
     objects: dict[str, int] = {}
     for r in rows:
@@ -339,22 +398,44 @@ def bench_commands(
     groups: dict[frozenset[str], list[str]] = {}
     for name in sorted(by_instance, key=lambda n: (objects[n], instance_sort_key(n))):
         groups.setdefault(frozenset(by_instance[name]), []).append(name)
-    base = (
-        f"sdar bench --suite {shlex.quote(settings.suite)} --out {shlex.quote(str(out))}",
-        f"--workers {settings.workers} --time-limit {_number(settings.time_limit_s)} "
-        f"--seed {settings.seed}",
-    )
+    base = _base_command(out, settings)
     everything = set(suite_names)
     commands = []
     for combos, names in groups.items():
-        ids = [c.id for c in COMBINATIONS if c.id in combos]
-        ids += sorted(combos - set(ids))  # ids of another version, kept as they are
-        combo_arg = "all" if ids == [c.id for c in COMBINATIONS] else ",".join(ids)
-        command = f"{base[0]} --combos {shlex.quote(combo_arg)} {base[1]}"
+        command = f"{base[0]} --combos {shlex.quote(_combo_arg(set(combos)))} {base[1]}"
         if len(groups) > 1 or set(names) != everything:
             command += f" --only {shlex.quote(','.join(names))}"
         commands.append(command)
     return commands
+
+
+def _base_command(out: str | Path, settings: BenchSettings) -> tuple[str, str]:
+    workers = f"--workers {settings.workers} " if settings.workers else ""
+    where = " --backend ray" if settings.backend == "ray" else ""
+    where += f" --shard {settings.shard}" if settings.shard else ""
+    return (
+        f"sdar bench --suite {shlex.quote(settings.suite)} --out {shlex.quote(str(out))}",
+        f"{workers}--time-limit {_number(settings.time_limit_s)} --seed {settings.seed}{where}",
+    )
+
+
+def _combo_arg(combos: set[str]) -> str:
+    ids = [c.id for c in COMBINATIONS if c.id in combos]
+    ids += sorted(combos - set(ids))  # ids of another version, kept as they are
+    return "all" if ids == [c.id for c in COMBINATIONS] else ",".join(ids)
+
+
+def _shard_command(
+    out: str | Path, settings: BenchSettings, rows: Sequence[Mapping[str, str]],
+    suite_names: Iterable[str],
+) -> str:  # fmt: skip
+    head, tail = _base_command(out, settings)
+    command = f"{head} --combos {shlex.quote(_combo_arg({r['combination'] for r in rows}))} {tail}"
+    selected = set(settings.instances)
+    if selected != set(suite_names):
+        names = sorted(selected, key=instance_sort_key)
+        command += f" --only {shlex.quote(','.join(names))}"
+    return command
 
 
 def _number(value: float) -> str:
@@ -408,28 +489,48 @@ def bench_command(args: argparse.Namespace) -> int:
 
 
 def _bench(args: argparse.Namespace) -> int:
+    merge: Sequence[Path] | None = args.merge
+    if merge:
+        from sdar_tamp.evaluation.merge import merge_folders
+
+        results = merge_folders(merge, args.out)
+    else:
+        only = [s.strip() for s in args.only.split(",") if s.strip()] if args.only else None
+        results = run_bench(
+            args.suite, args.out, args.combos, workers=args.workers, time_limit=args.time_limit,
+            instances=only, max_objects=args.max_objects, seed=args.seed,
+            progress=not args.quiet, restart=args.restart,
+            backend=args.backend, address=args.address, shard=args.shard,
+        )  # fmt: skip
+    print(f"results: {results}")
+    return _redraw(results.parent, args.out)
+
+
+def _suite_names(settings: BenchSettings) -> list[str]:
+    """The instance names of the recorded suite; those of the record when the suite is not
+    on this machine (a merged folder of a sweep made elsewhere)."""
+    try:
+        return [e.name for e in suite_entries(settings.suite)]
+    except SdarError:
+        return list(settings.instances)
+
+
+def _redraw(folder: Path, out: str | Path) -> int:
+    """Plots and report of a benchmark folder; prints the success table."""
     from sdar_tamp.evaluation.report import success_lines, write_report
 
-    only = [s.strip() for s in args.only.split(",") if s.strip()] if args.only else None
-    results = run_bench(
-        args.suite, args.out, args.combos, workers=args.workers, time_limit=args.time_limit,
-        instances=only, max_objects=args.max_objects, seed=args.seed, progress=not args.quiet,
-        restart=args.restart,
-    )  # fmt: skip
-    print(f"results: {results}")
     try:
         from sdar_tamp.evaluation.plots import write_plots
     except ImportError as error:  # matplotlib is an optional dependency (extra "viz")
         print(f"no plots: {error} (pip install 'sdar-tamp[viz]')", file=sys.stderr)
     else:
-        print(f"plots: {', '.join(p.name for p in write_plots(results.parent))}")
-    rows = load_results(results.parent)
-    settings = read_settings(results.parent)
+        print(f"plots: {', '.join(p.name for p in write_plots(folder))}")
+    rows = load_results(folder)
+    settings = read_settings(folder)
     commands: list[str] = []
     if settings is not None and rows:
-        names = [e.name for e in suite_entries(args.suite)]
-        commands = bench_commands(args.out, settings, rows, names)
+        commands = bench_commands(out, settings, rows, _suite_names(settings))
     version = settings.version if settings is not None else None
-    print(f"report: {write_report(results.parent, commands, version)}")
+    print(f"report: {write_report(folder, commands, version)}")
     print("\n".join(success_lines(rows)))
     return 0

@@ -2,14 +2,16 @@
 
 A row of ``results.csv`` is the outcome of one (instance, combination) pair *under* a seed, a
 time limit, a number of parallel workers (they share the cores, so planning times and even
-successes within the time limit depend on it), the instance file's content and the package
+successes within the time limit depend on it), the backend that ran it (local processes or
+Ray), the shard of the sweep the folder holds, the instance file's content and the package
 version. The first run writes these to ``settings.json``; a rerun reuses rows only when its
 own settings are the same, and otherwise stops with one line naming every difference (rather
 than silently mixing outcomes of different settings). Instances added by a later run are
 added to the record; an instance file whose content changed is a difference.
 
 A folder written before the record existed is checked against the seed and time limit its
-rows hold, then gets a record.
+rows hold, then gets a record. A record written before ``backend`` and ``shard`` existed
+reads as the process backend, unsharded.
 """
 
 from __future__ import annotations
@@ -37,6 +39,8 @@ class BenchSettings:
     """Everything a benchmark row depends on besides its (instance, combination) pair.
 
     ``suite``: a shipped suite name or the resolved path of a folder; ``time_limit_s`` [s];
+    ``workers``: runs at once (0: one per CPU of the Ray cluster); ``backend``: ``process``
+    or ``ray``; ``shard``: ``"i/N"`` for one shard of a sweep, ``""`` for all of it;
     ``instances``: instance name -> SHA-256 of its file."""
 
     version: str
@@ -45,12 +49,14 @@ class BenchSettings:
     time_limit_s: float
     workers: int
     instances: Mapping[str, str] = field(default_factory=dict)
+    backend: str = "process"
+    shard: str = ""
 
     def to_json(self) -> dict[str, Any]:
         return dict(
             format=FORMAT, version=self.version, suite=self.suite, seed=self.seed,
-            time_limit_s=self.time_limit_s, workers=self.workers,
-            instances=dict(sorted(self.instances.items())),
+            time_limit_s=self.time_limit_s, workers=self.workers, backend=self.backend,
+            shard=self.shard, instances=dict(sorted(self.instances.items())),
         )  # fmt: skip
 
 
@@ -73,6 +79,7 @@ def read_settings(out_dir: Path) -> BenchSettings | None:
             version=str(data["version"]), suite=str(data["suite"]), seed=int(data["seed"]),
             time_limit_s=float(data["time_limit_s"]), workers=int(data["workers"]),
             instances={str(k): str(v) for k, v in dict(data["instances"]).items()},
+            backend=str(data.get("backend", "process")), shard=str(data.get("shard", "")),
         )  # fmt: skip
     except (ValueError, KeyError, TypeError, AttributeError) as error:
         raise SdarError(
@@ -94,14 +101,27 @@ def _limit(value: float) -> str:
     return f"{value:g} s"
 
 
-def _differences(old: BenchSettings, new: BenchSettings) -> list[str]:
+def _workers(value: int) -> str:
+    return str(value) if value else "one per cluster CPU"
+
+
+def _shard(value: str) -> str:
+    return value or "none"
+
+
+def differences(old: BenchSettings, new: BenchSettings, *, shard: bool = True) -> list[str]:
+    """What differs between two records (one phrase each), ``shard`` included unless told
+    otherwise; an instance counts only when both records hold it with other contents."""
     pairs = [
         ("version", old.version, new.version),
         ("suite", old.suite, new.suite),
         ("seed", str(old.seed), str(new.seed)),
         ("time limit", _limit(old.time_limit_s), _limit(new.time_limit_s)),
-        ("workers", str(old.workers), str(new.workers)),
+        ("workers", _workers(old.workers), _workers(new.workers)),
+        ("backend", old.backend, new.backend),
     ]
+    if shard:
+        pairs.append(("shard", _shard(old.shard), _shard(new.shard)))
     found = [f"{name} {now} (the rows: {then})" for name, then, now in pairs if then != now]
     found += [
         f"instance {name} (file changed since its rows)"
@@ -139,7 +159,7 @@ def reconcile(
         found = _row_differences(rows, new)
         merged = new
     else:
-        found = _differences(old, new)
+        found = differences(old, new)
         merged = replace(new, instances={**old.instances, **new.instances})
     if found:
         raise SettingsMismatch(

@@ -49,11 +49,12 @@ STARTUP_LIMIT = 120.0  # [s] a fresh worker may take to start its first task (im
 @dataclass(frozen=True)
 class WorkerFailure:
     """A task without an answer: the function raised, the worker died or overran the hard
-    limit. ``external``: the worker was terminated from outside (SIGTERM, SIGINT, SIGHUP), so
-    the task itself is not to blame."""
+    limit (``timed_out``). ``external``: the worker was terminated from outside (SIGTERM,
+    SIGINT, SIGHUP; on Ray, its node died), so the task itself is not to blame."""
 
     reason: str
     external: bool = False
+    timed_out: bool = False
 
 
 def _follow_parent(parent_pid: int) -> None:
@@ -273,6 +274,7 @@ class WorkerPool(Generic[T, R]):
         if time.monotonic() > job.deadline:
             self._discard(worker, kill=True)
             return WorkerFailure(
-                f"no answer within the hard limit of {self.hard_limit:g} s: worker killed"
+                f"no answer within the hard limit of {self.hard_limit:g} s: worker killed",
+                timed_out=True,
             )
         return _WORKING

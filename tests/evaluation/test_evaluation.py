@@ -183,3 +183,20 @@ def test_bench_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert main(args) == 0  # nothing left to run
     assert (tmp_path / RESULTS).read_text() == before
     assert "| SDAR | 1 | 1 | 100% | - |" in capsys.readouterr().out
+
+
+def test_sweep_plots_stay_small(tmp_path: Path) -> None:
+    """Past 60 instances the execution times are boxes per family, not a bar per instance."""
+    pytest.importorskip("matplotlib")
+    from sdar_tamp.evaluation.plots import MAX_BARS, plot_execution_times
+
+    rows = [
+        _row(f"{'RSDM'[k % 4]}{k + 5}", c, True) for k in range(MAX_BARS + 1)
+        for c in ("sdar", "baseline")
+    ]  # fmt: skip
+    append_rows(tmp_path / RESULTS, COLUMNS, rows)
+    path = plot_execution_times(load_results(tmp_path), tmp_path / "times.png")
+    head = path.read_bytes()
+    assert head[:8] == PNG
+    width = int.from_bytes(head[16:20], "big")  # the PNG header's image width [px]
+    assert width < 2000  # 61 instances as bars: 0.7 in each, over 5000 px
