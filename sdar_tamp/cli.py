@@ -399,7 +399,9 @@ def build_parser() -> argparse.ArgumentParser:
         "bench", help="evaluate planner combinations on a suite", description=cmd_bench.__doc__
     )
     bench.add_argument("--suite", default="paper", help="paper, stress or a folder of instances")
-    bench.add_argument("--out", type=Path, required=True, help="output folder")
+    bench.add_argument(
+        "-o", "--output", "--out", dest="out", type=Path, required=True, help="output folder"
+    )
     bench.add_argument(
         "--combos",
         default="all",

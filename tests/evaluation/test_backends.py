@@ -29,7 +29,7 @@ def test_address_is_for_ray_only(tmp_path: Path, capsys: pytest.CaptureFixture[s
     with pytest.raises(ParameterError, match="address is for the ray backend only"):
         check_backend("process", "10.0.0.1:6379")
     out = tmp_path / "out"
-    assert main(["bench", "--out", str(out), "--only", "R4", "--address", "h:1", "-q"]) == 2
+    assert main(["bench", "-o", str(out), "--only", "R4", "--address", "h:1", "-q"]) == 2
     assert "address is for the ray backend only" in capsys.readouterr().err
     assert not out.exists()
 
