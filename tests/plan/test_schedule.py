@@ -121,13 +121,21 @@ class _Blind(WorldSweep):
         return None
 
 
-def test_without_the_separation_the_validator_rejects_the_schedule(swap: Solved) -> None:
-    scene, options = swap.ctx.scene, ScheduleOptions()
-    blocks = [arm_blocks(swap.plan, scene, i, options.tick) for i in range(2)]
-    blind = _Blind(swap.instance, scene, options.max_tcp_step)
-    mutant = _Placement(swap.plan, blocks, blind, options, "objects").run()
+@pytest.fixture(scope="module")
+def crowded(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
+    """Twelve objects of the paper suite (mixed family): the arms work close to each other."""
+    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "M2.yaml"))
+
+
+def test_without_the_separation_the_validator_rejects_the_schedule(crowded: Solved) -> None:
+    """With a replay that sees no conflict, the scheduler pulls the arms' blocks together
+    until they touch; the validator's replay sees it."""
+    scene, options = crowded.ctx.scene, ScheduleOptions()
+    blocks = [arm_blocks(crowded.plan, scene, i, options.tick) for i in range(2)]
+    blind = _Blind(crowded.instance, scene, options.max_tcp_step)
+    mutant = _Placement(crowded.plan, blocks, blind, options, "objects").run()
     assert check_timeline(mutant, scene) is None  # limits and dwells still hold
-    report = validate_plan(swap.instance, mutant, scene)
+    report = validate_plan(crowded.instance, mutant, scene)
     assert not report.ok and report.violation is not None
     assert report.violation.kind == "collision"
     names = report.violation.message
