@@ -406,7 +406,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--combos",
         default="all",
         help="all, or some of sdar,baseline,baseline-tp+sdar-m,sdar-t+baseline-mp,"
-        "sdar-t+plain,baseline-tp+plain (default: all)",
+        "sdar-t+plain,baseline-tp+plain,sdar-async (default: all)",
     )
     bench.add_argument(
         "--workers",

@@ -13,7 +13,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 from sdar_tamp.app.cache import PlannerCache
-from sdar_tamp.app.config import MOTION_PLANNERS, TASK_PLANNERS, PlannerConfig, check_choice
+from sdar_tamp.app.config import (
+    EXECUTIONS,
+    MOTION_PLANNERS,
+    TASK_PLANNERS,
+    PlannerConfig,
+    check_choice,
+)
 from sdar_tamp.app.plan_export import decoder_of, motion_levels, plan_file_from_solution
 from sdar_tamp.app.problem import rearrangement_problem
 from sdar_tamp.app.records import RunFigures, SolveOutcome, task_records
@@ -33,6 +39,7 @@ def solve_instance(
     seed: int | None = None,
     task_planner: str | None = None,
     motion_planner: str | None = None,
+    execution: str | None = None,
     progress: Callable[[int, int], None] | None = None,
     cache: PlannerCache | None = None,
 ) -> SolveOutcome:
@@ -40,8 +47,8 @@ def solve_instance(
 
     ``config``: the planner configuration (default: :class:`PlannerConfig`, 60 s); the
     keywords, when given, replace its fields: ``time_limit`` [s] (finite and > 0), ``seed``
-    (an integer >= 0), ``task_planner``, ``motion_planner``. Values are checked before the
-    instance is read.
+    (an integer >= 0), ``task_planner``, ``motion_planner``, ``execution``. Values are checked
+    before the instance is read.
 
     ``cache``: keeps the world and the motion planner between calls with the same scene
     (building the optimiser takes a few seconds; it is reported as ``setup_time``, not as
@@ -58,8 +65,14 @@ def solve_instance(
         check_choice("task_planner", task_planner, TASK_PLANNERS)
     if motion_planner is not None:
         check_choice("motion_planner", motion_planner, MOTION_PLANNERS)
+    if execution is not None:
+        check_choice("execution", execution, EXECUTIONS)
     config = (config or PlannerConfig()).replace(
-        max_time=time_limit, seed=seed, task_planner=task_planner, motion_planner=motion_planner
+        max_time=time_limit,
+        seed=seed,
+        task_planner=task_planner,
+        motion_planner=motion_planner,
+        execution=execution,
     )
     instance = load_instance(instance_path)
     world = (cache or PlannerCache()).world(instance.scene_path(instance_path), config.trajopt)

@@ -36,12 +36,14 @@ FAMILY_ORDER = "RSDM"
 
 @dataclass(frozen=True)
 class Combination:
-    """A task planner paired with a motion planner (the paper's six, :data:`COMBINATIONS`)."""
+    """A task planner paired with a motion planner and an execution (the paper's six, all
+    synchronous, and SDAR executed asynchronously: :data:`COMBINATIONS`)."""
 
     id: str
     label: str
     task_planner: str  # sdar | baseline
     motion_planner: str  # sdar | plain | sequential
+    execution: str = "sync"  # sync | async
 
 
 COMBINATIONS = (
@@ -51,6 +53,7 @@ COMBINATIONS = (
     Combination("sdar-t+baseline-mp", "SDAR-T + Baseline MP", "sdar", "sequential"),
     Combination("sdar-t+plain", "SDAR-T + plain TO", "sdar", "plain"),
     Combination("baseline-tp+plain", "Baseline TP + plain TO", "baseline", "plain"),
+    Combination("sdar-async", "SDAR, asynchronous", "sdar", "sdar", "async"),
 )
 
 

@@ -199,7 +199,7 @@ def _run_task(task: _Task) -> Answer:
     try:
         outcome = solve_instance(
             path, time_limit=task.time_limit, seed=task.seed, task_planner=c.task_planner,
-            motion_planner=c.motion_planner, cache=_worker_cache(),
+            motion_planner=c.motion_planner, execution=c.execution, cache=_worker_cache(),
         )  # fmt: skip
     except Exception as error:  # one broken run is recorded as such, not the end of the bench
         log.exception("%s with %s raised", e.name, c.id)

@@ -200,3 +200,25 @@ def test_sweep_plots_stay_small(tmp_path: Path) -> None:
     assert head[:8] == PNG
     width = int.from_bytes(head[16:20], "big")  # the PNG header's image width [px]
     assert width < 2000  # 61 instances as bars: 0.7 in each, over 5000 px
+
+
+def test_the_asynchronous_combination_reaches_the_solver(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``sdar-async`` is SDAR with ``execution="async"``; the paper's six stay synchronous."""
+    import sdar_tamp.app.command as command
+    from sdar_tamp.evaluation import runner
+    from sdar_tamp.evaluation.results import COMBINATIONS, parse_combos
+
+    assert [c.id for c in parse_combos("sdar-async")] == ["sdar-async"]
+    assert [c.execution for c in COMBINATIONS].count("async") == 1
+    seen: list[Any] = []
+
+    def capture(path: Path, **kwargs: Any) -> Any:
+        seen.append(kwargs["execution"])
+        raise RuntimeError("stop")
+
+    monkeypatch.setattr(command, "solve_instance", capture)
+    (entry,) = runner.suite_entries("paper", only=["R4"])
+    for combo in parse_combos("sdar,sdar-async"):
+        row, _, _ = runner._run_task(runner._Task(entry, combo, 60.0, 0))
+        assert row["status"] == "error" and row["combination"] == combo.id
+    assert seen == ["sync", "async"]
