@@ -28,6 +28,7 @@ from math import inf
 import numpy as np
 import numpy.typing as npt
 
+from sdar_tamp.errors import ParameterError
 from solvers.classical.compiled import CompiledTask, bits
 
 ENGINES = ("auto", "python", "numpy")
@@ -50,7 +51,7 @@ class RelaxedHeuristic:
         self, compiled: CompiledTask, name: str, costs: list[float], engine: str = "auto"
     ) -> None:
         if engine not in ENGINES:
-            raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
+            raise ParameterError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
         self.name = name
         self.costs = costs
         task = compiled.task

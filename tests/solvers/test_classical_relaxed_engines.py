@@ -6,12 +6,12 @@ import random
 from math import inf
 
 import pytest
+from classical_helpers import load
 
+from sdar_tamp.errors import ParameterError
 from solvers.classical import ground
 from solvers.classical.compiled import CompiledTask, bits
 from solvers.classical.heuristics import RelaxedHeuristic
-
-from classical_helpers import load
 
 CASES = [
     ("blocksworld", "reverse4"),
@@ -149,5 +149,5 @@ def test_auto_engine_keeps_small_tasks_on_the_queue() -> None:
 
 def test_unknown_engine_is_an_error() -> None:
     compiled = CompiledTask(ground(load("blocksworld", "sussman")))
-    with pytest.raises(ValueError, match="engine must be one of auto, python, numpy"):
+    with pytest.raises(ParameterError, match="engine must be one of auto, python, numpy"):
         RelaxedHeuristic(compiled, "ff", compiled.costs, engine="cuda")
