@@ -8,9 +8,10 @@ Costs are propagated with the preconditions-left counter algorithm: a relaxed op
 its counter of unreached preconditions drops to 0, and facts are settled cheapest first from a
 binary heap (generalised Dijkstra). The search stops as soon as every goal fact is settled.
 h_FF extracts a relaxed plan from the h_add best supporters and sums the costs of its distinct
-operators; that plan's operators are the *preferred* operators. A fact's best supporter is the
-relaxed operator of lowest id among those reaching it at its cost, so the relaxed plan does not
-depend on the order of exploration.
+operators; that plan's operators are the *preferred* operators. On tasks large enough for the
+choice of engine below, a fact's best supporter is the relaxed operator of lowest id among those
+reaching it at its cost, so the relaxed plan does not depend on the order of exploration (small
+tasks keep the first supporter found).
 
 On larger tasks h_add (and so h_FF) can instead run vectorised (:class:`VectorHAdd`): NumPy
 Bellman-Ford sweeps over all relaxed operators until no fact cost drops. The values and best
@@ -94,12 +95,15 @@ class RelaxedHeuristic:
         self.integral = all(c == int(c) and c < 2**20 for c in costs)
         self.int_cost = [int(c) for c in ucost] if self.integral else []
         self.vector: VectorHAdd | None = None
-        if name in ("add", "ff") and engine != "python":
-            size = sum(map(len, upre)) + sum(map(len, ueff))
-            if engine == "numpy" or size >= VECTOR_MIN_SIZE:
-                self.vector = VectorHAdd(count, upre, ueff, ucost)
-                if engine == "auto" and not self._vector_is_faster(compiled.init):
-                    self.vector = None
+        size = sum(map(len, upre)) + sum(map(len, ueff))
+        # lowest-id best supporters, so that both engines give the same relaxed plans; small
+        # tasks under "auto" keep the first supporter found (the exploration order's)
+        self.canonical = engine != "auto" or size >= VECTOR_MIN_SIZE
+        vectorise = engine == "numpy" or (engine == "auto" and size >= VECTOR_MIN_SIZE)
+        if name in ("add", "ff") and vectorise:
+            self.vector = VectorHAdd(count, upre, ueff, ucost)
+            if engine == "auto" and not self._vector_is_faster(compiled.init):
+                self.vector = None
         self.engine = "python" if self.vector is None else "numpy"
 
     def _vector_is_faster(self, state: int) -> bool:
@@ -143,6 +147,7 @@ class RelaxedHeuristic:
         left = self.left[:]
         acc = self.zeros[:] if use_max else self.ucost[:]
         ucost, ueff, pre_of, is_goal = self.ucost, self.ueff, self.pre_of, self.is_goal
+        canonical = self.canonical
         heap: list[tuple[float, int]] = []
         true_facts = bits(state)
         goals_left = len(self.goal)
@@ -165,7 +170,7 @@ class RelaxedHeuristic:
                     cost[g] = value
                     supporter[g] = u
                     heappush(heap, (value, g))
-                elif value == cost[g] and u < supporter[g]:
+                elif canonical and value == cost[g] and u < supporter[g]:
                     supporter[g] = u
         limit = inf  # once every goal is settled: finish the facts of the same cost, then stop
         while heap:
@@ -177,6 +182,8 @@ class RelaxedHeuristic:
             if is_goal[fact]:
                 goals_left -= 1
                 if not goals_left:
+                    if not canonical:
+                        break
                     limit = value
             for u in pre_of[fact]:
                 if use_max:
@@ -192,7 +199,7 @@ class RelaxedHeuristic:
                             cost[g] = new
                             supporter[g] = u
                             heappush(heap, (new, g))
-                        elif new == cost[g] and u < supporter[g]:
+                        elif canonical and new == cost[g] and u < supporter[g]:
                             supporter[g] = u
         return cost, supporter
 
@@ -203,6 +210,7 @@ class RelaxedHeuristic:
         left = self.left[:]
         acc = self.int_cost[:]
         ueff, pre_of, is_goal = self.ueff, self.pre_of, self.is_goal
+        canonical = self.canonical
         true_facts = bits(state)
         goals_left = len(self.goal)
         for fact in true_facts:
@@ -227,7 +235,7 @@ class RelaxedHeuristic:
                     while len(buckets) <= value:
                         buckets.append([])
                     buckets[value].append(g)
-                elif value == cost[g] and u < supporter[g]:
+                elif canonical and value == cost[g] and u < supporter[g]:
                     supporter[g] = u
         value = 0
         while value < len(buckets):
@@ -236,6 +244,8 @@ class RelaxedHeuristic:
                     continue
                 if is_goal[fact]:
                     goals_left -= 1
+                    if not goals_left and not canonical:
+                        return cost, supporter
                 for u in pre_of[fact]:
                     acc[u] += value
                     left[u] -= 1
@@ -248,7 +258,7 @@ class RelaxedHeuristic:
                                 while len(buckets) <= new:
                                     buckets.append([])
                                 buckets[new].append(g)
-                            elif new == cost[g] and u < supporter[g]:
+                            elif canonical and new == cost[g] and u < supporter[g]:
                                 supporter[g] = u
             if not goals_left:  # every goal settled, and every fact as cheap as the last one
                 break
