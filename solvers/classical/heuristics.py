@@ -8,15 +8,33 @@ Costs are propagated with the preconditions-left counter algorithm: a relaxed op
 its counter of unreached preconditions drops to 0, and facts are settled cheapest first from a
 binary heap (generalised Dijkstra). The search stops as soon as every goal fact is settled.
 h_FF extracts a relaxed plan from the h_add best supporters and sums the costs of its distinct
-operators; that plan's operators are the *preferred* operators.
+operators; that plan's operators are the *preferred* operators. On tasks large enough for the
+choice of engine below, a fact's best supporter is the relaxed operator of lowest id among those
+reaching it at its cost, so the relaxed plan does not depend on the order of exploration (small
+tasks keep the first supporter found).
+
+On larger tasks h_add (and so h_FF) can instead run vectorised (:class:`VectorHAdd`): NumPy
+Bellman-Ford sweeps over all relaxed operators until no fact cost drops. The values and best
+supporters are the same; which of the two is faster depends on the task (few sweeps over many
+operators favour NumPy, long chains of cheap steps the queue), so the heuristic times both on
+the initial state and keeps the faster.
 """
 
 from __future__ import annotations
 
+import time
 from heapq import heappop, heappush
 from math import inf
 
+import numpy as np
+import numpy.typing as npt
+
+from sdar_tamp.errors import ParameterError
 from solvers.classical.compiled import CompiledTask, bits
+
+ENGINES = ("auto", "python", "numpy")
+# below this many (precondition + effect) entries the queue-based h_add is always used
+VECTOR_MIN_SIZE = 4000
 
 # "lmcount": landmark count; "ff-lmcount": h_FF and landmark count in alternating queues
 HEURISTICS = ("ff", "add", "max", "blind", "lmcount", "ff-lmcount")
@@ -26,9 +44,15 @@ class RelaxedHeuristic:
     """Callable ``state -> (h, preferred operator ids or None)``; ``h`` is ``inf`` at dead ends.
 
     ``costs`` are the operator costs the heuristic uses (the search may pass adjusted costs).
+    ``engine`` (h_add and h_FF only): ``"python"`` (queue-based), ``"numpy"`` (vectorised) or
+    ``"auto"`` (the queue below :data:`VECTOR_MIN_SIZE`, else the faster on the initial state).
     """
 
-    def __init__(self, compiled: CompiledTask, name: str, costs: list[float]) -> None:
+    def __init__(
+        self, compiled: CompiledTask, name: str, costs: list[float], engine: str = "auto"
+    ) -> None:
+        if engine not in ENGINES:
+            raise ParameterError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
         self.name = name
         self.costs = costs
         task = compiled.task
@@ -70,14 +94,43 @@ class RelaxedHeuristic:
         # with whole-number costs h_add settles facts from a bucket queue instead of a heap
         self.integral = all(c == int(c) and c < 2**20 for c in costs)
         self.int_cost = [int(c) for c in ucost] if self.integral else []
+        self.vector: VectorHAdd | None = None
+        size = sum(map(len, upre)) + sum(map(len, ueff))
+        # lowest-id best supporters, so that both engines give the same relaxed plans; small
+        # tasks under "auto" keep the first supporter found (the exploration order's)
+        self.canonical = engine != "auto" or size >= VECTOR_MIN_SIZE
+        vectorise = engine == "numpy" or (engine == "auto" and size >= VECTOR_MIN_SIZE)
+        if name in ("add", "ff") and vectorise:
+            self.vector = VectorHAdd(count, upre, ueff, ucost)
+            if engine == "auto" and not self._vector_is_faster(compiled.init):
+                self.vector = None
+        self.engine = "python" if self.vector is None else "numpy"
+
+    def _vector_is_faster(self, state: int) -> bool:
+        """Time both h_add engines on ``state`` (best of three runs each)."""
+        assert self.vector is not None
+        best = [inf, inf]
+        for _ in range(3):
+            for i, run in enumerate((self._propagate_scalar, self.vector.propagate)):
+                start = time.perf_counter()
+                run(state)
+                best[i] = min(best[i], time.perf_counter() - start)
+        return best[1] < best[0]
+
+    def _propagate_scalar(self, state: int) -> tuple[list[float], list[int]]:
+        if self.integral and self.name != "max":
+            return self._propagate_buckets(state)
+        return self._propagate(state, self.name == "max")
 
     def __call__(self, state: int, preferred: bool = False) -> tuple[float, set[int] | None]:
         if self.name == "blind":
             return (0.0 if state & self.goal_mask == self.goal_mask else self.min_cost), None
-        if self.integral and self.name != "max":
-            cost, supporter = self._propagate_buckets(state)
+        if self.vector is not None:
+            if state & self.goal_mask == self.goal_mask:
+                return 0.0, (set() if preferred or self.name == "ff" else None)
+            cost, supporter = self.vector.propagate(state, self.name == "ff" or preferred)
         else:
-            cost, supporter = self._propagate(state, self.name == "max")
+            cost, supporter = self._propagate_scalar(state)
         goal = self.goal
         if self.name == "ff":
             return self._relaxed_plan(cost, supporter)
@@ -94,6 +147,7 @@ class RelaxedHeuristic:
         left = self.left[:]
         acc = self.zeros[:] if use_max else self.ucost[:]
         ucost, ueff, pre_of, is_goal = self.ucost, self.ueff, self.pre_of, self.is_goal
+        canonical = self.canonical
         heap: list[tuple[float, int]] = []
         true_facts = bits(state)
         goals_left = len(self.goal)
@@ -116,14 +170,21 @@ class RelaxedHeuristic:
                     cost[g] = value
                     supporter[g] = u
                     heappush(heap, (value, g))
+                elif canonical and value == cost[g] and u < supporter[g]:
+                    supporter[g] = u
+        limit = inf  # once every goal is settled: finish the facts of the same cost, then stop
         while heap:
             value, fact = heappop(heap)
             if value > cost[fact]:
                 continue
+            if value > limit:
+                break
             if is_goal[fact]:
                 goals_left -= 1
                 if not goals_left:
-                    break
+                    if not canonical:
+                        break
+                    limit = value
             for u in pre_of[fact]:
                 if use_max:
                     if value > acc[u]:
@@ -138,6 +199,8 @@ class RelaxedHeuristic:
                             cost[g] = new
                             supporter[g] = u
                             heappush(heap, (new, g))
+                        elif canonical and new == cost[g] and u < supporter[g]:
+                            supporter[g] = u
         return cost, supporter
 
     def _propagate_buckets(self, state: int) -> tuple[list[float], list[int]]:
@@ -147,6 +210,7 @@ class RelaxedHeuristic:
         left = self.left[:]
         acc = self.int_cost[:]
         ueff, pre_of, is_goal = self.ueff, self.pre_of, self.is_goal
+        canonical = self.canonical
         true_facts = bits(state)
         goals_left = len(self.goal)
         for fact in true_facts:
@@ -171,6 +235,8 @@ class RelaxedHeuristic:
                     while len(buckets) <= value:
                         buckets.append([])
                     buckets[value].append(g)
+                elif canonical and value == cost[g] and u < supporter[g]:
+                    supporter[g] = u
         value = 0
         while value < len(buckets):
             for fact in buckets[value]:  # zero-cost operators append to the bucket being read
@@ -178,7 +244,7 @@ class RelaxedHeuristic:
                     continue
                 if is_goal[fact]:
                     goals_left -= 1
-                    if not goals_left:
+                    if not goals_left and not canonical:
                         return cost, supporter
                 for u in pre_of[fact]:
                     acc[u] += value
@@ -192,6 +258,10 @@ class RelaxedHeuristic:
                                 while len(buckets) <= new:
                                     buckets.append([])
                                 buckets[new].append(g)
+                            elif canonical and new == cost[g] and u < supporter[g]:
+                                supporter[g] = u
+            if not goals_left:  # every goal settled, and every fact as cheap as the last one
+                break
             value += 1
         return cost, supporter
 
@@ -219,3 +289,73 @@ class RelaxedHeuristic:
                     seen.add(p)
                     stack.append(p)
         return h, operators
+
+
+class VectorHAdd:
+    """h_add by NumPy Bellman-Ford sweeps, with the same costs and best supporters.
+
+    A sweep computes every relaxed operator's cost (its cost plus the sum of its precondition
+    costs; preconditions are padded columns pointing at an extra always-true fact) and lowers
+    every fact's cost to its cheapest achiever's; sweeps repeat until nothing drops. Achiever
+    lists are sorted by (fact, operator id), so the first achiever at the fact's cost is the one
+    of lowest id.
+    """
+
+    def __init__(
+        self,
+        count: int,
+        upre: list[tuple[int, ...]],
+        ueff: list[tuple[int, ...]],
+        ucost: list[float],
+    ) -> None:
+        self.count = count
+        width = max((len(pre) for pre in upre), default=0) or 1
+        columns = np.full((width, len(upre)), count, dtype=np.intp)  # ``count``: always true
+        for u, pre in enumerate(upre):
+            columns[: len(pre), u] = pre
+        self.columns = [np.ascontiguousarray(column) for column in columns]
+        self.ucost = np.asarray(ucost, dtype=np.float64)
+        pairs = sorted({(g, u) for u, eff in enumerate(ueff) for g in eff})
+        self.eff_fact = np.asarray([g for g, _u in pairs], dtype=np.intp)
+        self.eff_op = np.asarray([u for _g, u in pairs], dtype=np.intp)
+        achieved, starts, counts = np.unique(self.eff_fact, return_index=True, return_counts=True)
+        self.achieved = achieved  # facts with at least one achiever
+        self.starts = starts  # where each achieved fact's achievers start in eff_op
+        self.segment = np.repeat(np.arange(len(achieved)), counts)  # eff entry -> achieved fact
+        self.nbytes = count // 8 + 1
+        self.extra = 1 << count
+
+    def initial_costs(self, state: int) -> npt.NDArray[np.float64]:
+        """0 for the facts of ``state`` and the extra fact, inf for the others."""
+        raw = np.frombuffer((state | self.extra).to_bytes(self.nbytes, "little"), dtype=np.uint8)
+        true = np.unpackbits(raw, bitorder="little")[: self.count + 1]
+        return np.where(true, 0.0, inf)
+
+    def propagate(self, state: int, supporters: bool = True) -> tuple[list[float], list[int]]:
+        """Fact costs (as a list) and, if asked, best supporters (-1 where none is needed)."""
+        cost = self.initial_costs(state)
+        if not len(self.achieved):
+            return cost.tolist(), [-1] * (self.count + 1)
+        achieved, starts, eff_op, columns = self.achieved, self.starts, self.eff_op, self.columns
+        first, rest = columns[0], columns[1:]
+        current = cost[achieved]
+        while True:
+            op_cost = self.ucost + cost[first]
+            for column in rest:
+                op_cost += cost[column]
+            reached = op_cost[eff_op]
+            best = np.minimum.reduceat(reached, starts)
+            if not (best < current).any():
+                break
+            np.minimum(current, best, out=current)
+            cost[achieved] = current
+        if not supporters:
+            return cost.tolist(), []
+        match = np.flatnonzero(reached == current[self.segment])
+        segment = self.segment[match]
+        leading = np.ones(len(match), dtype=bool)
+        leading[1:] = segment[1:] != segment[:-1]
+        chosen = match[leading]
+        supporter = np.full(self.count + 1, -1, dtype=np.intp)
+        supporter[self.eff_fact[chosen]] = eff_op[chosen]
+        return cost.tolist(), supporter.tolist()
