@@ -135,6 +135,7 @@ SCENE_CASES: dict[str, Edit] = {
     "joint key": _set(["arms", 0, "joint_limits", "wrist_4"], [-1.0, 1.0]),
     "zero velocity": _set(["arms", 1, "velocity_limit"], 0.0),
     "table": _set(["table", "size"], [1.4, 0.8]),
+    "velocity safety": _set(["velocity_safety"], 1.2),
 }
 PLAN_CASES: dict[str, Edit] = {
     "format": _set(["format"], "other-plan"),

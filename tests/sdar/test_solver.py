@@ -328,4 +328,7 @@ def test_motions_come_from_the_quick_stream_first(
         calls[attempts] = {k: s.calls for k, s in solution.streams.items() if "motion" in k}
     motions = calls[0]["plan-dual-motion"]
     assert motions >= 3 and calls[0]["plan-dual-motion-quick"] == 0
-    assert calls[quick] == {"plan-dual-motion": 0, "plan-dual-motion-quick": motions}
+    # with quick attempts the full planner is never needed here; a quick attempt that fails
+    # moves on to the next grounding's quick attempt, so there may be more quick calls
+    assert calls[quick]["plan-dual-motion"] == 0
+    assert calls[quick]["plan-dual-motion-quick"] >= motions
