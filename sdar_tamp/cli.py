@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from sdar_tamp import __version__
 from sdar_tamp.arguments import (
@@ -499,12 +500,29 @@ def _add_logging_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _configure_logging(args: argparse.Namespace) -> None:
-    """The command line is a program: it owns the root handler and the package's level."""
+    """With ``-v`` or ``--log-level`` the program shows the package's log lines of that level on
+    stderr; without them logging is left as it is (Python shows warnings and errors)."""
     import logging
 
-    name = args.log_level or ("warning", "info", "debug")[min(getattr(args, "verbose", 0), 2)]
-    logging.basicConfig(format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr)
+    verbose = getattr(args, "verbose", 0)
+    name = args.log_level or (None, "info", "debug")[min(verbose, 2)]
+    if name is None:
+        return
+    logging.basicConfig(format="%(levelname)s %(name)s: %(message)s", handlers=[_Stderr()])
     logging.getLogger("sdar_tamp").setLevel(name.upper())
+
+
+class _Stderr(logging.StreamHandler):  # type: ignore[type-arg]
+    """A handler writing to whatever ``sys.stderr`` is when a record comes (not the stream of
+    the moment it was made, which may be closed by then)."""
+
+    @property
+    def stream(self) -> Any:
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value: Any) -> None:
+        pass
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -183,9 +183,16 @@ def test_log_level_options_set_the_package_logger(
     import logging
 
     logger = logging.getLogger("sdar_tamp")
-    monkeypatch.setattr(logger, "level", logger.level)  # restored after the test
+    monkeypatch.setattr(logger, "level", logging.NOTSET)  # restored after the test
+    root = logging.getLogger()
+    monkeypatch.setattr(root, "handlers", [])  # restored after the test
     assert main(["check", str(domain_file("blocksworld")), *flags]) == 0
+    if level == "WARNING":  # no option: logging is left as it was (Python shows warnings)
+        assert logger.level == logging.NOTSET and root.handlers == []
+        return
     assert logging.getLevelName(logger.level) == level
+    (handler,) = root.handlers
+    handler.handle(logging.makeLogRecord({"msg": "to the stderr of the moment"}))
 
 
 def test_an_unknown_log_level_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
