@@ -27,9 +27,10 @@ unit: $(STAMP)
 
 test: lint typecheck unit
 
-# The declared minimum Python, in its own environment (needs python3.10 on the PATH).
+# The declared minimum Python, in its own environment: PY310 names its interpreter.
+PY310 ?= python3.10
 test-py310:
-	$(MAKE) test VENV=.venv310 PYTHON=python3.10
+	$(MAKE) test VENV=.venv310 PYTHON=$(PY310)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_classical.py
