@@ -196,6 +196,18 @@ def _planar_error(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, fl
     return math.hypot(a[0] - b[0], a[1] - b[1]), min(d, math.pi - d)
 
 
+def contact_allowed(pair: CollisionPair, exempt: Mapping[str, tuple[str, FloatArray]]) -> bool:
+    """The contact rule: ``pair`` is the gripper of an arm touching the object of its grasp or
+    release while that arm stands at its event configuration (``exempt``: arm -> (object,
+    configuration))."""
+    for arm, (obj, _) in exempt.items():
+        target = f"object:{obj}"
+        other = pair.second if pair.first == target else pair.first if pair.second == target else ""
+        if other.startswith(f"{arm}_gripper"):
+            return True
+    return False
+
+
 def tcp_positions(
     q: FloatArray, kins: Mapping[str, ArmKinematics], layout: ArmLayout
 ) -> FloatArray:
@@ -283,12 +295,7 @@ class _Replay:
         return Violation(t, "collision", text + (" ..." if len(pairs) > 3 else ""))
 
     def allowed(self, p: CollisionPair) -> bool:
-        for arm, (obj, _) in self.exempt.items():
-            target = f"object:{obj}"
-            other = p.second if p.first == target else p.first if p.second == target else ""
-            if other.startswith(f"{arm}_gripper"):
-                return True
-        return False
+        return contact_allowed(p, self.exempt)
 
     def subdivisions(self, q: FloatArray) -> NDArray[np.int_]:
         """See :func:`tcp_subdivisions`."""

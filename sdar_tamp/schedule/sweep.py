@@ -17,7 +17,7 @@ import numpy as np
 
 from sdar_tamp.plan_file import PlanEvent
 from sdar_tamp.plan_rules import STILL_TOL
-from sdar_tamp.replay import POS_TOL, tcp_subdivisions
+from sdar_tamp.replay import POS_TOL, contact_allowed, tcp_subdivisions
 from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Instance
@@ -117,12 +117,7 @@ class WorldSweep:
         return Conflict(tick, "collision", ", ".join(f"{p.first} with {p.second}" for p in pairs))
 
     def allowed(self, p: CollisionPair) -> bool:
-        for arm, (obj, _) in self.exempt.items():
-            target = f"object:{obj}"
-            other = p.second if p.first == target else p.first if p.second == target else ""
-            if other.startswith(f"{arm}_gripper"):
-                return True
-        return False
+        return contact_allowed(p, self.exempt)
 
     def apply(self, timed: TimedEvent) -> Conflict | None:
         """Perform one event: a grasp of a resting object, a release onto a free spot."""
