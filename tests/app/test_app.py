@@ -36,6 +36,10 @@ from streams.grasps import GraspOptions
 from streams.motion import DualMotionPlanner
 from streams.trajopt import TrajOptOptions
 
+#: A solve's time budget: generous, so that a busy machine slows a test down but never turns
+#: a solvable case into a timeout (the budget is not what these tests check).
+BUDGET = 600.0
+
 SQUARE = (0.04, 0.04, 0.05)  # graspable across both sides: 12 grasps in the default set
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 
@@ -309,7 +313,7 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(tmp_path: Path)
     a = ObjectSpec("a", SQUARE, Pose2D(-0.1, 0.15, 0.0), Pose2D(0.1, -0.15, 0.3))
     b = ObjectSpec("b", SQUARE, Pose2D(0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.0))
     path = save_instance(Instance("two", WORKSPACE, (a, b)), tmp_path / "two.yaml")
-    outcome = solve_instance(path, PlannerConfig(execution="async"), time_limit=120.0)
+    outcome = solve_instance(path, PlannerConfig(execution="async"), time_limit=BUDGET)
     assert outcome.plan is not None and outcome.valid, outcome.violation
     assert outcome.figures.schedule_time > 0.0
     metrics = outcome.plan.metrics

@@ -14,6 +14,10 @@ from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, save_instance
 from sdar_tamp.world.scene import Workspace
 from solvers.solution import Solution, Status
 
+#: A solve's time budget: generous, so that a busy machine slows a test down but never turns
+#: a solvable case into a timeout (the budget is not what these tests check).
+BUDGET = 600.0
+
 SIZE = (0.08, 0.04, 0.05)
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 
@@ -38,7 +42,7 @@ def test_a_boxed_in_instance_is_infeasible_before_any_search(
         raise AssertionError("the search must not run")
 
     monkeypatch.setattr(solving, "solve", never)
-    outcome = solve_instance(_boxed_in(tmp_path), time_limit=60.0)
+    outcome = solve_instance(_boxed_in(tmp_path), time_limit=BUDGET)
     assert outcome.status == "infeasible" and outcome.plan is None and not outcome.success
     assert "none of o0, o1, o2 can ever be picked first" in outcome.diagnosis[0]
     assert "o1: no grasp clear of o0, o2" in outcome.diagnosis
@@ -73,5 +77,5 @@ def test_a_cube_and_a_short_bar_are_planned_for_and_validated(tmp_path: Path) ->
     cube = ObjectSpec("cube", (0.05, 0.05, 0.05), Pose2D(-0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.4))
     bar = ObjectSpec("bar", (0.08, 0.04, 0.03), Pose2D(0.1, 0.15, 0.0), Pose2D(0.1, -0.15, -0.3))
     path = save_instance(Instance("edge", WORKSPACE, (cube, bar)), tmp_path / "edge.yaml")
-    outcome = solve_instance(path, time_limit=60.0)
+    outcome = solve_instance(path, time_limit=BUDGET)
     assert outcome.status == "solved" and outcome.valid, (outcome.violation, outcome.diagnosis)

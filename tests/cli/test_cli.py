@@ -31,7 +31,7 @@ def test_every_subcommand_has_help(capsys: pytest.CaptureFixture[str]) -> None:
 def test_demo_solves_validates_and_draws_the_mixed_instance(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    assert main(["demo", "--out", str(tmp_path)]) == 0
+    assert main(["demo", "--out", str(tmp_path), "--time-limit", "600"]) == 0
     out = capsys.readouterr().out
     assert "M1: solved, plan valid" in out and "per step: median" in out
     for name in ("plan.json", "plan.html", "storyboard.png"):
@@ -45,7 +45,22 @@ def test_solve_writes_a_plan_that_validates(
 ) -> None:
     instance = domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml")
     plan = tmp_path / "S4.json"
-    assert main(["solve", str(instance), "-o", str(plan), "--json", "--seed", "3"]) == 0
+    assert (
+        main(
+            [
+                "solve",
+                str(instance),
+                "-o",
+                str(plan),
+                "--json",
+                "--seed",
+                "3",
+                "--time-limit",
+                "600",
+            ]
+        )
+        == 0
+    )
     captured = capsys.readouterr()
     record = json.loads(captured.out)  # --json: one object on stdout, no progress bar
     assert captured.err == ""

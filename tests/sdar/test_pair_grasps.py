@@ -19,6 +19,10 @@ from solvers.solution import Status
 from streams.context import WorldContext
 from streams.motion import DualMotionPlanner
 
+#: A solve's time budget: generous, so that a busy machine slows a test down but never turns
+#: a solvable case into a timeout (the budget is not what these tests check).
+BUDGET = 600.0
+
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 CUBE = (0.04, 0.04, 0.05)
 BAR = (0.08, 0.04, 0.05)
@@ -105,7 +109,7 @@ def test_close_neighbours_trade_places_in_one_dual_arm_swap(
     synchronous swap, no buffer, and the plan validates."""
     inst = _swap(BAR, 0.026, math.pi / 2, 0.3)
     r = rearrangement_problem(inst, ctx, planner=planner)
-    solution = solve_rearrangement(r, "sdar", 60.0)
+    solution = solve_rearrangement(r, "sdar", BUDGET)
     assert solution.status is Status.SOLVED, solution.diagnosis
     assert [t["kind"] for t in solution.trace] == ["swap"]
     assert not any(any(t["to_buffer"]) for t in solution.trace)

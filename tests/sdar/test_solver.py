@@ -27,6 +27,10 @@ from streams.context import WorldContext
 from streams.motion import DualMotionPlanner
 from streams.stream_map import make_stream_map
 
+#: A solve's time budget: generous, so that a busy machine slows a test down but never turns
+#: a solvable case into a timeout (the budget is not what these tests check).
+BUDGET = 600.0
+
 SIZE = (0.08, 0.04, 0.05)
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 
@@ -53,7 +57,7 @@ def solved_three(ctx: WorldContext, planner: DualMotionPlanner) -> tuple[Rearran
     the solution. With the default motion planner its options are ``SdarOptions(max_time)``
     (the default quick attempts), so it is also the quick run of the motion-stream test."""
     r = rearrangement_problem(_three(), ctx, planner=planner)
-    return r, solve_rearrangement(r, "sdar", 60.0)
+    return r, solve_rearrangement(r, "sdar", BUDGET)
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +66,7 @@ def solved_swap(ctx: WorldContext, planner: DualMotionPlanner) -> tuple[Rearrang
     ``solve(algorithm="sdar")``; with the default motion planner ``solve_rearrangement`` runs
     the same solver configuration (``test_both_entry_points_configure_sdar_alike``)."""
     r = rearrangement_problem(_swap(), ctx, planner=planner)
-    return r, solve(r.problem, algorithm="sdar", max_time=60, verbose=False)
+    return r, solve(r.problem, algorithm="sdar", max_time=BUDGET, verbose=False)
 
 
 def _three() -> Instance:
@@ -119,7 +123,7 @@ def test_plan_is_a_plan_of_the_domain(
 
 def test_baseline_task_planner_solves_too(ctx: WorldContext, planner: DualMotionPlanner) -> None:
     r = rearrangement_problem(_swap(), ctx, planner=planner)
-    solution = solve_rearrangement(r, "baseline", 60.0)
+    solution = solve_rearrangement(r, "baseline", BUDGET)
     assert solution.status is Status.SOLVED
     # the baseline has no dual-arm swap: one object goes through a buffer
     assert sum(sum(t["to_buffer"]) for t in solution.trace) == 1
@@ -146,8 +150,8 @@ def test_both_entry_points_configure_sdar_alike(
 
     monkeypatch.setattr(SdarSolver, "solve", record)
     r = rearrangement_problem(_swap(), ctx, planner=planner)
-    solve(r.problem, algorithm="sdar", max_time=60, verbose=False)
-    solve_rearrangement(r, "sdar", 60.0)
+    solve(r.problem, algorithm="sdar", max_time=BUDGET, verbose=False)
+    solve_rearrangement(r, "sdar", BUDGET)
     assert len(built) == 2 and built[0] == built[1]
 
 
@@ -160,7 +164,7 @@ def test_no_ik_gives_infeasible_with_a_diagnosis(
     r = rearrangement_problem(
         _swap(), ctx, planner=planner, overrides={"inverse-kinematics": no_ik}
     )
-    solution = solve_rearrangement(r, "sdar", 60.0)
+    solution = solve_rearrangement(r, "sdar", BUDGET)
     assert solution.status is Status.INFEASIBLE and solution.plan is None
     assert "no candidate step could be grounded" in solution.diagnosis[0]
     assert any("no grasp with IK" in d for d in solution.diagnosis)
@@ -201,7 +205,7 @@ def test_crowded_goal_is_unblocked_by_an_eviction(
     r = rearrangement_problem(
         inst, ctx, planner=planner, overrides={"inverse-kinematics": crowded_ik}
     )
-    solution = solve_rearrangement(r, "sdar", 60.0)
+    solution = solve_rearrangement(r, "sdar", BUDGET)
     assert solution.status is Status.SOLVED, solution.diagnosis
     kinds = [t["kind"] for t in solution.trace]
     assert "evict" in kinds
@@ -245,7 +249,7 @@ def test_same_seed_gives_the_same_plan(
     # a second, independent solve of the shared instance with the same seed (0)
     r = rearrangement_problem(_three(), ctx, planner=planner, seed=0)
     a = plan_file_from_solution(*solved_three)
-    b = plan_file_from_solution(r, solve_rearrangement(r, "sdar", 60.0))
+    b = plan_file_from_solution(r, solve_rearrangement(r, "sdar", BUDGET))
     assert np.array_equal(a.q, b.q) and np.array_equal(a.t, b.t)
     assert [(e.t, e.arm, e.type, e.object) for e in a.events] == [
         (e.t, e.arm, e.type, e.object) for e in b.events
@@ -259,7 +263,7 @@ def test_baseline_motion_planner_works_one_arm_at_a_time(
     """The baseline motion planner: one arm moves at a time, and at every gripper action the
     other arm waits at its retract (home) pose; a swap has one arm hold its object at home."""
     r = rearrangement_problem(instance(), ctx, planner=planner, motion="sequential")
-    solution = solve_rearrangement(r, task_planner, 60.0)
+    solution = solve_rearrangement(r, task_planner, BUDGET)
     assert solution.status is Status.SOLVED and solution.plan is not None
     names = [a.name for a in solution.plan]
     assert "pick-both" not in names and "place-both" not in names
@@ -297,7 +301,7 @@ def test_colliding_first_grasps_widen_the_options(
     buffered: dict[int, int] = {}
     for more in (2, 6):
         r = rearrangement_problem(instance, ctx, planner=planner)
-        options = SdarOptions(max_time=60.0, more_options=more, pair_grasps=0)
+        options = SdarOptions(max_time=BUDGET, more_options=more, pair_grasps=0)
         solution = SdarSolver(r.problem, make_task_planner("sdar"), options).solve()
         assert solution.status is Status.SOLVED
         kinds[more] = [t["kind"] for t in solution.trace]
@@ -316,7 +320,7 @@ def test_motions_come_from_the_quick_stream_first(
 
     quick = SdarOptions.quick_attempts
     r = rearrangement_problem(_three(), ctx, planner=planner)
-    options = SdarOptions(max_time=60.0, quick_attempts=0)
+    options = SdarOptions(max_time=BUDGET, quick_attempts=0)
     runs = {
         quick: solved_three,
         0: (r, SdarSolver(r.problem, make_task_planner("sdar"), options).solve()),

@@ -414,7 +414,7 @@ def _chromium(url: str, workdir: Path, *extra: str) -> subprocess.CompletedProce
         *extra, url,
     ]  # fmt: skip
     env = {**os.environ, "HOME": str(workdir)}
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=env, check=False)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env, check=False)
 
 
 needs_chromium = pytest.mark.skipif(
