@@ -31,6 +31,7 @@ from sdar_tamp.schedule.pieces import arm_blocks
 from sdar_tamp.solve_command import solve_instance
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.scene import load_scene
+from sdar_tamp.world.suites import SUITES
 
 
 def _suite_files(suite: str) -> list[Path]:
@@ -57,7 +58,7 @@ def _plan(path: Path, args: argparse.Namespace, shared: dict[str, object]) -> Pl
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--suite", default="paper", choices=("paper", "stress"))
+    ap.add_argument("--suite", default="paper", choices=SUITES)
     ap.add_argument("--only", default="", help="comma-separated instance names")
     ap.add_argument("--plans", type=Path, default=None, help="folder of plan files <name>.json")
     ap.add_argument("--save", action="store_true", help="solve and write the plans to --plans")

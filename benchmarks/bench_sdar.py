@@ -27,6 +27,7 @@ from sdar_tamp.app.command import solve_instance
 from sdar_tamp.app.records import SolveOutcome
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import load_instance
+from sdar_tamp.world.suites import SUITES
 
 
 def _suite_files(suite: str) -> list[Path]:
@@ -41,7 +42,7 @@ def _suite_files(suite: str) -> list[Path]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--suite", default="paper", choices=("paper", "stress"))
+    ap.add_argument("--suite", default="paper", choices=SUITES)
     ap.add_argument("--max-objects", type=int, default=None)
     ap.add_argument("--time-limit", type=float, default=60.0)
     ap.add_argument("--task-planner", default="sdar", choices=("sdar", "baseline"))

@@ -24,6 +24,11 @@ from sdar_tamp.errors import SdarError
 from sdar_tamp.export.command import add_export_parser
 from sdar_tamp.textfile import read_text
 
+#: The generator's families and the named suites, spelt out so that the command line starts
+#: without NumPy (tests/cli checks they match sdar_tamp.world.generators and .suites).
+CLI_FAMILIES = ("R", "S", "D", "M", "N")
+CLI_SUITES = ("paper", "stress", "dense")
+
 DEMO_DOMAIN = "dual_arm_rearrangement"
 DEMO_INSTANCE = "suites/paper/M1.yaml"
 _FORCE = "replace output files that exist (default: refuse)"
@@ -314,10 +319,10 @@ def build_parser() -> argparse.ArgumentParser:
     generate = sub.add_parser(
         "generate", help="generate rearrangement instances", description=cmd_generate.__doc__
     )
-    generate.add_argument("--family", choices=("R", "S", "D", "M"), help="instance family")
+    generate.add_argument("--family", choices=CLI_FAMILIES, help="instance family")
     generate.add_argument("--objects", type=COUNT.parse, help="number of objects")
     generate.add_argument("--seed", type=SEED.parse, default=0, help="random seed (default: 0)")
-    generate.add_argument("--suite", choices=("paper", "stress"), help="a whole suite")
+    generate.add_argument("--suite", choices=CLI_SUITES, help="a whole suite")
     generate.add_argument(
         "-o",
         "--output",
@@ -399,7 +404,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench", help="evaluate planner combinations on a suite", description=cmd_bench.__doc__
     )
-    bench.add_argument("--suite", default="paper", help="paper, stress or a folder of instances")
+    bench.add_argument(
+        "--suite", default="paper", help="paper, stress, dense or a folder of instances"
+    )
     bench.add_argument(
         "-o", "--output", "--out", dest="out", type=Path, required=True, help="output folder"
     )

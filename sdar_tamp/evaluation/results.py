@@ -31,7 +31,7 @@ COLUMNS = (
     "abstract_buffer_moves", "abstract_steps", "violation", "diagnosis",
 )  # fmt: skip
 STEP_COLUMNS = ("instance", "combination", "step", "selection_s", "motion_s")
-FAMILY_ORDER = "RSDM"
+FAMILY_ORDER = "RSDMN"
 
 
 @dataclass(frozen=True)

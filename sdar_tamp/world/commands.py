@@ -23,7 +23,7 @@ def generate(
 
 
 def generate_suite(suite: str, out_dir: Path, accept: Acceptance | None = None) -> list[Path]:
-    """Write the named suite (``paper`` or ``stress``) into ``out_dir``."""
+    """Write the named suite (``paper``, ``stress`` or ``dense``) into ``out_dir``."""
     return _generate_suite(suite, Path(out_dir), accept)
 
 

@@ -4,7 +4,10 @@
 * ``S`` single cycle: exactly one dependency cycle (a simple cycle), the rest acyclic;
 * ``D`` double cycle: exactly two disjoint simple cycles, the rest acyclic;
 * ``M`` mixed (12 objects in the paper): at least one independent object, one chain of two or
-  more and one cycle.
+  more and one cycle;
+* ``N`` dense (beyond the paper): mixed sizes packed from the middle at the clearance,
+  neighbours of one size trading places, the others turned on their spot
+  (:mod:`sdar_tamp.world.dense`).
 
 Structured families are built from a *successor map*: object ``i`` with successor ``j`` gets
 its goal on (a perturbation of) ``j``'s start, overlapping no other start and no other goal, so
@@ -34,6 +37,13 @@ import numpy as np
 
 from sdar_tamp.arguments import COUNT, SEED, Real
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.world.dense import (
+    DENSE_SIZES,
+    dense_goals,
+    dense_sizes,
+    neighbour_pairs,
+    packed_arrangement,
+)
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError
 from sdar_tamp.world.footprint import corners, inflate, inside_rectangle, overlap_matrix
@@ -41,7 +51,7 @@ from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, validate_inst
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.transforms import BoolArray, FloatArray
 
-FAMILIES = ("R", "S", "D", "M")
+FAMILIES = ("R", "S", "D", "M", "N")
 DEFAULT_SIZE = (0.08, 0.04, 0.05)
 DEFAULT_WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 _LENGTH = Real(0.0, closed=True, unit="m")
@@ -99,11 +109,11 @@ def generate_instance(
         raise ParameterError(f"family: expected one of {list(FAMILIES)}, got {family!r}")
     n_objects = COUNT.check("objects", n_objects)
     seed = SEED.check("seed", seed)
-    minimum = {"R": 1, "S": 2, "D": 4, "M": 5}[family]
+    minimum = {"R": 1, "S": 2, "D": 4, "M": 5, "N": 3}[family]
     if n_objects < minimum:
         raise ParameterError(f"objects: family {family} needs at least {minimum}, got {n_objects}")
     opts = options or GeneratorOptions()
-    limit = max_objects(opts)
+    limit = max_objects(_smallest(opts) if family == "N" else opts)
     if n_objects > limit:
         raise ParameterError(
             f"objects: at most {limit} objects of {opts.size[0]:g} x {opts.size[1]:g} m with "
@@ -145,6 +155,13 @@ def generate_instance(
     )
 
 
+def _smallest(opts: GeneratorOptions) -> GeneratorOptions:
+    """The options with the smallest footprint of the dense family's sizes: the area bound of
+    a table of mixed sizes."""
+    small = min(DENSE_SIZES, key=lambda s: s[0] * s[1])
+    return GeneratorOptions(size=small, workspace=opts.workspace, gap=opts.gap)
+
+
 def _extent(opts: GeneratorOptions) -> str:
     ws = opts.workspace
     return f"{ws.x[1] - ws.x[0]:g} x {ws.y[1] - ws.y[0]:g} m"
@@ -171,6 +188,9 @@ def _verified(family: str, inst: Instance) -> bool:
     if family == "M":
         s = g.structure()
         return bool(s.independent and s.chains and s.cycles)
+    if family == "N":  # at least one pair of neighbours trading places
+        edges = set(g.edges)
+        return any((j, i) in edges for i, j in edges)
     return True
 
 
@@ -215,6 +235,8 @@ def _attempt(
 ) -> Instance | int | None:
     """An instance; or the number of objects placed when a random arrangement found no
     room for the next one; or ``None`` when the goals could not be pinned."""
+    if family == "N":
+        return _dense_attempt(n, rng, opts, name, seed)
     sizes = np.tile(np.array(opts.size[:2]), (n, 1))
     starts = _arrangement(n, sizes, rng, opts)
     if len(starts) < n:
@@ -234,6 +256,30 @@ def _attempt(
         for i in range(n)
     )
     return Instance(name, opts.workspace, objects, family=family, seed=seed)
+
+
+def _dense_attempt(
+    n: int, rng: np.random.Generator, opts: GeneratorOptions, name: str, seed: int
+) -> Instance | int | None:
+    """A dense instance (``opts.size`` is not used: the sizes are mixed)."""
+    ws = opts.workspace
+    sizes = dense_sizes(n, rng)
+    starts = packed_arrangement(sizes, rng, ws.x, ws.y, opts.gap, opts.samples)
+    if len(starts) < n:
+        return len(starts)
+    goals, swapped = dense_goals(starts, sizes, neighbour_pairs(n, rng), rng, opts.gap, ws.x, ws.y)
+    if not swapped:
+        return None
+    objects = tuple(
+        ObjectSpec(
+            f"o{i}",
+            (float(sizes[i, 0]), float(sizes[i, 1]), float(sizes[i, 2])),
+            Pose2D(*map(float, starts[i])),
+            Pose2D(*map(float, goals[i])),
+        )
+        for i in range(n)
+    )
+    return Instance(name, ws, objects, family="N", seed=seed)
 
 
 def _candidates(

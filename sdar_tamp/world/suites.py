@@ -4,6 +4,8 @@
   and the mixed cases ``M1`` to ``M10`` (12 objects each): 37 instances.
 * ``stress``: R, S, D and mixed with 16, 20 and 24 objects (``R16`` ... ``D24``; the mixed ones
   are named ``Mn16``, ``Mn20``, ``Mn24`` since ``M#`` is an index in the paper): 12 instances.
+* ``dense``: the dense family ``N`` with 16, 20 and 24 objects at the paper's clearance
+  (``N16``, ``N20``, ``N24``): mixed sizes, neighbours trading places, turned goals.
 
 Seeds are fixed per instance (:func:`suite_members`), so a suite regenerates identically. The
 shipped copies live in ``domains/dual_arm_rearrangement/suites/<suite>/``.
@@ -19,8 +21,8 @@ from sdar_tamp.world.errors import SuiteError
 from sdar_tamp.world.generators import Acceptance, GeneratorOptions, generate_instance
 from sdar_tamp.world.instance import Instance, load_instance, save_instance
 
-SUITES = ("paper", "stress")
-_FAMILY_SEED = {"R": 1000, "S": 2000, "D": 3000, "M": 4000}
+SUITES = ("paper", "stress", "dense")
+_FAMILY_SEED = {"R": 1000, "S": 2000, "D": 3000, "M": 4000, "N": 5000}
 STRESS_GAP = 0.01  # [m]
 
 
@@ -56,6 +58,8 @@ def suite_members(suite: str) -> tuple[SuiteMember, ...]:
             for n in (16, 20, 24)
         ]
         return tuple(members)
+    if suite == "dense":
+        return tuple(SuiteMember(f"N{n}", "N", n, _FAMILY_SEED["N"] + n) for n in (16, 20, 24))
     raise SuiteError(f"unknown suite {suite!r}; expected one of {list(SUITES)}")
 
 

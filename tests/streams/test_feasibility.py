@@ -112,6 +112,19 @@ def test_the_stress_suite_is_generated_without_provably_unsolvable_instances(
     assert accepted == shipped[[i.name for i in shipped].index("D20")]
 
 
+def test_the_dense_suite_is_generated_without_provably_unsolvable_instances(
+    ctx: WorldContext,
+) -> None:
+    check = ProofCheck(ctx)
+    shipped = load_suite("dense")
+    assert all(check(inst) is None for inst in shipped)
+    m = suite_members("dense")[0]
+    first = generate_instance(m.family, m.n_objects, m.seed, name=m.name)
+    reason = check(first)  # packed at the paper's clearance: the first sample boxes o0 in
+    assert reason is not None and "picked first" in reason and "o0" in reason
+    assert generate_instance(m.family, m.n_objects, m.seed, name=m.name, accept=check) == shipped[0]
+
+
 def test_too_little_room_for_the_planner_is_told_apart_from_no_plan_at_all(
     ctx: WorldContext,
 ) -> None:
