@@ -118,8 +118,9 @@ class DualArmTrajOpt:
     """The NLP for one :class:`TrajOptOptions`, built at construction, solved many times.
 
     The collision rows of one knot are one small CasADi function of that knot's joints and
-    the parameters, mapped over the interior knots (``Function.map``) and expanded, so the
-    symbolic work is done once per knot shape rather than once per knot. A slot names its
+    the parameters, mapped over the interior knots (``Function.map``), and so are their
+    derivatives (see :meth:`_build`): the build differentiates one knot, not the whole
+    horizon, and takes a fraction of a second. A slot names its
     sphere by the joint frame it hangs on (a one-hot row over the six frames of its arm; a
     held sphere hangs on tool0) and its centre [m] and radius [m] in that frame, so the
     graph grows with the frames, not with every sphere of the arm."""
@@ -176,19 +177,51 @@ class DualArmTrajOpt:
         return ca.vertcat(*g)
 
     def _build(self) -> None:
-        o, lay, K = self.options, self._lay, self.options.knots
-        dof = self._arms.dof
-        q_knot, p_knot = sx_sym("q", dof), sx_sym("p", lay.size)
-        rows = ca.Function("knot_clearance", [q_knot, p_knot], [self._knot_rows(q_knot, p_knot)])
-        self._n_collision = int(rows.size1_out(0)) * (K - 2)
-        x, p = ca.MX.sym("x", (K - 2) * dof), ca.MX.sym("p", lay.size)
-        X = ca.reshape(x, dof, K - 2)
+        """The NLP over the interior knots, with its derivatives assembled from one knot's:
+        the clearance rows, their Jacobian and the Hessian of their weighted sum are small
+        SX functions of one knot, mapped over the knots, so CasADi differentiates one knot,
+        not the whole horizon (the collision Jacobian and Hessian are block diagonal)."""
+        o, lay = self.options, self._lay
+        dof, n = self._arms.dof, self.options.knots - 2
+        q_k, p_k = sx_sym("q", dof), sx_sym("p", lay.size)
+        rows_k = self._knot_rows(q_k, p_k)
+        lam_k = sx_sym("lam", int(rows_k.shape[0]))
+        rows = ca.Function("knot_rows", [q_k, p_k], [rows_k])
+        rows_jac = ca.Function("knot_rows_jac", [q_k, p_k], [rows_k, ca.jacobian(rows_k, q_k)])
+        rows_hess = ca.Function(
+            "knot_rows_hess",
+            [q_k, p_k, lam_k],
+            [ca.triu(ca.hessian(ca.dot(lam_k, rows_k), q_k)[0])],
+        )
+        n_rows = int(rows_k.shape[0])
+        self._n_collision = n_rows * n
+
+        x, p = ca.MX.sym("x", n * dof), ca.MX.sym("p", lay.size)
+        X = ca.reshape(x, dof, n)  # one column per interior knot
         Q = ca.horzcat(lay.sym(p, "q0").T, X, lay.sym(p, "q1").T)
         d1 = Q[:, 1:] - Q[:, :-1]
         d2 = Q[:, 2:] - 2 * Q[:, 1:-1] + Q[:, :-2]
         cost = o.w_length * ca.sumsqr(d1) + ca.sumsqr(d2)
-        clearance = rows.map(K - 2)(X, p)  # (rows, K - 2): one column per interior knot
-        g = ca.vertcat(ca.vec(clearance), ca.vec(d1), ca.vec(d2))
+        linear = ca.vertcat(ca.vec(d1), ca.vec(d2))
+        g = ca.vertcat(ca.vec(rows.map(n)(X, p)), linear)
+
+        def blocks(M: Any) -> Any:  # (r, dof * n) side by side -> block diagonal
+            return ca.diagcat(*[M[:, k * dof : (k + 1) * dof] for k in range(n)])
+
+        g_knots, J_knots = rows_jac.map(n)(X, p)
+        jac_g = ca.Function(
+            "jac_g", [x, p],
+            [ca.vertcat(ca.vec(g_knots), linear),
+             ca.vertcat(blocks(J_knots), ca.jacobian(linear, x))],
+            ["x", "p"], ["g", "jac_g_x"],
+        )  # fmt: skip
+        lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", int(g.shape[0]))
+        H_knots = rows_hess.map(n)(X, p, ca.reshape(lam_g[: n_rows * n], n_rows, n))
+        hess_lag = ca.Function(
+            "hess_lag", [x, p, lam_f, lam_g],
+            [lam_f * ca.triu(ca.hessian(cost, x)[0]) + blocks(H_knots)],
+            ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"],
+        )  # fmt: skip
         nlp = {"x": x, "p": p, "f": cost, "g": g}
         opts = {
             "ipopt.print_level": 0,
@@ -200,13 +233,15 @@ class DualArmTrajOpt:
             "ipopt.acceptable_iter": 3,
             "ipopt.constr_viol_tol": 1e-4,
             "ipopt.mu_strategy": "adaptive",
-            "expand": True,
+            "jac_g": jac_g,
+            "hess_lag": hess_lag,
         }
         self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", nlp, opts)
-        self._g_fn = ca.Function("g", [x, p], [g]).expand()
+        self._nlp, self._jac_g, self._hess_lag = nlp, jac_g, hess_lag
+        self._g_fn = ca.Function("g", [x, p], [g])
         scene = self.ctx.scene
         lo, hi = scene.joint_array("lower"), scene.joint_array("upper")
-        self._lbx, self._ubx = np.tile(lo, K - 2), np.tile(hi, K - 2)
+        self._lbx, self._ubx = np.tile(lo, n), np.tile(hi, n)
         self._vmax = scene.joint_array("velocity_limit")
         self._amax = scene.joint_array("acceleration_limit")
 
