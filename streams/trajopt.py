@@ -405,7 +405,7 @@ def _arm_sphere_table(ctx: WorldContext, arm: str) -> _ArmSphereTables:
 
 class OptimiserBuild:
     """A :class:`DualArmTrajOpt` under construction in a background thread (building the NLP
-    takes a few seconds of CPU; planning that needs no optimisation goes on meanwhile).
+    takes a few tenths of a second of CPU; planning that needs no optimisation goes on meanwhile).
 
     :meth:`get` waits for it (``waited`` [s] adds up the waits) and re-raises an error of
     the build. ``build_time`` [s] is the CPU time of the build (NaN until it is done)."""
