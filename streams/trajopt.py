@@ -10,8 +10,9 @@ small weight on squared first differences (length). Constraints at every interio
   (``T`` per call; the exact timing is :mod:`streams.timing`'s job);
 * sphere clearances in *slots*: arm-arm (coarse spheres, held objects included, so the two
   held objects are checked against each other), arm-obstacle per arm, arm-table per arm.
-  A slot picks one sphere of an arm with a one-hot parameter row, so the NLP is built once
-  and each call chooses the pairs that matter: the ones closest along the warm start,
+  A slot names one sphere of an arm by parameters (its joint frame, as a one-hot row, and
+  its centre and radius in that frame), so the NLP is built once and each call chooses the
+  pairs that matter: the ones closest along the warm start,
   refreshed by an active-set round when the solution comes near a pair without a slot.
 
 The evenly spaced straight line is the unconstrained minimiser of the cost; when it satisfies
@@ -36,7 +37,7 @@ from sdar_tamp.logs import get_logger
 from sdar_tamp.world.transforms import FloatArray
 from streams._casadi import ca, sx_sym, to_array
 from streams.context import WorldContext
-from streams.fk_casadi import joint_frames, sphere_centres
+from streams.fk_casadi import joint_frames
 from streams.sphere_pairs import (
     HeldSpheres,
     PathSpheres,
@@ -114,76 +115,114 @@ class _Layout:
 
 
 class DualArmTrajOpt:
-    """The NLP for one :class:`TrajOptOptions`, built at construction, solved many times."""
+    """The NLP for one :class:`TrajOptOptions`, built at construction, solved many times.
+
+    The collision rows of one knot are one small CasADi function of that knot's joints and
+    the parameters, mapped over the interior knots (``Function.map``), and so are their
+    derivatives (see :meth:`_build`): the build differentiates one knot, not the whole
+    horizon, and takes a fraction of a second. A slot names its
+    sphere by the joint frame it hangs on (a one-hot row over the six frames of its arm; a
+    held sphere hangs on tool0) and its centre [m] and radius [m] in that frame, so the
+    graph grows with the frames, not with every sphere of the arm."""
 
     def __init__(self, ctx: WorldContext, options: TrajOptOptions | None = None) -> None:
         self.ctx = ctx
         self.options = o = options or TrajOptOptions()
-        arms = ctx.arm_names
         self._arms = self.ctx.layout
         dof = self._arms.dof
-        self._n_arm = [len(ctx.fk[a].spheres) + o.held_slots for a in arms]
-        self._n_coarse = [len(ctx.fk[a].coarse) + o.held_slots for a in arms]
         lay = _Layout()
         lay.add("q0", 1, dof)
         lay.add("q1", 1, dof)
         for i in range(len(self._arms)):
-            lay.add(f"held{i}", o.held_slots, 4)
-            lay.add(f"aa_sel{i}", o.arm_arm_slots, self._n_coarse[i])
-            lay.add(f"ao_sel{i}", o.obstacle_slots, self._n_arm[i])
+            for kind, slots in _slot_kinds(o):
+                lay.add(f"{kind}_frame{i}", slots, FRAMES)
+                lay.add(f"{kind}_centre{i}", slots, 3)
+                lay.add(f"{kind}_radius{i}", slots, 1)
             lay.add(f"ao_obs{i}", o.obstacle_slots, 4)
-            lay.add(f"t_sel{i}", o.table_slots, self._n_arm[i])
         lay.add("margin", 1, 1)
         self._lay = lay
+        self._spheres = [_arm_sphere_table(ctx, arm) for arm in ctx.arm_names]
         self._build()
 
     # -- construction ------------------------------------------------------------------
-    def _arm_spheres_sx(self, i: int, q: Any, p: Any) -> tuple[Any, Any, Any, Any]:
-        """Fine and coarse sphere centres ``(n, 3)`` and radii ``(n, 1)`` (held ones last)."""
-        arm = self.ctx.arm_names[i]
-        fk = self.ctx.fk[arm]
-        frames = joint_frames(q, fk.T_world_base)
-        held = self._lay.sym(p, f"held{i}")
-        tool0 = frames[5]
-        hc = (tool0[:3, :3] @ held[:, :3].T + ca.repmat(tool0[:3, 3], 1, held.shape[0])).T
-        C = ca.vertcat(sphere_centres(frames, fk.spheres), hc)
-        R = ca.vertcat(ca.DM(fk.spheres.radius), held[:, 3])
-        CC = ca.vertcat(sphere_centres(frames, fk.coarse), hc)
-        CR = ca.vertcat(ca.DM(fk.coarse.radius), held[:, 3])
-        return C, R, CC, CR
+    def _slot_centres(self, frames: list[Any], p: Any, kind: str, i: int) -> tuple[Any, Any]:
+        """World centres ``(slots, 3)`` and radii ``(slots, 1)`` of one arm's slots."""
+        lay = self._lay
+        W, C = lay.sym(p, f"{kind}_frame{i}"), lay.sym(p, f"{kind}_centre{i}")
+        n = int(W.shape[0])
+        P: Any = 0
+        for j, T in enumerate(frames):
+            placed = T[:3, :3] @ C.T + ca.repmat(T[:3, 3], 1, n)
+            P = P + placed * ca.repmat(W[:, j].T, 3, 1)
+        return P.T, lay.sym(p, f"{kind}_radius{i}")
+
+    def _knot_rows(self, q: Any, p: Any) -> Any:
+        """The collision rows of one knot ``q`` ``(dof,)``: arm-arm slots, then arm-obstacle
+        and arm-table slots per arm."""
+        lay, arms = self._lay, self._arms
+        m = lay.sym(p, "margin")
+        frames = [
+            joint_frames(q[sl], self.ctx.fk[arm].T_world_base)
+            for arm, sl in zip(self.ctx.arm_names, arms.slices, strict=True)
+        ]
+        (cl, rl), (cr, rr) = (self._slot_centres(frames[i], p, "aa", i) for i in (0, 1))
+        g = [ca.sum2((cl - cr) ** 2) - (rl + rr + m) ** 2]
+        for i in range(len(arms)):
+            c, r = self._slot_centres(frames[i], p, "ao", i)
+            obs = lay.sym(p, f"ao_obs{i}")
+            g.append(ca.sum2((c - obs[:, :3]) ** 2) - (r + obs[:, 3] + m) ** 2)
+        for i in range(len(arms)):
+            c, r = self._slot_centres(frames[i], p, "t", i)
+            g.append(c[:, 2] - r - m)
+        return ca.vertcat(*g)
 
     def _build(self) -> None:
-        o, lay, K = self.options, self._lay, self.options.knots
-        arms, dof = self._arms, self._arms.dof
-        x = sx_sym("x", (K - 2) * dof)
-        p = sx_sym("p", lay.size)
-        q0, q1 = lay.sym(p, "q0").T, lay.sym(p, "q1").T
-        Q = [q0] + [x[dof * k : dof * (k + 1)] for k in range(K - 2)] + [q1]
-        m = lay.sym(p, "margin")
-        cost = 0
-        for k in range(K - 1):
-            cost += o.w_length * ca.sumsqr(Q[k + 1] - Q[k])
-        for k in range(1, K - 1):
-            cost += ca.sumsqr(Q[k + 1] - 2 * Q[k] + Q[k - 1])
-        g: list[Any] = []
-        sel = {name: lay.sym(p, name) for name in lay.blocks if "sel" in name or "obs" in name}
-        for k in range(1, K - 1):
-            CR = [self._arm_spheres_sx(i, Q[k][sl], p) for i, sl in enumerate(arms.slices)]
-            cl, cr = sel["aa_sel0"] @ CR[0][2], sel["aa_sel1"] @ CR[1][2]
-            rl, rr = sel["aa_sel0"] @ CR[0][3], sel["aa_sel1"] @ CR[1][3]
-            g.append(ca.sum2((cl - cr) ** 2) - (rl + rr + m) ** 2)
-            for i in range(len(arms)):
-                C, R = CR[i][0], CR[i][1]
-                obs = sel[f"ao_obs{i}"]
-                c, r = sel[f"ao_sel{i}"] @ C, sel[f"ao_sel{i}"] @ R
-                g.append(ca.sum2((c - obs[:, :3]) ** 2) - (r + obs[:, 3] + m) ** 2)
-            for i in range(len(arms)):
-                C, R = CR[i][0], CR[i][1]
-                g.append(sel[f"t_sel{i}"] @ C[:, 2] - sel[f"t_sel{i}"] @ R - m)
-        self._n_collision = sum(int(e.shape[0]) for e in g)
-        g.extend(Q[k + 1] - Q[k] for k in range(K - 1))
-        g.extend(Q[k + 1] - 2 * Q[k] + Q[k - 1] for k in range(1, K - 1))
-        nlp = {"x": x, "p": p, "f": cost, "g": ca.vertcat(*g)}
+        """The NLP over the interior knots, with its derivatives assembled from one knot's:
+        the clearance rows, their Jacobian and the Hessian of their weighted sum are small
+        SX functions of one knot, mapped over the knots, so CasADi differentiates one knot,
+        not the whole horizon (the collision Jacobian and Hessian are block diagonal)."""
+        o, lay = self.options, self._lay
+        dof, n = self._arms.dof, self.options.knots - 2
+        q_k, p_k = sx_sym("q", dof), sx_sym("p", lay.size)
+        rows_k = self._knot_rows(q_k, p_k)
+        lam_k = sx_sym("lam", int(rows_k.shape[0]))
+        rows = ca.Function("knot_rows", [q_k, p_k], [rows_k])
+        rows_jac = ca.Function("knot_rows_jac", [q_k, p_k], [rows_k, ca.jacobian(rows_k, q_k)])
+        rows_hess = ca.Function(
+            "knot_rows_hess",
+            [q_k, p_k, lam_k],
+            [ca.triu(ca.hessian(ca.dot(lam_k, rows_k), q_k)[0])],
+        )
+        n_rows = int(rows_k.shape[0])
+        self._n_collision = n_rows * n
+
+        x, p = ca.MX.sym("x", n * dof), ca.MX.sym("p", lay.size)
+        X = ca.reshape(x, dof, n)  # one column per interior knot
+        Q = ca.horzcat(lay.sym(p, "q0").T, X, lay.sym(p, "q1").T)
+        d1 = Q[:, 1:] - Q[:, :-1]
+        d2 = Q[:, 2:] - 2 * Q[:, 1:-1] + Q[:, :-2]
+        cost = o.w_length * ca.sumsqr(d1) + ca.sumsqr(d2)
+        linear = ca.vertcat(ca.vec(d1), ca.vec(d2))
+        g = ca.vertcat(ca.vec(rows.map(n)(X, p)), linear)
+
+        def blocks(M: Any) -> Any:  # (r, dof * n) side by side -> block diagonal
+            return ca.diagcat(*[M[:, k * dof : (k + 1) * dof] for k in range(n)])
+
+        g_knots, J_knots = rows_jac.map(n)(X, p)
+        jac_g = ca.Function(
+            "jac_g", [x, p],
+            [ca.vertcat(ca.vec(g_knots), linear),
+             ca.vertcat(blocks(J_knots), ca.jacobian(linear, x))],
+            ["x", "p"], ["g", "jac_g_x"],
+        )  # fmt: skip
+        lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", int(g.shape[0]))
+        H_knots = rows_hess.map(n)(X, p, ca.reshape(lam_g[: n_rows * n], n_rows, n))
+        hess_lag = ca.Function(
+            "hess_lag", [x, p, lam_f, lam_g],
+            [lam_f * ca.triu(ca.hessian(cost, x)[0]) + blocks(H_knots)],
+            ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"],
+        )  # fmt: skip
+        nlp = {"x": x, "p": p, "f": cost, "g": g}
         opts = {
             "ipopt.print_level": 0,
             "print_time": False,
@@ -194,13 +233,15 @@ class DualArmTrajOpt:
             "ipopt.acceptable_iter": 3,
             "ipopt.constr_viol_tol": 1e-4,
             "ipopt.mu_strategy": "adaptive",
-            "expand": True,
+            "jac_g": jac_g,
+            "hess_lag": hess_lag,
         }
         self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", nlp, opts)
-        self._g_fn = ca.Function("g", [x, p], [nlp["g"]])
+        self._nlp, self._jac_g, self._hess_lag = nlp, jac_g, hess_lag
+        self._g_fn = ca.Function("g", [x, p], [g])
         scene = self.ctx.scene
         lo, hi = scene.joint_array("lower"), scene.joint_array("upper")
-        self._lbx, self._ubx = np.tile(lo, K - 2), np.tile(hi, K - 2)
+        self._lbx, self._ubx = np.tile(lo, n), np.tile(hi, n)
         self._vmax = scene.joint_array("velocity_limit")
         self._amax = scene.joint_array("acceleration_limit")
 
@@ -273,19 +314,19 @@ class DualArmTrajOpt:
         lay.put(p, "q1", query.q_goal)
         lay.put(p, "margin", np.array([o.margin]))
         for i in range(len(self._arms)):
-            held = np.zeros((o.held_slots, 4))
-            h = query.held[i]
-            held[: len(h.radius), :3] = h.centre
-            held[: len(h.radius), 3] = h.radius
-            lay.put(p, f"held{i}", held)
-            lay.put(p, f"aa_sel{i}", _one_hot(s.aa[:, i], o.arm_arm_slots, self._n_coarse[i]))
-            lay.put(p, f"ao_sel{i}", _one_hot(s.ao[i][:, 0], o.obstacle_slots, self._n_arm[i]))
+            fine, coarse = self._spheres[i].with_held(query.held[i])
+            chosen = (("aa", coarse, s.aa[:, i]), ("ao", fine, s.ao[i][:, 0]),
+                      ("t", fine, s.table[i]))  # fmt: skip
+            for (kind, slots), (_, table, idx) in zip(_slot_kinds(o), chosen, strict=True):
+                frame, centre, radius = table.slots(idx, slots)
+                lay.put(p, f"{kind}_frame{i}", frame)
+                lay.put(p, f"{kind}_centre{i}", centre)
+                lay.put(p, f"{kind}_radius{i}", radius)
             obs = np.zeros((o.obstacle_slots, 4))
             idx = s.ao[i][:, 1]
             obs[: len(idx), :3] = query.obstacles[0][idx]
             obs[: len(idx), 3] = query.obstacles[1][idx]
             lay.put(p, f"ao_obs{i}", obs)
-            lay.put(p, f"t_sel{i}", _one_hot(s.table[i], o.table_slots, self._n_arm[i]))
         per_knot = np.concatenate(
             [_slot_lb(s.aa_lb, o.arm_arm_slots)]
             + [_slot_lb(lb, o.obstacle_slots) for lb in s.ao_lb]
@@ -303,9 +344,68 @@ class DualArmTrajOpt:
         return p, lbg, ubg
 
 
+#: Joint frames of an arm a sphere may hang on (frame ``j`` carries link ``j + 1``; tool0 is
+#: the last).
+FRAMES = 6
+
+
+def _slot_kinds(o: TrajOptOptions) -> tuple[tuple[str, int], ...]:
+    """Slot blocks per arm, in the order of the rows: arm-arm, arm-obstacle, arm-table."""
+    return (("aa", o.arm_arm_slots), ("ao", o.obstacle_slots), ("t", o.table_slots))
+
+
+@dataclass(frozen=True)
+class _SphereTable:
+    """Spheres of one arm as the optimiser's slots see them: frame index ``(n,)`` (0-based),
+    centre in that frame ``(n, 3)`` [m], radius ``(n,)`` [m]."""
+
+    frame: Any
+    centre: FloatArray
+    radius: FloatArray
+
+    def plus(self, held: HeldSpheres) -> _SphereTable:
+        """With the held spheres appended (on tool0), as :func:`path_spheres` orders them."""
+        n = len(held.radius)
+        return _SphereTable(
+            np.concatenate([self.frame, np.full(n, FRAMES - 1, dtype=np.int64)]),
+            np.concatenate([self.centre, np.asarray(held.centre).reshape(n, 3)]),
+            np.concatenate([self.radius, held.radius]),
+        )
+
+    def slots(self, idx: Any, slots: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Slot rows for spheres ``idx``: one-hot frames ``(slots, FRAMES)``, centres
+        ``(slots, 3)``, radii ``(slots, 1)``; unused slots are zero."""
+        idx = np.asarray(idx, dtype=np.int64)
+        frame = np.zeros((slots, FRAMES))
+        centre, radius = np.zeros((slots, 3)), np.zeros((slots, 1))
+        frame[np.arange(len(idx)), self.frame[idx]] = 1.0
+        centre[: len(idx)] = self.centre[idx]
+        radius[: len(idx), 0] = self.radius[idx]
+        return frame, centre, radius
+
+
+@dataclass(frozen=True)
+class _ArmSphereTables:
+    fine: _SphereTable
+    coarse: _SphereTable
+
+    def with_held(self, held: HeldSpheres) -> tuple[_SphereTable, _SphereTable]:
+        return self.fine.plus(held), self.coarse.plus(held)
+
+
+def _arm_sphere_table(ctx: WorldContext, arm: str) -> _ArmSphereTables:
+    fk = ctx.fk[arm]
+
+    def table(spheres: Any) -> _SphereTable:
+        frame = np.asarray(spheres.joint, dtype=np.int64) - 1
+        return _SphereTable(frame, np.asarray(spheres.centre), np.asarray(spheres.radius))
+
+    return _ArmSphereTables(table(fk.spheres), table(fk.coarse))
+
+
 class OptimiserBuild:
     """A :class:`DualArmTrajOpt` under construction in a background thread (building the NLP
-    takes a few seconds of CPU; planning that needs no optimisation goes on meanwhile).
+    takes a few tenths of a second of CPU; planning that needs no optimisation goes on meanwhile).
 
     :meth:`get` waits for it (``waited`` [s] adds up the waits) and re-raises an error of
     the build. ``build_time`` [s] is the CPU time of the build (NaN until it is done)."""
@@ -391,12 +491,6 @@ def densify(path: FloatArray, factor: int) -> FloatArray:
     s = np.linspace(0.0, 1.0, factor + 1)[:-1]
     seg = path[:-1, None] * (1.0 - s[None, :, None]) + path[1:, None] * s[None, :, None]
     return np.concatenate([seg.reshape(-1, path.shape[1]), path[-1:]])
-
-
-def _one_hot(idx: FloatArray, slots: int, n: int) -> FloatArray:
-    out = np.zeros((slots, n))
-    out[np.arange(len(idx)), np.asarray(idx, dtype=np.int64)] = 1.0
-    return out
 
 
 def _slot_lb(lb: FloatArray, slots: int) -> FloatArray:

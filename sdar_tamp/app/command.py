@@ -51,7 +51,7 @@ def solve_instance(
     before the instance is read.
 
     ``cache``: keeps the world and the motion planner between calls with the same scene
-    (building the optimiser takes a few seconds; it is reported as ``setup_time``, not as
+    (building the optimiser takes a few tenths of a second; it is reported as ``setup_time``, not as
     planning time).
 
     Raises:

@@ -68,9 +68,9 @@ def rearrangement_problem(
     ``config``: the planner configuration (default: :class:`PlannerConfig`); ``seed``,
     ``motion`` (its ``motion_planner``) and ``gripper_time`` [s], when given, replace its
     fields. ``planner``: a motion planner to share between problems (its optimiser takes a
-    few seconds to build; default: a new one with ``config.trajopt``). ``overrides``: stream
-    name -> plain callable replacing the shipped stream (same signature and kind as in
-    :mod:`streams.stream_map`).
+    few tenths of a second to build; default: a new one with ``config.trajopt``).
+    ``overrides``: stream name -> plain callable replacing the shipped stream (same signature
+    and kind as in :mod:`streams.stream_map`).
 
     Raises:
         ParameterError: a value out of range, an unknown motion planner or stream name.

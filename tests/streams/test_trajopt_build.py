@@ -12,7 +12,7 @@ from streams.context import WorldContext
 from streams.trajopt import OptimiserBuild, TrajOptOptions
 
 build = OptimiserBuild(WorldContext.load(), TrajOptOptions())
-time.sleep(1.5)  # deep in the build (it takes a few seconds of CPU) when the program ends
+time.sleep(0.05)  # in the build (a few tenths of a second of CPU) when the program ends
 """
 
 
