@@ -362,9 +362,9 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument(
         "--execution",
         choices=("sync", "async"),
-        default="sync",
+        default="async",
         help="sync: both arms on one synchronous timeline; async: each arm on its own, "
-        "kept only when shorter and collision-free (default: sync)",
+        "re-timed for itself, kept only when shorter and valid (default: async)",
     )
     solve.add_argument("--json", action="store_true", help=_JSON + " (implies -q)")
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress bar")

@@ -20,6 +20,7 @@ from sdar_tamp.app.config import (
     PlannerConfig,
     check_choice,
 )
+from sdar_tamp.app.execution import schedule_plan
 from sdar_tamp.app.plan_export import decoder_of, motion_levels, plan_file_from_solution
 from sdar_tamp.app.problem import rearrangement_problem
 from sdar_tamp.app.records import RunFigures, SolveOutcome, task_records
@@ -27,7 +28,6 @@ from sdar_tamp.app.solving import solve_rearrangement
 from sdar_tamp.arguments import SEED, TIME_LIMIT
 from sdar_tamp.plan_rules import Violation
 from sdar_tamp.replay import validate_plan
-from sdar_tamp.schedule import schedule_async
 from sdar_tamp.world.instance import load_instance
 
 
@@ -114,7 +114,7 @@ def solve_instance(
     plan = plan_file_from_solution(rearrangement, solution, metrics)
     if config.execution == "async":
         started = time.perf_counter()
-        plan = schedule_async(plan, instance, rearrangement.ctx.scene).plan
+        plan = schedule_plan(plan, instance, rearrangement.ctx.scene, world.planner.shape).plan
         figures = dataclasses.replace(figures, schedule_time=time.perf_counter() - started)
     report = validate_plan(instance, plan, rearrangement.ctx.scene)
     violation = "" if report.ok or report.violation is None else describe(report.violation)

@@ -19,7 +19,8 @@ from numpy.typing import NDArray
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import FILE_ARM_JOINTS, FILE_ARMS, PlanEvent, PlanFile, StepRecord
 from sdar_tamp.plan_rules import STILL_TOL
-from sdar_tamp.schedule.spline import retime
+from sdar_tamp.schedule.retiming import ArmRetimer, on_ticks
+from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
 
@@ -82,12 +83,21 @@ def _rest_points(t: FloatArray, i: int, j: int) -> list[int]:
 
 
 def arm_blocks(
-    plan: PlanFile, scene: Scene, arm: int, tick: float, retimed: bool = True
+    plan: PlanFile,
+    scene: Scene,
+    arm: int,
+    tick: float,
+    retimed: bool = True,
+    retimer: ArmRetimer | None = None,
 ) -> list[Block]:
     """The blocks of arm ``arm`` in order, every motion on a grid of ``tick`` [s]: at its
-    synchronous pace (see :func:`on_ticks`) or, with ``retimed``, re-timed for the arm's own
-    limits (:func:`~sdar_tamp.schedule.spline.retime`) when that is shorter."""
+    synchronous pace (see :func:`on_ticks`) or, with ``retimed``, re-timed for the arm alone
+    by ``retimer`` (default: uniformly faster, :class:`ArmRetimer` without a path timer) when
+    that is shorter."""
     spec = scene.arms[arm]
+    v, a = np.array(spec.velocity_limit), np.array(spec.acceleration_limit)
+    if retimer is None:
+        retimer = ArmRetimer(ArmKinematics.from_scene(scene, spec.name), v, a, tick)
     t, q = plan.t, plan.q[:, arm_columns(arm)]
     moving = np.any(np.abs(np.diff(q, axis=0)) > STILL_TOL, axis=1)
     cuts: list[tuple[int, int]] = []
@@ -105,14 +115,14 @@ def arm_blocks(
             attached[k] = e
         else:
             after.setdefault(k, []).append(e)
-    v, a = np.array(spec.velocity_limit), np.array(spec.acceleration_limit)
     blocks = [_still(arm, q[0], e, t) for e in after.get(-1, [])]
     for k, (i, j) in enumerate(cuts):
         sync = on_ticks(t[i : j + 1], q[i : j + 1], tick, v, a)
         samples = sync
         if retimed:
-            fast = retime(t[i : j + 1], q[i : j + 1], v, a, tick)
-            samples = fast if len(fast) < len(sync) else sync
+            slow_start = bool(after.get(k - 1)) or (k - 1) in attached
+            slow_end = k in attached
+            samples = retimer.retime(t[i : j + 1], q[i : j + 1], slow_start, slow_end)
         step = _step_at(plan, 0.5 * (t[i] + t[j]))
         event = attached.get(k)
         blocks.append(Block(arm, samples, sync, event, float(t[i]), float(t[j]), i, step))
@@ -124,19 +134,3 @@ def _still(arm: int, q_arm: FloatArray, e: PlanEvent, t: FloatArray) -> Block:
     """An event without a motion before it (the arm stands where it is)."""
     row = np.array(q_arm)[None]
     return Block(arm, row, row, e, e.t, e.t, int(np.searchsorted(t, e.t)), None)
-
-
-def on_ticks(
-    t: FloatArray, q: FloatArray, tick: float, v_max: FloatArray, a_max: FloatArray
-) -> FloatArray:
-    """The rest-to-rest motion ``q`` ``(m, 6)`` at ``t`` ``(m,)`` on a grid of ``tick`` [s].
-
-    When no sampling step exceeds ``tick``, the same samples one tick apart: every step gets
-    ``c = tick / h >= 1`` times longer, velocities shrink by ``1 / c`` and accelerations
-    (second divided differences, with the arm at rest one tick before and after) by at least
-    as much, so the motion meets every limit the original met. Otherwise the smooth motion
-    through the samples at its own pace or slower, within ``v_max`` [rad/s] and ``a_max``
-    [rad/s^2] ``(6,)`` (:func:`~sdar_tamp.schedule.spline.retime`)."""
-    if np.all(np.diff(t) <= tick + 1e-12):
-        return np.array(q)
-    return retime(t, q, v_max, a_max, tick, max_rate=1.0)

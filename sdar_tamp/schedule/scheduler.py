@@ -2,24 +2,29 @@
 
 In a synchronous plan a step lasts as long as the slower arm's motion and one arm's gripper
 dwell stops the other arm too. :func:`schedule_async` cuts each arm's timeline into blocks
-(:mod:`sdar_tamp.schedule.pieces`: rest-to-rest motions, each optionally ending in a gripper
-event and the arm's own dwell) and places them on a new common timeline of ``tick`` [s], one
-block at a time in the order they ended in the synchronous plan, each at the earliest tick that
+(:mod:`sdar_tamp.schedule.pieces`: rest-to-rest motions, each re-timed for its arm alone by
+:mod:`sdar_tamp.schedule.retiming` and optionally ending in a gripper event and the arm's own
+dwell) and places them on a new common timeline of ``tick`` [s], group by group (the blocks
+that overlapped in the synchronous plan, :func:`groups`), each block of a group at the
+earliest tick that
 
 * follows the arm's previous block (and its dwell),
 * keeps the cross-arm order of gripper events (``order="objects"``: the events on one object,
   the later one at least a dwell after the earlier; ``order="events"``: every event keeps its
   place relative to the other arm's events),
+* lets the block end no later than it ended in the synchronous plan,
 * and passes the replay (:mod:`sdar_tamp.schedule.sweep`) of everything from the arm's last
   block to the end of both timelines: no collision between the arms, their held objects, the
   table and the resting objects where they rest at that time; released objects land on free
   spots. An arm whose next block is not placed yet stands where its last block left it.
 
-Every stretch of the result is replayed once both arms are fixed there, so the schedule is
-collision-free at the validator's points. Blocks start and end at rest and are sampled on the
-common grid, so the limits hold (see :mod:`sdar_tamp.schedule.spline`). When no placement is
-found for a block within ``max_wait`` [s] (a block blocked by the other arm standing still
-where it will stay), the next ordering is tried, and at last the synchronous plan is kept.
+When a block finds no start, the group is taken back and tried with the other arm first; when
+that fails too, the group goes as in the synchronous plan (both arms at their synchronous pace
+and offsets), shifted as early as both arms allow: in the same configurations and world as
+there, so it passes. Every stretch of the result is replayed once both arms are fixed there,
+so the schedule is collision-free at the validator's points. Blocks start and end at rest and
+are sampled on the common grid, so the limits hold. The result is kept only when shorter than
+the synchronous plan (else the next ordering is tried, and at last the synchronous plan kept).
 """
 
 from __future__ import annotations
@@ -34,13 +39,14 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import GRIPPER_DWELL, MAX_DT, PlanEvent, PlanFile, StepRecord
 from sdar_tamp.plan_rules import check_timeline
 from sdar_tamp.schedule.pieces import Block, arm_blocks, arm_columns
+from sdar_tamp.schedule.retiming import ArmRetimer, PathTimer
 from sdar_tamp.schedule.sweep import Conflict, TimedEvent, WorldSweep
 from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
 
 ORDERS = ("objects", "events")
-MAX_PULLS = 4  #: blocks of the other arm that may go first when a block finds no start
 
 
 @dataclass(frozen=True)
@@ -48,7 +54,11 @@ class ScheduleOptions:
     """``tick`` [s]: the common grid (at most the plan format's 0.02 s); ``retime``: play each
     motion as fast as its arm's limits allow (else at its synchronous pace); ``orders``: the
     cross-arm event orderings to try, in turn; ``max_tcp_step`` [m]: the replay's resolution;
-    ``max_wait`` [s]: the longest delay tried for one block."""
+    ``max_wait`` [s]: the longest delay tried for one block; ``timer``: the time-optimal
+    path timing each arm's motions are re-timed with (None: uniformly faster, see
+    :mod:`sdar_tamp.schedule.retiming`); ``straight`` [m] and ``grasp_speed`` [m/s]: the slow
+    tool travel at a gripper event that re-timing keeps; ``max_checks``: the collision
+    queries the search may make; past them the remaining steps keep their synchronous pace."""
 
     tick: float = MAX_DT
     retime: bool = True
@@ -56,10 +66,22 @@ class ScheduleOptions:
     max_tcp_step: float = 0.005
     dwell: float = GRIPPER_DWELL
     max_wait: float = 20.0
+    max_checks: int = 40_000
+    timer: PathTimer | None = None
+    straight: float = 0.02
+    grasp_speed: float = 0.25
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.tick) and 0.0 < self.tick <= MAX_DT):
             raise ParameterError(f"tick: expected a time in (0, {MAX_DT}] s, got {self.tick!r}")
+        if isinstance(self.max_checks, bool) or not (
+            isinstance(self.max_checks, int) and self.max_checks > 0
+        ):
+            raise ParameterError(f"max_checks: expected an integer > 0, got {self.max_checks!r}")
+        for name in ("straight", "grasp_speed"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ParameterError(f"{name}: expected a finite number > 0, got {value!r}")
         for name in ("max_tcp_step", "dwell", "max_wait"):
             value = getattr(self, name)
             positive = value > 0.0 or name != "max_tcp_step"
@@ -117,7 +139,10 @@ def schedule_async(
     """Re-schedule the synchronous ``plan`` of ``instance`` for asynchronous execution (see the
     module docstring). The plan is assumed valid for ``instance`` in ``scene``."""
     options = options or ScheduleOptions()
-    blocks = [arm_blocks(plan, scene, i, options.tick, options.retime) for i in range(2)]
+    blocks = [
+        arm_blocks(plan, scene, i, options.tick, options.retime, retimer(scene, i, options))
+        for i in range(2)
+    ]
     sweep = WorldSweep(instance, scene, options.max_tcp_step)
     reasons = []
     for order in options.orders:
@@ -139,6 +164,36 @@ def schedule_async(
     return Schedule(plan, False, plan.duration, None, "", "; ".join(reasons), sweep.checks)
 
 
+def retimer(scene: Scene, arm: int, options: ScheduleOptions) -> ArmRetimer:
+    """The re-timing of arm ``arm`` (scene order) the ``options`` ask for."""
+    spec = scene.arms[arm]
+    return ArmRetimer(
+        ArmKinematics.from_scene(scene, spec.name),
+        np.array(spec.velocity_limit),
+        np.array(spec.acceleration_limit),
+        options.tick,
+        options.timer,
+        options.straight,
+        options.grasp_speed,
+    )
+
+
+def groups(blocks: list[list[Block]]) -> list[list[Block]]:
+    """Both arms' blocks in groups that overlapped (or touched) in the synchronous plan, in
+    time order; a group's blocks in the order they ended there."""
+    ordered = sorted((b for arm in blocks for b in arm), key=lambda b: (b.sync_start, b.arm))
+    out: list[list[Block]] = []
+    end = -math.inf
+    for b in ordered:
+        if out and b.sync_start <= end + 1e-9:
+            out[-1].append(b)
+            end = max(end, b.sync_key)
+        else:
+            out.append([b])
+            end = b.sync_key
+    return [sorted(g, key=lambda b: (b.sync_key, b.arm)) for g in out]
+
+
 class _Placement:
     """The greedy placement of both arms' blocks for one event ordering."""
 
@@ -154,6 +209,7 @@ class _Placement:
         self.tick = options.tick
         self.dwell = math.ceil(options.dwell / options.tick - 1e-9)
         self.max_wait = math.ceil(options.max_wait / options.tick)
+        self.max_checks = options.max_checks
         self.traj: list[list[FloatArray]] = [[plan.q[0, arm_columns(i)]] for i in range(2)]
         self.events: list[TimedEvent] = []
         self.event_tick: dict[int, int] = {}  # id(sync event) -> tick
@@ -163,56 +219,61 @@ class _Placement:
         return len(self.traj[arm]) - 1
 
     def run(self) -> PlanFile:
-        """Place every block in the order the blocks ended in the synchronous plan. A block
-        that finds no start goes together with the other arm's next block, both at their
-        synchronous pace and offset, when the two moved at the same time there; else the
-        other arm's next blocks may go first (at most ``MAX_PULLS``)."""
-        nxt = [0, 0]
-        while nxt[0] < len(self.blocks[0]) or nxt[1] < len(self.blocks[1]):
-            keys = [
-                self.blocks[a][nxt[a]].sync_key if nxt[a] < len(self.blocks[a]) else math.inf
-                for a in range(2)
-            ]
-            arm = 0 if keys[0] <= keys[1] else 1
-            block = self.blocks[arm][nxt[arm]]
-            try:
-                self.place([_Entry(arm, block, block.q, 0)])
-            except _NoPlacement as failure:
-                nxt[1 - arm] += self.recover(arm, block, nxt[1 - arm], failure)
-            nxt[arm] += 1
+        """Place the blocks group by group (:func:`groups`: the blocks that overlapped in the
+        synchronous plan), each block of a group on its own, in the order the blocks ended
+        there, at the earliest tick that lets its motion end no later than it did there. When
+        a block finds no such start, the group's blocks placed so far are taken back and the
+        whole group goes at once, every block at its synchronous pace and offset (a copy of
+        the synchronous plan's stretch, shifted earlier)."""
+        for group in groups(self.blocks):
+            mark = self.mark()
+            searching = self.sweep.checks < self.max_checks
+            if searching and (
+                self.alone(group) or (len(group) > 1 and self.alone(self.flipped(group)))
+            ):
+                continue
+            self.undo(mark)
+            first = min(b.sync_index for b in group)
+            self.place([_Entry(b.arm, b, b.q_sync, b.sync_index - first) for b in group])
         return self.assemble()
 
-    def recover(self, arm: int, block: Block, k: int, failure: _NoPlacement) -> int:
-        """Place ``block`` after its failure, with or after the other arm's blocks from its
-        ``k``-th on; the number of those placed. Raises ``failure`` when nothing works."""
-        other = self.blocks[1 - arm]
-        if k < len(other) and self.ready(other[k]):
-            ahead = other[k]
-            if ahead.sync_start < block.sync_end and block.sync_start < ahead.sync_end:
-                offset = ahead.sync_index - block.sync_index
-                pair = [
-                    _Entry(arm, block, block.q_sync, max(0, -offset)),
-                    _Entry(1 - arm, ahead, ahead.q_sync, max(0, offset)),
-                ]
-                try:
-                    self.place(pair)
-                    return 1
-                except _NoPlacement:
-                    pass
-        for pulled in range(1, MAX_PULLS + 1):
-            j = k + pulled - 1
-            if j >= len(other) or not self.ready(other[j]):
-                break
-            try:
-                self.place([_Entry(1 - arm, other[j], other[j].q, 0)])
-            except _NoPlacement:
-                break
-            try:
-                self.place([_Entry(arm, block, block.q, 0)])
-                return pulled
-            except _NoPlacement:
-                continue
-        raise failure
+    def alone(self, group: list[Block]) -> bool:
+        """Place the blocks of ``group`` one by one, in this order, each ending no later than
+        in the synchronous plan; False (with the group's placements taken back) when one finds
+        no start."""
+        mark = self.mark()
+        try:
+            for block in group:
+                latest = math.ceil(block.sync_end / self.tick - 1e-9) - block.motion_ticks
+                self.place([_Entry(block.arm, block, block.q, 0)], latest)
+        except _NoPlacement:
+            self.undo(mark)
+            return False
+        return True
+
+    def flipped(self, group: list[Block]) -> list[Block]:
+        """``group`` with the other arm's blocks first (each arm's blocks in order), unless
+        that breaks the order of the events (then ``group`` itself)."""
+        first = group[0].arm
+        out = [b for b in group if b.arm != first] + [b for b in group if b.arm == first]
+        timed = [b.event for b in out if b.event is not None]
+        for i, e in enumerate(timed):
+            if any(self.must_follow(e, o) for o in timed[i + 1 :]):
+                return group
+        return out
+
+    def mark(self) -> tuple[list[int], list[TimedEvent], dict[int, int], int]:
+        """What :meth:`undo` restores."""
+        lengths = [len(traj) for traj in self.traj]
+        return lengths, list(self.events), dict(self.event_tick), len(self.steps)
+
+    def undo(self, mark: tuple[list[int], list[TimedEvent], dict[int, int], int]) -> None:
+        """Take back every placement since ``mark``."""
+        lengths, events, event_tick, steps = mark
+        for traj, n in zip(self.traj, lengths, strict=True):
+            del traj[n:]
+        self.events, self.event_tick = events, event_tick
+        del self.steps[steps:]
 
     def ready(self, block: Block) -> bool:
         """Whether the events ``block``'s event must follow are placed."""
@@ -234,7 +295,7 @@ class _Placement:
         e = entry.block.event
         if e is not None:
             for other in self.plan.events:
-                if self.must_follow(e, other):
+                if self.must_follow(e, other) and id(other) in self.event_tick:
                     same = other.object == e.object
                     k = self.event_tick[id(other)] + (self.dwell if same else 0)
                     s = max(s, k - (len(entry.q) - 1))
@@ -251,21 +312,25 @@ class _Placement:
         """Ticks of the entry's motion and of the dwell after its event."""
         return len(entry.q) - 1 + (self.dwell if entry.block.event is not None else 0)
 
-    def place(self, entries: list[_Entry]) -> None:
-        """Place the blocks of ``entries`` (one per arm) at the earliest common start ``s``
-        (each at ``s + offset``) whose replay passes; raises :class:`_NoPlacement`."""
+    def place(self, entries: list[_Entry], latest: int | None = None) -> None:
+        """Place the blocks of ``entries`` (an arm's in order, apart by their offsets) at the
+        earliest common start ``s`` (each at ``s + offset``), at most ``latest`` when given,
+        whose replay passes; raises :class:`_NoPlacement`."""
         arms = [e.arm for e in entries]
         k0 = min(self.horizon(a) for a in arms)
         start = max(self.earliest(e) for e in entries)
+        stop = start + self.max_wait
+        if latest is not None:
+            stop = min(stop, max(start, latest))
         before = [e for e in self.events if e.tick < k0]
         later = [e for e in self.events if e.tick >= k0]
         conflict: Conflict | None = None
-        for s in range(start, start + self.max_wait + 1):
+        for s in range(start, stop + 1):
             ends = [s + e.offset + self.length(e) for e in entries]
             k1 = max(*ends, *(self.horizon(a) for a in range(2)))
             q = np.concatenate([self.rows(0, k0, k1), self.rows(1, k0, k1)], axis=1)
             new: list[TimedEvent] = []
-            for e in entries:
+            for e in sorted(entries, key=lambda e: (e.arm, e.offset)):
                 begin = s + e.offset
                 cols = arm_columns(e.arm)
                 q[begin - k0 : begin - k0 + len(e.q), cols] = e.q
@@ -276,7 +341,8 @@ class _Placement:
             self.sweep.reset(before)
             conflict = self.sweep.run(k0, q, events)
             if conflict is None:
-                for e, end, timed in zip(entries, ends, _events_of(entries, new), strict=True):
+                placed = zip(entries, ends, _events_of(entries, new), strict=True)
+                for e, end, timed in sorted(placed, key=lambda x: (x[0].arm, x[0].offset)):
                     self.commit(e, s + e.offset, q[: end - k0 + 1, arm_columns(e.arm)], k0, timed)
                 return
             if conflict.tick < s:  # while an arm waits for its start: later is no better

@@ -290,9 +290,12 @@ def test_the_command_line_reaches_the_planner_config(
     args = ["solve", instance, "-q", "--grasps", "10", "--motion-planner", "sequential"]
     with pytest.raises(Stop):
         main([*args, "--time-limit", "5", "--seed", "2", "--execution", "async"])
-    (config,) = seen
+    config = seen[0]
     assert config.sdar.grasps == 10 and config.motion_planner == "sequential"
     assert (config.max_time, config.seed, config.execution) == (5.0, 2, "async")
+    with pytest.raises(Stop):
+        main(["solve", instance, "-q"])
+    assert seen[-1].execution == "async"  # the default of `sdar solve`
     with pytest.raises(SystemExit):
         main(["solve", instance, "--execution", "later"])
     assert "argument --execution: invalid choice: 'later'" in capsys.readouterr().err

@@ -5,12 +5,14 @@ validator rejects the plan)."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from sdar_tamp.app.execution import execution_options, schedule_plan
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile, load_plan, save_plan
 from sdar_tamp.plan_rules import STILL_TOL, check_timeline
@@ -22,7 +24,7 @@ from sdar_tamp.rearrangement import (
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule.pieces import arm_blocks, arm_columns, on_ticks
-from sdar_tamp.schedule.scheduler import _Placement
+from sdar_tamp.schedule.scheduler import Schedule, _Placement, groups
 from sdar_tamp.schedule.spline import ClampedSpline, retime
 from sdar_tamp.schedule.sweep import Conflict, TimedEvent, WorldSweep
 from sdar_tamp.world.instance import Instance, load_instance
@@ -238,6 +240,10 @@ def test_options_are_checked() -> None:
         {"max_wait": float("nan")},
         {"orders": ()},
         {"orders": ("fifo",)},
+        {"max_checks": 0},
+        {"max_checks": True},
+        {"straight": 0.0},
+        {"grasp_speed": float("inf")},
     ):
         with pytest.raises(ParameterError):
             ScheduleOptions(**kwargs)  # type: ignore[arg-type]
@@ -245,3 +251,69 @@ def test_options_are_checked() -> None:
         retime(np.array([0.0, 1.0]), np.zeros((2, 1)), np.ones(1), np.ones(1), -1.0)
     with pytest.raises(ParameterError, match="increasing"):
         ClampedSpline.fit(np.array([0.0, 0.0]), np.zeros((2, 1)))
+
+
+# -- per-arm time-optimal re-timing, the group search, the fallbacks ------------------------
+def test_the_time_optimal_schedule_is_valid_and_beats_the_uniform_one(uneven: Solved) -> None:
+    scene = uneven.ctx.scene
+    fast = schedule_plan(uneven.plan, uneven.instance, scene)
+    uniform = schedule_async(uneven.plan, uneven.instance, scene)
+    assert fast.asynchronous, fast.reason
+    assert fast.plan.duration < uniform.plan.duration <= uneven.plan.duration
+    report = validate_plan(uneven.instance, fast.plan, scene)
+    assert report.ok, report.violation
+    assert _dwell_overlaps(fast.plan) >= 1
+
+
+def test_a_crowded_schedule_is_never_longer_and_keeps_the_arms_apart(crowded: Solved) -> None:
+    """Twelve objects, the arms close together: whatever the search falls back to, the plan
+    is never longer than the synchronous one and the replay finds no collision."""
+    s = schedule_plan(crowded.plan, crowded.instance, crowded.ctx.scene)
+    assert s.plan.duration <= crowded.plan.duration
+    report = validate_plan(crowded.instance, s.plan, crowded.ctx.scene)
+    assert report.ok, report.violation
+
+
+def test_groups_hold_the_blocks_that_overlapped(uneven: Solved) -> None:
+    options = execution_options(uneven.ctx.scene)
+    blocks = [arm_blocks(uneven.plan, uneven.ctx.scene, i, options.tick) for i in range(2)]
+    found = groups(blocks)
+    assert sorted(id(b) for g in found for b in g) == sorted(id(b) for a in blocks for b in a)
+    for g in found:  # in the order they ended in the synchronous plan
+        assert [b.sync_key for b in g] == sorted(b.sync_key for b in g)
+    for a, b in itertools.pairwise(found):  # in time order, apart
+        assert max(x.sync_key for x in a) < min(x.sync_start for x in b)
+    assert any(len({b.arm for b in g}) == 2 for g in found)  # both arms moved together
+
+
+def test_past_the_search_budget_the_steps_keep_their_synchronous_pace(uneven: Solved) -> None:
+    scene = uneven.ctx.scene
+    full = schedule_async(uneven.plan, uneven.instance, scene, execution_options(scene))
+    options = dataclasses.replace(execution_options(scene), max_checks=1)
+    s = schedule_async(uneven.plan, uneven.instance, scene, options)
+    assert s.checks < full.checks
+    assert s.plan.duration <= uneven.plan.duration
+    assert s.async_duration is not None and s.async_duration > full.plan.duration
+    assert validate_plan(uneven.instance, s.plan, scene).ok
+
+
+def test_a_schedule_the_replay_rejects_is_dropped(
+    uneven: Solved, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A scheduler whose result moves an arm during its own dwell: the application replays
+    it, keeps the synchronous plan and says why."""
+    scene = uneven.ctx.scene
+    good = schedule_plan(uneven.plan, uneven.instance, scene)
+    e = good.plan.events[0]
+    k = int(np.searchsorted(good.plan.t, e.t))
+    q = np.array(good.plan.q)
+    q[k + 1 : k + 5, arm_columns(good.plan.arm_names.index(e.arm)).start] += 1e-3
+    bad = dataclasses.replace(good, plan=dataclasses.replace(good.plan, q=q))
+
+    def broken(*args: object, **kwargs: object) -> Schedule:
+        return bad
+
+    monkeypatch.setattr("sdar_tamp.app.execution.schedule_async", broken)
+    s = schedule_plan(uneven.plan, uneven.instance, scene)
+    assert not s.asynchronous and s.plan is uneven.plan
+    assert "replay rejects" in s.reason

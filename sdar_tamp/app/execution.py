@@ -1,0 +1,75 @@
+"""How a synchronous plan is executed asynchronously: the scheduler's options, with each arm's
+motions re-timed by the same time-optimal path timing the motion planner uses
+(:func:`streams.timing.time_parameterize`) and the same slow tool travel at gripper events."""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.replay import validate_plan
+from sdar_tamp.schedule import Schedule, ScheduleOptions, schedule_async
+from sdar_tamp.schedule.retiming import PathTimer
+from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import FloatArray
+from streams.shape import ShapeOptions
+from streams.timing import time_parameterize
+
+_log = logging.getLogger(__name__)
+
+
+def path_timer(safety: float) -> PathTimer:
+    """The motion planner's time-optimal path timing at ``safety`` (the scene's
+    ``velocity_safety``, in (0, 1]), as the scheduler's :data:`PathTimer`."""
+
+    def timer(
+        path: FloatArray,
+        v_max: FloatArray,
+        a_max: FloatArray,
+        path_speed: FloatArray | None,
+        dt: float,
+    ) -> tuple[FloatArray, FloatArray]:
+        traj = time_parameterize(path, v_max, a_max, dt=dt, safety=safety, path_speed=path_speed)
+        return traj.t, traj.q
+
+    return timer
+
+
+def execution_options(scene: Scene, shape: ShapeOptions | None = None) -> ScheduleOptions:
+    """The scheduler's options for plans of ``scene`` whose motions have ``shape`` (default:
+    the motion planner's default shape)."""
+    shape = shape or ShapeOptions()
+    return ScheduleOptions(
+        timer=path_timer(scene.velocity_safety),
+        straight=shape.straight,
+        grasp_speed=shape.grasp_speed,
+    )
+
+
+def schedule_plan(
+    plan: PlanFile,
+    instance: Instance,
+    scene: Scene,
+    shape: ShapeOptions | None = None,
+    options: ScheduleOptions | None = None,
+) -> Schedule:
+    """``plan`` re-scheduled for asynchronous execution (``options``: default
+    :func:`execution_options`), and the result replayed by the independent validator: a
+    schedule it rejects is dropped for the synchronous plan (and logged), so the plan returned
+    is never longer than ``plan`` and valid whenever ``plan`` is."""
+    options = options or execution_options(scene, shape)
+    result = schedule_async(plan, instance, scene, options)
+    if not result.asynchronous:
+        return result
+    report = validate_plan(instance, result.plan, scene)
+    if report.ok:
+        return result
+    why = "the replay rejects the schedule" + (
+        f" at t={report.violation.t:.3f} s: {report.violation.kind}: {report.violation.message}"
+        if report.violation is not None
+        else ""
+    )
+    _log.warning("%s: %s; the synchronous plan is kept", instance.name, why)
+    return dataclasses.replace(result, plan=plan, asynchronous=False, reason=why)
