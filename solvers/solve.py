@@ -65,6 +65,32 @@ _APPROXIMATED = {
 }
 
 
+#: The prefix of ``planner`` names that run Fast Downward (``"fd"`` alone: its default search).
+FD_PREFIX = "fd:"
+
+
+def parse_planner_choice(planner: str) -> tuple[str, str, str, float]:
+    """``(backend, search, heuristic, weight)`` of a ``solve(planner=...)`` value: a name of
+    :func:`parse_planner` (this package's planner, backend ``"sdar"``), or the same name after
+    ``fd:`` (Fast Downward, backend ``"fd"``, e.g. ``fd:wastar-ff``, ``fd:lazy-gbfs-ff-lmcount``,
+    ``fd:ff-astar``); ``fd`` alone is Fast Downward with the default ``wastar-ff``.
+
+    Raises:
+        ParameterError: an unknown name, or one without a Fast Downward configuration.
+        BackendUnavailableError: ``fd`` asked for and ``up-fast-downward`` not installed (the
+            message names the ``sdar-tamp[fd]`` extra).
+    """
+    name = str(planner)
+    if name.lower() != "fd" and not name.lower().startswith(FD_PREFIX):
+        return ("sdar", *parse_planner(name))
+    from solvers.classical.fast_downward import require_fast_downward, search_engine
+
+    search, heuristic, weight = parse_planner(name[len(FD_PREFIX) :] or "wastar-ff")
+    search_engine(search, heuristic, weight)
+    require_fast_downward()
+    return "fd", search, heuristic, weight
+
+
 def parse_planner(planner: str) -> tuple[str, str, float]:
     """``(search, heuristic, weight)`` of a planner name: ``SEARCH-HEURISTIC`` (e.g.
     ``wastar-ff``, ``gbfs-add``, ``astar-max``) or one of PDDLStream's names
@@ -145,7 +171,10 @@ def solve(
             each call, so a blocking call delays the ``TIMEOUT`` until it returns.
         planner: ``SEARCH-HEURISTIC`` of the classical planner, e.g. ``wastar-ff``,
             ``gbfs-ff``, ``astar-max``, or a PDDLStream planner name such as ``ff-astar``,
-            ``max-astar`` or ``ff-wastar2`` (see :func:`parse_planner`).
+            ``max-astar`` or ``ff-wastar2`` (see :func:`parse_planner`). With the prefix
+            ``fd:`` (``fd:wastar-ff``, ``fd:ff-astar``; ``fd`` alone for ``fd:wastar-ff``)
+            Fast Downward's search runs the same configuration on this package's grounding
+            (``pip install 'sdar-tamp[fd]'``; see :func:`parse_planner_choice`).
         task_planner: with ``algorithm="sdar"``: ``sdar`` (SDAR-T) or ``baseline``
             (default: the problem's ``solve_defaults``, else ``sdar``).
         sdar_options: with ``algorithm="sdar"``: SDAR-M's budgets and switches
@@ -196,7 +225,7 @@ def solve(
             return _solve_sdar(problem, task_planner, max_time, stream_info, verbose, sdar_options)
     if sdar_options is not None:
         raise ParameterError(f"sdar_options applies to algorithm 'sdar' only, not {algorithm!r}")
-    search, heuristic, weight = parse_planner(planner)
+    backend, search, heuristic, weight = parse_planner_choice(planner)
     options = StreamOptions(
         algorithm=algorithm,
         unit_costs=unit_costs,
@@ -212,6 +241,7 @@ def solve(
         search=search,
         heuristic=heuristic,
         weight=weight,
+        backend=backend,
     )
     if constraints is not None and not isinstance(constraints, PlanConstraints):
         raise ParameterError(

@@ -295,7 +295,7 @@ class VectorHAdd:
     """h_add by NumPy Bellman-Ford sweeps, with the same costs and best supporters.
 
     A sweep computes every relaxed operator's cost (its cost plus the sum of its precondition
-    costs; preconditions are padded columns pointing at an extra always-true fact) and lowers
+    costs, one precondition column at a time over the operators that have one) and lowers
     every fact's cost to its cheapest achiever's; sweeps repeat until nothing drops. Achiever
     lists are sorted by (fact, operator id), so the first achiever at the fact's cost is the one
     of lowest id.
@@ -309,15 +309,21 @@ class VectorHAdd:
         ucost: list[float],
     ) -> None:
         self.count = count
-        width = max((len(pre) for pre in upre), default=0) or 1
-        columns = np.full((width, len(upre)), count, dtype=np.intp)  # ``count``: always true
-        for u, pre in enumerate(upre):
-            columns[: len(pre), u] = pre
-        self.columns = [np.ascontiguousarray(column) for column in columns]
-        self.ucost = np.asarray(ucost, dtype=np.float64)
+        # operators are stored widest precondition first, so that precondition column j only
+        # covers the leading operators with more than j preconditions (no padding)
+        order = sorted(range(len(upre)), key=lambda u: -len(upre[u]))
+        position = np.empty(len(upre), dtype=np.intp)
+        position[order] = np.arange(len(upre))
+        width = max((len(pre) for pre in upre), default=0)
+        self.columns = [
+            np.asarray([upre[u][j] for u in order if len(upre[u]) > j], dtype=np.intp)
+            for j in range(width)
+        ]
+        self.ucost = np.asarray([ucost[u] for u in order], dtype=np.float64)
         pairs = sorted({(g, u) for u, eff in enumerate(ueff) for g in eff})
         self.eff_fact = np.asarray([g for g, _u in pairs], dtype=np.intp)
-        self.eff_op = np.asarray([u for _g, u in pairs], dtype=np.intp)
+        self.eff_id = np.asarray([u for _g, u in pairs], dtype=np.intp)  # relaxed operator id
+        self.eff_op = position[self.eff_id]  # its position in the stored order
         achieved, starts, counts = np.unique(self.eff_fact, return_index=True, return_counts=True)
         self.achieved = achieved  # facts with at least one achiever
         self.starts = starts  # where each achieved fact's achievers start in eff_op
@@ -337,15 +343,15 @@ class VectorHAdd:
         if not len(self.achieved):
             return cost.tolist(), [-1] * (self.count + 1)
         achieved, starts, eff_op, columns = self.achieved, self.starts, self.eff_op, self.columns
-        first, rest = columns[0], columns[1:]
+        ucost = self.ucost
         current = cost[achieved]
         while True:
-            op_cost = self.ucost + cost[first]
-            for column in rest:
-                op_cost += cost[column]
+            op_cost = ucost.copy()
+            for column in columns:
+                op_cost[: len(column)] += cost[column]
             reached = op_cost[eff_op]
             best = np.minimum.reduceat(reached, starts)
-            if not (best < current).any():
+            if not np.count_nonzero(best < current):
                 break
             np.minimum(current, best, out=current)
             cost[achieved] = current
@@ -357,5 +363,5 @@ class VectorHAdd:
         leading[1:] = segment[1:] != segment[:-1]
         chosen = match[leading]
         supporter = np.full(self.count + 1, -1, dtype=np.intp)
-        supporter[self.eff_fact[chosen]] = eff_op[chosen]
+        supporter[self.eff_fact[chosen]] = self.eff_id[chosen]
         return cost.tolist(), supporter.tolist()

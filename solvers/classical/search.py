@@ -17,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from heapq import heappop, heappush
 from math import inf
+from typing import Any
 
 from solvers.classical.compiled import CompiledTask
 from solvers.classical.landmarks import LandmarkCount
@@ -76,7 +77,8 @@ class _Queues:
     def __init__(self, size: int, use_preferred: bool) -> None:
         self.size = size
         self.count = 2 * size if use_preferred else size
-        self.heaps: list[list[Entry]] = [[] for _ in range(self.count)]
+        # Entry tuples; lists of _BatchQueues' form in lazy greedy search
+        self.heaps: list[list[Any]] = [[] for _ in range(self.count)]
         self.priority = [0] * self.count
         self.best = [inf] * size  # the lowest value seen of each heuristic
 
@@ -120,7 +122,54 @@ class _Queues:
         if best < 0:
             return None
         priority[best] += 1
-        return heappop(self.heaps[best])
+        entry: Entry = heappop(self.heaps[best])
+        return entry
+
+
+class _BatchQueues(_Queues):
+    """Queues whose entries hold every successor of one expanded state (greedy lazy search).
+
+    In greedy search all successors of a state share its priority and have consecutive
+    insertion counters, so no other entry can come between them: one heap entry per expansion
+    (``[priority, h, counter, origin, g, operators, next position]``) taken one operator at a
+    time gives the same order as one entry per successor, at a fraction of the heap work.
+    """
+
+    def push_batch(
+        self,
+        values: tuple[float, ...],
+        h_weight: float,
+        counter: int,
+        origin: int,
+        g: float,
+        operators: list[int],
+        preferred: list[int],
+    ) -> None:
+        heaps = self.heaps
+        for i, h in enumerate(values):
+            if operators:
+                heappush(heaps[i], [h_weight * h, h, counter, origin, g, operators, 0])
+            if preferred and self.count > self.size:
+                heappush(heaps[self.size + i], [h_weight * h, h, counter, origin, g, preferred, 0])
+
+    def pop_successor(self) -> tuple[int, int, float] | None:
+        """``(origin, operator, origin's g)`` of the next successor, or None when empty."""
+        best = -1
+        priority = self.priority
+        for i, heap in enumerate(self.heaps):
+            if heap and (best < 0 or priority[i] < priority[best]):
+                best = i
+        if best < 0:
+            return None
+        priority[best] += 1
+        heap = self.heaps[best]
+        entry: list[Any] = heap[0]
+        operators, position = entry[5], entry[6]
+        if position + 1 == len(operators):
+            heappop(heap)
+        else:
+            entry[6] = position + 1
+        return entry[3], operators[position], entry[4]
 
 
 def _trace(parent: dict[int, tuple[int, int] | None], state: int) -> tuple[int, ...]:
@@ -235,18 +284,30 @@ def _lazy(
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
     evaluate = evaluator.evaluate
     expanded, generated, evaluated = 0, 1, 0
-    queues = _Queues(evaluator.size, preferred)
+    greedy = g_weight == 0.0  # one queue entry per expansion (see _BatchQueues)
+    queues = _BatchQueues(evaluator.size, preferred)
     init = compiled.init
-    queues.push((0.0,) * evaluator.size, 0.0, h_weight, 0, (-1, -1, 0.0), False)
+    if greedy:
+        queues.push_batch((0.0,) * evaluator.size, h_weight, 0, -1, 0.0, [-1], [])
+    else:
+        queues.push((0.0,) * evaluator.size, 0.0, h_weight, 0, (-1, -1, 0.0), False)
     parent: dict[int, tuple[int, int] | None] = {}
     closed: dict[int, float] = {}
     reached_of: dict[int, int] = {}
     counter = 1
     while True:
-        entry = queues.pop()
-        if entry is None:
-            return SearchOutcome("unsolvable", (), expanded, generated, evaluated)
-        origin, op, g = entry[3]
+        if greedy:
+            taken = queues.pop_successor()
+            if taken is None:
+                return SearchOutcome("unsolvable", (), expanded, generated, evaluated)
+            origin, op, g = taken
+            if op >= 0:
+                g += costs[op]
+        else:
+            entry = queues.pop()
+            if entry is None:
+                return SearchOutcome("unsolvable", (), expanded, generated, evaluated)
+            origin, op, g = entry[3]
         state = init if op < 0 else successor(origin, op)
         known = closed.get(state)
         if known is not None and (not reopen or g >= known):
@@ -264,6 +325,15 @@ def _lazy(
             return SearchOutcome("solved", _trace(parent, state), expanded, generated, evaluated)
         queues.note(values)
         expanded += 1
+        if greedy:
+            successors = applicable(state)
+            if cost_bound != inf:
+                successors = [o for o in successors if g + costs[o] < cost_bound]
+            generated += len(successors)
+            chosen = [o for o in successors if o in prefs] if prefs else []
+            queues.push_batch(values, h_weight, counter, state, g, successors, chosen)
+            counter += 1
+            continue
         push = queues.push
         for succ_op in applicable(state):
             new_g = g + costs[succ_op]

@@ -45,6 +45,7 @@ from sdar_tamp.language.semantics import ground_atom
 from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
+from solvers.classical.fast_downward import plan_task_with_fast_downward
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
 from solvers.stream_planning.blocking import Blocks, guard_fluent_uses
 from solvers.stream_planning.calls import CallRunner, CallTimeout
@@ -86,6 +87,7 @@ class StreamOptions:
     search: str = "wastar"
     heuristic: str = "ff"
     weight: float = 2.0
+    backend: str = "sdar"  # the classical planner: "sdar" (this package's) or "fd" (Fast Downward)
     max_cost: float = math.inf  # plans above it are not returned (PlanConstraints.max_cost)
     effort_weight: float | None = None  # optimistic actions pay weight * stream effort
     unit_efforts: bool = False  # every stream call has effort 1
@@ -197,7 +199,8 @@ class StreamSolver:
             extra_cost=extra,
         )
         start = time.perf_counter()
-        result = classical_plan(
+        planner = plan_task_with_fast_downward if self.options.backend == "fd" else classical_plan
+        result = planner(
             task,
             search=self.options.search,
             heuristic=self.options.heuristic,

@@ -177,3 +177,35 @@ def test_cost_bound_keeps_only_cheaper_plans(search: str, lazy: bool) -> None:
     assert at_bound.status is PlanStatus.UNSOLVABLE  # 11 is the optimum: nothing cheaper
     above = plan(task, search=search, heuristic="max", lazy=lazy, cost_bound=11.5)
     assert above.status is PlanStatus.SOLVED and above.cost == 11.0
+
+
+def test_batched_greedy_queues_pop_in_per_successor_order() -> None:
+    import random
+
+    from solvers.classical.search import _BatchQueues, _Queues
+
+    rng = random.Random(7)
+    single, batched = _Queues(2, True), _BatchQueues(2, True)
+    counter, taken_single, taken_batched = 0, [], []
+    for expansion in range(60):
+        values = (float(rng.randint(0, 5)), float(rng.randint(0, 5)))
+        operators = [rng.randint(0, 99) for _ in range(rng.randint(1, 6))]
+        chosen = [o for o in operators if o % 3 == 0]
+        batched.push_batch(values, 1.0, expansion, expansion, 0.0, operators, chosen)
+        for o in operators:
+            single.push(values, 0.0, 1.0, counter, (expansion, o, 0.0), o % 3 == 0)
+            counter += 1
+        for queues in (single, batched):
+            if expansion % 4 == 0:
+                queues.boost()
+        for _ in range(rng.randint(0, 4)):  # interleave pops with pushes
+            entry = single.pop()
+            taken_single.append(None if entry is None else entry[3][:2])
+            pair = batched.pop_successor()
+            taken_batched.append(None if pair is None else pair[:2])
+    while (entry := single.pop()) is not None:
+        taken_single.append(entry[3][:2])
+    while (pair := batched.pop_successor()) is not None:
+        taken_batched.append(pair[:2])
+    assert len(taken_single) > 200
+    assert taken_batched == taken_single
