@@ -19,7 +19,8 @@ the coal narrow phase on the surviving pairs, all in C++.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections import OrderedDict
+from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,9 +60,14 @@ class CollisionWorld:
 
     Configurations ``q`` ``(layout.dof,)`` hold every arm's joints in the scene's
     :class:`~sdar_tamp.world.layout.ArmLayout` (``scene.layout``).
-    Changing objects or grasps rebuilds the geometry lazily (about a millisecond); queries at
-    a fixed object set are the fast path.
+    Changing objects or grasps rebuilds the geometry lazily (several milliseconds for a dozen
+    objects); queries at a fixed object set are the fast path. The last
+    :attr:`GEOMETRY_CACHE` geometries are kept by arrangement (resting boxes and held objects,
+    compared exactly), so going back to an arrangement seen before costs no rebuild.
     """
+
+    #: How many built geometries (arrangements) one world keeps.
+    GEOMETRY_CACHE = 16
 
     def __init__(self, scene: Scene, *, tolerance: float = 1e-3) -> None:
         self._scene = scene
@@ -72,6 +78,7 @@ class CollisionWorld:
         self.layout = scene.layout
         self._q = scene.home
         self._geometry: cm.SceneGeometry | None = None
+        self._built: OrderedDict[Hashable, cm.SceneGeometry] = OrderedDict()
 
     # -- objects and grasps ---------------------------------------------------------------
     @property
@@ -188,12 +195,32 @@ class CollisionWorld:
 
     def _scene_geometry(self) -> cm.SceneGeometry:
         if self._geometry is None:
+            key = self._arrangement_key()
+            cached = self._built.get(key)
+            if cached is not None:
+                self._built.move_to_end(key)
+                self._geometry = cached
+                return cached
             resting = {n: (b.T_world_obj, self._shrunk(b)) for n, b in self._resting.items()}
             held = {a: (n, T, self._shrunk(b)) for a, (n, T, b) in self._held.items()}
             self._geometry = cm.build_scene_geometry(
                 self._arms, self._scene.table.size, resting, held, self._pairs()
             )
+            self._built[key] = self._geometry
+            if len(self._built) > self.GEOMETRY_CACHE:
+                self._built.popitem(last=False)
         return self._geometry
+
+    def _arrangement_key(self) -> Hashable:
+        """What the geometry is built from, exactly: the resting boxes in order, and each
+        arm's held object with its pose in the tool frame."""
+        resting = tuple(
+            (n, b.T_world_obj.tobytes(), tuple(b.size)) for n, b in self._resting.items()
+        )
+        held = tuple(
+            (a, n, T.tobytes(), tuple(b.size)) for a, (n, T, b) in sorted(self._held.items())
+        )
+        return resting, held
 
     def _pairs(self) -> list[tuple[str, str]]:
         shapes = self._arms.shapes

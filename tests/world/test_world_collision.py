@@ -158,3 +158,45 @@ def test_configuration_of_the_wrong_shape_is_refused(world: CollisionWorld, scen
     with pytest.raises(ArmLayoutError, match="got \\(13,\\)"):
         world.set_configuration(np.zeros(13))
     np.testing.assert_allclose(world.configuration, scene.home)  # unchanged
+
+
+def test_an_arrangement_seen_before_reuses_its_geometry_and_answers_alike(
+    world: CollisionWorld, kins: dict, scene: Scene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import sdar_tamp.world.collision_model as cm
+
+    builds: list[int] = []
+    build = cm.build_scene_geometry
+    monkeypatch.setattr(cm, "build_scene_geometry", lambda *a: builds.append(1) or build(*a))
+    home = np.array(kins["right"].spec.home)
+    grasp = _reach(kins["left"], 0.0, 0.1, SIZE[2] / 2)
+    off = _reach(kins["left"], 0.0, 0.13, SIZE[2] / 2)
+    first = {"o0": _box(0.0, 0.1), "o1": _box(-0.1, -0.2)}
+    moved = {"o0": _box(0.1, 0.1), "o1": _box(-0.1, -0.2)}
+    answers = []
+    for objects in (first, moved, first, moved):
+        world.set_objects(objects)
+        answers.append((world.in_collision(_q(off, home)), world.report(_q(off, home))))
+    assert len(builds) == 2  # one per arrangement
+    assert answers[0] == answers[2] and answers[1] == answers[3]
+    assert answers[0][0] and not answers[1][0]
+    # holding an object is another arrangement; the pose it is put down at is computed
+    # through the tool (equal within rounding, not bit for bit): compared exactly, a third one
+    world.set_objects(first)
+    world.attach("left", "o0", grasp)
+    assert not world.in_collision(_q(off, home))
+    world.detach("left", grasp)
+    assert world.in_collision(_q(off, home))
+    assert len(builds) == 4
+    # the answers match a fresh world's
+    fresh = CollisionWorld(scene)
+    fresh.set_objects(first)
+    assert fresh.report(_q(off, home)) == world.report(_q(off, home))
+    # a bounded cache: far more arrangements than it keeps, then the first one is rebuilt
+    for k in range(CollisionWorld.GEOMETRY_CACHE + 1):
+        world.set_objects({"o0": _box(0.0, -0.1 + 0.001 * k)})
+        world.in_collision(_q(off, home))
+    count = len(builds)
+    world.set_objects(first)
+    world.in_collision(_q(off, home))
+    assert len(builds) == count + 1
