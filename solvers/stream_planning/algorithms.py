@@ -557,6 +557,8 @@ class StreamSolver:
             state = self._instance(skeleton, index, inputs, bindings)
             if state is None:
                 return None
+            if skeleton.states.get(index) is not state:
+                skeleton.chosen.pop(index, None)  # outputs of another instance: not for this one
             skeleton.states[index] = state
             if index not in skeleton.chosen:
                 outputs = self._take(skeleton, index, state)
@@ -614,12 +616,17 @@ class StreamSolver:
 
     def _upstream_retry(self, skeleton: Skeleton, index: int) -> bool | None:
         """Step ``index`` cannot succeed with the outputs chosen before it: resample those
-        (False), unless no generator before it can give other outputs (None: dead)."""
-        upstream = [i for i in skeleton.chosen if i < index]
-        for i in upstream:
+        that can give others (False), unless none can (None: dead).
+
+        A step that cannot give other outputs (a single-call stream, an exhausted generator)
+        keeps what it gave this skeleton: called again it would produce nothing, and its
+        output stays valid as long as its inputs do (:meth:`_process` drops it when a
+        resampled step upstream changes them).
+        """
+        retry = [i for i in skeleton.chosen if i < index and self._can_retry(skeleton, i)]
+        for i in retry:
             del skeleton.chosen[i]
-        live = any(self._can_retry(skeleton, i) for i in upstream)
-        return False if live else None
+        return False if retry else None
 
     def _can_retry(self, skeleton: Skeleton, index: int) -> bool:
         """Can stream step ``index`` give other outputs (a test cannot)?"""
