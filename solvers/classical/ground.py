@@ -64,6 +64,7 @@ class _Instantiator:
         self.task = task
         self.norm = norm
         self.base = base
+        self.sizes = {predicate: len(facts) for predicate, facts in base.relations.items()}
         self.fixed = fixed_predicates(norm)
         self.variable = norm.fluent | norm.derived
         atoms = sorted(
@@ -183,7 +184,9 @@ class _Instantiator:
                 simple.append((cond, lit.predicate, lit.positive, _positional(lit, params)))
             else:
                 atoms, filters = split_condition(effect.condition, self.fixed)
-                general.append((effect, compile_join(atoms, filters, prebound=params)))
+                general.append(
+                    (effect, compile_join(atoms, filters, prebound=params, sizes=self.sizes))
+                )
         needs_binding = bool(general) or any(isinstance(c, FunctionTerm) for c in action.costs)
         fixed_cost = None if needs_binding else self.cost(action, {})
         ids = self.ids
@@ -243,7 +246,7 @@ class _Instantiator:
             atoms, filters = split_condition(axiom.body, self.fixed)
             head = Lit(axiom.predicate, axiom.head)
             stratum = self.norm.strata[axiom.predicate]
-            plan = compile_join(atoms, filters)
+            plan = compile_join(atoms, filters, sizes=self.sizes)
             for binding in run_join(plan, self.base, deadline=self.deadline):
                 body = self.literals(axiom.body, binding)
                 head_id = self.ids.get((axiom.predicate, _ground_args(head, binding)))
@@ -266,9 +269,7 @@ def ground_normalized(
         inst.ids[(p, a)] for p, a in norm.facts if p in norm.fluent and (p, a) in inst.ids
     )
     derived = frozenset(i for i, atom in enumerate(inst.facts) if atom.predicate in norm.derived)
-    static = frozenset(
-        Atom(p, a) for p in inst.fixed for a in base.relations.get(p, ()) if not p.startswith("~")
-    )
+    static = {p: base.relations.get(p, set()) for p in sorted(inst.fixed) if not p.startswith("~")}
     return GroundTask(
         facts=inst.facts,
         derived=derived,
@@ -278,7 +279,7 @@ def ground_normalized(
         goal_reachable=goal is not None,
         operators=tuple(operators),
         axioms=tuple(inst.axioms()),
-        static_facts=static,
+        static_relations=static,
         source=task,
     )
 

@@ -9,7 +9,7 @@ up only the facts that agree with the values already bound (hash indexes built o
 from __future__ import annotations
 
 import time
-from collections.abc import Collection, Iterable, Iterator
+from collections.abc import Collection, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 
 from sdar_tamp.language.model import EQUALITY
@@ -31,8 +31,12 @@ class FactBase:
     def __init__(self, facts: Iterable[tuple[str, Fact]] = ()) -> None:
         self.relations: dict[str, set[Fact]] = {}
         self._indexes: dict[str, dict[tuple[int, ...], dict[Fact, list[Fact]]]] = {}
-        for predicate, args in facts:
-            self.add(predicate, args)
+        relations = self.relations
+        for predicate, args in facts:  # no index exists yet: filling the sets is enough
+            relation = relations.get(predicate)
+            if relation is None:
+                relation = relations[predicate] = set()
+            relation.add(args)
 
     def add(self, predicate: str, args: Fact) -> bool:
         """Add a fact; False when it was already there."""
@@ -76,9 +80,19 @@ class JoinPlan:
 
 
 def compile_join(
-    atoms: list[Lit], filters: list[Lit], prebound: Collection[str] = (), first: int | None = None
+    atoms: list[Lit],
+    filters: list[Lit],
+    prebound: Collection[str] = (),
+    first: int | None = None,
+    sizes: Mapping[str, int] | None = None,
 ) -> JoinPlan:
-    """Order ``atoms`` (``first`` leads) so that each step shares the most bound terms."""
+    """Order ``atoms`` (``first`` leads) so that each step binds as few candidates as it can.
+
+    Atoms whose terms are all bound come first (each is a lookup that can only prune), then
+    those sharing the most bound terms; ``sizes`` (facts per predicate, when known) breaks a
+    tie in favour of the smaller relation, so a join starts from the few facts of a fluent
+    rather than from a large static relation over the same variables.
+    """
     bound = set(prebound)
     remaining = list(range(len(atoms)))
     pending = list(filters)
@@ -93,15 +107,9 @@ def compile_join(
         if first is not None and not steps:
             chosen = first
         else:
-            # most bound terms first; on a tie the later atom, since callers put the broad
-            # type literals ``(type ?x)`` before the body atoms, which are usually smaller
-            chosen = max(
-                remaining,
-                key=lambda i: (
-                    sum(1 for a in atoms[i].args if not a.startswith("?") or a in bound),
-                    i,
-                ),
-            )
+            # on a full tie the later atom, since callers put the broad type literals
+            # ``(type ?x)`` before the body atoms, which are usually smaller
+            chosen = max(remaining, key=lambda i: _priority(atoms[i], bound, sizes, i))
         remaining.remove(chosen)
         atom = atoms[chosen]
         key_positions: list[int] = []
@@ -136,6 +144,14 @@ def compile_join(
         unbound = sorted({a for f in pending for a in f.args if a.startswith("?")} - bound)
         raise ValueError(f"unbound variables in filter literals: {unbound}")
     return JoinPlan(tuple(steps), tuple(initial))
+
+
+def _priority(
+    atom: Lit, bound: Collection[str], sizes: Mapping[str, int] | None, index: int
+) -> tuple[bool, int, int, int]:
+    known = sum(1 for a in atom.args if not a.startswith("?") or a in bound)
+    size = sizes.get(atom.predicate, 0) if sizes is not None else 0
+    return (known == len(atom.args), known, -size, index)
 
 
 def _value(term: str, binding: dict[str, str]) -> str:

@@ -11,6 +11,7 @@ round), so no parameter combination that is not supported by reachable facts is 
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from sdar_tamp.language.model import EQUALITY
@@ -64,11 +65,15 @@ def _rule(
     filters: list[Lit],
     head: Lit,
     direct: tuple[tuple[str, tuple[int | str, ...]], ...] = (),
+    sizes: Mapping[str, int] | None = None,
 ) -> _Rule:
-    return _Rule(tuple(atoms), head, compile_join(atoms, filters), tuple(filters), direct)
+    plan = compile_join(atoms, filters, sizes=sizes)
+    return _Rule(tuple(atoms), head, plan, tuple(filters), direct)
 
 
-def _rules(norm: NormTask, fixed: frozenset[str]) -> list[_Rule]:
+def _rules(
+    norm: NormTask, fixed: frozenset[str], sizes: Mapping[str, int] | None = None
+) -> list[_Rule]:
     rules: list[_Rule] = []
     for action in norm.actions:
         atoms, filters = split_condition(action.precondition, fixed)
@@ -85,12 +90,16 @@ def _rules(norm: NormTask, fixed: frozenset[str]) -> list[_Rule]:
                 direct.append((lit.predicate, spec))
                 continue
             cond_atoms, cond_filters = split_condition(effect.condition, fixed)
-            rules.append(_rule([head, *cond_atoms], cond_filters, lit))
-        rules.append(_rule(atoms, filters, head, tuple(direct)))
+            rules.append(_rule([head, *cond_atoms], cond_filters, lit, sizes=sizes))
+        rules.append(_rule(atoms, filters, head, tuple(direct), sizes))
     for axiom in norm.axioms:
         atoms, filters = split_condition(axiom.body, fixed)
-        rules.append(_rule(atoms, filters, Lit(axiom.predicate, axiom.head)))
+        rules.append(_rule(atoms, filters, Lit(axiom.predicate, axiom.head), sizes=sizes))
     return rules
+
+
+def _sizes(base: FactBase) -> dict[str, int]:
+    return {predicate: len(facts) for predicate, facts in base.relations.items()}
 
 
 def fixed_predicates(norm: NormTask) -> frozenset[str]:
@@ -109,15 +118,17 @@ def fixed_predicates(norm: NormTask) -> frozenset[str]:
 def reachable_facts(norm: NormTask, deadline: float | None = None) -> FactBase:
     """The least fixpoint of the relaxed program: init facts, reachable facts, action instances."""
     fixed = fixed_predicates(norm)
-    rules = _rules(norm, fixed)
     base = FactBase(norm.facts)
+    rules = _rules(norm, fixed, _sizes(base))
     seeded: dict[tuple[int, int], JoinPlan] = {}  # (rule, atom): plan with that atom first
 
     def seeded_plan(r: int, i: int) -> JoinPlan:
         plan = seeded.get((r, i))
         if plan is None:
             rule = rules[r]
-            plan = seeded[(r, i)] = compile_join(list(rule.atoms), list(rule.filters), first=i)
+            plan = seeded[(r, i)] = compile_join(
+                list(rule.atoms), list(rule.filters), first=i, sizes=_sizes(base)
+            )
         return plan
 
     delta: dict[str, set[Fact]] | None = None  # None: first round, everything is new

@@ -7,7 +7,9 @@ A state is a set of fact ids; the search packs it into a Python ``int`` bitset.
 
 from __future__ import annotations
 
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
+from functools import cached_property
 
 from sdar_tamp.language.model import Atom
 from solvers.classical.problem import GroundAction, PlanningTask
@@ -63,8 +65,18 @@ class GroundTask:
     goal_reachable: bool
     operators: tuple[GroundOperator, ...]
     axioms: tuple[GroundAxiom, ...]
-    static_facts: frozenset[Atom]
+    #: the reachable facts of each static predicate (what :attr:`static_facts` lists)
+    static_relations: Mapping[str, Collection[tuple[str, ...]]]
     source: PlanningTask
+
+    @cached_property
+    def static_facts(self) -> frozenset[Atom]:
+        """The facts of static predicates (true in every state; built on first use)."""
+        return frozenset(
+            Atom(predicate, args)
+            for predicate, relation in self.static_relations.items()
+            for args in relation
+        )
 
     def fact_id(self, atom: Atom) -> int:
         """The number of a fluent or derived fact (``ValueError`` if static or unreachable)."""

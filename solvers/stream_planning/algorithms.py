@@ -27,8 +27,9 @@ from __future__ import annotations
 import heapq
 import math
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from itertools import chain
 from typing import Any
 
 from sdar_tamp.language.model import (
@@ -147,6 +148,10 @@ class StreamSolver:
         self._order = 0
         self._calls = 0  # stream calls made so far (the queue's work is counted in calls)
         self._unreachable = False  # the last plan search found the goal relaxed-unreachable
+        # incremental: the instances (but fluent ones) that may still be called, and how many
+        # of the engine's instances (in creation order) have been looked at for it
+        self._callable: dict[tuple[str, tuple[str, ...]], InstanceState] = {}
+        self._seen_instances = 0
 
     # --- helpers --------------------------------------------------------------------------
 
@@ -161,15 +166,15 @@ class StreamSolver:
         if self.remaining() <= 0:
             raise _Timeout
 
-    def _objects(self, facts: Iterable[Atom]) -> dict[str, str]:
+    def _objects(self, facts: Collection[Atom]) -> dict[str, str]:
+        constants = self.problem.domain.constants
         names = dict.fromkeys(self.problem.facts.objects, "object")
-        names.update(dict.fromkeys(self.problem.domain.constants, "object"))
-        for atom in facts:
-            for arg in atom.args:
-                names.setdefault(arg, "object")
-        declared = {n: self.problem.domain.constants.get(n, "object") for n in names}
+        names.update(dict.fromkeys(constants, "object"))
+        names.update(dict.fromkeys(chain.from_iterable(atom.args for atom in facts), "object"))
+        declared = {n: constants.get(n, "object") for n in names}
+        types = self.problem.domain.types
         return infer_object_types(
-            declared, (a for a in facts if len(a.args) == 1), self.problem.domain.types
+            declared, (a for a in facts if len(a.args) == 1 and a.predicate in types.parents), types
         )
 
     def plan(
@@ -323,19 +328,33 @@ class StreamSolver:
         return self._search(lazy=False)
 
     def _sample_up_to(self, level: int) -> None:
-        """Incremental: call every instance (but fluent ones) until all exceed ``level``."""
+        """Incremental: call every instance (but fluent ones) until all exceed ``level``.
+
+        Each pass calls, in the order of their keys, the instances known when it began that
+        are within ``level``, once each; passes repeat until none is. Only instances that may
+        still produce are looked at (:attr:`_callable`: exhausted ones drop out for good)."""
+        engine = self.engine
+        callable_ = self._callable
+        keys = engine.instance_keys
         progress = True
         while progress:
             progress = False
-            for key in sorted(self.engine.instances):
-                state = self.engine.instances[key]
-                instance = state.instance
-                if instance.exhausted or instance.external.declaration.fluents:
+            for key in keys[self._seen_instances :]:
+                state = engine.instances[key]
+                if not state.instance.external.declaration.fluents:
+                    callable_[key] = state
+            self._seen_instances = len(keys)
+            for key in sorted(callable_):
+                state = callable_[key]
+                if state.instance.exhausted:
+                    del callable_[key]
                     continue
                 if state.next_level <= level:
                     self._check_time()
                     self._sample_state(state)
                     progress = True
+                    if state.instance.exhausted:
+                        del callable_[key]
 
     def _world(self, level: int, lazy: bool) -> OptimisticWorld:
         """The facts to plan over: the optimistic world, or in incremental without fluent
@@ -541,6 +560,8 @@ class StreamSolver:
             state = self._instance(skeleton, index, inputs, bindings)
             if state is None:
                 return None
+            if skeleton.states.get(index) is not state:
+                skeleton.chosen.pop(index, None)  # outputs of another instance: not for this one
             skeleton.states[index] = state
             if index not in skeleton.chosen:
                 outputs = self._take(skeleton, index, state)
@@ -598,12 +619,17 @@ class StreamSolver:
 
     def _upstream_retry(self, skeleton: Skeleton, index: int) -> bool | None:
         """Step ``index`` cannot succeed with the outputs chosen before it: resample those
-        (False), unless no generator before it can give other outputs (None: dead)."""
-        upstream = [i for i in skeleton.chosen if i < index]
-        for i in upstream:
+        that can give others (False), unless none can (None: dead).
+
+        A step that cannot give other outputs (a single-call stream, an exhausted generator)
+        keeps what it gave this skeleton: called again it would produce nothing, and its
+        output stays valid as long as its inputs do (:meth:`_process` drops it when a
+        resampled step upstream changes them).
+        """
+        retry = [i for i in skeleton.chosen if i < index and self._can_retry(skeleton, i)]
+        for i in retry:
             del skeleton.chosen[i]
-        live = any(self._can_retry(skeleton, i) for i in upstream)
-        return False if live else None
+        return False if retry else None
 
     def _can_retry(self, skeleton: Skeleton, index: int) -> bool:
         """Can stream step ``index`` give other outputs (a test cannot)?"""

@@ -115,6 +115,8 @@ class Engine:
         self.store = FactStore()
         self.numeric: dict[tuple[str, tuple[str, ...]], float] = dict(problem.facts.numeric)
         self.instances: dict[tuple[str, tuple[str, ...]], InstanceState] = {}
+        # the keys of ``instances`` in creation order (a consumer keeps its own cursor)
+        self.instance_keys: list[tuple[str, tuple[str, ...]]] = []
         # fluent instances for states other than the initial one, and the calls made on all
         # instances of a (fluent stream, inputs) pair: the pair's complexity counts them all
         self.variants: dict[tuple[str, tuple[str, ...], tuple[Atom, ...]], InstanceState] = {}
@@ -178,6 +180,7 @@ class Engine:
                 instance = StreamInstance(stream, inputs, self._fluents(stream))
                 state = InstanceState(instance, level)
                 self.instances[(query.name, inputs)] = state
+                self.instance_keys.append((query.name, inputs))
                 if stream.info.eager:
                     self._eager.append(state)
             elif query.name in self.functions:
