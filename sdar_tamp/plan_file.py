@@ -482,8 +482,9 @@ def build_plan_file(
     """Concatenate ``items`` into one timeline (arms in scene order).
 
     Each segment must start where the timeline stands. Consecutive gripper events (no motion
-    between them) happen at the same instant, followed by one dwell of ``gripper_time`` [s]
-    with the robot still. The timeline is resampled linearly wherever the spacing exceeds
+    between them) of different arms happen at the same instant, followed by one dwell of
+    ``gripper_time`` [s] with the robot still; a second event of one arm waits for the dwell
+    of its first. The timeline is resampled linearly wherever the spacing exceeds
     ``dt`` [s]. ``final_poses``: start poses ``(x, y, yaw)`` [m, m, rad] of the objects in
     ``start_poses`` (``sizes`` must name the same objects), updated at every release from the
     tool pose (``T_world_tcp @ T_tcp_object`` projected on the table). Metrics: see
@@ -507,6 +508,7 @@ def build_plan_file(
     ts: list[FloatArray] = [np.zeros(1)]
     qs: list[FloatArray] = [q_now[None]]
     now, dwell = 0.0, False
+    acting: set[str] = set()  # arms whose gripper acts at ``now`` (their dwell not yet over)
     events: list[PlanEvent] = []
     steps: list[StepRecord] = []
     final: dict[str, Pose3] = {
@@ -521,7 +523,13 @@ def build_plan_file(
                     f"items[{n}]: expected an arm of {list(names)}, a type of "
                     f"{list(EVENT_TYPES)} and a known object, got {item}"
                 )
+            if item.arm in acting and gripper_time > 0.0:  # the arm's previous dwell first
+                now += gripper_time
+                ts.append(np.array([now]))
+                qs.append(q_now[None])
+                acting.clear()
             events.append(PlanEvent(now, item.arm, item.type, item.object, item.T_tcp_object))
+            acting.add(item.arm)
             dwell = True
             if item.type == "grasp":
                 held[item.arm] = item.object
@@ -536,6 +544,7 @@ def build_plan_file(
             ts.append(np.array([now]))
             qs.append(q_now[None])
         dwell = False
+        acting.clear()
         t, q = np.asarray(item.t, dtype=np.float64), np.asarray(item.q, dtype=np.float64)
         if t.ndim != 1 or q.shape != (len(t), layout.dof) or len(t) == 0 or t[0] != 0.0:
             raise ParameterError(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from collections.abc import Callable
@@ -24,6 +25,7 @@ from sdar_tamp.plan_file import (
     resample,
     save_plan,
 )
+from sdar_tamp.plan_rules import check_timeline
 from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import pose_xyz_yaw
@@ -193,6 +195,27 @@ def test_timeline_dwell_and_resampling(plan: PlanFile, scene: Scene) -> None:
     bounds = [x for s in plan.steps for x in (s.t_start, s.t_end)]
     assert bounds == pytest.approx([0.0, 0.1, 0.6, 0.66])
     assert plan.steps[0].level == "plain" and plan.steps[0].objects == ("o1",)
+
+
+def test_a_second_event_of_one_arm_waits_for_the_dwell_of_its_first(scene: Scene) -> None:
+    """A release and a grasp of one arm with no motion between them (an arm that puts an
+    object down and takes it up again): the grasp comes one dwell after the release."""
+    items: list[MotionSegment | GripperEvent] = [
+        GripperEvent("left", "grasp", "o1", T_TCP_OBJ),
+        GripperEvent("right", "grasp", "o2", T_TCP_OBJ),
+        GripperEvent("left", "release", "o1", T_TCP_OBJ),
+        GripperEvent("left", "grasp", "o1", T_TCP_OBJ),
+    ]
+    plan = build_plan_file(scene, "T2", STARTS, SIZES, items, {})
+    assert [e.t for e in plan.events] == pytest.approx([0.0, 0.0, 0.5, 1.0])
+    assert plan.duration == pytest.approx(3 * 0.5)
+    assert check_timeline(plan, scene) is None
+    # without the wait the timeline breaks the dwell rule the validator enforces
+    squeezed = dataclasses.replace(
+        plan, events=tuple(dataclasses.replace(e, t=min(e.t, 0.5)) for e in plan.events)
+    )
+    limit = check_timeline(squeezed, scene)
+    assert limit is not None and limit.kind == "dwell"
 
 
 def test_metrics_and_final_poses(plan: PlanFile, scene: Scene) -> None:
