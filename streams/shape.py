@@ -111,7 +111,7 @@ def clearance_lift(
     way = start + np.linspace(0.0, 1.0, n)[:, None] * (end - start)
     top = 0.0  # the table
     for box in objects.values():
-        if min(footprint_distance(box, p) for p in way) <= reach:
+        if footprint_distances(box, way).min() <= reach:
             top = max(top, float(box_corners(box)[:, 2].max()))
     need = (top + options.lift_margin - z_low) / rise
     return float(np.clip(need, options.min_lift, options.max_lift))
@@ -132,6 +132,14 @@ def footprint_distance(box: ObjectBox, xy: FloatArray) -> float:
     local = T[:2, :2].T @ (np.asarray(xy, dtype=np.float64) - T[:2, 3])
     out = np.maximum(np.abs(local) - 0.5 * np.asarray(box.size[:2]), 0.0)
     return float(np.linalg.norm(out))
+
+
+def footprint_distances(box: ObjectBox, xy: FloatArray) -> FloatArray:
+    """:func:`footprint_distance` for every point of ``xy`` ``(n, 2)``: ``(n,)`` [m]."""
+    T = np.asarray(box.T_world_obj, dtype=np.float64)
+    local = (np.asarray(xy, dtype=np.float64) - T[:2, 3]) @ T[:2, :2]
+    out = np.maximum(np.abs(local) - 0.5 * np.asarray(box.size[:2]), 0.0)
+    return np.asarray(np.linalg.norm(out, axis=1), dtype=np.float64)
 
 
 def straight_prefix(

@@ -25,12 +25,16 @@ scaled by the smallest factor that restores every limit) and sampled again; with
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.transforms import FloatArray
+
+IntArray = npt.NDArray[np.intp]
 
 
 @dataclass(frozen=True)
@@ -102,27 +106,88 @@ def spline_curve(waypoints: FloatArray, samples: int) -> FloatArray:
     return q
 
 
-def _accel_rows(
-    dq: FloatArray, ddq: FloatArray, dq1: FloatArray, ddq1: FloatArray, ds: float
-) -> FloatArray:
-    """Rows ``(2n, 2)`` in ``(x, u)`` of the joint accelerations at both ends of a step
-    (``x_{i+1} = x + 2 u ds``); each row times ``(x, u)`` must stay in ``[-a, a]``."""
-    return np.concatenate([np.stack([ddq, dq], 1), np.stack([ddq1, dq1 + 2 * ds * ddq1], 1)])
+def _accel_rows(dq: FloatArray, ddq: FloatArray, ds: float) -> FloatArray:
+    """Rows ``(k - 1, 2n, 2)`` in ``(x, u)`` of the joint accelerations at both ends of every
+    step between the ``k`` grid points of ``dq``, ``ddq`` ``(k, n)`` (``x_{i+1} = x + 2 u
+    ds``); each row times ``(x, u)`` must stay in ``[-a, a]``."""
+    start = np.stack([ddq[:-1], dq[:-1]], axis=2)
+    end = np.stack([ddq[1:], dq[1:] + 2 * ds * ddq[1:]], axis=2)
+    return np.concatenate([start, end], axis=1)
 
 
-def _max_x(rows: FloatArray, a2: FloatArray, xv: float, xn: float, ds: float) -> float:
-    """Largest ``x`` in the polygon of the backward pass at one grid point."""
+@functools.lru_cache(maxsize=8)
+def _pairs(m: int) -> tuple[IntArray, IntArray]:
+    """Index pairs ``i < j`` of ``m`` constraint rows (every candidate vertex)."""
+    i, j = np.triu_indices(m, 1)
+    return i, j
+
+
+#: Candidates farther than this outside the box rows are dropped before the full check
+#: (looser than the check's own 1e-9: the full check alone decides).
+_SLACK = 1e-6
+
+
+def _constraints(rows: FloatArray, a2: FloatArray, ds: float) -> tuple[FloatArray, FloatArray]:
+    """The backward pass's constraint rows ``G`` ``(k, 4 + 2r, 2)`` and right-hand sides
+    ``h`` ``(k, 4 + 2r)`` in ``(x, u)`` for the acceleration rows ``(k, r, 2)`` of ``k``
+    grid steps: the box ``0 <= x <= xv``, ``0 <= x + 2 u ds <= xn`` (``xv`` and ``xn`` are
+    left at 0 here), then ``rows <= a2`` and ``-rows <= a2``."""
+    k = len(rows)
     box = np.array([[1.0, 0.0], [-1.0, 0.0], [1.0, 2 * ds], [-1.0, -2 * ds]])
-    G = np.concatenate([box, rows, -rows])
-    h = np.concatenate([np.array([xv, 0.0, xn, 0.0]), a2, a2])
-    i, j = np.triu_indices(len(G), 1)
-    det = G[i, 0] * G[j, 1] - G[i, 1] * G[j, 0]
-    ok = np.abs(det) > 1e-12
-    i, j, det = i[ok], j[ok], det[ok]
-    x = (h[i] * G[j, 1] - G[i, 1] * h[j]) / det
-    u = (G[i, 0] * h[j] - h[i] * G[j, 0]) / det
-    feas = np.all(G @ np.stack([x, u]) <= h[:, None] + 1e-9, axis=0)
-    return float(max(0.0, x[feas].max())) if feas.any() else 0.0
+    G = np.concatenate([np.broadcast_to(box, (k, 4, 2)), rows, -rows], axis=1)
+    h = np.zeros((k, G.shape[1]))
+    h[:, 4:] = np.concatenate([a2, a2])
+    return G, h
+
+
+class _Vertices:
+    """Every candidate vertex of the backward pass's polygons, all grid steps at once.
+
+    A vertex is the intersection of two constraint lines. Those that do not involve the
+    line ``x + 2 u ds = xn`` (row 2, the only one that changes during the pass) are
+    computed once for every step (``x``, ``u`` ``(k, pairs)``, ``keep`` marks those inside
+    the fixed box rows); those on row 2 are computed per step (:meth:`max_x`)."""
+
+    def __init__(self, G: FloatArray, h: FloatArray, xv: FloatArray) -> None:
+        self.G, self.h = G, h.copy()
+        self.h[:, 0] = xv
+        i, j = _pairs(G.shape[1])
+        fixed = (i != 2) & (j != 2)
+        i, j = i[fixed], j[fixed]
+        Gi0, Gi1, Gj0, Gj1 = G[:, i, 0], G[:, i, 1], G[:, j, 0], G[:, j, 1]
+        det = Gi0 * Gj1 - Gi1 * Gj0
+        ok = np.abs(det) > 1e-12
+        det = np.where(ok, det, 1.0)
+        hi, hj = self.h[:, i], self.h[:, j]
+        self.x = (hi * Gj1 - Gi1 * hj) / det
+        self.u = (Gi0 * hj - hi * Gj0) / det
+        self.w = self.x + G[:, 2:3, 1] * self.u
+        self.keep = (
+            ok & (self.x <= xv[:, None] + _SLACK) & (self.x >= -_SLACK) & (self.w >= -_SLACK)
+        )
+        i2, j2 = _pairs(G.shape[1])
+        row2 = (i2 == 2) | (j2 == 2)
+        self.i2, self.j2 = i2[row2], j2[row2]
+
+    def max_x(self, k: int, xn: float) -> float:
+        """Largest ``x`` over the vertices of step ``k``'s polygon with ``x + 2 u ds <= xn``
+        that satisfy every constraint (0 when none does)."""
+        G, h = self.G[k], self.h[k].copy()
+        h[2] = xn
+        sel = self.keep[k] & (self.w[k] <= xn + _SLACK)
+        i, j = self.i2, self.j2
+        det = G[i, 0] * G[j, 1] - G[i, 1] * G[j, 0]
+        ok = np.abs(det) > 1e-12
+        i, j, det = i[ok], j[ok], det[ok]
+        x2 = (h[i] * G[j, 1] - G[i, 1] * h[j]) / det
+        u2 = (G[i, 0] * h[j] - h[i] * G[j, 0]) / det
+        near = (x2 <= h[0] + _SLACK) & (x2 >= -_SLACK)
+        x = np.concatenate([self.x[k, sel], x2[near]])
+        u = np.concatenate([self.u[k, sel], u2[near]])
+        if not len(x):
+            return 0.0
+        feas = np.all(G @ np.stack([x, u]) <= h[:, None] + 1e-9, axis=0)
+        return float(max(0.0, x[feas].max())) if feas.any() else 0.0
 
 
 def _u_range(rows: FloatArray, a2: FloatArray, x: float) -> tuple[float, float]:
@@ -199,10 +264,11 @@ def time_parameterize(
     if cap is not None:
         xv = np.minimum(xv, _grid_cap(s, cap, sg) ** 2)
     a2 = np.concatenate([a, a])
-    rows = [_accel_rows(dq[i], ddq[i], dq[i + 1], ddq[i + 1], ds) for i in range(n_grid - 1)]
+    rows = _accel_rows(dq, ddq, ds)
+    vertices = _Vertices(*_constraints(rows, a2, ds), xv[:-1])
     xmax = np.zeros(n_grid)
     for i in range(n_grid - 2, -1, -1):
-        xmax[i] = _max_x(rows[i], a2, float(xv[i]), float(xmax[i + 1]), ds)
+        xmax[i] = vertices.max_x(i, float(xmax[i + 1]))
     x = np.zeros(n_grid)
     u = np.zeros(n_grid - 1)
     for i in range(n_grid - 1):

@@ -19,9 +19,10 @@ the coal narrow phase on the surviving pairs, all in C++.
 
 from __future__ import annotations
 
+import functools
 from collections import OrderedDict
 from collections.abc import Hashable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -29,6 +30,18 @@ from sdar_tamp.world import collision_model as cm
 from sdar_tamp.world.errors import ArmLayoutError, CollisionModelError
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse
+
+
+@functools.lru_cache(maxsize=4)
+def _shared_arms(scene: Scene) -> cm.DualArmModel:
+    return cm.build_dual_arm(scene)
+
+
+def _dual_arm(scene: Scene) -> cm.DualArmModel:
+    """The arms' model of ``scene``, built once per scene and shared by its worlds (the model
+    and the arm shapes are only read); each world gets its own pinocchio data."""
+    shared = _shared_arms(scene)
+    return replace(shared, data=shared.model.createData())
 
 
 @dataclass(frozen=True)
@@ -72,7 +85,7 @@ class CollisionWorld:
     def __init__(self, scene: Scene, *, tolerance: float = 1e-3) -> None:
         self._scene = scene
         self._tolerance = tolerance
-        self._arms = cm.build_dual_arm(scene)
+        self._arms = _dual_arm(scene)
         self._resting: dict[str, ObjectBox] = {}
         self._held: dict[str, tuple[str, FloatArray, ObjectBox]] = {}
         self.layout = scene.layout

@@ -143,17 +143,12 @@ def build_scene_geometry(
         geometry.addGeometryObject(
             pin.GeometryObject(f"held:{name}", arms.wrist_joint[arm], placement, _coal.box(size))
         )
+    # one pass over the names (indexing geometryObjects copies a Python proxy per access)
+    all_names = [str(obj.name) for obj in geometry.geometryObjects]
+    ids = {name: k for k, name in enumerate(all_names)}
     for a, b in pairs:
-        geometry.addCollisionPair(
-            pin.CollisionPair(geometry.getGeometryId(a), geometry.getGeometryId(b))
-        )
-    names = tuple(
-        (
-            str(geometry.geometryObjects[p.first].name),
-            str(geometry.geometryObjects[p.second].name),
-        )
-        for p in geometry.collisionPairs
-    )
+        geometry.addCollisionPair(pin.CollisionPair(ids[a], ids[b]))
+    names = tuple((all_names[p.first], all_names[p.second]) for p in geometry.collisionPairs)
     data = geometry.createData()
     manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(arms.model, geometry, data)
     return SceneGeometry(geometry, data, manager, names)

@@ -7,6 +7,7 @@ frozen dataclasses. World frame: table centre at the origin, z up, table top at 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from importlib.resources import files
 from pathlib import Path
 
@@ -91,6 +92,11 @@ class ArmSpec:
 
     @property
     def T_world_base(self) -> FloatArray:
+        """The base pose ``(4, 4)`` in the world (a copy)."""
+        return self._T_world_base.copy()
+
+    @cached_property
+    def _T_world_base(self) -> FloatArray:
         x, y, z = self.base_xyz
         return pose_xyz_yaw(x, y, z, self.base_yaw)
 

@@ -17,6 +17,7 @@ from streams.shape import (
     ShapeOptions,
     clearance_lift,
     footprint_distance,
+    footprint_distances,
     round_corner,
     straight_end_deviation,
 )
@@ -108,3 +109,11 @@ def test_straight_end_deviation(ctx: WorldContext) -> None:
     lateral, angle = straight_end_deviation(kin, cut, grasp, 0.02)
     assert lateral > 0.002 or angle > np.radians(2.0)
     assert straight_end_deviation(kin, up[:3], grasp, 0.02) == (math.inf, math.inf)
+
+
+def test_footprint_distances_match_one_point_at_a_time() -> None:
+    box = ObjectBox(pose_xyz_yaw(0.1, -0.05, 0.025, 0.7), (0.08, 0.04, 0.05))
+    pts = np.random.default_rng(3).uniform(-0.3, 0.3, (50, 2))
+    expected = [footprint_distance(box, p) for p in pts]
+    np.testing.assert_allclose(footprint_distances(box, pts), expected, atol=1e-12)
+    assert footprint_distances(box, np.array([[0.1, -0.05]]))[0] == 0.0

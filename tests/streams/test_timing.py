@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 from sdar_tamp.errors import ParameterError
+from streams import timing
 from streams.timing import (
     natural_spline,
     sample_limit_ratio,
@@ -109,3 +110,39 @@ def test_path_speed_cap_slows_the_capped_part_only() -> None:
     first = capped.q[1:, 0] <= 0.5
     assert np.abs(vel[first]).max() <= 0.2 * 1.01
     assert np.abs(vel).max() > 1.0  # the rest is not capped
+
+
+def _max_x_every_vertex(rows: np.ndarray, a2: np.ndarray, xv: float, xn: float, ds: float) -> float:
+    """The backward pass's step by plain enumeration of every pair of constraint lines."""
+    box = np.array([[1.0, 0.0], [-1.0, 0.0], [1.0, 2 * ds], [-1.0, -2 * ds]])
+    G = np.concatenate([box, rows, -rows])
+    h = np.concatenate([np.array([xv, 0.0, xn, 0.0]), a2, a2])
+    best = 0.0
+    for i in range(len(G)):
+        for j in range(i + 1, len(G)):
+            det = G[i, 0] * G[j, 1] - G[i, 1] * G[j, 0]
+            if abs(det) <= 1e-12:
+                continue
+            x = (h[i] * G[j, 1] - G[i, 1] * h[j]) / det
+            u = (G[i, 0] * h[j] - h[i] * G[j, 0]) / det
+            if np.all(G @ np.array([x, u]) <= h + 1e-9):
+                best = max(best, x)
+    return best
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_vertex_search_matches_plain_enumeration(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    k, n, ds = 12, 4, 0.02
+    dq = rng.normal(0.0, 0.5, (k + 1, n))
+    ddq = rng.normal(0.0, 2.0, (k + 1, n))
+    dq[:, 1] = 0.0  # a joint that does not move: parallel and empty rows
+    ddq[:, 1] = 0.0
+    a2 = np.tile(rng.uniform(2.0, 6.0, n), 2)
+    rows = timing._accel_rows(dq, ddq, ds)
+    xv = rng.uniform(0.5, 4.0, k)
+    vertices = timing._Vertices(*timing._constraints(rows, a2, ds), xv)
+    for step in range(k):
+        for xn in (0.0, 0.3, 2.0, 50.0):
+            expected = _max_x_every_vertex(rows[step], a2, float(xv[step]), xn, ds)
+            assert vertices.max_x(step, xn) == pytest.approx(expected, rel=1e-12, abs=1e-15)

@@ -200,3 +200,33 @@ def test_an_arrangement_seen_before_reuses_its_geometry_and_answers_alike(
     world.set_objects(first)
     world.in_collision(_q(off, home))
     assert len(builds) == count + 1
+
+
+def test_worlds_of_one_scene_share_the_arm_model_but_not_its_data(
+    scene: Scene, kins: dict[str, ArmKinematics]
+) -> None:
+    first, second = CollisionWorld(scene), CollisionWorld(scene)
+    assert first._arms.model is second._arms.model
+    assert first._arms.data is not second._arms.data
+    q = _q(_reach(kins["left"], 0.0, 0.13, SIZE[2] / 2), np.array(scene.arm("right").home))
+    first.set_objects({"o": _box(0.0, 0.1)})  # a finger lands in the object
+    # one world's queries (which write its pinocchio data) leave the other's answers alone
+    assert first.in_collision(q)
+    assert not second.in_collision(q)
+    assert first.in_collision(q)
+
+
+def test_pair_names_follow_the_pairs_activated(scene: Scene) -> None:
+    world = CollisionWorld(scene)
+    world.set_objects({"o": _box(-0.2, 0.0), "p": _box(0.2, 0.1)})
+    world.in_collision()
+    names = world._geometry.pair_names  # type: ignore[union-attr]
+    assert set(names) == set(world._pairs())
+    assert len(names) == len(world._pairs())
+
+
+def test_base_pose_is_a_copy(scene: Scene) -> None:
+    arm = scene.arms[0]
+    T = arm.T_world_base
+    T[:3, 3] += 1.0
+    assert not np.allclose(arm.T_world_base, T)
