@@ -11,6 +11,7 @@ then by the estimated motion time. Groundings that failed before are skipped (se
 from __future__ import annotations
 
 import itertools
+from collections import Counter
 from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -117,23 +118,27 @@ class Grounder:
         if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps:
             stages.append((opt.pair_grasps, opt.pair_grasps))
         found: list[Grounding] = []
-        for limit, grasps in stages:
+        misses: Counter[str] = Counter()  # why combinations of options failed
+        for k, (limit, grasps) in enumerate(stages):
             per_move = [
                 self._move_options(a, m, lifted, limit, grasps)
                 for a, m in zip(arms, step.moves, strict=True)
             ]
+            more_grasps = any(g > grasps for _, g in stages[k + 1 :])
             for a, m, options in zip(arms, step.moves, per_move, strict=True):
-                if not options:
+                if not options and not more_grasps:
                     target = "a buffer" if m.to_buffer else "its goal"
                     show = self.cache.show
                     self.failures.why(step, arms, f"no grasp with IK for {show(a)} at "
                                       f"{show(m.obj)} and at {target}")  # fmt: skip
                     return []
-            found = self._combinations(step, arms, per_move, mode)
-            if found or all(len(options) < limit for options in per_move):
-                break
+            if all(per_move):
+                found = self._combinations(step, arms, per_move, mode, misses)
+            exhausted = all(len(options) < limit for options in per_move)
+            if found or (exhausted and not more_grasps):
+                break  # a later stage offers nothing new once every grasp was tried
         if not found:
-            self.failures.why(step, arms, "the arms' configurations collide (or were tried)")
+            self.failures.why(step, arms, _no_grounding(misses))
         return sorted(found, key=lambda g: g.estimate)
 
     def _move_options(
@@ -168,28 +173,39 @@ class Grounder:
         arms: tuple[str, ...],
         per_move: Sequence[Sequence[Option]],
         mode: MotionMode,
+        misses: Counter[str] | None = None,
     ) -> list[Grounding]:
         """The groundings of every combination of the moves' options not yet tried whose
-        dual-arm configurations are collision-free."""
+        dual-arm configurations are collision-free; ``misses`` counts why the others fail."""
         idle = [a for a in self.home if a not in arms]
         current = self.cache.current_dualconf()
         found: list[Grounding] = []
+        misses = Counter() if misses is None else misses
         for combo in _product(per_move):
             if self.tabu.blocked(self.key(step, arms, combo), mode):
+                misses[_TRIED] += 1
                 continue
             if not self.options.one_arm_at_a_time and not self._grippers_clear(step, combo):
+                misses[_GRIPPERS] += 1
                 continue
             if self.options.one_arm_at_a_time:
                 one = self._ground_one_arm(step, arms, combo, current)
                 if one is not None:
                     found.append(one)
+                else:
+                    misses[_ONE_ARM] += 1
                 continue
             pick = {a: o.pick for a, o in zip(arms, combo, strict=True)}
             place = {a: o.place for a, o in zip(arms, combo, strict=True)}
             for a in idle:  # the idle arm waits at its retract (home) configuration
                 pick[a] = place[a] = self.home[a]
-            d_pick, d_place = self._combine(pick), self._combine(place)
-            if d_pick is None or d_place is None:
+            d_pick = self._combine(pick)
+            if d_pick is None:
+                misses[_AT_PICK] += 1
+                continue
+            d_place = self._combine(place)
+            if d_place is None:
+                misses[_AT_PLACE] += 1
                 continue
             distance = self.cache.distance
             estimate = distance(current, d_pick) + distance(d_pick, d_place)
@@ -250,6 +266,21 @@ class Grounder:
             ):
                 return [(k, True), (k, False), (1 - k, True), (1 - k, False)]
         return [(0, True), (1, True), (1, False), (0, False)]
+
+
+_TRIED = "tried before"
+_GRIPPERS = "a gripper meets the other object at its target"
+_ONE_ARM = "an arm collides with the other arm at home"
+_AT_PICK = "the arms collide at the objects"
+_AT_PLACE = "the arms collide at the targets"
+
+
+def _no_grounding(misses: Counter[str]) -> str:
+    """Why no combination of the moves' options was a grounding, by count."""
+    if not misses:
+        return "no combination of grasp options to try"
+    parts = ", ".join(f"{why} ({n})" for why, n in misses.most_common())
+    return f"no combination of grasp options works: {parts}"
 
 
 def _product(options: Sequence[Sequence[Option]]) -> list[tuple[Option, ...]]:
