@@ -78,6 +78,7 @@ class Grounder:
         self.tabu = tabu
         self.failures = failures
         self.deadline = deadline
+        self._free: dict[Hashable, tuple[frozenset[str], ...]] = {}
 
     def key(self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...]) -> Hashable:
         """The tabu key of a grounding in the current arrangement."""
@@ -120,9 +121,16 @@ class Grounder:
         found: list[Grounding] = []
         misses: Counter[str] = Counter()  # why combinations of options failed
         for k, (limit, grasps) in enumerate(stages):
+            allowed: Sequence[frozenset[str] | None] = [None] * len(step.moves)
+            if grasps > opt.grasps:  # the pair search: only grasps of a pair that can work
+                free = self.free_pairs(step, arms, grasps)
+                if free is not None and not all(free):
+                    misses[_NO_FREE_PAIR] += 1
+                    break
+                allowed = free or allowed
             per_move = [
-                self._move_options(a, m, lifted, limit, grasps)
-                for a, m in zip(arms, step.moves, strict=True)
+                self._move_options(a, m, lifted, limit, grasps, only)
+                for a, m, only in zip(arms, step.moves, allowed, strict=True)
             ]
             more_grasps = any(g > grasps for _, g in stages[k + 1 :])
             for a, m, options in zip(arms, step.moves, per_move, strict=True):
@@ -141,8 +149,64 @@ class Grounder:
             self.failures.why(step, arms, _no_grounding(misses))
         return sorted(found, key=lambda g: g.estimate)
 
+    def free_pairs(
+        self, step: Step, arms: tuple[str, ...], grasps: int
+    ) -> tuple[frozenset[str], ...] | None:
+        """Per move of a step of two goal moves, the grasps (of the first ``grasps``) that
+        belong to a pair whose grippers clear the other object at its target and whose arms
+        clear each other at the objects and at the targets, with no other object on the table
+        (IK without fluents, every branch). Other objects only remove IK options, so a grasp
+        outside these sets is never part of a grounding, in any arrangement. Kept while the
+        two objects rest where they are. None for other steps."""
+        if len(step.moves) != 2 or any(m.to_buffer for m in step.moves):
+            return None
+        cache, voc = self.cache, self.cache.voc
+        current = cache.current_poses()
+        key = (step.moves, arms, tuple(current[o] for o in step.objects), grasps)
+        if key in self._free:
+            return self._free[key]
+        confs: list[dict[str, tuple[list[str], list[str]]]] = []
+        for arm, m in zip(arms, step.moves, strict=True):
+            here, goal = current[m.obj], self.goals[m.obj]
+            by_grasp: dict[str, tuple[list[str], list[str]]] = {}
+            for (g,) in cache.outputs(voc.grasp, (m.obj,), grasps):
+                picks = [q for (q,) in cache.outputs(voc.ik, (arm, m.obj, here, g), _BRANCHES)]
+                places = [q for (q,) in cache.outputs(voc.ik, (arm, m.obj, goal, g), _BRANCHES)]
+                if picks and places:
+                    by_grasp[g] = (picks, places)
+            confs.append(by_grasp)
+        (a, b), (arm_a, arm_b) = step.objects, arms
+        ta, tb = self.goals[a], self.goals[b]
+        ok_a: set[str] = set()
+        ok_b: set[str] = set()
+        test = voc.grasp_cfree if voc.grasp_cfree in cache.streams else None
+
+        def clear(x: Sequence[str], y: Sequence[str]) -> bool:
+            return any(self._combine({arm_a: qa, arm_b: qb}) for qa in x for qb in y)
+
+        for ga, (pick_a, place_a) in confs[0].items():
+            for gb, (pick_b, place_b) in confs[1].items():
+                if ga in ok_a and gb in ok_b:
+                    continue
+                if test is not None and not (
+                    cache.test(test, (a, ta, ga, b, tb)) and cache.test(test, (b, tb, gb, a, ta))
+                ):
+                    continue
+                if clear(pick_a, pick_b) and clear(place_a, place_b):
+                    ok_a.add(ga)
+                    ok_b.add(gb)
+        result = (frozenset(ok_a), frozenset(ok_b))
+        self._free[key] = result
+        return result
+
     def _move_options(
-        self, arm: str, move: Move, lifted: frozenset[str], limit: int, grasps: int
+        self,
+        arm: str,
+        move: Move,
+        lifted: frozenset[str],
+        limit: int,
+        grasps: int,
+        only: frozenset[str] | None = None,
     ) -> list[Option]:
         cache, voc, opt = self.cache, self.cache.voc, self.options
         p = cache.current_poses()[move.obj]
@@ -155,6 +219,8 @@ class Grounder:
         after = cache.fluents(voc.atpose, without=lifted)
         found: list[Option] = []
         for (g,) in cache.outputs(voc.grasp, (move.obj,), grasps):
+            if only is not None and g not in only:
+                continue
             picks = cache.outputs(voc.ik, (arm, move.obj, p, g), 1, resting)
             if not picks:
                 continue
@@ -268,6 +334,9 @@ class Grounder:
         return [(0, True), (1, True), (1, False), (0, False)]
 
 
+#: IK solutions asked per grasp and pose when no other object is on the table (every branch).
+_BRANCHES = 8
+_NO_FREE_PAIR = "no pair of grasps keeps the arms apart, whatever the other objects"
 _TRIED = "tried before"
 _GRIPPERS = "a gripper meets the other object at its target"
 _ONE_ARM = "an arm collides with the other arm at home"

@@ -4,6 +4,7 @@ object at its target."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -180,6 +181,38 @@ def test_boxed_in_neighbours_need_the_moderate_pair_tilts(
     for g in found:
         tilts = {round(abs(math.degrees(value(o.grasp).tilt))) for o in g.options}
         assert tilts & moderate
+        # every grounding's grasps belong to pairs that work with no other object around
+        free = solver.grounder.free_pairs(swap, g.arms, solver.options.pair_grasps)
+        assert free is not None
+        assert all(o.grasp in grasps for o, grasps in zip(g.options, free, strict=True))
+
+
+def test_a_swap_no_grasp_pair_allows_is_dropped_before_any_ik_among_the_others(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    """Two bars side by side, 2.6 cm apart, held across their 4 cm side: both grippers'
+    fingers would close in the same gap. No pair works even on an empty table, and the
+    pair search says so instead of asking IK in the arrangement."""
+    d = 0.04 + CLEARANCE
+    a, b = Pose2D(0.0, d / 2, 0.0), Pose2D(0.0, -d / 2, 0.0)
+    size = (0.06, 0.04, 0.05)
+    inst = Instance(
+        "bars",
+        WORKSPACE,
+        (
+            ObjectSpec("a", size, a, Pose2D(b.x, b.y, math.pi)),
+            ObjectSpec("b", size, b, Pose2D(a.x, a.y, math.pi)),
+        ),
+    )
+    solver = _solver(inst, ctx, planner)
+    (swap,) = [s for s in solver.planner.candidates(solver.view()) if s.kind == "swap"]
+    assert solver.grounder.select([swap], MotionMode.FULL) == []
+    reasons = solver.failures.reasons
+    assert len(reasons) == 2  # both arm assignments
+    assert all("no pair of grasps keeps the arms apart" in r for r in reasons)
+    for arms in itertools.permutations(sorted(solver.home)):
+        free = solver.grounder.free_pairs(swap, arms, solver.options.pair_grasps)
+        assert free == (frozenset(), frozenset())
 
 
 def test_neighbours_in_a_row_trade_places_in_one_swap(
