@@ -11,6 +11,10 @@ contact counts. Survivors are ranked by the joint distance of their pre-grasp fr
 current configuration. :func:`compatible_pairs` then pairs candidates of the two arms whose
 configurations are collision-free together (the sub-task instantiation of SDAR-M).
 
+The closed-form part does not depend on the other objects: :class:`GraspIK` computes it once
+for every grasp of an object at a pose, and :func:`collision_free_candidates` filters it for
+an arrangement (the IK stream keeps one table per pose).
+
 Values holding arrays (:class:`IKRequest`, :class:`IKCandidate`) compare by identity.
 """
 

@@ -109,8 +109,10 @@ class Grounder:
         from ``options_per_move`` options per move, or from ``more_options`` when none of
         those combinations works (two arms reaching for neighbouring objects often collide
         with the first grasps and not with tilted ones), and for a two-move step at last
-        from every grasp of the grasp set (two grippers placing touching objects at once
-        need a compatible pair, often two grasps tilted away from each other; ``pair_kinds``)."""
+        from the first ``pair_grasps`` grasps, the stream's pair grasps included (two grippers
+        placing touching objects at once need a compatible pair, often two grasps tilted away
+        from each other; ``pair_kinds``), restricted to the grasps of :meth:`free_pairs`. A
+        stage with more grasps is reached even when the earlier ones ran out of options."""
         lifted = frozenset(step.objects)
         opt = self.options
         stages = [(opt.options_per_move, opt.grasps)]
