@@ -7,7 +7,10 @@ that the fingertips stay clear of the table (:mod:`sdar_tamp.world.graspability`
 instance loader shares: an object it accepts has a top-down grasp).
 
 Order (the paper's expanding grasp angles): every top-down grasp first, then tilted grasps
-with growing approach angles ``+t, -t`` for ``t`` in ``tilts``. The tilt turns the tool about
+with growing approach angles ``+t, -t`` for ``t`` in ``tilts``; then, appended after that
+set, the *pair tilts* (:attr:`GraspOptions.pair_tilts`), moderate angles that lean two
+grippers closing on touching neighbours at once away from each other without reaching over
+the other neighbours (SDAR-M searches them only for such pairs). The tilt turns the tool about
 its closing axis, i.e. in the plane perpendicular to the closing axis. Closing axes are tried
 short side first; a side wider than the gripper's graspable width is rejected (up to
 :data:`~sdar_tamp.world.graspability.WIDTH_TOLERANCE`), and so is a tilt that would leave
@@ -35,6 +38,10 @@ from sdar_tamp.world.transforms import FloatArray
 
 #: The paper's grasp set: top-down, then 45 degrees either way.
 DEFAULT_TILTS = (np.pi / 4,)
+#: Moderate tilts [rad] (20 and 30 degrees) appended for pairs of grasps: two wrists above
+#: objects 7 cm apart collide when both grasp top-down, and a 45-degree gripper meets the
+#: neighbours of a densely packed object.
+DEFAULT_PAIR_TILTS = (np.pi / 9, np.pi / 6)
 
 
 @dataclass(frozen=True)
@@ -42,16 +49,23 @@ class GraspOptions:
     """Which grasps :func:`sample_grasps` builds for each object (the grasp set).
 
     ``tilts`` [rad]: growing approach angles in (0, pi/2), each tried as ``+t`` then ``-t``
-    after every top-down grasp; ``symmetric``: both 180-degree wrist variants of each grasp.
-    With the defaults an object graspable across both sides has 12 grasps.
+    after every top-down grasp; ``symmetric``: both 180-degree wrist variants of each grasp;
+    ``pair_tilts`` [rad]: angles in (0, pi/2) appended after the grasp set proper, ``+t``
+    then ``-t`` (for two objects grasped at once; see the module docstring). With the defaults
+    an object graspable across both sides has 12 grasps, then 16 pair grasps.
     """
 
     tilts: tuple[float, ...] = DEFAULT_TILTS
     symmetric: bool = True
+    pair_tilts: tuple[float, ...] = DEFAULT_PAIR_TILTS
 
     def __post_init__(self) -> None:
-        if any(not 0.0 < t < np.pi / 2 for t in self.tilts):
-            raise ParameterError(f"grasp tilts must lie in (0, pi/2) [rad], got {list(self.tilts)}")
+        for name in ("tilts", "pair_tilts"):
+            angles = getattr(self, name)
+            if any(not 0.0 < t < np.pi / 2 for t in angles):
+                raise ParameterError(
+                    f"grasp {name} must lie in (0, pi/2) [rad], got {list(angles)}"
+                )
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,20 +117,25 @@ def sample_grasps(
     tilts: Sequence[float] = DEFAULT_TILTS,
     symmetric: bool = True,
     min_width: float = 0.0,
+    pair_tilts: Sequence[float] = (),
 ) -> tuple[Grasp, ...]:
     """All grasps of a cuboid of ``size`` (lx, ly, lz) [m], in the order described above.
 
     ``max_width`` [m]: the largest side the fingers can close on (opening minus margin);
-    ``tilts`` [rad]: growing positive tilt angles, each tried as ``+t`` then ``-t``.
+    ``tilts`` [rad]: growing positive tilt angles, each tried as ``+t`` then ``-t``;
+    ``pair_tilts`` [rad]: the same, appended after every grasp of ``tilts`` (an angle of
+    ``tilts`` is not repeated).
     """
-    if any(t <= 0.0 or t >= np.pi / 2 for t in tilts):
-        raise ValueError(f"tilts must lie in (0, pi/2) [rad], got {list(tilts)}")
+    for t in (*tilts, *pair_tilts):
+        if t <= 0.0 or t >= np.pi / 2:
+            raise ValueError(f"tilts must lie in (0, pi/2) [rad], got {[*tilts, *pair_tilts]}")
     axes = [
         a
         for a in sorted((0, 1), key=lambda a: size[a])
         if min_width - WIDTH_TOLERANCE <= size[a] and fits_between_fingers(size[a], max_width)
     ]
-    angles = [0.0] + [s * t for t in sorted(tilts) for s in (1.0, -1.0)]
+    extra = sorted(t for t in set(pair_tilts) if not any(abs(t - u) < 1e-9 for u in tilts))
+    angles = [0.0] + [s * t for t in (*sorted(tilts), *extra) for s in (1.0, -1.0)]
     flips = (False, True) if symmetric else (False,)
     out: list[Grasp] = []
     for tilt in angles:

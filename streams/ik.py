@@ -11,6 +11,10 @@ contact counts. Survivors are ranked by the joint distance of their pre-grasp fr
 current configuration. :func:`compatible_pairs` then pairs candidates of the two arms whose
 configurations are collision-free together (the sub-task instantiation of SDAR-M).
 
+The closed-form part does not depend on the other objects: :class:`GraspIK` computes it once
+for every grasp of an object at a pose, and :func:`collision_free_candidates` filters it for
+an arrangement (the IK stream keeps one table per pose).
+
 Values holding arrays (:class:`IKRequest`, :class:`IKCandidate`) compare by identity.
 """
 
@@ -53,6 +57,90 @@ class IKCandidate:
     cost: float  # joint distance of q_pre from the arm's current configuration [rad]
 
 
+class GraspIK:
+    """The closed-form IK of one arm for grasps of one object at one pose, computed at once
+    and kept: the branches whose grasp and pre-grasp (``lift`` [m] back along the approach)
+    are both real, within the joint limits and on one branch (joint distance below
+    ``max_branch_jump`` [rad]), and, on first use, the straight approach between them. None
+    of it depends on the other objects, so one table serves every arrangement; collision
+    checks are :func:`collision_free_candidates`' job.
+    """
+
+    def __init__(
+        self,
+        ctx: WorldContext,
+        arm: str,
+        obj: str,
+        box: ObjectBox,
+        grasps: Sequence[Grasp],
+        lift: float = 0.08,
+        max_branch_jump: float = 1.0,
+    ) -> None:
+        self.arm, self.obj, self.box, self.lift = arm, obj, box, lift
+        self.grasps = tuple(grasps)
+        self._kin = ctx.kinematics[arm]
+        n = len(self.grasps)
+        if n == 0:
+            self.q = self.q_pre = np.zeros((0, 0, 6))
+            self.ok = np.zeros((0, 0), dtype=np.bool_)
+        else:
+            T_tcp = box.T_world_obj @ np.stack([g.T_object_tcp for g in self.grasps])
+            both = self._kin.ik_tcp(np.concatenate([T_tcp, pregrasp_offset(T_tcp, lift)]))
+            self.q, self.q_pre = both.q[:n], both.q[n:]
+            ok = both.valid[:n] & both.valid[n:]
+            self.ok = ok & (np.abs(self.q - self.q_pre).max(axis=-1) < max_branch_jump)
+        self._sweeps: dict[tuple[int, int], FloatArray | None] = {}
+
+    def sweep(self, gi: int, b: int) -> FloatArray | None:
+        """Configurations ``(k, 6)`` of the straight approach of grasp ``gi`` on branch ``b``,
+        from the grasp back to the pre-grasp (None: unreachable)."""
+        key = (gi, b)
+        if key not in self._sweeps:
+            self._sweeps[key] = straight_tool_move(
+                self._kin, self.q[gi, b], -self.lift, step=SWEEP_STEP
+            )
+        return self._sweeps[key]
+
+
+def collision_free_candidates(
+    ctx: WorldContext,
+    world: CollisionWorld,
+    objects: Mapping[str, ObjectBox],
+    table: GraspIK,
+    q_current: Mapping[str, FloatArray],
+    indices: Sequence[int] | None = None,
+    other_q: Mapping[str, FloatArray] | None = None,
+) -> list[IKCandidate]:
+    """The branches of ``table`` (grasps ``indices``, default all) whose grasp, pre-grasp and
+    approach are collision-free among ``objects`` (see the module docstring), cheapest first."""
+    park = {a: ctx.home(a) for a in ctx.arm_names}
+    if other_q is not None:
+        park.update({a: np.asarray(q, dtype=np.float64) for a, q in other_q.items()})
+    ensure_objects(world, objects)
+    arm, obj = table.arm, table.obj
+    ref = np.asarray(q_current[arm], dtype=np.float64)
+    wanted = range(len(table.grasps)) if indices is None else indices
+    out: list[IKCandidate] = []
+    for gi in wanted:
+        for b in np.flatnonzero(table.ok[gi]):
+            q, q_pre = table.q[gi, b], table.q_pre[gi, b]
+            if _collides(ctx, world, park, arm, obj, q) or _collides(
+                ctx, world, park, arm, obj, q_pre
+            ):
+                continue
+            sweep = table.sweep(gi, int(b))
+            if sweep is None or any(
+                _collides(ctx, world, park, arm, obj, qs) for qs in sweep[1:-1]
+            ):
+                continue  # the straight approach between them is blocked or unreachable
+            cost = float(np.linalg.norm(q_pre - ref))
+            out.append(
+                IKCandidate(arm, obj, table.grasps[gi], int(b), q.copy(), q_pre.copy(), cost)
+            )
+    out.sort(key=lambda c: c.cost)
+    return out
+
+
 def solve_ik_candidates(
     ctx: WorldContext,
     world: CollisionWorld,
@@ -68,47 +156,12 @@ def solve_ik_candidates(
     ``world`` is used as scratch space (its resting objects are replaced); ``objects`` are the
     resting objects of the current arrangement, name -> box.
     """
-    park = {a: ctx.home(a) for a in ctx.arm_names}
-    if other_q is not None:
-        park.update({a: np.asarray(q, dtype=np.float64) for a, q in other_q.items()})
-    ensure_objects(world, objects)
     out: list[IKCandidate] = []
-    by_object: dict[tuple[str, str], list[IKRequest]] = {}
     for r in requests:
-        by_object.setdefault((r.arm, r.obj), []).append(r)
-    for (arm, obj), reqs in by_object.items():
-        kin = ctx.kinematics[arm]
-        grasps = [g for r in reqs for g in r.grasps]
-        boxes = [r.box for r in reqs for _ in r.grasps]
-        if not grasps:
+        if not r.grasps:
             continue
-        T_obj = np.stack([b.T_world_obj for b in boxes])
-        T_tcp = T_obj @ np.stack([g.T_object_tcp for g in grasps])
-        both = kin.ik_tcp(np.concatenate([T_tcp, pregrasp_offset(T_tcp, lift)]))
-        n = len(grasps)
-        q, q_pre = both.q[:n], both.q[n:]
-        ok = both.valid[:n] & both.valid[n:]
-        ok &= np.abs(q - q_pre).max(axis=-1) < max_branch_jump
-        if not ok.any():
-            continue
-        ref = np.asarray(q_current[arm], dtype=np.float64)
-        dual = dict(park)
-        for gi, b in zip(*np.nonzero(ok), strict=True):
-            if _collides(ctx, world, dual, arm, obj, q[gi, b]) or _collides(
-                ctx, world, dual, arm, obj, q_pre[gi, b]
-            ):
-                continue
-            sweep = straight_tool_move(kin, q[gi, b], -lift, step=SWEEP_STEP)
-            if sweep is None or any(
-                _collides(ctx, world, dual, arm, obj, qs) for qs in sweep[1:-1]
-            ):
-                continue  # the straight approach between them is blocked or unreachable
-            cost = float(np.linalg.norm(q_pre[gi, b] - ref))
-            out.append(
-                IKCandidate(
-                    arm, obj, grasps[gi], int(b), q[gi, b].copy(), q_pre[gi, b].copy(), cost
-                )
-            )
+        table = GraspIK(ctx, r.arm, r.obj, r.box, r.grasps, lift, max_branch_jump)
+        out += collision_free_candidates(ctx, world, objects, table, q_current, None, other_q)
     out.sort(key=lambda c: c.cost)
     return out
 

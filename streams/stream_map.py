@@ -16,6 +16,7 @@ Fluent facts (``atpose ?o ?p``, ``holding ?a ?o ?g``) arrive as tuples in ``flue
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -33,7 +34,7 @@ from streams.blocking import GraspBlocking, gripper_boxes
 from streams.buffers import sample_buffers
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, sample_grasps
-from streams.ik import IKRequest, SceneCache, solve_ik_candidates
+from streams.ik import GraspIK, SceneCache, collision_free_candidates
 from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
 from streams.sampling import SamplingOptions
 from streams.validate import HeldObject
@@ -96,6 +97,9 @@ class DualConf:
 #: Collision worlds kept for IK queries, one per object arrangement (a step of SDAR-M asks
 #: for a few: the current one, and per target the one after the pick plus the object there).
 WORLD_CACHE = 32
+#: Poses (arm, object, pose) whose closed-form IK of every grasp is kept: the starts, goals
+#: and recent buffers of a run.
+IK_TABLES = 512
 #: Clearance [m] IK asks of grasp, pre-grasp and approach configurations from the other
 #: objects (the timed trajectory may deviate slightly from the checked configurations).
 IK_MARGIN = 0.003
@@ -138,6 +142,9 @@ class DualArmStreams:
         self.motion = motion
         self.grasp_options = grasps
         self._grasps: dict[str, tuple[Grasp, ...]] = {}
+        self._set_sizes: dict[str, int] = {}
+        self._boxes: dict[tuple[str, Pose2D], ObjectBox] = {}
+        self._ik_tables: OrderedDict[tuple[str, str, Pose2D], GraspIK] = OrderedDict()
         self._buffer_calls = 0
         self._blocking: GraspBlocking | None = None
 
@@ -152,18 +159,39 @@ class DualArmStreams:
         return self.sizes.get(obj, self.ctx.scene.object_size)
 
     def box(self, obj: str, p: Pose2D) -> ObjectBox:
-        s = self.size(obj)
-        return ObjectBox(pose_xyz_yaw(p.x, p.y, s[2] / 2.0, p.yaw), s)
+        key = (obj, p)
+        box = self._boxes.get(key)
+        if box is None:
+            s = self.size(obj)
+            box = self._boxes[key] = ObjectBox(pose_xyz_yaw(p.x, p.y, s[2] / 2.0, p.yaw), s)
+        return box
 
     def grasps(self, obj: str) -> tuple[Grasp, ...]:
+        """The grasps ``sample-grasp`` yields for ``obj``: the grasp set proper, then the
+        pair grasps (:attr:`GraspOptions.pair_tilts`)."""
         if obj not in self._grasps:
+            options = self.grasp_options
             self._grasps[obj] = sample_grasps(
                 self.size(obj),
                 self.ctx.scene.gripper.max_graspable_width,
-                self.grasp_options.tilts,
-                self.grasp_options.symmetric,
+                options.tilts,
+                options.symmetric,
+                pair_tilts=options.pair_tilts,
+            )
+            self._set_sizes[obj] = len(
+                sample_grasps(
+                    self.size(obj),
+                    self.ctx.scene.gripper.max_graspable_width,
+                    options.tilts,
+                    options.symmetric,
+                )
             )
         return self._grasps[obj]
+
+    def grasp_set(self, obj: str) -> tuple[Grasp, ...]:
+        """The grasp set proper of ``obj`` (without the pair grasps): what the grasp-blocking
+        test proves impossible."""
+        return self.grasps(obj)[: self._set_sizes[obj]]
 
     def resting(self, fluents: Sequence[tuple[Any, ...]]) -> dict[str, ObjectBox]:
         return {f[1]: self.box(f[1], f[2]) for f in fluents if f[0] == "atpose"}
@@ -179,11 +207,29 @@ class DualArmStreams:
         placed = {f[1]: f[2] for f in fluents if f[0] == "atpose"}
         placed[obj] = p
         objects = {o: self.box(o, q) for o, q in placed.items()}
-        request = IKRequest(arm, obj, objects[obj], (g,))
+        table = self._grasp_ik(arm, obj, p)
+        index = g.index
+        if not (index < len(table.grasps) and table.grasps[index] is g):
+            table = GraspIK(self.ctx, arm, obj, objects[obj], (g,))  # a grasp from elsewhere
+            index = 0
         home = {a: self.ctx.home(a) for a in self.ctx.arm_names}
         world = self.scenes.world(frozenset(placed.items()), objects)
-        for c in solve_ik_candidates(self.ctx, world, objects, [request], home):
+        for c in collision_free_candidates(self.ctx, world, objects, table, home, (index,)):
             yield (ArmConf(arm, tuple(map(float, c.q)), tuple(map(float, c.q_pre))),)
+
+    def _grasp_ik(self, arm: str, obj: str, p: Pose2D) -> GraspIK:
+        """The closed-form IK of every grasp of ``obj`` at ``p`` (kept for the
+        :data:`IK_TABLES` poses used last)."""
+        key = (arm, obj, p)
+        table = self._ik_tables.get(key)
+        if table is None:
+            table = GraspIK(self.ctx, arm, obj, self.box(obj, p), self.grasps(obj))
+            if len(self._ik_tables) >= IK_TABLES:
+                self._ik_tables.popitem(last=False)
+            self._ik_tables[key] = table
+        else:
+            self._ik_tables.move_to_end(key)
+        return table
 
     def sample_buffer(
         self, obj: str, fluents: Sequence[tuple[Any, ...]] = ()
@@ -280,10 +326,10 @@ class DualArmStreams:
 
     def test_blocks_grasps(self, o: str, p: Pose2D, o2: str, p2: Pose2D) -> bool:
         """``o`` at ``p`` leaves no grasp of ``o2`` at ``p2`` (every grasp of the grasp set
-        puts a gripper box into ``o``'s box): a dependency edge that footprints miss."""
+        proper puts a gripper box into ``o``'s box): a dependency edge that footprints miss."""
         if o == o2:
             return False
-        return self.blocking.blocks_all(self.grasps(o2), self.box(o2, p2), self.box(o, p))
+        return self.blocking.blocks_all(self.grasp_set(o2), self.box(o2, p2), self.box(o, p))
 
     def test_grasp_cfree(self, o: str, p: Pose2D, g: Grasp, o2: str, p2: Pose2D) -> bool:
         """The gripper holding ``o`` at ``p`` with ``g`` is clear of ``o2`` at ``p2`` (two

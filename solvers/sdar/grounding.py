@@ -11,6 +11,7 @@ then by the estimated motion time. Groundings that failed before are skipped (se
 from __future__ import annotations
 
 import itertools
+from collections import Counter
 from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -77,6 +78,7 @@ class Grounder:
         self.tabu = tabu
         self.failures = failures
         self.deadline = deadline
+        self._free: dict[Hashable, tuple[frozenset[str], ...]] = {}
 
     def key(self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...]) -> Hashable:
         """The tabu key of a grounding in the current arrangement."""
@@ -107,8 +109,10 @@ class Grounder:
         from ``options_per_move`` options per move, or from ``more_options`` when none of
         those combinations works (two arms reaching for neighbouring objects often collide
         with the first grasps and not with tilted ones), and for a two-move step at last
-        from every grasp of the grasp set (two grippers placing touching objects at once
-        need a compatible pair, often two grasps tilted away from each other; ``pair_kinds``)."""
+        from the first ``pair_grasps`` grasps, the stream's pair grasps included (two grippers
+        placing touching objects at once need a compatible pair, often two grasps tilted away
+        from each other; ``pair_kinds``), restricted to the grasps of :meth:`free_pairs`. A
+        stage with more grasps is reached even when the earlier ones ran out of options."""
         lifted = frozenset(step.objects)
         opt = self.options
         stages = [(opt.options_per_move, opt.grasps)]
@@ -117,27 +121,94 @@ class Grounder:
         if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps:
             stages.append((opt.pair_grasps, opt.pair_grasps))
         found: list[Grounding] = []
-        for limit, grasps in stages:
+        misses: Counter[str] = Counter()  # why combinations of options failed
+        for k, (limit, grasps) in enumerate(stages):
+            allowed: Sequence[frozenset[str] | None] = [None] * len(step.moves)
+            if grasps > opt.grasps:  # the pair search: only grasps of a pair that can work
+                free = self.free_pairs(step, arms, grasps)
+                if free is not None and not all(free):
+                    misses[_NO_FREE_PAIR] += 1
+                    break
+                allowed = free or allowed
             per_move = [
-                self._move_options(a, m, lifted, limit, grasps)
-                for a, m in zip(arms, step.moves, strict=True)
+                self._move_options(a, m, lifted, limit, grasps, only)
+                for a, m, only in zip(arms, step.moves, allowed, strict=True)
             ]
+            more_grasps = any(g > grasps for _, g in stages[k + 1 :])
             for a, m, options in zip(arms, step.moves, per_move, strict=True):
-                if not options:
+                if not options and not more_grasps:
                     target = "a buffer" if m.to_buffer else "its goal"
                     show = self.cache.show
                     self.failures.why(step, arms, f"no grasp with IK for {show(a)} at "
                                       f"{show(m.obj)} and at {target}")  # fmt: skip
                     return []
-            found = self._combinations(step, arms, per_move, mode)
-            if found or all(len(options) < limit for options in per_move):
-                break
+            if all(per_move):
+                found = self._combinations(step, arms, per_move, mode, misses)
+            exhausted = all(len(options) < limit for options in per_move)
+            if found or (exhausted and not more_grasps):
+                break  # a later stage offers nothing new once every grasp was tried
         if not found:
-            self.failures.why(step, arms, "the arms' configurations collide (or were tried)")
+            self.failures.why(step, arms, _no_grounding(misses))
         return sorted(found, key=lambda g: g.estimate)
 
+    def free_pairs(
+        self, step: Step, arms: tuple[str, ...], grasps: int
+    ) -> tuple[frozenset[str], ...] | None:
+        """Per move of a step of two goal moves, the grasps (of the first ``grasps``) that
+        belong to a pair whose grippers clear the other object at its target and whose arms
+        clear each other at the objects and at the targets, with no other object on the table
+        (IK without fluents, every branch). Other objects only remove IK options, so a grasp
+        outside these sets is never part of a grounding, in any arrangement. Kept while the
+        two objects rest where they are. None for other steps."""
+        if len(step.moves) != 2 or any(m.to_buffer for m in step.moves):
+            return None
+        cache, voc = self.cache, self.cache.voc
+        current = cache.current_poses()
+        key = (step.moves, arms, tuple(current[o] for o in step.objects), grasps)
+        if key in self._free:
+            return self._free[key]
+        confs: list[dict[str, tuple[list[str], list[str]]]] = []
+        for arm, m in zip(arms, step.moves, strict=True):
+            here, goal = current[m.obj], self.goals[m.obj]
+            by_grasp: dict[str, tuple[list[str], list[str]]] = {}
+            for (g,) in cache.outputs(voc.grasp, (m.obj,), grasps):
+                picks = [q for (q,) in cache.outputs(voc.ik, (arm, m.obj, here, g), _BRANCHES)]
+                places = [q for (q,) in cache.outputs(voc.ik, (arm, m.obj, goal, g), _BRANCHES)]
+                if picks and places:
+                    by_grasp[g] = (picks, places)
+            confs.append(by_grasp)
+        (a, b), (arm_a, arm_b) = step.objects, arms
+        ta, tb = self.goals[a], self.goals[b]
+        ok_a: set[str] = set()
+        ok_b: set[str] = set()
+        test = voc.grasp_cfree if voc.grasp_cfree in cache.streams else None
+
+        def clear(x: Sequence[str], y: Sequence[str]) -> bool:
+            return any(self._combine({arm_a: qa, arm_b: qb}) for qa in x for qb in y)
+
+        for ga, (pick_a, place_a) in confs[0].items():
+            for gb, (pick_b, place_b) in confs[1].items():
+                if ga in ok_a and gb in ok_b:
+                    continue
+                if test is not None and not (
+                    cache.test(test, (a, ta, ga, b, tb)) and cache.test(test, (b, tb, gb, a, ta))
+                ):
+                    continue
+                if clear(pick_a, pick_b) and clear(place_a, place_b):
+                    ok_a.add(ga)
+                    ok_b.add(gb)
+        result = (frozenset(ok_a), frozenset(ok_b))
+        self._free[key] = result
+        return result
+
     def _move_options(
-        self, arm: str, move: Move, lifted: frozenset[str], limit: int, grasps: int
+        self,
+        arm: str,
+        move: Move,
+        lifted: frozenset[str],
+        limit: int,
+        grasps: int,
+        only: frozenset[str] | None = None,
     ) -> list[Option]:
         cache, voc, opt = self.cache, self.cache.voc, self.options
         p = cache.current_poses()[move.obj]
@@ -150,6 +221,8 @@ class Grounder:
         after = cache.fluents(voc.atpose, without=lifted)
         found: list[Option] = []
         for (g,) in cache.outputs(voc.grasp, (move.obj,), grasps):
+            if only is not None and g not in only:
+                continue
             picks = cache.outputs(voc.ik, (arm, move.obj, p, g), 1, resting)
             if not picks:
                 continue
@@ -168,28 +241,39 @@ class Grounder:
         arms: tuple[str, ...],
         per_move: Sequence[Sequence[Option]],
         mode: MotionMode,
+        misses: Counter[str] | None = None,
     ) -> list[Grounding]:
         """The groundings of every combination of the moves' options not yet tried whose
-        dual-arm configurations are collision-free."""
+        dual-arm configurations are collision-free; ``misses`` counts why the others fail."""
         idle = [a for a in self.home if a not in arms]
         current = self.cache.current_dualconf()
         found: list[Grounding] = []
+        misses = Counter() if misses is None else misses
         for combo in _product(per_move):
             if self.tabu.blocked(self.key(step, arms, combo), mode):
+                misses[_TRIED] += 1
                 continue
             if not self.options.one_arm_at_a_time and not self._grippers_clear(step, combo):
+                misses[_GRIPPERS] += 1
                 continue
             if self.options.one_arm_at_a_time:
                 one = self._ground_one_arm(step, arms, combo, current)
                 if one is not None:
                     found.append(one)
+                else:
+                    misses[_ONE_ARM] += 1
                 continue
             pick = {a: o.pick for a, o in zip(arms, combo, strict=True)}
             place = {a: o.place for a, o in zip(arms, combo, strict=True)}
             for a in idle:  # the idle arm waits at its retract (home) configuration
                 pick[a] = place[a] = self.home[a]
-            d_pick, d_place = self._combine(pick), self._combine(place)
-            if d_pick is None or d_place is None:
+            d_pick = self._combine(pick)
+            if d_pick is None:
+                misses[_AT_PICK] += 1
+                continue
+            d_place = self._combine(place)
+            if d_place is None:
+                misses[_AT_PLACE] += 1
                 continue
             distance = self.cache.distance
             estimate = distance(current, d_pick) + distance(d_pick, d_place)
@@ -250,6 +334,24 @@ class Grounder:
             ):
                 return [(k, True), (k, False), (1 - k, True), (1 - k, False)]
         return [(0, True), (1, True), (1, False), (0, False)]
+
+
+#: IK solutions asked per grasp and pose when no other object is on the table (every branch).
+_BRANCHES = 8
+_NO_FREE_PAIR = "no pair of grasps keeps the arms apart, whatever the other objects"
+_TRIED = "tried before"
+_GRIPPERS = "a gripper meets the other object at its target"
+_ONE_ARM = "an arm collides with the other arm at home"
+_AT_PICK = "the arms collide at the objects"
+_AT_PLACE = "the arms collide at the targets"
+
+
+def _no_grounding(misses: Counter[str]) -> str:
+    """Why no combination of the moves' options was a grounding, by count."""
+    if not misses:
+        return "no combination of grasp options to try"
+    parts = ", ".join(f"{why} ({n})" for why, n in misses.most_common())
+    return f"no combination of grasp options works: {parts}"
 
 
 def _product(options: Sequence[Sequence[Option]]) -> list[tuple[Option, ...]]:

@@ -20,8 +20,9 @@ class SdarOptions:
     grasps: int = 6  # grasps tried per object
     options_per_move: int = 2  # (grasp, pick IK, place IK) options kept per arm and move
     more_options: int = 6  # kept instead when every pair of the first ones makes the arms collide
-    pair_grasps: int = 12  # grasps searched per object of a pair_kinds step when no pair of
-    # the first options works (a swap of touching objects needs two compatible grasps)
+    pair_grasps: int = 28  # grasps searched per object of a pair_kinds step when no pair of
+    # the first options works (a swap of touching objects needs two compatible grasps, often
+    # two moderately tilted ones: the grasp stream's pair grasps come after its grasp set)
     pair_kinds: tuple[str, ...] = ("swap",)
     expand_kinds: tuple[str, ...] = ("pair", "swap", "chain", "cycle")  # two-move steps
     buffers: int = 4  # buffer poses tried per buffer move

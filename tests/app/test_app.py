@@ -191,7 +191,8 @@ def test_a_larger_grasp_set_reaches_the_stream_and_its_cut_is_logged(
     with caplog.at_level(logging.INFO, logger="sdar_tamp.app"):
         r = rearrangement_problem(_one(), ctx, config=config, planner=planner)
     sample = r.problem.stream_map["sample-grasp"]
-    assert len(_outputs(sample("a"))) == 20
+    # the grasp set, then the pair grasps (20 and 30 degrees: 4 angles x 2 sides x 2 wrists)
+    assert len(_outputs(sample("a"))) == 20 + 16
     assert any("tries the first 6 grasps" in m and "up to 20" in m for m in caplog.messages)
     caplog.clear()
     wide = config.replace(sdar=SdarOptions(grasps=20))

@@ -4,11 +4,17 @@ object at its target."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
 
-from sdar_tamp.app import plan_file_from_solution, rearrangement_problem, solve_rearrangement
+from sdar_tamp.app import (
+    PlannerConfig,
+    plan_file_from_solution,
+    rearrangement_problem,
+    solve_rearrangement,
+)
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.scene import Workspace
@@ -17,6 +23,7 @@ from solvers.sdar.planners import make_task_planner
 from solvers.sdar.solver import SdarOptions, SdarSolver
 from solvers.solution import Status
 from streams.context import WorldContext
+from streams.grasps import GraspOptions
 from streams.motion import DualMotionPlanner
 
 #: A solve's time budget: generous, so that a busy machine slows a test down but never turns
@@ -53,9 +60,40 @@ def _swap(size: tuple[float, float, float], gap: float, yaw: float, turn: float)
     )
 
 
-def _solver(inst: Instance, ctx: WorldContext, planner: DualMotionPlanner, **kw: int) -> SdarSolver:
-    r = rearrangement_problem(inst, ctx, planner=planner)
-    return SdarSolver(r.problem, make_task_planner("sdar"), SdarOptions(max_time=30.0, **kw))
+def _solver(
+    inst: Instance,
+    ctx: WorldContext,
+    planner: DualMotionPlanner,
+    grasps: GraspOptions | None = None,
+    **kw: int,
+) -> SdarSolver:
+    config = PlannerConfig(grasps=grasps or GraspOptions())
+    r = rearrangement_problem(inst, ctx, planner=planner, config=config)
+    return SdarSolver(r.problem, make_task_planner("sdar"), SdarOptions(max_time=BUDGET, **kw))
+
+
+DENSE_CUBE = (0.045, 0.045, 0.05)
+CLEARANCE = 0.026  # [m] the paper suite's clearance between objects
+
+
+def _row(axis: int) -> Instance:
+    """Four cubes in a row along ``axis`` (0: x, 1: y), 2.6 cm apart: the middle two trade
+    places (goals turned half a turn), the outer two stay."""
+    d = DENSE_CUBE[0] + CLEARANCE
+
+    def at(k: float, yaw: float = 0.0) -> Pose2D:
+        return Pose2D(0.0, k * d, yaw) if axis == 1 else Pose2D(k * d, 0.0, yaw)
+
+    return Instance(
+        "row",
+        WORKSPACE,
+        (
+            ObjectSpec("a", DENSE_CUBE, at(0.5), at(-0.5, math.pi)),
+            ObjectSpec("b", DENSE_CUBE, at(-0.5), at(0.5, math.pi)),
+            ObjectSpec("n1", DENSE_CUBE, at(1.5), at(1.5)),
+            ObjectSpec("n2", DENSE_CUBE, at(-1.5), at(-1.5)),
+        ),
+    )
 
 
 def test_the_pair_search_reaches_grasps_beyond_the_first_ones(
@@ -113,6 +151,78 @@ def test_close_neighbours_trade_places_in_one_dual_arm_swap(
     assert solution.status is Status.SOLVED, solution.diagnosis
     assert [t["kind"] for t in solution.trace] == ["swap"]
     assert not any(any(t["to_buffer"]) for t in solution.trace)
+    plan = plan_file_from_solution(r, solution)
+    assert plan.metrics["actions"] == 2
+    report = validate_plan(r.instance, plan, ctx.scene)
+    assert report.ok, report.violation
+
+
+def test_boxed_in_neighbours_need_the_moderate_pair_tilts(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    """The middle two of a row of cubes (along y) trade places: top-down, the two wrists
+    collide; at 45 degrees a gripper reaches over an outer cube (so the first six grasps give
+    fewer than six options, and the pair search must still run). Only the pair tilts of 20
+    and 30 degrees make a compatible pair."""
+    inst = _row(axis=1)
+    groundings = {}
+    for options in (GraspOptions(pair_tilts=()), GraspOptions()):
+        solver = _solver(inst, ctx, planner, grasps=options)
+        (swap,) = [s for s in solver.planner.candidates(solver.view()) if s.kind == "swap"]
+        groundings[options.pair_tilts] = solver.grounder.select([swap], MotionMode.FULL)
+        value = solver.cache.table.value
+        if not options.pair_tilts:
+            assert solver.failures.reasons
+            assert all("the arms collide at the objects" in r for r in solver.failures.reasons)
+    assert groundings[()] == []
+    found = groundings[GraspOptions().pair_tilts]
+    assert found
+    moderate = {20, 30}
+    for g in found:
+        tilts = {round(abs(math.degrees(value(o.grasp).tilt))) for o in g.options}
+        assert tilts & moderate
+        # every grounding's grasps belong to pairs that work with no other object around
+        free = solver.grounder.free_pairs(swap, g.arms, solver.options.pair_grasps)
+        assert free is not None
+        assert all(o.grasp in grasps for o, grasps in zip(g.options, free, strict=True))
+
+
+def test_a_swap_no_grasp_pair_allows_is_dropped_before_any_ik_among_the_others(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    """Two bars side by side, 2.6 cm apart, held across their 4 cm side: both grippers'
+    fingers would close in the same gap. No pair works even on an empty table, and the
+    pair search says so instead of asking IK in the arrangement."""
+    d = 0.04 + CLEARANCE
+    a, b = Pose2D(0.0, d / 2, 0.0), Pose2D(0.0, -d / 2, 0.0)
+    size = (0.06, 0.04, 0.05)
+    inst = Instance(
+        "bars",
+        WORKSPACE,
+        (
+            ObjectSpec("a", size, a, Pose2D(b.x, b.y, math.pi)),
+            ObjectSpec("b", size, b, Pose2D(a.x, a.y, math.pi)),
+        ),
+    )
+    solver = _solver(inst, ctx, planner)
+    (swap,) = [s for s in solver.planner.candidates(solver.view()) if s.kind == "swap"]
+    assert solver.grounder.select([swap], MotionMode.FULL) == []
+    reasons = solver.failures.reasons
+    assert len(reasons) == 2  # both arm assignments
+    assert all("no pair of grasps keeps the arms apart" in r for r in reasons)
+    for arms in itertools.permutations(sorted(solver.home)):
+        free = solver.grounder.free_pairs(swap, arms, solver.options.pair_grasps)
+        assert free == (frozenset(), frozenset())
+
+
+def test_neighbours_in_a_row_trade_places_in_one_swap(
+    ctx: WorldContext, planner: DualMotionPlanner
+) -> None:
+    inst = _row(axis=1)
+    r = rearrangement_problem(inst, ctx, planner=planner)
+    solution = solve_rearrangement(r, "sdar", BUDGET)
+    assert solution.status is Status.SOLVED, solution.diagnosis
+    assert [t["kind"] for t in solution.trace] == ["swap"]
     plan = plan_file_from_solution(r, solution)
     assert plan.metrics["actions"] == 2
     report = validate_plan(r.instance, plan, ctx.scene)

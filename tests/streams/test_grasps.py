@@ -1,11 +1,12 @@
 import numpy as np
 import pytest
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.graspability import FINGER_DEPTH, TABLE_CLEARANCE, fingertip_drop
 from sdar_tamp.world.transforms import pose_xyz_yaw
 from streams.context import WorldContext
-from streams.grasps import pregrasp_offset, sample_grasps
+from streams.grasps import GraspOptions, pregrasp_offset, sample_grasps
 from streams.ik import IKRequest, solve_ik_candidates
 
 
@@ -84,3 +85,25 @@ def test_a_short_bar_is_held_above_the_table(ctx: WorldContext) -> None:
 
 def test_a_bar_too_short_to_hold_gets_no_grasp() -> None:
     assert sample_grasps((0.08, 0.04, 0.01), 0.05) == ()
+
+
+def test_pair_tilts_come_after_the_grasp_set_each_angle_once() -> None:
+    size = (0.08, 0.04, 0.05)
+    proper = sample_grasps(size, 0.075)
+    grasps = sample_grasps(size, 0.075, pair_tilts=(np.pi / 6, np.pi / 9, np.pi / 4))
+    # the grasp set is a prefix; 45 degrees is not repeated; pair tilts grow, +t then -t
+    assert [(g.tilt, g.flipped) for g in grasps[: len(proper)]] == [
+        (g.tilt, g.flipped) for g in proper
+    ]
+    assert [round(float(np.degrees(g.tilt))) for g in grasps[len(proper) :]] == [
+        20, 20, -20, -20, 30, 30, -30, -30
+    ]  # fmt: skip
+    assert [g.index for g in grasps] == list(range(len(grasps)))
+    with pytest.raises(ValueError, match="tilts"):
+        sample_grasps(size, 0.075, pair_tilts=(np.pi / 2,))
+
+
+def test_grasp_options_reject_pair_tilts_out_of_range() -> None:
+    assert GraspOptions().pair_tilts  # moderate tilts by default
+    with pytest.raises(ParameterError, match=r"pair_tilts must lie in \(0, pi/2\)"):
+        GraspOptions(pair_tilts=(0.0,))

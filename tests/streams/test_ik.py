@@ -5,7 +5,14 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from streams.context import WorldContext
 from streams.grasps import pregrasp_offset, sample_grasps
-from streams.ik import IKRequest, SceneCache, compatible_pairs, solve_ik_candidates
+from streams.ik import (
+    GraspIK,
+    IKRequest,
+    SceneCache,
+    collision_free_candidates,
+    compatible_pairs,
+    solve_ik_candidates,
+)
 
 
 def _requests(
@@ -92,3 +99,30 @@ def test_scene_cache_keeps_one_world_per_arrangement(
 def test_scene_cache_refuses_no_capacity(ctx: WorldContext) -> None:
     with pytest.raises(ParameterError, match="capacity must be >= 1, got 0"):
         SceneCache(ctx, margin=0.003, capacity=0)
+
+
+def test_one_grasp_ik_table_serves_every_arrangement(
+    ctx: WorldContext, objects: dict[str, ObjectBox]
+) -> None:
+    """The closed-form IK of a pose, computed once, filtered by each arrangement's collisions,
+    gives what a fresh solve gives; an object put where the gripper goes removes candidates."""
+    world = ctx.new_world()
+    name = next(iter(objects))
+    box = objects[name]
+    grasps = sample_grasps(box.size, ctx.scene.gripper.max_graspable_width)
+    home = {a: ctx.home(a) for a in ctx.arm_names}
+    table = GraspIK(ctx, "left", name, box, grasps)
+    fresh = solve_ik_candidates(ctx, world, objects, [IKRequest("left", name, box, grasps)], home)
+    kept = collision_free_candidates(ctx, world, objects, table, home)
+    assert fresh and [(c.grasp.index, c.branch) for c in kept] == [
+        (c.grasp.index, c.branch) for c in fresh
+    ]
+    one = collision_free_candidates(ctx, world, objects, table, home, (fresh[0].grasp.index,))
+    assert {c.grasp.index for c in one} == {fresh[0].grasp.index}
+    # a tall box over the object's top leaves no top-down grasp
+    T = box.T_world_obj.copy()
+    T[2, 3] += 0.12
+    crowded = {**objects, "lid": ObjectBox(T, (0.06, 0.06, 0.05))}
+    blocked = collision_free_candidates(ctx, world, crowded, table, home)
+    assert len(blocked) < len(kept)
+    assert not any(c.grasp.is_top_down for c in blocked)

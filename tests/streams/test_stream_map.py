@@ -32,7 +32,10 @@ def test_overlap_grasp_and_ik_streams(ctx: WorldContext, instance: Instance) -> 
     assert sm["test-overlap"](o.name, o.start, "x", Pose2D(o.start.x + 0.02, o.start.y, 0.0))
     assert not sm["test-overlap"](o.name, o.start, "x", Pose2D(o.start.x + 0.3, o.start.y, 0.0))
     grasps = [g for (g,) in sm["sample-grasp"](o.name)]
-    assert len(grasps) == 6 and grasps[0].is_top_down
+    # the grasp set (top-down, then 45 degrees either way), then the pair grasps (20 and 30)
+    assert len(grasps) == 6 + 8 and grasps[0].is_top_down
+    tilts = [round(float(np.degrees(abs(g.tilt)))) for g in grasps]
+    assert tilts == [0, 0, 45, 45, 45, 45, 20, 20, 20, 20, 30, 30, 30, 30]
     fluents = [("atpose", x.name, x.start) for x in instance.objects]
     confs = [c for (c,) in sm["inverse-kinematics"]("left", o.name, o.start, grasps[0], fluents)]
     T_obj = np.eye(4)
