@@ -57,9 +57,9 @@ def _solve(ctx: WorldContext, planner: DualMotionPlanner, instance: Instance) ->
 
 @pytest.fixture(scope="module")
 def uneven(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
-    """Four objects of the paper suite (one through a buffer): the arms' motions differ in
-    length, so running each arm on its own timeline saves time."""
-    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "D4.yaml"))
+    """Five independent objects of the paper suite (four paired moves, then one arm alone):
+    the arms' motions differ in length, so running each arm on its own timeline saves time."""
+    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "R5.yaml"))
 
 
 @pytest.fixture(scope="module")
@@ -81,7 +81,8 @@ def _dwell_overlaps(plan: PlanFile) -> int:
 
 # -- the schedule -----------------------------------------------------------------------------
 def test_an_async_plan_validates_and_is_shorter(uneven: Solved, tmp_path: Path) -> None:
-    s = schedule_async(uneven.plan, uneven.instance, uneven.ctx.scene)
+    scene = uneven.ctx.scene
+    s = schedule_async(uneven.plan, uneven.instance, scene, execution_options(scene))
     assert s.asynchronous, s.reason
     assert s.async_duration is not None and s.async_duration < s.sync_duration
     assert s.plan.duration == pytest.approx(s.async_duration)
@@ -149,7 +150,8 @@ def test_without_the_separation_the_validator_rejects_the_schedule(crowded: Solv
 
 
 def test_a_per_arm_dwell_violation_is_rejected(uneven: Solved) -> None:
-    plan = schedule_async(uneven.plan, uneven.instance, uneven.ctx.scene).plan
+    scene = uneven.ctx.scene
+    plan = schedule_async(uneven.plan, uneven.instance, scene, execution_options(scene)).plan
     e = next(
         e
         for e in plan.events
