@@ -25,6 +25,10 @@ from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
+#: Arrangements whose collision geometry the sweep keeps: placing a block replays the
+#: events before it again and again, so the same arrangements come back.
+SWEEP_GEOMETRIES = 16
+
 
 @dataclass(frozen=True, eq=False)
 class TimedEvent:
@@ -55,7 +59,7 @@ class WorldSweep:
         self.kins = {a: ArmKinematics.from_scene(scene, a) for a in self.names}
         self.sizes = {o.name: o.size for o in instance.objects}
         self.start = {o.name: o.start.as_tuple() for o in instance.objects}
-        self.world = CollisionWorld(scene)
+        self.world = CollisionWorld(scene, keep=SWEEP_GEOMETRIES)
         self.rest: dict[str, tuple[float, float, float]] = {}
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
         self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)

@@ -74,15 +74,17 @@ class CollisionWorld:
     Configurations ``q`` ``(layout.dof,)`` hold every arm's joints in the scene's
     :class:`~sdar_tamp.world.layout.ArmLayout` (``scene.layout``).
     Changing objects or grasps rebuilds the geometry lazily (several milliseconds for a dozen
-    objects); queries at a fixed object set are the fast path. The last
-    :attr:`GEOMETRY_CACHE` geometries are kept by arrangement (resting boxes and held objects,
-    compared exactly), so going back to an arrangement seen before costs no rebuild.
+    objects); queries at a fixed object set are the fast path. With ``keep`` > 0 the last
+    ``keep`` geometries are kept by arrangement (resting boxes and held objects, compared
+    exactly), so going back to an arrangement seen before costs no rebuild (for a user that
+    goes back and forth, such as the asynchronous scheduler's sweep; each kept geometry holds a
+    copy of the arms' shapes, tens of MB for a dozen).
     """
 
-    #: How many built geometries (arrangements) one world keeps.
-    GEOMETRY_CACHE = 16
-
-    def __init__(self, scene: Scene, *, tolerance: float = 1e-3) -> None:
+    def __init__(self, scene: Scene, *, tolerance: float = 1e-3, keep: int = 0) -> None:
+        if keep < 0:
+            raise CollisionModelError(f"keep: expected a number of geometries >= 0, got {keep}")
+        self._keep = keep
         self._scene = scene
         self._tolerance = tolerance
         self._arms = _dual_arm(scene)
@@ -219,9 +221,10 @@ class CollisionWorld:
             self._geometry = cm.build_scene_geometry(
                 self._arms, self._scene.table.size, resting, held, self._pairs()
             )
-            self._built[key] = self._geometry
-            if len(self._built) > self.GEOMETRY_CACHE:
-                self._built.popitem(last=False)
+            if self._keep:
+                self._built[key] = self._geometry
+                if len(self._built) > self._keep:
+                    self._built.popitem(last=False)
         return self._geometry
 
     def _arrangement_key(self) -> Hashable:

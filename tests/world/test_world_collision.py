@@ -161,10 +161,12 @@ def test_configuration_of_the_wrong_shape_is_refused(world: CollisionWorld, scen
 
 
 def test_an_arrangement_seen_before_reuses_its_geometry_and_answers_alike(
-    world: CollisionWorld, kins: dict, scene: Scene, monkeypatch: pytest.MonkeyPatch
+    kins: dict, scene: Scene, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import sdar_tamp.world.collision_model as cm
 
+    keep = 16
+    world = CollisionWorld(scene, keep=keep)
     builds: list[int] = []
     build = cm.build_scene_geometry
     monkeypatch.setattr(cm, "build_scene_geometry", lambda *a: builds.append(1) or build(*a))
@@ -193,13 +195,22 @@ def test_an_arrangement_seen_before_reuses_its_geometry_and_answers_alike(
     fresh.set_objects(first)
     assert fresh.report(_q(off, home)) == world.report(_q(off, home))
     # a bounded cache: far more arrangements than it keeps, then the first one is rebuilt
-    for k in range(CollisionWorld.GEOMETRY_CACHE + 1):
+    for k in range(keep + 1):
         world.set_objects({"o0": _box(0.0, -0.1 + 0.001 * k)})
         world.in_collision(_q(off, home))
     count = len(builds)
     world.set_objects(first)
     world.in_collision(_q(off, home))
     assert len(builds) == count + 1
+    # by default nothing is kept: every change of arrangement is a build
+    plain = CollisionWorld(scene)
+    before = len(builds)
+    for objects in (first, moved, first):
+        plain.set_objects(objects)
+        plain.in_collision(_q(off, home))
+    assert len(builds) == before + 3
+    with pytest.raises(CollisionModelError, match="keep: expected a number of geometries >= 0"):
+        CollisionWorld(scene, keep=-1)
 
 
 def test_worlds_of_one_scene_share_the_arm_model_but_not_its_data(
