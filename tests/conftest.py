@@ -1,10 +1,14 @@
-"""Suite-wide settings: how many processes `pytest -n auto` starts."""
+"""Suite-wide settings (how many processes `pytest -n auto` starts) and the expensive shared
+fixtures: the world context and the motion planner."""
 
 from __future__ import annotations
 
 import os
 
 import pytest
+
+from streams.context import WorldContext
+from streams.motion import DualMotionPlanner
 
 #: Most of the suite's time is spent in a few long planning tests; beyond four processes the
 #: start-up of each (pinocchio, CasADi, the optimiser build) outweighs what they share out.
@@ -20,3 +24,15 @@ def usable_cpus() -> int:
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     return max(1, min(MAX_WORKERS, usable_cpus()))
+
+
+@pytest.fixture(scope="session")
+def ctx() -> WorldContext:
+    """The shipped scene's world context (kinematics, collision, sphere models)."""
+    return WorldContext.load()
+
+
+@pytest.fixture(scope="session")
+def planner(ctx: WorldContext) -> DualMotionPlanner:
+    """The motion planner of ``ctx``: built once per test process (the optimiser with it)."""
+    return DualMotionPlanner(ctx)

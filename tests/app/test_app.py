@@ -44,16 +44,6 @@ SQUARE = (0.04, 0.04, 0.05)  # graspable across both sides: 12 grasps in the def
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 
 
-@pytest.fixture(scope="module")
-def ctx() -> WorldContext:
-    return WorldContext.load()
-
-
-@pytest.fixture(scope="module")
-def planner(ctx: WorldContext) -> DualMotionPlanner:
-    return DualMotionPlanner(ctx)
-
-
 def _one() -> Instance:
     spec = ObjectSpec("a", SQUARE, Pose2D(-0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.3))
     return Instance("one", WORKSPACE, (spec,))

@@ -62,8 +62,7 @@ def _segment(result: MotionResult, kind: str) -> MotionSegment:
 
 
 @pytest.fixture(scope="module")
-def planned(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Planned:
-    ctx, planner = world_ctx, motion_planner
+def planned(ctx: WorldContext, planner: DualMotionPlanner) -> Planned:
     instance = parse_instance(INSTANCE, "t2.yaml")
     o1 = instance.objects[0]
     start = {o.name: _box(o, o.start) for o in instance.objects}

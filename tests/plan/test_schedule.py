@@ -56,17 +56,17 @@ def _solve(ctx: WorldContext, planner: DualMotionPlanner, instance: Instance) ->
 
 
 @pytest.fixture(scope="module")
-def uneven(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
+def uneven(ctx: WorldContext, planner: DualMotionPlanner) -> Solved:
     """Five independent objects of the paper suite (four paired moves, then one arm alone):
     the arms' motions differ in length, so running each arm on its own timeline saves time."""
-    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "R5.yaml"))
+    return _solve(ctx, planner, load_instance(shipped_suite_dir("paper") / "R5.yaml"))
 
 
 @pytest.fixture(scope="module")
-def swap(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
+def swap(ctx: WorldContext, planner: DualMotionPlanner) -> Solved:
     """Five objects of the paper suite, two swaps among them: the arms cross each other's
     paths holding objects, so they must move at the same time."""
-    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "D5.yaml"))
+    return _solve(ctx, planner, load_instance(shipped_suite_dir("paper") / "D5.yaml"))
 
 
 def _dwell_overlaps(plan: PlanFile) -> int:
@@ -129,9 +129,9 @@ class _Blind(WorldSweep):
 
 
 @pytest.fixture(scope="module")
-def crowded(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Solved:
+def crowded(ctx: WorldContext, planner: DualMotionPlanner) -> Solved:
     """Twelve objects of the paper suite (mixed family): the arms work close to each other."""
-    return _solve(world_ctx, motion_planner, load_instance(shipped_suite_dir("paper") / "M2.yaml"))
+    return _solve(ctx, planner, load_instance(shipped_suite_dir("paper") / "M2.yaml"))
 
 
 def test_without_the_separation_the_validator_rejects_the_schedule(crowded: Solved) -> None:

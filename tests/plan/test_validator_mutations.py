@@ -96,8 +96,7 @@ def _segment(result: MotionResult, kind: str) -> MotionSegment:
 
 
 @pytest.fixture(scope="module")
-def base(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Base:
-    ctx = world_ctx
+def base(ctx: WorldContext, planner: DualMotionPlanner) -> Base:
     instance = parse_instance(INSTANCE, "d3.yaml")
     objects = {o.name: o for o in instance.objects}
     start = {o.name: _box(o, o.start) for o in instance.objects}
@@ -131,8 +130,7 @@ def base(world_ctx: WorldContext, motion_planner: DualMotionPlanner) -> Base:
     # the "drop" mutants pause; the others are blended (no stop at the pre-grasp points)
     unblended = DualMotionPlanner(ctx, shape=ShapeOptions(blend=False))
     a, b, c = (
-        plan_dual_motion(p, r)
-        for p, r in zip((motion_planner, unblended, motion_planner), requests, strict=True)
+        plan_dual_motion(p, r) for p, r in zip((planner, unblended, planner), requests, strict=True)
     )
     assert a.blended and c.blended and not b.blended
     items: list[MotionSegment | GripperEvent] = [

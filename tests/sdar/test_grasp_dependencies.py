@@ -3,8 +3,6 @@ stream on hand-built scenes, and how SDAR-T orders moves with them."""
 
 from __future__ import annotations
 
-import pytest
-
 from sdar_tamp.app import rearrangement_problem
 from sdar_tamp.graph import DependencyGraph
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
@@ -19,16 +17,6 @@ from streams.motion import DualMotionPlanner
 BAR = (0.08, 0.04, 0.05)  # graspable across its 4 cm side only (y)
 CUBE = (0.04, 0.04, 0.05)  # graspable across both sides
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
-
-
-@pytest.fixture(scope="module")
-def ctx() -> WorldContext:
-    return WorldContext.load()
-
-
-@pytest.fixture(scope="module")
-def planner(ctx: WorldContext) -> DualMotionPlanner:
-    return DualMotionPlanner(ctx)
 
 
 def _view(ctx: WorldContext, planner: DualMotionPlanner, *objects: ObjectSpec) -> TaskView:

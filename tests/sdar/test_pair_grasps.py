@@ -7,8 +7,6 @@ from __future__ import annotations
 import itertools
 import math
 
-import pytest
-
 from sdar_tamp.app import (
     PlannerConfig,
     plan_file_from_solution,
@@ -33,16 +31,6 @@ BUDGET = 600.0
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 CUBE = (0.04, 0.04, 0.05)
 BAR = (0.08, 0.04, 0.05)
-
-
-@pytest.fixture(scope="module")
-def ctx() -> WorldContext:
-    return WorldContext.load()
-
-
-@pytest.fixture(scope="module")
-def planner(ctx: WorldContext) -> DualMotionPlanner:
-    return DualMotionPlanner(ctx)
 
 
 def _swap(size: tuple[float, float, float], gap: float, yaw: float, turn: float) -> Instance:

@@ -35,16 +35,6 @@ SIZE = (0.08, 0.04, 0.05)
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 
 
-@pytest.fixture(scope="module")
-def ctx() -> WorldContext:
-    return WorldContext.load()
-
-
-@pytest.fixture(scope="module")
-def planner(ctx: WorldContext) -> DualMotionPlanner:
-    return DualMotionPlanner(ctx)
-
-
 def _swap() -> Instance:
     """Two objects whose goals are each other's starts (a 2-cycle: one dual-arm swap)."""
     a, b = Pose2D(-0.1, 0.1, 0.0), Pose2D(0.1, -0.1, 0.5)

@@ -1,4 +1,5 @@
-"""Shared, expensive fixtures: the world context and the motion planner (built once)."""
+"""Shared fixtures of the stream tests: the mixed instance M1 and its objects at their starts
+(the world context and the motion planner come from tests/conftest.py)."""
 
 from __future__ import annotations
 
@@ -8,18 +9,6 @@ from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.instance import Instance, load_instance
 from sdar_tamp.world.scene import domain_path
 from sdar_tamp.world.transforms import pose_xyz_yaw
-from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
-
-
-@pytest.fixture(scope="session")
-def ctx() -> WorldContext:
-    return WorldContext.load()
-
-
-@pytest.fixture(scope="session")
-def planner(ctx: WorldContext) -> DualMotionPlanner:
-    return DualMotionPlanner(ctx)
 
 
 @pytest.fixture(scope="session")
