@@ -728,6 +728,15 @@ def plan_dual_motion(
     problem = planner.transfer_problem(request, retreat[-1][-1], approach[0][0])
     attempts: list[str] = []
     report: ValidationReport | None = None
+
+    def succeeded(
+        level: str, traj: TimedTrajectory, valid: ValidationReport, blended: bool
+    ) -> MotionResult:
+        return MotionResult(True, level, traj, planner.optimisation_time,
+                            time.perf_counter() - t0, tuple(attempts), valid,
+                            ipopt_solves=planner.ipopt_solves, direct_paths=planner.direct_paths,
+                            sampled_paths=planner.sampled_paths, blended=blended)  # fmt: skip
+
     for strategy in ladder:
         stages = strategy(planner, problem)
         if stages is None:
@@ -738,21 +747,12 @@ def plan_dual_motion(
             report = validate_trajectory(ctx, planner.world, blended.q, blended.t)
             if report.ok:
                 attempts.append(f"{strategy.name}: ok (blended)")
-                return MotionResult(True, strategy.name, blended, planner.optimisation_time,
-                                    time.perf_counter() - t0, tuple(attempts), report,
-                                    ipopt_solves=planner.ipopt_solves,
-                                    direct_paths=planner.direct_paths,
-                                    sampled_paths=planner.sampled_paths,
-                                    blended=True)  # fmt: skip
+                return succeeded(strategy.name, blended, report, blended=True)
         traj = planner.assemble(retreat, stages, approach)
         report = validate_trajectory(ctx, planner.world, traj.q, traj.t)
         if report.ok:
             attempts.append(f"{strategy.name}: ok")
-            return MotionResult(True, strategy.name, traj, planner.optimisation_time,
-                                time.perf_counter() - t0, tuple(attempts), report,
-                                ipopt_solves=planner.ipopt_solves,
-                                direct_paths=planner.direct_paths,
-                                sampled_paths=planner.sampled_paths)  # fmt: skip
+            return succeeded(strategy.name, traj, report, blended=False)
         attempts.append(
             f"{strategy.name}: validation failed ({report.reason} at sample {report.index}"
             + "".join(f", {p.first}-{p.second}" for p in report.pairs[:2])

@@ -20,8 +20,7 @@ from pathlib import Path
 
 from sdar_tamp.errors import ParameterError
 from solvers.classical.errors import BackendUnavailableError, PlanValidationError
-from solvers.classical.ground import ground
-from solvers.classical.join import GroundingTimeout
+from solvers.classical.planner import ground_or_timeout
 from solvers.classical.problem import (
     GroundAction,
     PlanningTask,
@@ -208,13 +207,9 @@ def plan_task_with_fast_downward(
         time_limit = None
     start = time.perf_counter()
     deadline = None if time_limit is None else start + time_limit
-    try:
-        ground_task = ground(task, deadline=deadline)
-    except GroundingTimeout:
-        elapsed = time.perf_counter() - start
-        return SearchResult(
-            PlanStatus.TIMEOUT, None, 0.0, SearchStatistics(0, 0, 0, 0, 0, 0, elapsed, 0.0)
-        )
+    ground_task = ground_or_timeout(task, start, deadline)
+    if isinstance(ground_task, SearchResult):
+        return ground_task
     grounded = time.perf_counter()
 
     def statistics(log: str = "") -> SearchStatistics:

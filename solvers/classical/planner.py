@@ -34,6 +34,20 @@ def _check(name: str, value: object, choices: tuple[str, ...]) -> None:
         raise ParameterError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
 
 
+def ground_or_timeout(
+    task: PlanningTask, start: float, deadline: float | None
+) -> GroundTask | SearchResult:
+    """``task`` grounded, or a ``TIMEOUT`` result when grounding passes ``deadline``
+    (``time.perf_counter`` [s]; the clock started at ``start``)."""
+    try:
+        return ground(task, deadline=deadline)
+    except GroundingTimeout:
+        elapsed = time.perf_counter() - start
+        return SearchResult(
+            PlanStatus.TIMEOUT, None, 0.0, SearchStatistics(0, 0, 0, 0, 0, 0, elapsed, 0.0)
+        )
+
+
 def plan(
     task: PlanningTask,
     *,
@@ -71,13 +85,9 @@ def plan(
         raise ParameterError(f"time_limit must be > 0 seconds or None; got {time_limit!r}")
     start = time.perf_counter()
     deadline = None if time_limit is None else start + time_limit
-    try:
-        ground_task = ground(task, deadline=deadline)
-    except GroundingTimeout:
-        elapsed = time.perf_counter() - start
-        return SearchResult(
-            PlanStatus.TIMEOUT, None, 0.0, SearchStatistics(0, 0, 0, 0, 0, 0, elapsed, 0.0)
-        )
+    ground_task = ground_or_timeout(task, start, deadline)
+    if isinstance(ground_task, SearchResult):
+        return ground_task
     grounded = time.perf_counter()
     outcome = _search(
         ground_task, search, heuristic, weight, preferred_operators, lazy, deadline, cost_bound

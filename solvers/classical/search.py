@@ -113,15 +113,22 @@ class _Queues:
         if improved:
             self.boost()
 
-    def pop(self) -> Entry | None:
+    def _take_turn(self) -> int:
+        """The non-empty queue whose turn it is (lowest priority count), its count raised;
+        -1 when every queue is empty."""
         best = -1
         priority = self.priority
         for i, heap in enumerate(self.heaps):
             if heap and (best < 0 or priority[i] < priority[best]):
                 best = i
+        if best >= 0:
+            priority[best] += 1
+        return best
+
+    def pop(self) -> Entry | None:
+        best = self._take_turn()
         if best < 0:
             return None
-        priority[best] += 1
         entry: Entry = heappop(self.heaps[best])
         return entry
 
@@ -154,14 +161,9 @@ class _BatchQueues(_Queues):
 
     def pop_successor(self) -> tuple[int, int, float] | None:
         """``(origin, operator, origin's g)`` of the next successor, or None when empty."""
-        best = -1
-        priority = self.priority
-        for i, heap in enumerate(self.heaps):
-            if heap and (best < 0 or priority[i] < priority[best]):
-                best = i
+        best = self._take_turn()
         if best < 0:
             return None
-        priority[best] += 1
         heap = self.heaps[best]
         entry: list[Any] = heap[0]
         operators, position = entry[5], entry[6]
