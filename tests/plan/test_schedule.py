@@ -16,11 +16,6 @@ from sdar_tamp.app.execution import execution_options, schedule_plan
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile, load_plan, save_plan
 from sdar_tamp.plan_rules import STILL_TOL, check_timeline
-from sdar_tamp.rearrangement import (
-    plan_file_from_solution,
-    rearrangement_problem,
-    solve_rearrangement,
-)
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule.pieces import arm_blocks, arm_columns, on_ticks
@@ -30,13 +25,7 @@ from sdar_tamp.schedule.sweep import Conflict, TimedEvent, WorldSweep
 from sdar_tamp.world.instance import Instance, load_instance
 from sdar_tamp.world.suites import shipped_suite_dir
 from sdar_tamp.world.transforms import FloatArray
-from solvers.solution import Status
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
-
-#: A solve's time budget: generous, so that a busy machine slows a test down but never turns
-#: a solvable case into a timeout (the budget is not what these tests check).
-BUDGET = 600.0
 
 
 @dataclass(frozen=True)
@@ -46,27 +35,30 @@ class Solved:
     plan: PlanFile
 
 
-def _solve(ctx: WorldContext, planner: DualMotionPlanner, instance: Instance) -> Solved:
-    r = rearrangement_problem(instance, ctx, planner=planner)
-    solution = solve_rearrangement(r, "sdar", BUDGET)
-    assert solution.status is Status.SOLVED
-    plan = plan_file_from_solution(r, solution)
-    assert validate_plan(instance, plan, ctx.scene).ok
+#: The synchronous SDAR plans these tests schedule, solved once and shipped (see
+#: ``solved/regenerate.py``): the scheduler is under test here, not the planner.
+SOLVED = Path(__file__).resolve().parent / "solved"
+
+
+def _solved(ctx: WorldContext, name: str) -> Solved:
+    instance = load_instance(shipped_suite_dir("paper") / f"{name}.yaml")
+    plan = load_plan(SOLVED / f"{name}.plan.json")
+    assert validate_plan(instance, plan, ctx.scene).ok  # still a plan of today's instance
     return Solved(ctx, instance, plan)
 
 
 @pytest.fixture(scope="module")
-def uneven(ctx: WorldContext, planner: DualMotionPlanner) -> Solved:
+def uneven(ctx: WorldContext) -> Solved:
     """Five independent objects of the paper suite (four paired moves, then one arm alone):
     the arms' motions differ in length, so running each arm on its own timeline saves time."""
-    return _solve(ctx, planner, load_instance(shipped_suite_dir("paper") / "R5.yaml"))
+    return _solved(ctx, "R5")
 
 
 @pytest.fixture(scope="module")
-def swap(ctx: WorldContext, planner: DualMotionPlanner) -> Solved:
+def swap(ctx: WorldContext) -> Solved:
     """Five objects of the paper suite, two swaps among them: the arms cross each other's
     paths holding objects, so they must move at the same time."""
-    return _solve(ctx, planner, load_instance(shipped_suite_dir("paper") / "D5.yaml"))
+    return _solved(ctx, "D5")
 
 
 def _dwell_overlaps(plan: PlanFile) -> int:
@@ -129,9 +121,9 @@ class _Blind(WorldSweep):
 
 
 @pytest.fixture(scope="module")
-def crowded(ctx: WorldContext, planner: DualMotionPlanner) -> Solved:
+def crowded(ctx: WorldContext) -> Solved:
     """Twelve objects of the paper suite (mixed family): the arms work close to each other."""
-    return _solve(ctx, planner, load_instance(shipped_suite_dir("paper") / "M2.yaml"))
+    return _solved(ctx, "M2")
 
 
 def test_without_the_separation_the_validator_rejects_the_schedule(crowded: Solved) -> None:
