@@ -35,7 +35,14 @@ from streams.buffers import GRASP_CORRIDOR, BufferPool
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, sample_grasps
 from streams.ik import GraspIK, SceneCache, collision_free_candidates
-from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
+from streams.motion import (
+    DualMotionPlanner,
+    MotionRequest,
+    MotionResult,
+    TransferStrategy,
+    default_strategies,
+    plan_dual_motion,
+)
 from streams.sampling import SamplingOptions
 from streams.validate import HeldObject
 
@@ -151,6 +158,7 @@ class DualArmStreams:
         self._ik_tables: OrderedDict[tuple[str, str, Pose2D], GraspIK] = OrderedDict()
         self._buffer_calls = 0
         self._buffer_pools: dict[Size, BufferPool] = {}
+        self._plain_failed: set[Hashable] = set()  # motions the quick stream failed
         self._blocking: GraspBlocking | None = None
 
     @property
@@ -316,21 +324,29 @@ class DualArmStreams:
         retreat = tuple(a.pre is not None for a in q1.arms)
         approach = tuple(a.pre is not None for a in q2.arms)
         request = MotionRequest(q1.q, q2.q, objects, held, retreat, approach)
-        strategies = None
+        strategies: tuple[TransferStrategy, ...] | None = None
         if self.motion == "ompl":
             from streams.sampling import SampledStrategy
 
             strategies = (SampledStrategy(options=SamplingOptions(seed=self.seed)),)
+        key = _motion_key(q1, q2, fluents)
+        ladder = self.motion == "sdar" and not quick
+        if ladder and key in self._plain_failed:
+            # the quick stream (the ladder's first rung alone, deterministic) failed on this
+            # very motion: the ladder starts at its second rung
+            strategies = default_strategies()[1:]
         result = plan_dual_motion(
             self.planner,
             request,
-            fallbacks=self.motion == "sdar" and not quick,
+            fallbacks=ladder,
             sequential_only=self.motion == "sequential",
             strategies=strategies,
         )
         if result.success:
             yield (result,)
         else:
+            if quick and self.motion == "sdar" and result.attempts:
+                self._plain_failed.add(key)
             LOG.debug("plan-dual-motion failed: %s", result.reason)
 
     def test_overlap(self, o: str, p: Pose2D, o2: str, p2: Pose2D) -> bool:
@@ -377,6 +393,12 @@ class DualArmStreams:
     def _limits(self) -> tuple[FloatArray, FloatArray]:
         scene = self.ctx.scene
         return scene.joint_array("velocity_limit"), scene.joint_array("acceleration_limit")
+
+
+def _motion_key(q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]]) -> Hashable:
+    """A motion request as a value: end configurations and fluent facts (grasps compare by
+    identity: one object per grasp of an object, see :meth:`DualArmStreams.grasps`)."""
+    return (q1, q2, frozenset(tuple(fluents)))
 
 
 def make_stream_map(
