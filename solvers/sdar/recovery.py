@@ -137,14 +137,14 @@ class Recovery:
     ) -> None:
         members = self.blockers(boxed, current, done, chain)
         show = self.cache.show
-        where = "its goal" if boxed.lifted else "where it rests"
+        where = "at its goal" if boxed.lifted else "where it rests"
         if not members:
-            LOG.debug("sdar: %s boxed in at %s: no other objects make room", show(boxed.obj),
+            LOG.debug("sdar: %s boxed in %s: no other objects make room", show(boxed.obj),
                       where)  # fmt: skip
             return
         order = len(out)
         free = [m for m in members if self.reachable(Boxed(m, current[m]))]
-        LOG.debug("sdar: %s boxed in at %s (depth %d) by %s; graspable: %s", show(boxed.obj),
+        LOG.debug("sdar: %s boxed in %s (depth %d) by %s; graspable: %s", show(boxed.obj),
                   where, depth, ", ".join(map(show, sorted(members))),
                   ", ".join(map(show, free)) or "none")  # fmt: skip
         base = 3 * depth
@@ -254,10 +254,10 @@ class Recovery:
             else:
                 del self.deferred[obj]
         if self.deferred:
-            LOG.debug(
-                "sdar: waiting evicted objects: %s",
-                {o: [d.target for d in ds] for o, ds in self.deferred.items()},
-            )
+            show = self.cache.show
+            waiting = (f"{show(o)} for {', '.join(show(d.target) for d in ds)}"
+                       for o, ds in self.deferred.items())  # fmt: skip
+            LOG.debug("sdar: evicted objects waiting: %s", "; ".join(waiting))
         return [
             s
             for s in candidates
