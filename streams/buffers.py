@@ -9,16 +9,19 @@ grasp and its pre-grasp). Randomness comes from ``numpy.random.default_rng(seed)
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Hashable, Mapping, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
-from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
+from sdar_tamp.world.footprint import clearance, corners, inside_rectangle, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.transforms import BoolArray, FloatArray, pose_xyz_yaw
 from streams.context import WorldContext
 from streams.grasps import Grasp, pregrasp_offset, sample_grasps
+
+IntArray = npt.NDArray[np.intp]
 
 
 def reachable_top_down(
@@ -95,3 +98,83 @@ def sample_buffers(
             out.append(Pose2D(float(cand[i, 0]), float(cand[i, 1]), float(cand[i, 2])))
             taken = np.concatenate([taken, rect[i : i + 1]])
     return out
+
+
+#: Clearance [m] a buffer keeps, when the table allows, from every other footprint: a finger
+#: needs about 2.2 cm beside the object it grasps on the closing axis (1 cm from the open pad,
+#: then the 1.2 cm finger), plus the IK's 3 mm; so both the buffered object and its
+#: neighbours keep a grasp on every side.
+GRASP_CORRIDOR = 0.025
+
+
+class BufferPool:
+    """Candidate buffer poses of one object size, inside the workspace, with the arms that
+    reach each top-down (:func:`reachable_top_down`): that depends on neither the other
+    objects nor the call, so ``count`` poses are sampled once and each call only measures
+    their clearance from its footprints (:meth:`clearance`) and takes some of the clear ones
+    (:meth:`take`). Randomness: ``numpy.random.default_rng(seed)`` for the pool, the call's
+    seed for the order in which poses are taken."""
+
+    def __init__(
+        self,
+        ctx: WorldContext,
+        size: tuple[float, float, float],
+        seed: int,
+        workspace: Workspace | None = None,
+        count: int = 4096,
+    ) -> None:
+        if count < 1:
+            raise ValueError(f"count must be >= 1, got {count}")
+        self.size = size
+        ws = workspace or ctx.scene.workspace
+        rng = np.random.default_rng(seed)
+        cand = np.stack(
+            [rng.uniform(*ws.x, count), rng.uniform(*ws.y, count),
+             rng.choice([0.0, np.pi / 2], count) + rng.uniform(-0.3, 0.3, count)], axis=1,
+        )  # fmt: skip
+        rect = corners(cand, np.broadcast_to(size[:2], (count, 2)))
+        inside = inside_rectangle(rect, ws.x, ws.y)
+        self.poses: FloatArray = cand[inside]  # (n, 3)
+        self.rect: FloatArray = rect[inside]  # (n, 4, 2)
+        self._near: dict[Hashable, tuple[IntArray, FloatArray]] = {}
+        self.reach: dict[str, BoolArray] = {
+            arm: reachable_top_down(ctx, arm, self.poses, size) for arm in ctx.arm_names
+        }
+
+    def clearance(self, occupied: Mapping[Hashable, FloatArray]) -> FloatArray:
+        """``(n,)`` [m]: how far each pose's footprint may grow and stay clear of the
+        footprints ``occupied`` (key -> corners ``(4, 2)`` [m]; ``inf`` beyond
+        :data:`GRASP_CORRIDOR`, see :func:`~sdar_tamp.world.footprint.clearance`). The
+        clearance from one footprint is kept under its key (an object and its pose), so a
+        call only computes it for footprints it has not seen."""
+        out = np.full(len(self.poses), np.inf)
+        for key, rect in occupied.items():
+            near = self._near.get(key)
+            if near is None:
+                c = clearance(self.rect, rect, GRASP_CORRIDOR)
+                idx = np.flatnonzero(np.isfinite(c))
+                near = self._near[key] = (idx, c[idx])
+            idx, value = near
+            out[idx] = np.minimum(out[idx], value)
+        return out
+
+    def take(self, arm: str, clear: FloatArray, k: int, seed: int, margin: float) -> list[Pose2D]:
+        """Up to ``k`` poses ``arm`` reaches whose footprints, grown by ``margin`` [m], overlap
+        nothing (``clear > margin``, ``clear`` from :meth:`clearance`) nor one another."""
+        if k < 0:
+            raise ValueError(f"k must be >= 0, got {k}")
+        if not 0.0 <= margin <= GRASP_CORRIDOR:
+            raise ValueError(f"margin must be in [0, {GRASP_CORRIDOR}] [m], got {margin}")
+        free = np.flatnonzero((clear > margin) & self.reach[arm])
+        grown = np.array([self.size[0] + 2 * margin, self.size[1] + 2 * margin])
+        out: list[Pose2D] = []
+        chosen: list[FloatArray] = []
+        for i in np.random.default_rng(seed).permutation(free):
+            if len(out) >= k:
+                break
+            rect = corners(self.poses[i : i + 1], grown[None])
+            if chosen and overlap_matrix(rect, np.concatenate(chosen)).any():
+                continue
+            out.append(Pose2D(*(float(v) for v in self.poses[i])))
+            chosen.append(rect)
+        return out

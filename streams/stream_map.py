@@ -17,7 +17,7 @@ Fluent facts (``atpose ?o ?p``, ``holding ?a ?o ?g``) arrive as tuples in ``flue
 from __future__ import annotations
 
 from collections import OrderedDict
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
@@ -31,11 +31,18 @@ from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.blocking import GraspBlocking, gripper_boxes
-from streams.buffers import sample_buffers
+from streams.buffers import GRASP_CORRIDOR, BufferPool
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, sample_grasps
 from streams.ik import GraspIK, SceneCache, collision_free_candidates
-from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
+from streams.motion import (
+    DualMotionPlanner,
+    MotionRequest,
+    MotionResult,
+    TransferStrategy,
+    default_strategies,
+    plan_dual_motion,
+)
 from streams.sampling import SamplingOptions
 from streams.validate import HeldObject
 
@@ -103,6 +110,10 @@ IK_TABLES = 512
 #: Clearance [m] IK asks of grasp, pre-grasp and approach configurations from the other
 #: objects (the timed trajectory may deviate slightly from the checked configurations).
 IK_MARGIN = 0.003
+#: Buffers per arm and call of ``sample-buffer``, and the clearance [m] they keep from the
+#: other footprints when the grasp corridor does not fit.
+BUFFERS_PER_ARM = 4
+BUFFER_MARGIN = 0.01
 
 #: Motion planners of ``plan-dual-motion``: SDAR-M's ladder, plain optimisation, one arm at a
 #: time, and OMPL's RRTConnect (optional extra ``sdar-tamp[ompl]``, :mod:`streams.sampling`).
@@ -146,6 +157,8 @@ class DualArmStreams:
         self._boxes: dict[tuple[str, Pose2D], ObjectBox] = {}
         self._ik_tables: OrderedDict[tuple[str, str, Pose2D], GraspIK] = OrderedDict()
         self._buffer_calls = 0
+        self._buffer_pools: dict[Size, BufferPool] = {}
+        self._plain_failed: set[Hashable] = set()  # motions the quick stream failed
         self._blocking: GraspBlocking | None = None
 
     @property
@@ -234,20 +247,36 @@ class DualArmStreams:
     def sample_buffer(
         self, obj: str, fluents: Sequence[tuple[Any, ...]] = ()
     ) -> Iterator[tuple[Pose2D]]:
+        """Buffers of the first tier that has any, up to :data:`BUFFERS_PER_ARM` per arm:
+        clear of the resting objects and the goals (:attr:`reserved`) by the grasp corridor
+        (:data:`~streams.buffers.GRASP_CORRIDOR`), then by :data:`BUFFER_MARGIN` only; then
+        clear of the resting objects alone, by the corridor and then by the margin. The
+        corridor leaves a finger room beside the buffered object and beside its neighbours."""
         size = self.size(obj)
         resting = [(f[1], f[2]) for f in fluents if f[0] == "atpose" and f[1] != obj]
         goals = [(o, p) for o, p in self.reserved.items() if o != obj]
         self._buffer_calls += 1
         seed = self.seed * 100_003 + self._buffer_calls
-        found = False
-        for avoid in (resting + goals, resting):  # goals too if possible
-            occupied = self._footprints(avoid)
-            for arm in self.ctx.arm_names:
-                for p in sample_buffers(self.ctx, arm, size, occupied, 4, seed):
-                    found = True
-                    yield (p,)
-            if found:
-                return
+        pool = self._buffer_pools.get(size)
+        if pool is None:
+            pool = self._buffer_pools[size] = BufferPool(self.ctx, size, self.seed)
+        clear = pool.clearance(self._corners(resting))
+        with_goals = np.minimum(clear, pool.clearance(self._corners(goals)))
+        for avoid in (with_goals, clear):  # goals too if possible
+            for margin in (GRASP_CORRIDOR, BUFFER_MARGIN):
+                found = dict.fromkeys(  # both arms may reach one pose: once
+                    p
+                    for arm in self.ctx.arm_names
+                    for p in pool.take(arm, avoid, BUFFERS_PER_ARM, seed, margin)
+                )
+                if found:
+                    yield from ((p,) for p in found)
+                    return
+
+    def _corners(self, poses: Sequence[tuple[str, Pose2D]]) -> dict[Hashable, FloatArray]:
+        """Object and pose -> the footprint's corners ``(4, 2)`` [m]."""
+        rect = self._footprints(poses)
+        return {key: rect[k] for k, key in enumerate(poses)}
 
     def _footprints(self, poses: Sequence[tuple[str, Pose2D]]) -> FloatArray:
         if not poses:
@@ -295,21 +324,29 @@ class DualArmStreams:
         retreat = tuple(a.pre is not None for a in q1.arms)
         approach = tuple(a.pre is not None for a in q2.arms)
         request = MotionRequest(q1.q, q2.q, objects, held, retreat, approach)
-        strategies = None
+        strategies: tuple[TransferStrategy, ...] | None = None
         if self.motion == "ompl":
             from streams.sampling import SampledStrategy
 
             strategies = (SampledStrategy(options=SamplingOptions(seed=self.seed)),)
+        key = _motion_key(q1, q2, fluents)
+        ladder = self.motion == "sdar" and not quick
+        if ladder and key in self._plain_failed:
+            # the quick stream (the ladder's first rung alone, deterministic) failed on this
+            # very motion: the ladder starts at its second rung
+            strategies = default_strategies()[1:]
         result = plan_dual_motion(
             self.planner,
             request,
-            fallbacks=self.motion == "sdar" and not quick,
+            fallbacks=ladder,
             sequential_only=self.motion == "sequential",
             strategies=strategies,
         )
         if result.success:
             yield (result,)
         else:
+            if quick and self.motion == "sdar" and result.attempts:
+                self._plain_failed.add(key)
             LOG.debug("plan-dual-motion failed: %s", result.reason)
 
     def test_overlap(self, o: str, p: Pose2D, o2: str, p2: Pose2D) -> bool:
@@ -356,6 +393,12 @@ class DualArmStreams:
     def _limits(self) -> tuple[FloatArray, FloatArray]:
         scene = self.ctx.scene
         return scene.joint_array("velocity_limit"), scene.joint_array("acceleration_limit")
+
+
+def _motion_key(q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]]) -> Hashable:
+    """A motion request as a value: end configurations and fluent facts (grasps compare by
+    identity: one object per grasp of an object, see :meth:`DualArmStreams.grasps`)."""
+    return (q1, q2, frozenset(tuple(fluents)))
 
 
 def make_stream_map(

@@ -54,6 +54,50 @@ def overlap_matrix(a: FloatArray, b: FloatArray, tol: float = 1e-9) -> BoolArray
     return ~sep
 
 
+def clearance(a: FloatArray, b: FloatArray, reach: float) -> FloatArray:
+    """``(n,)`` [m]: for each rectangle ``a[i]``, the largest margin by which it can be grown
+    (on its own axes, as :func:`inflate`) and still overlap no rectangle of ``b``, up to
+    ``reach``: ``inf`` when every rectangle of ``b`` is farther than that, ``<= 0`` when one
+    overlaps ``a[i]`` as it is. So ``a[i]`` grown by ``m < reach`` is clear of ``b`` iff
+    ``clearance(a, b, reach)[i] > m``.
+
+    Per pair, the separating-axis gaps: along an axis of ``a`` a margin widens ``a`` by itself,
+    along an axis of ``b`` by ``|cos| + |sin|`` of the angle between them. Bounding circles
+    (grown by ``reach``) skip the far pairs, so only the close ones are computed.
+    """
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 4, 2)
+    b = np.asarray(b, dtype=np.float64).reshape(-1, 4, 2)
+    out = np.full(len(a), np.inf)
+    if len(a) == 0 or len(b) == 0:
+        return out
+    ca, ua, ha = _frame(a)
+    cb, ub, hb = _frame(b)
+    ra = np.hypot(ha[:, 0], ha[:, 1]) + np.sqrt(2.0) * reach
+    rb = np.hypot(hb[:, 0], hb[:, 1])
+    dx = ca[:, None, 0] - cb[None, :, 0]  # (n, m)
+    dy = ca[:, None, 1] - cb[None, :, 1]
+    i, j = np.nonzero(dx * dx + dy * dy < (ra[:, None] + rb[None]) ** 2)
+    if len(i) == 0:
+        return out
+    d = cb[j] - ca[i]  # (k, 2)
+    ua, ha, ub, hb = ua[i], ha[i], ub[j], hb[j]  # (k, 2, 2) axes as rows, (k, 2) half sides
+    dot = np.abs(np.einsum("kad,kbd->kab", ua, ub))  # |a's axis . b's axis|, (k, 2, 2)
+    on_a = np.abs(np.einsum("kad,kd->ka", ua, d)) - ha - np.einsum("kab,kb->ka", dot, hb)
+    along = dot.sum(axis=1)  # (k, 2): how much a margin widens a along b's axes
+    on_b = np.abs(np.einsum("kbd,kd->kb", ub, d)) - hb - np.einsum("kab,ka->kb", dot, ha)
+    pair = np.maximum(on_a.max(axis=1), (on_b / along).max(axis=1))
+    np.minimum.at(out, i, pair)
+    return out
+
+
+def _frame(rect: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Centres ``(n, 2)``, unit axes ``(n, 2, 2)`` (rows) and half sides ``(n, 2)`` [m] of
+    rectangles ``(n, 4, 2)`` given by their corners in order."""
+    e = np.stack([rect[:, 1] - rect[:, 0], rect[:, 2] - rect[:, 1]], axis=1)  # (n, 2, 2)
+    length = np.linalg.norm(e, axis=-1)  # (n, 2)
+    return rect.mean(axis=1), e / length[..., None], length / 2.0
+
+
 def inflate(sizes: FloatArray, margin: float) -> FloatArray:
     """Side lengths grown by ``margin`` [m] on every side."""
     return np.asarray(sizes, dtype=np.float64) + 2.0 * margin

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import itertools
 from collections import Counter
-from collections.abc import Hashable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -24,6 +24,9 @@ from solvers.sdar.tasks import Move, Step
 
 if TYPE_CHECKING:
     from solvers.sdar.options import SdarOptions
+
+
+BufferCheck = Callable[[tuple[Move, ...], str, str], bool]
 
 
 @dataclass(frozen=True)
@@ -79,6 +82,8 @@ class Grounder:
         self.failures = failures
         self.deadline = deadline
         self._free: dict[Hashable, tuple[frozenset[str], ...]] = {}
+        self.buffer_check: BufferCheck | None = None
+        """Keeps only the buffers it accepts for (the step's moves, object, buffer pose)."""
 
     def key(self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...]) -> Hashable:
         """The tabu key of a grounding in the current arrangement."""
@@ -131,7 +136,7 @@ class Grounder:
                     break
                 allowed = free or allowed
             per_move = [
-                self._move_options(a, m, lifted, limit, grasps, only)
+                self._move_options(a, m, lifted, limit, grasps, only, step.moves)
                 for a, m, only in zip(arms, step.moves, allowed, strict=True)
             ]
             more_grasps = any(g > grasps for _, g in stages[k + 1 :])
@@ -209,6 +214,7 @@ class Grounder:
         limit: int,
         grasps: int,
         only: frozenset[str] | None = None,
+        moves: tuple[Move, ...] = (),
     ) -> list[Option]:
         cache, voc, opt = self.cache, self.cache.voc, self.options
         p = cache.current_poses()[move.obj]
@@ -216,6 +222,8 @@ class Grounder:
         if move.to_buffer:
             targets = [out[0] for out in cache.outputs(voc.buffer, (move.obj,), opt.buffers,
                                                          resting)]  # fmt: skip
+            if self.buffer_check is not None:
+                targets = [t for t in targets if self.buffer_check(moves, move.obj, t)]
         else:
             targets = [self.goals[move.obj]]
         after = cache.fluents(voc.atpose, without=lifted)

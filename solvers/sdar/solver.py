@@ -84,7 +84,9 @@ class SdarSolver:
         self.executor = Executor(self.cache, self.failures)
         self.recovery = Recovery(self.cache, self.options, self.goals, tuple(self.home),
                                  self.deadline)  # fmt: skip
+        self.grounder.buffer_check = self.recovery.buffer_clear
         self.records: list[TaskRecord] = []
+        self.visited: set[frozenset[tuple[str, str]]] = set()  # arrangements met so far
 
     # -- set-up ------------------------------------------------------------------------------
     def _goal_poses(self, problem: PDDLProblem) -> dict[str, str]:
@@ -160,7 +162,10 @@ class SdarSolver:
                 break
             if self.options.progress is not None:
                 self.options.progress(len(view.done), len(self.goals))
-            candidates = self.recovery.allowed(self.planner.candidates(view))
+            self.visited.add(self._arrangement())
+            candidates = self._new_arrangements(
+                self.recovery.allowed(self.planner.candidates(view))
+            )
             self.failures.clear()
             if self._decide(view, candidates, decision):
                 continue
@@ -188,23 +193,41 @@ class SdarSolver:
         )
         return build_solution(self.cache, summary, self.records)
 
+    def _arrangement(self, at_goal: Sequence[str] = ()) -> frozenset[tuple[str, str]]:
+        """The current arrangement (object, pose), with the objects ``at_goal`` moved to their
+        goals."""
+        current = self.cache.current_poses()
+        current.update({o: self.goals[o] for o in at_goal})
+        return frozenset(current.items())
+
+    def _new_arrangements(self, candidates: Sequence[Step]) -> list[Step]:
+        """The candidates less those that only move objects to their goals and so would
+        recreate an arrangement met before (undoing the steps since then: a cycle)."""
+        return [
+            s
+            for s in candidates
+            if any(m.to_buffer for m in s.moves) or self._arrangement(s.objects) not in self.visited
+        ]
+
     def _decide(self, view: TaskView, candidates: Sequence[Step], decision: Decision) -> bool:
         """Execute one step: a candidate that brings an object to its goal if any works;
         otherwise an eviction (dead-end recovery); otherwise a candidate that only buffers."""
         productive = [s for s in candidates if s.progress > 0]
-        if self._step(view, productive, decision):
+        if self._step(view, productive, decision) is not None:
             return True
         if self.recovery.budget_left:
             evictions = self.recovery.candidates(view)
-            if evictions and self._step(view, evictions, decision, commit=False):
-                self.recovery.evictions += 1
+            evicted = self._step(view, evictions, decision, commit=False) if evictions else None
+            if evicted is not None:
+                self.recovery.executed(evicted)
                 return True
-        return self._step(view, [s for s in candidates if s.progress == 0], decision)
+        return self._step(view, [s for s in candidates if s.progress == 0], decision) is not None
 
     def _step(
         self, view: TaskView, candidates: Sequence[Step], decision: Decision, commit: bool = True
-    ) -> bool:
-        """Execute the best grounding whose motions exist. With a quick motion stream, up to
+    ) -> Step | None:
+        """Execute the best grounding whose motions exist; returns its step (``None`` when
+        none could be executed). With a quick motion stream, up to
         ``quick_attempts`` groundings of the best rank are tried with it first (a cheap
         motion for another grounding beats the fallbacks of the motion planner for the
         first one); then every grounding with the full motion planner."""
@@ -221,13 +244,18 @@ class SdarSolver:
                     ladder.left = 0  # the best rank is used up: the full motion planner
                     continue
             if not groundings:
-                return False
+                return None
             g = groundings[0]
+            key = self.grounder.key(g.step, g.arms, g.options)
+            after = dict(self.cache.current_poses())
+            after.update((m.obj, o.target) for m, o in zip(g.step.moves, g.options, strict=True))
+            if frozenset(after.items()) in self.visited:  # back to an earlier arrangement
+                self.tabu.add(key, MotionMode.FULL)
+                continue
             tried += 1
             record = TaskRecord(
                 g.step.kind, g.step.objects, g.arms, tuple(m.to_buffer for m in g.step.moves)
             )
-            key = self.grounder.key(g.step, g.arms, g.options)
             ok = self.executor.execute(g, record, mode)
             record.tried = tried
             record.motion_time = self.executor.motion_time - decision.motion_time
@@ -236,8 +264,8 @@ class SdarSolver:
                 self.records.append(record)
                 if commit:
                     self.planner.commit(g.step, view)
-                return True
+                return g.step
             self.tabu.add(key, mode)
             if mode is MotionMode.QUICK:
                 ladder.left -= 1
-        return False
+        return None

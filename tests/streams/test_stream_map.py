@@ -1,5 +1,6 @@
 import dataclasses
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -10,7 +11,7 @@ from sdar_tamp.language.streams import parse_stream_file
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance, Pose2D
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
+from streams.motion import DualMotionPlanner, MotionResult
 from streams.stream_map import STREAM_KINDS, ArmConf, DualArmStreams, DualConf, make_stream_map
 
 DOMAIN = Path(__file__).resolve().parents[2] / "domains" / "dual_arm_rearrangement"
@@ -166,3 +167,31 @@ def test_other_arm_needs_two_arms(ctx: WorldContext) -> None:
     with pytest.raises(ParameterError, match="other: defined for two arms, the scene has 3"):
         three.other("left")
     assert three.split(np.arange(18.0))["middle"].tolist() == list(range(12, 18))
+
+
+def test_the_full_motion_skips_the_rung_the_quick_stream_failed(
+    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The quick stream is the ladder's first rung alone (deterministic): after it failed on
+    a motion, the full stream starts that same motion at the second rung."""
+    import streams.stream_map as stream_map
+
+    calls: list[tuple[bool, tuple[str, ...] | None]] = []
+
+    def failing(planner: Any, request: Any, fallbacks: bool = True, sequential_only: bool = False,
+                strategies: Any = None) -> MotionResult:  # fmt: skip
+        calls.append((fallbacks, None if strategies is None else tuple(s.name for s in strategies)))
+        return MotionResult(False, None, None, 0.0, 0.0, ("plain: optimisation failed",),
+                            reason="plain: optimisation failed")  # fmt: skip
+
+    monkeypatch.setattr(stream_map, "plan_dual_motion", failing)
+    sm = make_stream_map(ctx, planner=planner)
+    home = [ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in ctx.arm_names]
+    d1 = DualConf(*home)
+    d2 = DualConf(ArmConf(home[0].arm, tuple(x + 0.1 for x in home[0].q)), home[1])
+    here = [("atpose", "o", Pose2D(0.1, 0.0, 0.0))]
+    there = [("atpose", "o", Pose2D(0.2, 0.0, 0.0))]
+    assert not list(sm["plan-dual-motion-quick"](d1, d2, here))
+    assert not list(sm["plan-dual-motion"](d1, d2, here))
+    assert not list(sm["plan-dual-motion"](d1, d2, there))  # another motion: the whole ladder
+    assert calls == [(False, None), (True, ("untangle", "sequential")), (True, None)]
