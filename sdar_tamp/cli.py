@@ -135,7 +135,9 @@ def cmd_demo(args: argparse.Namespace) -> int:
     print(f"Solving the shipped mixed instance {DEMO_INSTANCE} (12 objects) with SDAR:")
     bar = ProgressBar(instance.stem)
     try:
-        outcome = solve_instance(instance, time_limit=args.time_limit, progress=bar)
+        outcome = solve_instance(
+            instance, time_limit=args.time_limit, progress=bar, stage=bar.stage
+        )
     finally:
         bar.close()
     print(format_summary(outcome))
@@ -171,7 +173,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
         )
         if args.grasps is not None:
             config = config.replace(sdar=dataclasses.replace(config.sdar, grasps=args.grasps))
-        outcome = solve_instance(args.instance, config, progress=bar)
+        outcome = solve_instance(
+            args.instance, config, progress=bar, stage=bar.stage if bar is not None else None
+        )
     finally:
         if bar is not None:
             bar.close()

@@ -41,6 +41,7 @@ def solve_instance(
     motion_planner: str | None = None,
     execution: str | None = None,
     progress: Callable[[int, int], None] | None = None,
+    stage: Callable[[str], None] | None = None,
     cache: PlannerCache | None = None,
 ) -> SolveOutcome:
     """Solve the instance in ``instance_path`` and validate the plan.
@@ -49,6 +50,10 @@ def solve_instance(
     keywords, when given, replace its fields: ``time_limit`` [s] (finite and > 0), ``seed``
     (an integer >= 0), ``task_planner``, ``motion_planner``, ``execution``. Values are checked
     before the instance is read.
+
+    ``progress(done, total)``: called as objects reach their goals; ``stage(text)``: called
+    when the work after planning starts (``"scheduling"`` for asynchronous execution, then
+    ``"validating"``).
 
     ``cache``: keeps the world and the motion planner between calls with the same scene
     (building the optimiser takes a few tenths of a second; it is reported as ``setup_time``, not as
@@ -113,9 +118,13 @@ def solve_instance(
     }
     plan = plan_file_from_solution(rearrangement, solution, metrics)
     if config.execution == "async":
+        if stage is not None:
+            stage("scheduling")
         started = time.perf_counter()
         plan = schedule_plan(plan, instance, rearrangement.ctx.scene, world.planner.shape).plan
         figures = dataclasses.replace(figures, schedule_time=time.perf_counter() - started)
+    if stage is not None:
+        stage("validating")
     report = validate_plan(instance, plan, rearrangement.ctx.scene)
     violation = "" if report.ok or report.violation is None else describe(report.violation)
     return SolveOutcome(instance, "solved", plan, report.ok, violation, figures)

@@ -94,6 +94,11 @@ class ProgressBar:
             self._bar.total = total
         self._bar.update(done - self._bar.n)
 
+    def stage(self, text: str) -> None:
+        """Name what the run does after planning (shown beside the bar until replaced), so a
+        wait with every object placed says what it waits for."""
+        self._bar.set_postfix_str(text)
+
     def close(self) -> None:
         self._stop.set()
         self._ticker.join()

@@ -307,8 +307,12 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(tmp_path: Path)
     a = ObjectSpec("a", SQUARE, Pose2D(-0.1, 0.15, 0.0), Pose2D(0.1, -0.15, 0.3))
     b = ObjectSpec("b", SQUARE, Pose2D(0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.0))
     path = save_instance(Instance("two", WORKSPACE, (a, b)), tmp_path / "two.yaml")
-    outcome = solve_instance(path, PlannerConfig(execution="async"), time_limit=BUDGET)
+    stages: list[str] = []
+    outcome = solve_instance(
+        path, PlannerConfig(execution="async"), time_limit=BUDGET, stage=stages.append
+    )
     assert outcome.plan is not None and outcome.valid, outcome.violation
+    assert stages == ["scheduling", "validating"]  # named as they start
     assert outcome.figures.schedule_time > 0.0
     metrics = outcome.plan.metrics
     if metrics.get("execution") == "async":

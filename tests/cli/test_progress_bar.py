@@ -20,3 +20,16 @@ def test_bar_appears_at_once_and_refreshes_without_steps() -> None:
     finally:
         bar.close()
     assert "3/12" in out.getvalue()
+
+
+def test_the_stage_after_planning_is_named() -> None:
+    out = io.StringIO()
+    bar = ProgressBar("M1", stream=out, tick=60.0)
+    try:
+        bar(12, 12)
+        bar.stage("scheduling")
+        assert out.getvalue().rstrip().endswith("scheduling]")
+        bar.stage("validating")
+        assert out.getvalue().rstrip().endswith("validating]")
+    finally:
+        bar.close()
