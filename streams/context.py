@@ -55,10 +55,11 @@ class WorldContext:
     def home(self, arm: str) -> FloatArray:
         return np.array(self.scene.arm(arm).home, dtype=np.float64)
 
-    def new_world(self, margin: float = -1e-3) -> CollisionWorld:
+    def new_world(self, margin: float = -1e-3, arm_margin: float = 0.0) -> CollisionWorld:
         """A fresh collision world (mutable: each stream keeps its own). Resting and held
-        objects are grown by ``margin`` [m] per face (the default shrinks them 1 mm)."""
-        return CollisionWorld(self.scene, tolerance=-margin)
+        objects are grown by ``margin`` [m] per face (the default shrinks them 1 mm); the two
+        arms' shapes must keep ``arm_margin`` [m] apart."""
+        return CollisionWorld(self.scene, tolerance=-margin, arm_margin=arm_margin)
 
     def split(self, q: FloatArray) -> dict[str, FloatArray]:
         """A configuration ``(layout.dof,)`` as ``arm -> (arm dof,)``."""

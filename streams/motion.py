@@ -143,6 +143,10 @@ STRAIGHT_ANGLE_TOL = np.radians(2.0)
 #: Clearance [m] a transfer taken without optimisation keeps from resting and held objects
 #: on the exact check (the optimiser's sphere model asks 15 mm of its spheres).
 DIRECT_MARGIN = 0.005
+#: [m] the two arms' shapes keep apart at every checked sample of a planned motion: between
+#: samples (joint-space chords, at most 5 mm of tool travel) two wrists or a wrist and a
+#: finger passing within a millimetre can touch, which the replay would then find.
+ARM_CLEARANCE = 0.002
 #: TCP lifts [m] of the lightly bent paths tried when the straight line is not clear.
 DIRECT_LIFTS = (0.05, 0.12)
 #: Largest joint distance [rad] of a bent path's via configuration from the mid-point of its
@@ -180,8 +184,8 @@ class DualMotionPlanner:
         cache = optimisers if optimisers is not None else OptimiserCache()
         self._build = cache.get(ctx, options)
         self._trajopt: DualArmTrajOpt | None = None
-        self.world = ctx.new_world()
-        self.margin_world = ctx.new_world(margin=direct_margin)
+        self.world = ctx.new_world(arm_margin=ARM_CLEARANCE)
+        self.margin_world = ctx.new_world(margin=direct_margin, arm_margin=ARM_CLEARANCE)
         self.direct = direct
         self.direct_lifts = tuple(float(h) for h in direct_lifts)
         self._v = ctx.scene.joint_array("velocity_limit")

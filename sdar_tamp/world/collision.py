@@ -78,12 +78,21 @@ class CollisionWorld:
     ``keep`` geometries are kept by arrangement (resting boxes and held objects, compared
     exactly), so going back to an arrangement seen before costs no rebuild (for a user that
     goes back and forth, such as the asynchronous scheduler's sweep; each kept geometry holds a
-    copy of the arms' shapes, tens of MB for a dozen).
+    copy of the arms' shapes, tens of MB for a dozen). With ``arm_margin`` [m] > 0, shapes of
+    two different arms collide when they come closer than that (a planner's safety distance:
+    its samples then keep the arms apart between samples too).
     """
 
-    def __init__(self, scene: Scene, *, tolerance: float = 1e-3, keep: int = 0) -> None:
+    def __init__(
+        self, scene: Scene, *, tolerance: float = 1e-3, keep: int = 0, arm_margin: float = 0.0
+    ) -> None:
         if keep < 0:
             raise CollisionModelError(f"keep: expected a number of geometries >= 0, got {keep}")
+        if not 0.0 <= arm_margin < 0.05:
+            raise CollisionModelError(
+                f"arm_margin: expected a distance in [0, 0.05) [m], got {arm_margin}"
+            )
+        self._arm_margin = float(arm_margin)
         self._keep = keep
         self._scene = scene
         self._tolerance = tolerance
@@ -219,8 +228,9 @@ class CollisionWorld:
             resting = {n: (b.T_world_obj, self._shrunk(b)) for n, b in self._resting.items()}
             held = {a: (n, T, self._shrunk(b)) for a, (n, T, b) in self._held.items()}
             self._geometry = cm.build_scene_geometry(
-                self._arms, self._scene.table.size, resting, held, self._pairs()
-            )
+                self._arms, self._scene.table.size, resting, held, self._pairs(),
+                self._arm_margin,
+            )  # fmt: skip
             if self._keep:
                 self._built[key] = self._geometry
                 if len(self._built) > self._keep:

@@ -125,9 +125,11 @@ def build_scene_geometry(
     resting: dict[str, tuple[FloatArray, FloatArray]],
     held: dict[str, tuple[str, FloatArray, FloatArray]],
     pairs: list[tuple[str, str]],
+    arm_margin: float = 0.0,
 ) -> SceneGeometry:
     """Add table, resting objects ``name -> (T_world_obj, size)`` and held objects
-    ``arm -> (name, T_tool0_obj, size)`` to the arm shapes; activate the named ``pairs``."""
+    ``arm -> (name, T_tool0_obj, size)`` to the arm shapes; activate the named ``pairs``.
+    Pairs of two arms' shapes count as colliding closer than ``arm_margin`` [m]."""
     geometry = arms.arm_geometry.copy()
     sx, sy, sz = table_size
     table = pin.GeometryObject(
@@ -150,8 +152,19 @@ def build_scene_geometry(
         geometry.addCollisionPair(pin.CollisionPair(ids[a], ids[b]))
     names = tuple((all_names[p.first], all_names[p.second]) for p in geometry.collisionPairs)
     data = geometry.createData()
+    if arm_margin > 0.0:
+        owner = [_arm_of(a, arms) for a in all_names]
+        for k, p in enumerate(geometry.collisionPairs):
+            first, second = owner[p.first], owner[p.second]
+            if first is not None and second is not None and first != second:
+                data.collisionRequests[k].security_margin = arm_margin
     manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(arms.model, geometry, data)
     return SceneGeometry(geometry, data, manager, names)
+
+
+def _arm_of(shape: str, arms: DualArmModel) -> str | None:
+    """The arm a link or gripper shape belongs to (its name's prefix), else None."""
+    return next((arm for arm in arms.wrist_joint if shape.startswith(f"{arm}_")), None)
 
 
 def any_collision(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> bool:

@@ -1,9 +1,11 @@
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
-from sdar_tamp.world.collision import CollisionWorld, ObjectBox
+from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.errors import ArmLayoutError, CollisionModelError
 from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.layout import ArmLayout
@@ -241,3 +243,43 @@ def test_base_pose_is_a_copy(scene: Scene) -> None:
     T = arm.T_world_base
     T[:3, 3] += 1.0
     assert not np.allclose(arm.T_world_base, T)
+
+
+def _one_mm_apart(gap: Callable[[float], float], lo: float, hi: float) -> float:
+    """A value in ``[lo, hi]`` where ``gap`` (negative at ``lo``, positive at ``hi``) is 1 mm,
+    by bisection."""
+    assert gap(lo) < 0.0 < gap(hi)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if gap(mid) < 0.001 else (lo, mid)
+    return hi
+
+
+def test_an_arm_margin_keeps_the_two_arms_apart_only(scene: Scene, kins: dict) -> None:
+    """Two grippers 1 mm apart: free in the exact world, colliding with a 2 mm arm margin;
+    the margin leaves the other pairs alone (a finger 1 mm above the table stays free)."""
+    plain, strict = CollisionWorld(scene), CollisionWorld(scene, arm_margin=0.002)
+    q_l = _reach(kins["left"], -0.05, 0.0, 0.15)
+
+    def arms(x: float) -> np.ndarray:
+        return _q(q_l, _reach(kins["right"], x, 0.0, 0.15))
+
+    q = arms(_one_mm_apart(lambda x: plain.min_distance(arms(x)).distance, -0.05, 0.25))
+    assert 0.001 <= plain.min_distance(q).distance < 0.0012
+    assert not plain.in_collision(q) and strict.in_collision(q)
+    assert any(p.first.startswith("left_") and p.second.startswith("right_")
+               for p in strict.report(q))  # fmt: skip
+    home = np.array(kins["right"].spec.home)
+
+    def lowered(z: float) -> np.ndarray:
+        return _q(_reach(kins["left"], -0.05, 0.0, z), home)
+
+    q_t = lowered(_one_mm_apart(lambda z: plain.min_distance(lowered(z)).distance, 0.0, 0.3))
+    assert plain.min_distance(q_t).pair == CollisionPair("left_gripper_left_finger_0", "table")
+    assert not strict.in_collision(q_t)
+
+
+@pytest.mark.parametrize("margin", [-0.001, 0.05, float("nan")])
+def test_a_bad_arm_margin_is_refused(scene: Scene, margin: float) -> None:
+    with pytest.raises(CollisionModelError, match=r"arm_margin: expected a distance in \[0, 0"):
+        CollisionWorld(scene, arm_margin=margin)
