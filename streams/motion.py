@@ -143,9 +143,10 @@ STRAIGHT_ANGLE_TOL = np.radians(2.0)
 #: Clearance [m] a transfer taken without optimisation keeps from resting and held objects
 #: on the exact check (the optimiser's sphere model asks 15 mm of its spheres).
 DIRECT_MARGIN = 0.005
-#: [m] the two arms' shapes keep apart at every checked sample of a planned motion: between
-#: samples (joint-space chords, at most 5 mm of tool travel) two wrists or a wrist and a
-#: finger passing within a millimetre can touch, which the replay would then find.
+#: [m] where the two arms' shapes come closer than this at a checked sample of a planned
+#: motion, the chords to the neighbouring samples are checked finely (see
+#: :func:`streams.validate.validate_trajectory`): between samples at most 5 mm of tool travel
+#: apart, two wrists passing a millimetre apart at the samples can touch.
 ARM_CLEARANCE = 0.002
 #: TCP lifts [m] of the lightly bent paths tried when the straight line is not clear.
 DIRECT_LIFTS = (0.05, 0.12)
@@ -184,8 +185,9 @@ class DualMotionPlanner:
         cache = optimisers if optimisers is not None else OptimiserCache()
         self._build = cache.get(ctx, options)
         self._trajopt: DualArmTrajOpt | None = None
-        self.world = ctx.new_world(arm_margin=ARM_CLEARANCE)
-        self.margin_world = ctx.new_world(margin=direct_margin, arm_margin=ARM_CLEARANCE)
+        self.world = ctx.new_world()
+        self.margin_world = ctx.new_world(margin=direct_margin)
+        self.near_world = ctx.new_world(arm_margin=ARM_CLEARANCE)
         self.direct = direct
         self.direct_lifts = tuple(float(h) for h in direct_lifts)
         self._v = ctx.scene.joint_array("velocity_limit")
@@ -696,7 +698,9 @@ def _clear_phases(
             if phases is None:
                 break
             for label, paths in zip(("retreat", "approach"), phases, strict=True):
-                report = validate_trajectory(planner.ctx, planner.world, np.concatenate(paths))
+                report = validate_trajectory(
+                    planner.ctx, planner.world, np.concatenate(paths), near=planner.near_world
+                )
                 if not report.ok:
                     reason = f"{label} collides ({report.reason})"
                     break
@@ -724,6 +728,7 @@ def plan_dual_motion(
     q_start = np.asarray(request.q_start, dtype=np.float64)
     configure_world(ctx, planner.world, request.objects, request.held, q_start)
     configure_world(ctx, planner.margin_world, request.objects, request.held, q_start)
+    configure_world(ctx, planner.near_world, request.objects, request.held, q_start)
     phases = _clear_phases(planner, request, sequential_only and strategies is None)
     if isinstance(phases, str):
         return MotionResult(False, None, None, 0.0, time.perf_counter() - t0, (),
@@ -748,12 +753,14 @@ def plan_dual_motion(
             continue
         blended = planner.blend(request, retreat, stages, approach)
         if blended is not None:
-            report = validate_trajectory(ctx, planner.world, blended.q, blended.t)
+            report = validate_trajectory(
+                ctx, planner.world, blended.q, blended.t, near=planner.near_world
+            )
             if report.ok:
                 attempts.append(f"{strategy.name}: ok (blended)")
                 return succeeded(strategy.name, blended, report, blended=True)
         traj = planner.assemble(retreat, stages, approach)
-        report = validate_trajectory(ctx, planner.world, traj.q, traj.t)
+        report = validate_trajectory(ctx, planner.world, traj.q, traj.t, near=planner.near_world)
         if report.ok:
             attempts.append(f"{strategy.name}: ok")
             return succeeded(strategy.name, traj, report, blended=False)

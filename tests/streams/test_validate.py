@@ -61,3 +61,35 @@ def _tz(z: float) -> np.ndarray:
 
 def _home12(ctx: WorldContext) -> np.ndarray:
     return np.concatenate([ctx.home(a) for a in ctx.arm_names])
+
+
+class _Band:
+    """A stand-in world: colliding while the first joint is inside ``(lo, hi)``."""
+
+    def __init__(self, lo: float, hi: float) -> None:
+        self.lo, self.hi, self.queries = lo, hi, 0
+
+    def in_collision(self, q: np.ndarray) -> bool:
+        self.queries += 1
+        return bool(self.lo < q[0] < self.hi)
+
+    def report(self, q: np.ndarray) -> tuple[()]:
+        return ()
+
+
+def test_chords_beside_a_close_sample_are_checked_finely(ctx: WorldContext) -> None:
+    """Both samples are free, the chord between them is not (a graze between samples): found
+    only when ``near`` (the world with a safety distance) marks a sample as close."""
+    q0 = _home12(ctx)
+    q0[0] = 0.0
+    q1 = q0.copy()
+    q1[0] = 1.0
+    traj = np.stack([q0, q1])
+    world = _Band(0.45, 0.55)  # the contact: between the samples
+    plain = validate_trajectory(ctx, world, traj, max_tcp_step=10.0)  # type: ignore[arg-type]
+    assert plain.ok and plain.checks == 2
+    close = _Band(-0.1, 0.05)  # q0 is within the safety distance, q1 is not
+    report = validate_trajectory(ctx, world, traj, max_tcp_step=10.0, near=close)  # type: ignore[arg-type]
+    assert not report.ok and report.reason == "collision" and report.index == 0
+    far = _Band(5.0, 6.0)  # no sample close: no fine check, the graze stays unseen
+    assert validate_trajectory(ctx, world, traj, max_tcp_step=10.0, near=far).ok  # type: ignore[arg-type]
