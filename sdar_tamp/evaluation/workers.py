@@ -18,6 +18,7 @@ reaches the whole process group, and the parent alone decides what to do.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import math
 import multiprocessing
@@ -83,6 +84,32 @@ def _block(signals: set[int], how: str = "block") -> set[int]:
         return set()
     flag = {"block": signal.SIG_BLOCK, "unblock": signal.SIG_UNBLOCK, "set": signal.SIG_SETMASK}
     return {int(s) for s in signal.pthread_sigmask(flag[how], signals)}
+
+
+@contextlib.contextmanager
+def _signals_deferred(signals: tuple[int, ...]) -> Iterator[None]:
+    """Hold back the Python handlers of ``signals`` for the block, then run what arrived.
+
+    Blocking a signal in the calling thread is not enough: a signal sent to the process is
+    taken by any thread that does not block it (e.g. a BLAS worker thread started at import),
+    and Python then runs the handler in the main thread at its next bytecode, which may be
+    in the middle of ``Process.start()``: a child spawned but not yet sent its start-up data
+    would print ``EOFError: Ran out of input``. Only the main thread may set handlers;
+    elsewhere the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = {s: signal.getsignal(s) for s in signals}
+    for s in signals:
+        signal.signal(s, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        for s in dict.fromkeys(caught):
+            signal.raise_signal(s)
 
 
 def _serve(fn: Callable[[Any], Any], conn: Connection, parent_pid: int) -> None:
@@ -186,13 +213,15 @@ class WorkerPool(Generic[T, R]):
         # The new process inherits SIGINT and SIGTERM blocked, and ignores SIGINT before it
         # unblocks them: a Ctrl-C while it starts up reaches the parent only, and a signal to
         # the parent waits until the new worker is on the list that close() kills.
-        blocked = _block({signal.SIGINT, signal.SIGTERM})
-        try:
-            process.start()
-            worker = _Worker(process, mine)
-            self._live.append(worker)
-        finally:
-            _block(blocked, how="set")
+        # A signal that reaches the parent meanwhile is handled once the worker is listed.
+        with _signals_deferred((signal.SIGINT, signal.SIGTERM)):
+            blocked = _block({signal.SIGINT, signal.SIGTERM})
+            try:
+                process.start()
+                worker = _Worker(process, mine)
+                self._live.append(worker)
+            finally:
+                _block(blocked, how="set")
         theirs.close()
         return worker
 

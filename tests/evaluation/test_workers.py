@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.evaluation import workers
 from sdar_tamp.evaluation.workers import WorkerFailure, WorkerPool
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -62,6 +63,47 @@ def test_externally_terminated_worker_is_flagged() -> None:
         [(task, failure)] = list(pool.run([600.0]))
     assert task == 600.0 and isinstance(failure, WorkerFailure)
     assert failure.external and "SIGTERM" in failure.reason
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="needs pthread_sigmask")
+def test_a_signal_during_start_up_is_handled_once_the_worker_is_listed(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Another thread that blocks nothing takes a signal sent to the process (as BLAS
+    # threads do); the handler must still not run while a worker is half started.
+    idle = threading.Event()
+    threading.Thread(target=idle.wait, daemon=True).start()
+    real_block = workers._block
+
+    def block_then_signal(signals: set[int], how: str = "block") -> set[int]:
+        previous = real_block(signals, how)
+        if how == "block":
+            os.kill(os.getpid(), signal.SIGTERM)  # arrives on the idle thread
+            time.sleep(0.2)
+        return previous
+
+    monkeypatch.setattr(workers, "_block", block_then_signal)
+    pool: WorkerPool[int, int] = WorkerPool(int, workers=1)
+    listed: list[int] = []
+
+    class Stopped(Exception):
+        pass
+
+    def handler(signum: int, frame: object) -> None:
+        listed.append(len(pool.pids))
+        raise Stopped
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        with pytest.raises(Stopped):
+            pool._start()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        idle.set()
+        live = [w.process for w in pool._live]
+        pool.close(kill=True)
+    assert listed == [1]  # handled once, with the new worker on the list close() kills
+    assert len(live) == 1 and live[0].exitcode == -signal.SIGKILL
 
 
 def test_bad_arguments() -> None:
