@@ -11,10 +11,11 @@ densified once and checked again. The motion is then assembled, timed and valida
 any other strategy's (:func:`streams.motion.plan_dual_motion`).
 
 Work is bounded by counts, not seconds (``max_checks`` state checks for planning,
-``simplify_checks`` for shortcutting), so a query gives the same path for the same OMPL
-random state. OMPL seeds its generators from one process-wide seed, set once per process
-by the first query (``seed``): a process that runs the same queries in the same order gets
-the same paths. OMPL's console output is lowered to warnings during each query and restored.
+``simplify_checks`` for shortcutting), and every query restarts OMPL's process-wide seed
+sequence from a seed made of ``seed`` and the query's end configurations: a query gives the
+same path whatever the process planned before it (a benchmark worker that solves several
+instances in turn, in any order). OMPL's console output is lowered to warnings during each
+query (silenced while the seed is set) and restored.
 
 :class:`SampledStrategy` is a :class:`streams.motion.TransferStrategy`; with
 ``refine=True`` the trajectory optimiser is warm-started from the sampled path and its
@@ -25,6 +26,7 @@ from __future__ import annotations
 
 import importlib.util
 import threading
+import zlib
 from dataclasses import dataclass
 from typing import Any
 
@@ -62,7 +64,7 @@ class SamplingOptions:
     resolution: float = 0.02  # [rad] joint-space length between edge checks
     range: float = 0.0  # [rad] RRTConnect's step (0: OMPL's default, a fifth of the extent)
     curve_samples: int = 24  # samples of the timed curve handed to the exact check
-    seed: int = 0  # OMPL's process-wide seed (plus one), set by the first query of the process
+    seed: int = 0  # mixed with each query's end configurations into OMPL's seed
 
     def __post_init__(self) -> None:
         for name in ("max_checks", "simplify_checks", "curve_samples"):
@@ -76,8 +78,14 @@ class SamplingOptions:
             raise ParameterError(f"range must be >= 0 [rad], got {self.range}")
 
 
-_SEEDED: list[int] = []  # OMPL's seed, once per process
-_SEED_LOCK = threading.Lock()
+_SEED_LOCK = threading.Lock()  # OMPL's seed sequence is process-wide
+
+
+def query_seed(seed: int, q_a: FloatArray, q_b: FloatArray) -> int:
+    """OMPL's seed for one query: ``seed`` mixed with the end configurations (rounded to
+    1e-9 rad), in [1, 2**31 - 1] (OMPL refuses 0)."""
+    ends = np.round(np.concatenate([np.ravel(q_a), np.ravel(q_b)]), 9) + 0.0  # no -0.0
+    return zlib.crc32(ends.astype("<f8").tobytes(), seed & 0xFFFFFFFF) % (2**31 - 1) + 1
 
 
 def _ompl() -> tuple[Any, Any, Any]:
@@ -100,10 +108,6 @@ def sample_path(
     configured for the segment), shortcut; None when the budget runs out."""
     o = options or SamplingOptions()
     ob, og, ou = _ompl()
-    with _SEED_LOCK:
-        if not _SEEDED:
-            ou.RNG.setSeed(o.seed + 1)  # OMPL refuses 0
-            _SEEDED.append(o.seed)
     ctx, world = planner.ctx, planner.margin_world
     lo, hi = ctx.scene.joint_array("lower"), ctx.scene.joint_array("upper")
     q_a, q_b = np.asarray(q_a, dtype=np.float64), np.asarray(q_b, dtype=np.float64)
@@ -117,11 +121,16 @@ def sample_path(
     if len(free) == 0:
         return np.stack([q_a, q_b])
     level = ou.getLogLevel()
-    ou.setLogLevel(ou.LOG_WARN)
-    try:
-        return _plan(ob, og, world, q_a, q_b, lo, hi, free, o)
-    finally:
-        ou.setLogLevel(level)
+    with _SEED_LOCK:
+        try:
+            # setting the seed again restarts the sequence (OMPL logs an error that it is
+            # no longer the first seed: expected here, so silenced)
+            ou.setLogLevel(ou.LOG_NONE)
+            ou.RNG.setSeed(query_seed(o.seed, q_a, q_b))
+            ou.setLogLevel(ou.LOG_WARN)
+            return _plan(ob, og, world, q_a, q_b, lo, hi, free, o)
+        finally:
+            ou.setLogLevel(level)
 
 
 def _plan(

@@ -65,6 +65,26 @@ def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
 
 
 @needs_ompl
+def test_a_query_gives_the_same_path_whatever_ran_before_it(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    configure_world(ctx, planner.margin_world, objects, {}, BLOCKED_START)
+    retreat, approach = planner.phases(_blocked(objects)) or (None, None)
+    assert retreat is not None and approach is not None
+    q_a, q_b = retreat[-1][-1], approach[0][0]
+    first = sample_path(planner, q_a, q_b)
+    other = sample_path(planner, q_b, q_a)  # advances OMPL's process-wide sequence
+    again = sample_path(planner, q_a, q_b)
+    assert first is not None and other is not None and again is not None
+    np.testing.assert_array_equal(first, again)
+    reseeded = sample_path(planner, q_a, q_b, SamplingOptions(seed=1))
+    assert reseeded is not None and not np.array_equal(reseeded, first)
+    assert sampling.query_seed(0, q_a, q_b) == sampling.query_seed(0, q_a.copy(), q_b.copy())
+    assert sampling.query_seed(0, q_a, q_b) != sampling.query_seed(0, q_b, q_a)
+    assert all(1 <= sampling.query_seed(s, q_a, q_b) < 2**31 for s in (0, 1, 2**40))
+
+
+@needs_ompl
 def test_sampled_strategy_plans_a_validated_motion(
     ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
