@@ -151,6 +151,21 @@ def sample_grasps(
     return tuple(out)
 
 
+def half_turn_twins(grasps: Sequence[Grasp]) -> tuple[int | None, ...]:
+    """Per grasp, the index in ``grasps`` of its half-turn twin, or None.
+
+    A cuboid is symmetric under a half turn about its vertical axis, so the grasp of closing
+    axis ``a``, tilt ``t`` and ``flipped`` ``f`` and the grasp ``(a, -t, not f)`` hold it the
+    same way: the tool of one is the tool of the other turned by pi about the object's
+    vertical axis, and for a top-down grasp (the tool axis vertical) about its own axis, so
+    only wrist 3 differs (by pi). For a tilted grasp the twin leans the gripper to the other
+    side of the object (other clearances from the neighbours)."""
+    index = {(g.closing_axis, round(g.tilt, 9), g.flipped): k for k, g in enumerate(grasps)}
+    return tuple(
+        index.get((g.closing_axis, round(-g.tilt, 9) + 0.0, not g.flipped)) for g in grasps
+    )
+
+
 def pregrasp_offset(T_world_tcp: FloatArray, lift: float) -> FloatArray:
     """Poses ``(..., 4, 4)`` backed off by ``lift`` [m] against the approach (tool z)."""
     out = np.array(T_world_tcp, dtype=np.float64, copy=True)

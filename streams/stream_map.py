@@ -2,8 +2,8 @@
 
 Generators (``sample-grasp``, ``inverse-kinematics``, ``sample-buffer``, ``combine-confs``,
 ``plan-dual-motion``) yield one output tuple per call of ``next``; tests (``test-overlap``,
-``test-cfree``, ``test-blocks-grasps``, ``test-grasp-cfree``) return a bool; the function
-``Duration`` returns a number [s].
+``test-cfree``, ``test-blocks-grasps``, ``test-grasp-cfree``) return a bool; the functions
+``Duration``, ``Distance``, ``ArmDistance`` and ``NextMotion`` return a number [s].
 :data:`STREAM_KINDS` says which is which, so the wiring layer can wrap them (e.g.
 ``from_gen_fn`` / ``from_test`` / ``from_fn``). Replace any entry of the returned dict by
 another callable with the same signature to swap a stream.
@@ -33,7 +33,7 @@ from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.blocking import GraspBlocking, gripper_boxes
 from streams.buffers import GRASP_CORRIDOR, BufferPool
 from streams.context import WorldContext
-from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, sample_grasps
+from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, half_turn_twins, sample_grasps
 from streams.ik import GraspIK, SceneCache, collision_free_candidates
 from streams.motion import (
     DualMotionPlanner,
@@ -64,6 +64,8 @@ STREAM_KINDS: Mapping[str, str] = MappingProxyType(
         "test-grasp-cfree": "test",
         "Duration": "function",
         "Distance": "function",
+        "ArmDistance": "function",
+        "NextMotion": "function",
     }
 )
 
@@ -125,6 +127,11 @@ class DualArmStreams:
 
     ``reserved``: object name -> pose whose footprint buffers must avoid (the goals), unless
     no buffer can be found otherwise. ``motion``: one of :data:`MOTION_PLANNERS`.
+    ``half_turns``: ``inverse-kinematics`` of a top-down grasp yields, after the grasp's own
+    configurations, those of its half-turn twin (wrist 3 turned by pi; the cuboid and the
+    two-finger gripper are symmetric under that turn, so they hold the object the same way):
+    a placement may then end the held object's rotation either way round, and the transfer
+    need not turn wrist 3 by more than about pi/2 beyond what the base turns.
     """
 
     def __init__(
@@ -136,6 +143,7 @@ class DualArmStreams:
         reserved: Mapping[str, Pose2D] | None = None,
         motion: str = "sdar",
         grasps: GraspOptions = DEFAULT_GRASPS,
+        half_turns: bool = True,
     ) -> None:
         if motion not in MOTION_PLANNERS:
             raise ParameterError(
@@ -160,6 +168,8 @@ class DualArmStreams:
         self._buffer_pools: dict[Size, BufferPool] = {}
         self._plain_failed: set[Hashable] = set()  # motions the quick stream failed
         self._blocking: GraspBlocking | None = None
+        self._twin_index: dict[str, tuple[int | None, ...]] = {}
+        self.half_turns = half_turns
 
     @property
     def blocking(self) -> GraspBlocking:
@@ -227,8 +237,19 @@ class DualArmStreams:
             index = 0
         home = {a: self.ctx.home(a) for a in self.ctx.arm_names}
         world = self.scenes.world(frozenset(placed.items()), objects)
-        for c in collision_free_candidates(self.ctx, world, objects, table, home, (index,)):
-            yield (ArmConf(arm, tuple(map(float, c.q)), tuple(map(float, c.q_pre))),)
+        wanted = [index]
+        twin = self._twins(obj)[index] if table.grasps is self.grasps(obj) else None
+        if twin is not None and self.half_turns and g.is_top_down:
+            wanted.append(twin)  # the same hold with wrist 3 turned by pi: after g's own
+        for k in wanted:
+            for c in collision_free_candidates(self.ctx, world, objects, table, home, (k,)):
+                yield (ArmConf(arm, tuple(map(float, c.q)), tuple(map(float, c.q_pre))),)
+
+    def _twins(self, obj: str) -> tuple[int | None, ...]:
+        """Per grasp of ``obj``, the index of its half-turn twin (see :func:`half_turn_twins`)."""
+        if obj not in self._twin_index:
+            self._twin_index[obj] = half_turn_twins(self.grasps(obj))
+        return self._twin_index[obj]
 
     def _grasp_ik(self, arm: str, obj: str, p: Pose2D) -> GraspIK:
         """The closed-form IK of every grasp of ``obj`` at ``p`` (kept for the
@@ -389,6 +410,37 @@ class DualArmStreams:
         t = np.where(dq * a > v * v, dq / v + v / a, 2.0 * np.sqrt(dq / a))
         return float(t.max())
 
+    def arm_distance(self, q1: ArmConf, q2: ArmConf) -> float:
+        """Estimated duration [s] of one arm's motion ``q1 -> q2`` (as :meth:`distance`)."""
+        dq = np.abs(np.subtract(q2.q, q1.q))
+        v, a = (x[self.ctx.layout.slice(q1.arm)] for x in self._limits)
+        t = np.where(dq * a > v * v, dq / v + v / a, 2.0 * np.sqrt(dq / a))
+        return float(t.max())
+
+    def next_motion(self, q: ArmConf) -> float:
+        """Expected extra duration [s] of the arm's next motion from ``q`` to a top-down
+        grasp not yet known, from wrist 3 (the joint that turns most) and its limits.
+
+        The next grasp's wrist angle is taken as uniform, offered in both half-turn
+        variants (:meth:`inverse_kinematics`), of which the nearer reachable one is used:
+        from an angle ``x`` within ``[-pi/2, pi/2]`` that is ``pi/4`` on average; nearer a
+        limit of ``[-pi, pi]`` the far variant cannot be reached the short way round and the
+        mean grows to ``(x^2 + (pi - |x|)^2) / (2 pi)``. The result is the rest-to-rest time
+        of that mean less that of ``pi/4`` (0 within ``[-pi/2, pi/2]``)."""
+        lower, upper = self._wrist_range(q.arm)
+        if not self.half_turns or upper - lower < 2.0 * np.pi - 1e-6:
+            return 0.0  # the estimate assumes both variants and a full turn of range
+        x = abs(q.q[-1] - 0.5 * (lower + upper))
+        mean = np.pi / 4 if x <= np.pi / 2 else (x * x + (np.pi - x) ** 2) / (2.0 * np.pi)
+        v, a = (float(x[self.ctx.layout.slice(q.arm)][-1]) for x in self._limits)
+        return _rest_to_rest(mean, v, a) - _rest_to_rest(np.pi / 4, v, a)
+
+    def _wrist_range(self, arm: str) -> tuple[float, float]:
+        scene, part = self.ctx.scene, self.ctx.layout.slice(arm)
+        return float(scene.joint_array("lower")[part][-1]), float(
+            scene.joint_array("upper")[part][-1]
+        )
+
     @property
     def _limits(self) -> tuple[FloatArray, FloatArray]:
         scene = self.ctx.scene
@@ -399,6 +451,12 @@ def _motion_key(q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]]) 
     """A motion request as a value: end configurations and fluent facts (grasps compare by
     identity: one object per grasp of an object, see :meth:`DualArmStreams.grasps`)."""
     return (q1, q2, frozenset(tuple(fluents)))
+
+
+def _rest_to_rest(dq: float, v: float, a: float) -> float:
+    """Least time [s] to move one joint by ``dq`` [rad] from rest to rest at velocity and
+    acceleration limits ``v`` [rad/s], ``a`` [rad/s^2]."""
+    return dq / v + v / a if dq * a > v * v else 2.0 * float(np.sqrt(dq / a))
 
 
 def make_stream_map(
@@ -434,4 +492,6 @@ def make_stream_map(
         "test-grasp-cfree": s.test_grasp_cfree,
         "Duration": s.duration,
         "Distance": s.distance,
+        "ArmDistance": s.arm_distance,
+        "NextMotion": s.next_motion,
     }

@@ -54,4 +54,9 @@
   ; the execution time [s] of a motion
   (:function (Duration ?t) (traj ?t))
   ; an estimate [s] of the synchronous motion between two dual-arm configurations
-  (:function (Distance ?d1 ?d2) (and (dualconf ?d1) (dualconf ?d2))))
+  (:function (Distance ?d1 ?d2) (and (dualconf ?d1) (dualconf ?d2)))
+  ; an estimate [s] of one arm's motion between two of its configurations
+  (:function (ArmDistance ?q1 ?q2) (and (armconf ?q1) (armconf ?q2)))
+  ; an estimate [s] of how much longer than the least the arm's next motion from ?q will take
+  ; on average (its target not yet known)
+  (:function (NextMotion ?q) (armconf ?q)))

@@ -66,6 +66,20 @@ class StreamCache:
             return 0.0
         return float(self.functions[self.voc.distance].evaluate((d1, d2), self.table))
 
+    def arm_distance(self, q1: str, q2: str) -> float:
+        """The domain's estimated motion time of one arm between two of its configurations
+        (0 if the domain has no such function)."""
+        if self.voc.arm_distance not in self.functions or q1 == q2:
+            return 0.0
+        return float(self.functions[self.voc.arm_distance].evaluate((q1, q2), self.table))
+
+    def next_motion(self, q: str) -> float:
+        """The domain's expected extra time of an arm's next motion from ``q`` (0 if the
+        domain has no such function)."""
+        if self.voc.next_motion not in self.functions:
+            return 0.0
+        return float(self.functions[self.voc.next_motion].evaluate((q,), self.table))
+
     def show(self, name: str) -> str:
         """The printable value behind an object name."""
         return str(self.table.value(name))

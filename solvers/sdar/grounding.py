@@ -16,6 +16,7 @@ from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from sdar_tamp.language.model import Atom
 from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
@@ -90,17 +91,23 @@ class Grounder:
         return (self.cache.fluents(self.cache.voc.atpose), step.moves, arms, combo)
 
     def select(self, candidates: Sequence[Step], mode: MotionMode) -> list[Grounding]:
-        """Feasible groundings, best first: task-planner rank, then estimated motion time."""
+        """Feasible groundings, best first: task-planner rank, then estimated motion time.
+        Beyond the first ``choose_among`` groundings, up to ``peer_steps`` more candidates
+        alike to the first grounded one (:meth:`Step.peer_of`) are grounded and compared."""
         found: list[Grounding] = []
+        peers = 0  # candidates grounded as alike to the first one grounded
         for index, step in enumerate(candidates):
             if self.deadline.passed():
                 break
-            if found and (
-                step.rank > found[0].step.rank
-                or (index >= self.options.candidates and len(found) >= 1)
-                or len(found) >= self.options.choose_among
-            ):
-                break
+            if found:
+                peer = step.peer_of(found[0].step) and peers < self.options.peer_steps
+                if not peer and (
+                    step.rank > found[0].step.rank
+                    or index >= self.options.candidates
+                    or len(found) >= self.options.choose_among
+                ):
+                    break
+                peers += peer
             for arms in self._assignments(step):
                 found.extend(self._ground(step, arms, mode))
             found.sort(key=lambda g: (g.step.rank, g.estimate))
@@ -235,13 +242,29 @@ class Grounder:
             if not picks:
                 continue
             for t in targets:
-                places = cache.outputs(voc.ik, (arm, move.obj, t, g), 1, after)
-                if places:
-                    found.append(Option(g, picks[0][0], t, places[0][0]))
+                place = self._place(arm, move.obj, t, g, picks[0][0], after)
+                if place is not None:
+                    found.append(Option(g, picks[0][0], t, place))
                     break
             if len(found) >= limit:
                 break
         return found
+
+    def _place(
+        self, arm: str, obj: str, target: str, g: str, pick: str, after: tuple[Atom, ...]
+    ) -> str | None:
+        """The configuration placing ``obj`` at ``target`` with ``g`` that ``arm`` reaches
+        soonest from ``pick``, counting the expected extra time of the arm's next motion from
+        it (the domain's one-arm estimates; the IK stream's first when the domain has none,
+        or when ``place_branches`` is 1; the first of equals). The IK stream may offer the
+        same hold turned by a half turn of the wrist (a symmetric object): the transfer then
+        turns the wrist the shorter way, or the way that keeps it clear of its limits."""
+        cache = self.cache
+        limit = self.options.place_branches if cache.voc.arm_distance in cache.functions else 1
+        places = [q for (q,) in cache.outputs(cache.voc.ik, (arm, obj, target, g), limit, after)]
+        if not places:
+            return None
+        return min(places, key=lambda q: cache.arm_distance(pick, q) + cache.next_motion(q))
 
     def _combinations(
         self,
@@ -344,8 +367,9 @@ class Grounder:
         return [(0, True), (1, True), (1, False), (0, False)]
 
 
-#: IK solutions asked per grasp and pose when no other object is on the table (every branch).
-_BRANCHES = 8
+#: IK solutions asked per grasp and pose when no other object is on the table (every branch,
+#: and every branch of the half-turn twin where the IK stream offers it).
+_BRANCHES = 16
 _NO_FREE_PAIR = "no pair of grasps keeps the arms apart, whatever the other objects"
 _TRIED = "tried before"
 _GRIPPERS = "a gripper meets the other object at its target"

@@ -17,6 +17,7 @@ class SdarOptions:
     max_time: float = math.inf  # [s]
     candidates: int = 8  # candidate steps grounded per decision (more if none works)
     choose_among: int = 3  # feasible groundings compared by estimated motion time
+    peer_steps: int = 4  # more candidates alike to the task planner (Step.tie) compared so
     grasps: int = 6  # grasps tried per object
     options_per_move: int = 2  # (grasp, pick IK, place IK) options kept per arm and move
     more_options: int = 6  # kept instead when every pair of the first ones makes the arms collide
@@ -26,6 +27,7 @@ class SdarOptions:
     pair_kinds: tuple[str, ...] = ("swap",)
     expand_kinds: tuple[str, ...] = ("pair", "swap", "chain", "cycle")  # two-move steps
     buffers: int = 4  # buffer poses tried per buffer move
+    place_branches: int = 4  # IK solutions at a target compared by the time from the pick
     one_arm_at_a_time: bool = False  # the baseline motion planner (one arm moves at a time)
     quick_attempts: int = 6  # best-ranked groundings tried with the quick motion stream first
     progress: Callable[[int, int], None] | None = None  # (objects at goal, objects) per step

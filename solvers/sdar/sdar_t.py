@@ -39,7 +39,10 @@ first candidate always uses ``n + |minimum buffer set|`` actions, never more tha
 optimum (``n + |minimum FVS|``). Among them (or all of them, greedily, when the exact search
 exceeds ``node_budget``, which sets :attr:`SdarTaskPlanner.exact` to ``False``), objects that
 free more objects and have more predecessors come first. Ties break by object order, so the
-list is a function of the view. Steps of two moves are capped at ``max_candidates``; one-move
+list is a function of the view. Candidates whose keys differ only in object order get the
+same :attr:`~solvers.sdar.tasks.Step.tie` (e.g. pairs freeing as many objects and edges,
+cycle breaks of one ``x`` with partners of as many predecessors), so that SDAR-M may choose
+among them by expected motion time. Steps of two moves are capped at ``max_candidates``; one-move
 steps are always kept. :meth:`~SdarTaskPlanner.commit` does nothing: SDAR-T replans from the
 view at every step.
 """
@@ -102,7 +105,7 @@ class SdarTaskPlanner:
     def candidates(self, view: TaskView) -> list[Step]:
         names = view.remaining
         if len(names) <= 1:
-            return [Step((Move(x, bool(view.blockers(x))),), "last", LAST) for x in names]
+            return [Step((Move(x, bool(view.blockers(x))),), "last", LAST, ()) for x in names]
         scene = _Scene(view)
         goal_pairs = self._goal_pairs(scene)
         ranked = goal_pairs + self._cycle_breaks(scene, view, bool(goal_pairs))
@@ -112,7 +115,7 @@ class SdarTaskPlanner:
         for x in names:
             if not scene.blockers[x]:
                 key: _Key = (SINGLE, -scene.preds[x], scene.order[x])
-                kept.append((key, Step((Move(x),), "single", SINGLE)))
+                kept.append((key, Step((Move(x),), "single", SINGLE, key[1:-1])))
         movable = [x for x in names if x not in view.in_buffer]
         if not movable and not kept:
             movable = list(names)  # nothing else is possible: allow a buffer-to-buffer move
@@ -144,7 +147,7 @@ class SdarTaskPlanner:
                 kind = "swap" if bi and bj else "chain" if bi or bj else "pair"
                 freed, removed = scene.frees(frozenset((i, j)))
                 key = (GOAL_PAIR, -freed, -removed, scene.order[i], scene.order[j])
-                out.append((key, Step((Move(i), Move(j)), kind, GOAL_PAIR)))
+                out.append((key, Step((Move(i), Move(j)), kind, GOAL_PAIR, key[1:-2])))
         return out
 
     def _cycle_breaks(self, scene: _Scene, view: TaskView, goal_pairs: bool) -> _Ranked:
@@ -160,7 +163,8 @@ class SdarTaskPlanner:
                 linked = bool(scene.blockers[i])
                 rank = (CYCLE if linked else CYCLE_FREE) if x in optimal else DETOUR
                 key: _Key = (rank, int(not linked), *x_key, -scene.preds[i], scene.order[i])
-                out.append((key, Step((Move(i), Move(x, to_buffer=True)), "cycle", rank)))
+                step = Step((Move(i), Move(x, to_buffer=True)), "cycle", rank, key[1:-1])
+                out.append((key, step))
             if not partners and x in optimal:
                 key = (CYCLE_ALONE, *x_key)
                 out.append((key, Step((Move(x, to_buffer=True),), "cycle", CYCLE_ALONE)))
@@ -169,7 +173,8 @@ class SdarTaskPlanner:
             x_key = (-freed, -scene.preds[x], -removed, scene.order[x])
             for i in (i for i in scene.names if i != x and scene.blockers[i] <= {x}):
                 key = (CYCLE_FREE, 1, *x_key, -scene.preds[i], scene.order[i])
-                out.append((key, Step((Move(i), Move(x, to_buffer=True)), "cycle", CYCLE_FREE)))
+                step = Step((Move(i), Move(x, to_buffer=True)), "cycle", CYCLE_FREE, key[1:-1])
+                out.append((key, step))
         if all(key[0] >= CYCLE_ALONE for key, _ in out) and not goal_pairs:
             firsts = sorted((x for x in breakable if x in optimal), key=x_keys.__getitem__)
             for x, y in self._double_buffers(view, firsts[:_DOUBLE_FIRSTS], firsts):

@@ -29,11 +29,15 @@ class Step:
 
     ``kind`` names the rule that proposed it (``pair``, ``chain``, ``swap``, ``cycle``,
     ``single``, ``buffer``, ``last``, ``plan``); ``rank`` orders candidates (lower is better).
+    ``tie``: candidates of one rank with equal ties are alike to the task planner (their order
+    is only by object name), so the motion planner may take whichever it expects to execute
+    soonest; None: the task planner's order stands.
     """
 
     moves: tuple[Move, ...]
     kind: str
     rank: int = 0
+    tie: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         if not 1 <= len(self.moves) <= 2:
@@ -44,6 +48,10 @@ class Step:
     @property
     def objects(self) -> tuple[str, ...]:
         return tuple(m.obj for m in self.moves)
+
+    def peer_of(self, other: Step) -> bool:
+        """Alike to the task planner: the same rank and the same (not None) tie."""
+        return self.tie is not None and (self.rank, self.tie) == (other.rank, other.tie)
 
     @property
     def progress(self) -> int:

@@ -29,6 +29,10 @@ class SdarVocabulary:
     motion: str = "plan-dual-motion"  # (?d1 ?d2) -> ?t, fluents atpose holding
     quick_motion: str = "plan-dual-motion-quick"  # the same, cheaper and weaker (optional)
     distance: str = "distance"  # function (?d1 ?d2): estimated motion time (optional)
+    arm_distance: str = "armdistance"  # function (?q1 ?q2): one arm's estimated motion time
+    # (optional: a placement's configuration is then the one reached soonest from the pick)
+    next_motion: str = "nextmotion"  # function (?q): expected extra time of the arm's next
+    # motion from ?q (optional: added to arm_distance when choosing a placement)
     blocks_grasps: str = "test-blocks-grasps"  # (?o ?p ?o2 ?p2): o at p leaves o2 no grasp
     # at p2 (optional: dependency edges beyond footprint overlap)
     grasp_cfree: str = "test-grasp-cfree"  # (?o ?p ?g ?o2 ?p2): the gripper holding o at p
