@@ -412,6 +412,11 @@ class DualArmStreams:
 
     def arm_distance(self, q1: ArmConf, q2: ArmConf) -> float:
         """Estimated duration [s] of one arm's motion ``q1 -> q2`` (as :meth:`distance`)."""
+        if q1.arm != q2.arm:
+            raise ParameterError(
+                f"ArmDistance: both configurations must be of one arm; got {q1.arm!r} and "
+                f"{q2.arm!r}"
+            )
         dq = np.abs(np.subtract(q2.q, q1.q))
         v, a = (x[self.ctx.layout.slice(q1.arm)] for x in self._limits)
         t = np.where(dq * a > v * v, dq / v + v / a, 2.0 * np.sqrt(dq / a))
@@ -428,11 +433,12 @@ class DualArmStreams:
         mean grows to ``(x^2 + (pi - |x|)^2) / (2 pi)``. The result is the rest-to-rest time
         of that mean less that of ``pi/4`` (0 within ``[-pi/2, pi/2]``)."""
         lower, upper = self._wrist_range(q.arm)
-        if not self.half_turns or upper - lower < 2.0 * np.pi - 1e-6:
-            return 0.0  # the estimate assumes both variants and a full turn of range
-        x = abs(q.q[-1] - 0.5 * (lower + upper))
+        if not self.half_turns or abs(upper - lower - 2.0 * np.pi) > 1e-6:
+            return 0.0  # the estimate assumes both variants and exactly a full turn of range
+        x = min(abs(q.q[-1] - 0.5 * (lower + upper)), np.pi)
         mean = np.pi / 4 if x <= np.pi / 2 else (x * x + (np.pi - x) ** 2) / (2.0 * np.pi)
-        v, a = (float(x[self.ctx.layout.slice(q.arm)][-1]) for x in self._limits)
+        part = self.ctx.layout.slice(q.arm)
+        v, a = (float(limit[part][-1]) for limit in self._limits)
         return _rest_to_rest(mean, v, a) - _rest_to_rest(np.pi / 4, v, a)
 
     def _wrist_range(self, arm: str) -> tuple[float, float]:

@@ -43,9 +43,10 @@ def test_overlap_grasp_and_ik_streams(ctx: WorldContext, instance: Instance) -> 
     T_obj[:3, :3] = [[np.cos(o.start.yaw), -np.sin(o.start.yaw), 0],
                      [np.sin(o.start.yaw), np.cos(o.start.yaw), 0], [0, 0, 1]]  # fmt: skip
     T_obj[:3, 3] = (o.start.x, o.start.y, o.size[2] / 2)
-    for c in confs:
+    assert len(confs) == 2  # the grasp's own configuration, then its half-turn twin's
+    for c, g in zip(confs, grasps[:2], strict=True):
         tcp = ctx.kinematics["left"].fk_tcp(np.array(c.q))
-        np.testing.assert_allclose(tcp, T_obj @ grasps[0].T_object_tcp, atol=1e-9)
+        np.testing.assert_allclose(tcp, T_obj @ g.T_object_tcp, atol=1e-9)
     buffers = [p for (p,), _ in zip(sm["sample-buffer"](o.name, fluents), range(3), strict=False)]
     assert len(buffers) == 3
 
