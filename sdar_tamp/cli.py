@@ -115,9 +115,10 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    """Solve the shipped 12-object mixed instance M1 with SDAR, validate the plan by replay,
-    and write the plan file, the 3-D page and the storyboard (default: a folder in the
-    system's temporary directory; nothing is written to the working directory)."""
+    """Solve the shipped 12-object mixed instance M1 with SDAR as ``sdar solve`` does
+    (asynchronous execution), validate the plan by replay, and write the plan file, the 3-D
+    page and the storyboard (default: a folder in the system's temporary directory; nothing
+    is written to the working directory)."""
     import tempfile
 
     from sdar_tamp.app.command import solve_instance
@@ -136,7 +137,11 @@ def cmd_demo(args: argparse.Namespace) -> int:
     bar = ProgressBar(instance.stem)
     try:
         outcome = solve_instance(
-            instance, time_limit=args.time_limit, progress=bar, stage=bar.stage
+            instance,
+            time_limit=args.time_limit,
+            execution="async",  # `sdar solve`'s default
+            progress=bar,
+            stage=bar.stage,
         )
     finally:
         bar.close()

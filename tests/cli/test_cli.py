@@ -34,6 +34,7 @@ def test_demo_solves_validates_and_draws_the_mixed_instance(
     assert main(["demo", "--out", str(tmp_path), "--time-limit", "600"]) == 0
     out = capsys.readouterr().out
     assert "M1: solved, plan valid" in out and "per step: median" in out
+    assert "s asynchronous (synchronous " in out  # as `sdar solve` executes by default
     for name in ("plan.json", "plan.html", "storyboard.png"):
         assert (tmp_path / name).stat().st_size > 1000
     assert main(["validate", str(domain_file("dual_arm_rearrangement", "suites/paper/M1.yaml")),
