@@ -28,13 +28,16 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from sdar_tamp.logs import get_logger
 from sdar_tamp.world.transforms import FloatArray
+from streams import compiled
 from streams._casadi import ca, sx_sym, to_array
 from streams.context import WorldContext
 from streams.fk_casadi import joint_frames
@@ -65,6 +68,7 @@ class TrajOptOptions:
     max_iter: int = 25
     tol: float = 1e-3
     active_set_rounds: int = 2
+    compiled: bool = True  # derivatives compiled where a C compiler is (streams.compiled)
 
 
 @dataclass(frozen=True)
@@ -237,7 +241,9 @@ class DualArmTrajOpt:
             "hess_lag": hess_lag,
         }
         self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", nlp, opts)
-        self._nlp, self._jac_g, self._hess_lag = nlp, jac_g, hess_lag
+        self._nlp, self._jac_g, self._hess_lag, self._opts = nlp, jac_g, hess_lag, opts
+        self._library: Path | None = None  # the compiled derivatives, once they exist
+        self.compiled = False
         self._g_fn = ca.Function("g", [x, p], [g])
         scene = self.ctx.scene
         lo, hi = scene.joint_array("lower"), scene.joint_array("upper")
@@ -245,10 +251,55 @@ class DualArmTrajOpt:
         self._vmax = scene.joint_array("velocity_limit")
         self._amax = scene.joint_array("acceleration_limit")
 
+    # -- compiled derivatives ------------------------------------------------------------
+    def request_compiled(self, flags: Sequence[str] = compiled.FLAGS) -> None:
+        """Ask for the Jacobian and Hessian compiled (:mod:`streams.compiled`): from the
+        cache, or compiled in the background; :meth:`solve` switches to them once they are
+        there. The values are the same; only their evaluation is faster."""
+        functions = [self._jac_g, self._hess_lag]
+        self._library = compiled.request(functions, "sdar_trajopt", self.recipe(), flags)
+
+    def recipe(self) -> str:
+        """What the derivatives' code is made from: the options, the arms' layout and base
+        poses, the kinematic parameters and the code that builds the expressions (the key of
+        the compiled library; a loaded library is also checked by its values)."""
+        from sdar_tamp.world import kinematics, ur_ik
+        from streams import _casadi, fk_casadi
+
+        parts = [repr(self.options), repr(self.ctx.layout), repr(ur_ik.UR5E)]
+        for arm in self.ctx.arm_names:
+            parts.append(np.asarray(self.ctx.fk[arm].T_world_base).tobytes().hex())
+        for module in (_casadi, fk_casadi, kinematics, ur_ik):
+            parts.append(Path(module.__file__ or "").read_text(encoding="utf-8"))
+        parts.append(Path(__file__).read_text(encoding="utf-8"))
+        return "\n".join(parts)
+
+    def _use_compiled(self) -> None:
+        """Switch the solver to the compiled derivatives when their library has appeared."""
+        if self.compiled or self._library is None or not self._library.is_file():
+            return
+        functions = [self._jac_g, self._hess_lag]
+        try:
+            jac_g, hess_lag = twins = compiled.load(functions, self._library)
+            if not compiled.same_values(functions, twins):
+                _log.warning("%s gives other values: not used, removed", self._library)
+                self._library.unlink(missing_ok=True)  # compiled again by the next process
+            else:
+                opts = {**self._opts, "jac_g": jac_g, "hess_lag": hess_lag}
+                self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", self._nlp, opts)
+                self.compiled = True
+                _log.info("trajectory optimiser: compiled derivatives in use (%s)", self._library)
+        except RuntimeError as error:
+            _log.info("the compiled derivatives could not be loaded, kept uncompiled: %s", error)
+            self._library.unlink(missing_ok=True)  # not what it should be: compiled again
+        if not self.compiled:
+            self._library = None
+
     # -- solving -----------------------------------------------------------------------
     def solve(self, query: TransferQuery, warm_start: FloatArray | None = None) -> TrajOptResult:
         """Optimise the transfer; ``warm_start`` ``(K, dof)`` (default: the straight line)."""
         t0 = time.perf_counter()
+        self._use_compiled()
         o, K, dof = self.options, self.options.knots, self._arms.dof
         q_a, q_b = np.asarray(query.q_start), np.asarray(query.q_goal)
         straight = warm_start is None
@@ -434,6 +485,18 @@ class OptimiserBuild:
         finally:
             self.build_time = time.thread_time() - start
             self._done.set()
+        if self._result is not None and self.options.compiled:
+            # after the optimiser is handed out: the code generation (about 0.5 s) delays
+            # no solve; the solver switches to the compiled derivatives once they exist
+            self._request_compiled(self._result)
+
+    @staticmethod
+    def _request_compiled(optimiser: DualArmTrajOpt) -> None:
+        """Compiled derivatives are a speed-up only: whatever stops them, the build stands."""
+        try:
+            optimiser.request_compiled()
+        except Exception as error:  # any failure leaves CasADi's own evaluation
+            _log.info("compiled derivatives unavailable, kept uncompiled: %s", error)
 
     @property
     def ready(self) -> bool:

@@ -7,8 +7,14 @@ import os
 
 import pytest
 
+from streams import compiled
 from streams.context import WorldContext
 from streams.motion import DualMotionPlanner
+
+# The suite plans with CasADi's own evaluation of the optimiser's derivatives (the same
+# values as compiled, tests/streams/test_compiled.py): a fresh machine would otherwise spend
+# about 20 s of CPU compiling them beside the tests. Subprocesses inherit the switch.
+os.environ[compiled.ENV_SWITCH] = "0"
 
 #: Most of the suite's time is spent in a few long planning tests; beyond four processes the
 #: start-up of each (pinocchio, CasADi, the optimiser build) outweighs what they share out.

@@ -245,15 +245,16 @@ def test_optimisers_are_built_once_per_scene_and_options(
 
     monkeypatch.setattr(trajopt, "DualArmTrajOpt", Fake)
     cache = OptimiserCache()
-    a = cache.get(ctx, TrajOptOptions(knots=6))
-    b = cache.get(ctx, TrajOptOptions(knots=6))
-    c = cache.get(ctx, TrajOptOptions(knots=7), background=False)
+    six = TrajOptOptions(knots=6, compiled=False)
+    a = cache.get(ctx, six)
+    b = cache.get(ctx, six)
+    c = cache.get(ctx, TrajOptOptions(knots=7, compiled=False), background=False)
     assert a is b and c is not a and len(cache) == 2
     assert a.get() is b.get() and a.ready and a.build_time >= 0.0
     assert [o.knots for o in sorted(built, key=lambda o: o.knots)] == [6, 7]
-    planner = DualMotionPlanner(ctx, TrajOptOptions(knots=6), optimisers=cache)
+    planner = DualMotionPlanner(ctx, six, optimisers=cache)
     assert planner.trajopt is a.get() and len(built) == 2  # no second build
-    broken = cache.get(ctx, TrajOptOptions(knots=3))
+    broken = cache.get(ctx, TrajOptOptions(knots=3, compiled=False))
     with pytest.raises(ParameterError, match="no NLP with 3 knots"):
         broken.get()
 
