@@ -283,7 +283,7 @@ class DualArmTrajOpt:
             jac_g, hess_lag = twins = compiled.load(functions, self._library)
             if not compiled.same_values(functions, twins):
                 _log.warning("%s gives other values: not used, removed", self._library)
-                self._library.unlink(missing_ok=True)  # compiled again by the next process
+                _remove(self._library)  # compiled again by the next process
             else:
                 opts = {**self._opts, "jac_g": jac_g, "hess_lag": hess_lag}
                 self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", self._nlp, opts)
@@ -291,7 +291,7 @@ class DualArmTrajOpt:
                 _log.info("trajectory optimiser: compiled derivatives in use (%s)", self._library)
         except RuntimeError as error:
             _log.info("the compiled derivatives could not be loaded, kept uncompiled: %s", error)
-            self._library.unlink(missing_ok=True)  # not what it should be: compiled again
+            _remove(self._library)  # not what it should be: compiled again
         if not self.compiled:
             self._library = None
 
@@ -541,6 +541,15 @@ class OptimiserCache:
 #: The process-wide cache of built optimisers (a warm start for every later solve in the
 #: process with the same scene and options).
 OPTIMISERS = OptimiserCache()
+
+
+def _remove(library: Path) -> None:
+    """Delete a cached library that must not be used (a read-only cache keeps it: it is
+    refused again by its values next time, which costs a few milliseconds)."""
+    try:
+        library.unlink(missing_ok=True)
+    except OSError as error:
+        _log.info("could not remove %s: %s", library, error)
 
 
 def straight_line(q_a: FloatArray, q_b: FloatArray, knots: int) -> FloatArray:

@@ -229,3 +229,24 @@ def test_a_library_with_other_values_is_not_used_and_removed(
         opt.solve(_query(ctx))
     assert not opt.compiled and opt._library is None and not impostor.exists()
     assert "could not be loaded" in caplog.text or "gives other values" in caplog.text
+
+
+def test_a_broken_library_in_a_read_only_cache_is_only_refused(
+    ctx: WorldContext,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    opt = DualArmTrajOpt(ctx, TrajOptOptions(knots=5, compiled=False))
+    broken = tmp_path / "casadi-broken.so"
+    broken.write_bytes(b"not a shared library")
+
+    def refuse(self: Path, missing_ok: bool = False) -> None:
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "unlink", refuse)
+    opt._library = broken
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.trajopt"):
+        opt.solve(_query(ctx))
+    assert not opt.compiled and opt._library is None and broken.exists()
+    assert f"could not remove {broken}" in caplog.text
