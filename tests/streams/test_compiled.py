@@ -145,7 +145,10 @@ def _query(ctx: WorldContext) -> TransferQuery:
 def test_the_optimiser_gives_the_same_paths_compiled(
     ctx: WorldContext, cache: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
-    options = TrajOptOptions(knots=5, compiled=False)  # less code to compile than 10 knots
+    # few slots: far less code to compile (1 s instead of 8 s), the same kind of NLP
+    options = TrajOptOptions(
+        knots=5, arm_arm_slots=4, obstacle_slots=2, table_slots=2, compiled=False
+    )
     plain = DualArmTrajOpt(ctx, options)
     fast = DualArmTrajOpt(ctx, options)
     fast.request_compiled(FAST)
