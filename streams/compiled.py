@@ -3,9 +3,11 @@
 The optimiser's Jacobian and Hessian are SX functions that CasADi evaluates in its virtual
 machine; compiled, the same expressions evaluate about ten times faster (the Hessian of the
 12-DoF transfer: 4.2 ms -> 0.44 ms per call on one core), with the same values. Compiling
-takes about 20 s of CPU with ``-O1``, so it is done once per distinct code: the C source
-CasADi generates is hashed (with the flags and the CasADi version) and the shared library is
-kept in the cache folder (:func:`cache_dir`), where every later process loads it at once.
+takes about 20 s of CPU with ``-O1``, so it is done once per distinct code: the library is
+kept in the cache folder (:func:`cache_dir`) under a hash of the caller's *recipe* (a text
+that changes whenever the generated code would), the flags, the compiler and the CasADi
+version, where every later process finds it without generating any code; :func:`same_values`
+checks a loaded library against CasADi's own evaluation.
 
 Nothing here is required: without a C compiler (``$CC``, else ``cc``), with
 ``SDAR_TAMP_COMPILE=0``, or when anything fails, :func:`request` returns None and the caller
@@ -98,7 +100,8 @@ def request(
         _log.info("no C compiler (%s): %s stays uncompiled", os.environ.get("CC", "cc"), name)
         return None
     try:
-        start_compile(source(functions, name), target, cc, flags)
+        if start_compile(source(functions, name), target, cc, flags):
+            _log.info("compiling %s in the background into %s", name, target)
     except OSError as error:
         _log.info("compiling %s is not possible, kept uncompiled: %s", name, error)
         return None
@@ -135,7 +138,6 @@ def start_compile(code: str, target: Path, cc: str, flags: Sequence[str] = FLAGS
         stderr=subprocess.DEVNULL,
         start_new_session=True,
     )
-    _log.info("compiling the optimiser's derivatives in the background into %s", target)
     return True
 
 
