@@ -38,6 +38,37 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 PLANNERS = ("ours", "ours-gbfs", "fd", "pyperplan")
 
+# ``--set ipc13``: five problems of each of 13 domains of the aibasel/downward-benchmarks layout,
+# medium to hard for lama-first (the easy first problems of each domain left out), chosen once by
+# name so that every run compares the same 65 problems.
+IPC13: dict[str, tuple[str, ...]] = {
+    "gripper": ("prob04", "prob08", "prob12", "prob16", "prob20"),
+    "logistics00": (
+        "probLOGISTICS-8-0",
+        "probLOGISTICS-10-0",
+        "probLOGISTICS-12-0",
+        "probLOGISTICS-14-0",
+        "probLOGISTICS-15-1",
+    ),
+    "blocks": (
+        "probBLOCKS-8-0",
+        "probBLOCKS-10-0",
+        "probBLOCKS-12-0",
+        "probBLOCKS-14-0",
+        "probBLOCKS-16-1",
+    ),
+    "miconic": ("s8-0", "s12-0", "s16-0", "s20-0", "s24-0"),
+    "depot": ("p04", "p06", "p09", "p13", "p16"),
+    "driverlog": ("p04", "p08", "p12", "p15", "p17"),
+    "rovers": ("p08", "p14", "p20", "p25", "p29"),
+    "satellite": ("p06-pfile6", "p10-pfile10", "p15-pfile15", "p20-pfile20", "p26-HC-pfile6"),
+    "zenotravel": ("p04", "p08", "p12", "p14", "p16"),
+    "tpp": ("p06", "p12", "p18", "p22", "p25"),
+    "elevators-sat08-strips": ("p05", "p10", "p15", "p22", "p26"),
+    "transport-sat08-strips": ("p05", "p09", "p13", "p17", "p21"),
+    "visitall-sat11-strips": ("problem14", "problem20", "problem26", "problem32", "problem38"),
+}
+
 
 # ---------------------------------------------------------------- one run, in a child process
 def _worker(planner: str, domain: Path, problem: Path, plan_file: Path) -> None:
@@ -163,10 +194,17 @@ def _natural(name: str) -> list[Any]:
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
 
 
-def suite_problems(suite: Path) -> list[tuple[str, str, Path, Path]]:
+def suite_problems(
+    suite: Path, selection: dict[str, tuple[str, ...]] | None = None
+) -> list[tuple[str, str, Path, Path]]:
+    """Every problem of every domain folder of ``suite``, or only those named in ``selection``."""
     cases = []
     for folder in sorted(p for p in suite.iterdir() if (p / "domain.pddl").is_file()):
+        if selection is not None and folder.name not in selection:
+            continue
         problems = [p for p in folder.glob("*.pddl") if "domain" not in p.name]
+        if selection is not None:
+            problems = [p for p in problems if p.stem in selection[folder.name]]
         for problem in sorted(problems, key=lambda p: _natural(p.name)):
             cases.append((folder.name, problem.stem, folder / "domain.pddl", problem))
     return cases
@@ -199,6 +237,12 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--suite", type=Path, default=None, help="folder of domain folders")
     parser.add_argument("--domains", nargs="*", default=None, help="only these domain folders")
+    parser.add_argument(
+        "--set",
+        choices=("all", "ipc13"),
+        default="all",
+        help="all problems of the suite, or the 65 named in IPC13 (13 domains, 5 each)",
+    )
     parser.add_argument("--time-limit", type=float, default=60.0, help="CPU [s] per run")
     parser.add_argument(
         "--planners", nargs="*", default=["ours", "fd", "pyperplan"], choices=PLANNERS
@@ -220,7 +264,13 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     rows: list[dict[str, Any]] = []
     with tempfile.TemporaryDirectory(prefix="bench-classical-") as folder:
         tmp = Path(folder)
-        cases = suite_problems(args.suite) if args.suite else default_problems(tmp)
+        selection = IPC13 if args.set == "ipc13" else None
+        cases = suite_problems(args.suite, selection) if args.suite else default_problems(tmp)
+        if args.suite and selection is not None:
+            found = {(c[0], c[1]) for c in cases}
+            missing = [f"{d}/{n}" for d, names in selection.items() for n in names if (d, n) not in found]
+            if missing:
+                parser.error(f"--set ipc13: not in {args.suite}: {', '.join(missing)}")
         if args.domains:
             cases = [c for c in cases if c[0] in args.domains]
         for domain_name, name, domain, problem in cases:

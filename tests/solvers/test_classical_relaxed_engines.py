@@ -1,4 +1,5 @@
-"""The relaxed heuristics' engines (queue-based, vectorised) against a plain fixpoint reference."""
+"""The relaxed heuristics' engines (queue-based, compiled, vectorised) against a plain fixpoint
+reference."""
 
 from __future__ import annotations
 
@@ -9,9 +10,12 @@ import pytest
 from classical_helpers import load
 
 from sdar_tamp.errors import ParameterError
-from solvers.classical import ground
+from solvers.classical import ground, jit
 from solvers.classical.compiled import CompiledTask, bits
-from solvers.classical.heuristics import RelaxedHeuristic
+from solvers.classical.heuristics import VECTOR_MIN_SIZE, RelaxedHeuristic
+from solvers.classical.problem import PlanningTask
+
+needs_numba = pytest.mark.skipif(not jit.available(), reason="numba is not installed")
 
 CASES = [
     ("blocksworld", "reverse4"),
@@ -115,7 +119,7 @@ def test_engines_equal_the_reference(domain: str, problem: str, unit: bool) -> N
     heuristics = {
         (name, engine): RelaxedHeuristic(compiled, name, costs, engine=engine)
         for name in ("add", "ff", "max")
-        for engine in ("python", "numpy")
+        for engine in ("python", "numpy") + (("numba",) if jit.available() else ())
     }
     assert heuristics["ff", "numpy"].engine == "numpy"
     assert heuristics["max", "numpy"].engine == "python"  # h_max has no vectorised engine
@@ -142,6 +146,81 @@ def test_integral_costs_use_the_bucket_queue_and_agree() -> None:
         assert python(state, True) == numpy(state, True)
 
 
+def _gripper(balls: int) -> PlanningTask:
+    """A gripper task with ``balls`` balls (large enough for the compiled engine from ~70)."""
+    from sdar_tamp.language import parse_domain, parse_problem
+    from solvers.classical import task_from_problem
+
+    domain = parse_domain(
+        """(define (domain gripper) (:requirements :strips :typing)
+  (:types room ball gripper)
+  (:predicates (at-robby ?r - room) (at ?b - ball ?r - room) (free ?g - gripper)
+               (carry ?b - ball ?g - gripper))
+  (:action move :parameters (?from ?to - room)
+    :precondition (at-robby ?from) :effect (and (at-robby ?to) (not (at-robby ?from))))
+  (:action pick :parameters (?b - ball ?r - room ?g - gripper)
+    :precondition (and (at ?b ?r) (at-robby ?r) (free ?g))
+    :effect (and (carry ?b ?g) (not (at ?b ?r)) (not (free ?g))))
+  (:action drop :parameters (?b - ball ?r - room ?g - gripper)
+    :precondition (and (carry ?b ?g) (at-robby ?r))
+    :effect (and (at ?b ?r) (free ?g) (not (carry ?b ?g)))))"""
+    )
+    names = " ".join(f"b{i}" for i in range(balls))
+    problem = parse_problem(
+        f"""(define (problem g{balls}) (:domain gripper)
+  (:objects r1 r2 r3 - room left right - gripper {names} - ball)
+  (:init (at-robby r1) (free left) (free right)
+         {" ".join(f"(at b{i} r{1 + i % 3})" for i in range(balls))})
+  (:goal (and {" ".join(f"(at b{i} r{1 + (i + 1) % 3})" for i in range(balls))})))""",
+        domain,
+    )
+    return task_from_problem(domain, problem)
+
+
+@needs_numba
+def test_auto_engine_compiles_large_tasks_and_agrees() -> None:
+    from solvers.classical import plan
+
+    task = _gripper(100)
+    compiled = CompiledTask(ground(task))
+    auto = RelaxedHeuristic(compiled, "ff", compiled.costs)
+    assert auto.engine == "numba"
+    size = sum(map(len, auto.upre)) + sum(map(len, auto.ueff))
+    assert size >= VECTOR_MIN_SIZE
+    python = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
+    for state in _states(compiled, 60, seed=3):
+        assert auto(state, True) == python(state, True)
+    # and the planner runs on it (its plan is validated by plan())
+    fast = plan(task, search="lazy-gbfs", heuristic="ff-lmcount")
+    assert fast.plan is not None and fast.statistics.expanded > 0
+
+
+@needs_numba
+def test_compiled_engine_dead_end_and_goal_states() -> None:
+    compiled = CompiledTask(ground(load("blocksworld", "sussman")))
+    for name in ("ff", "add", "max"):
+        heuristic = RelaxedHeuristic(compiled, name, compiled.costs, engine="numba")
+        assert heuristic.engine == "numba"
+        goal_state = compiled.init | compiled.goal_mask
+        h, preferred = heuristic(goal_state, True)
+        assert h == 0.0 and not preferred
+    # a dead end: no fact at all is true, so no operator is applicable
+    for name, expected in (("ff", set()), ("add", None), ("max", None)):
+        heuristic = RelaxedHeuristic(compiled, name, compiled.costs, engine="numba")
+        assert heuristic(0, True) == (inf, expected)
+
+
+def test_numba_engine_without_numba_is_an_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    compiled = CompiledTask(ground(load("blocksworld", "sussman")))
+    monkeypatch.setattr(jit, "available", lambda: False)
+    with pytest.raises(ParameterError, match="engine 'numba' needs numba: pip install numba"):
+        RelaxedHeuristic(compiled, "ff", compiled.costs, engine="numba")
+    # "auto" falls back to the other engines
+    task = _gripper(100)
+    large = CompiledTask(ground(task))
+    assert RelaxedHeuristic(large, "ff", large.costs).engine in ("python", "numpy")
+
+
 def test_auto_engine_keeps_small_tasks_on_the_queue() -> None:
     compiled = CompiledTask(ground(load("blocksworld", "sussman")))
     assert RelaxedHeuristic(compiled, "ff", compiled.costs).engine == "python"
@@ -149,5 +228,5 @@ def test_auto_engine_keeps_small_tasks_on_the_queue() -> None:
 
 def test_unknown_engine_is_an_error() -> None:
     compiled = CompiledTask(ground(load("blocksworld", "sussman")))
-    with pytest.raises(ParameterError, match="engine must be one of auto, python, numpy"):
+    with pytest.raises(ParameterError, match="engine must be one of auto, python, numpy, numba"):
         RelaxedHeuristic(compiled, "ff", compiled.costs, engine="cuda")
