@@ -5,6 +5,7 @@ the time reported is the child's CPU time (user + system, interpreter start incl
 problem solved in 0.3 s mostly measures start-up). Planners:
 
 - ``ours``: ``solvers.classical.plan`` with ``lazy-gbfs`` + ``ff-lmcount`` (``sdar plan``'s default)
+- ``ours-noexp``: the same without the type-based exploration queue
 - ``ours-gbfs``: eager GBFS + h_FF with preferred operators (the stream algorithms' default)
 - ``fd``: Fast Downward's ``lama-first`` (``pip install sdar-tamp[fd]``; skipped if missing)
 - ``pyperplan``: GBFS + h_FF (``pip install pyperplan``; skipped if missing)
@@ -36,7 +37,7 @@ from typing import Any
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-PLANNERS = ("ours", "ours-gbfs", "fd", "pyperplan")
+PLANNERS = ("ours", "ours-noexp", "ours-gbfs", "fd", "pyperplan")
 
 # ``--set ipc13``: five problems of each of 13 domains of the aibasel/downward-benchmarks layout,
 # medium to hard for lama-first (the easy first problems of each domain left out), chosen once by
@@ -79,8 +80,14 @@ def _worker(planner: str, domain: Path, problem: Path, plan_file: Path) -> None:
 
         parsed_domain = parse_domain(domain.read_text(), str(domain))
         parsed = parse_problem(problem.read_text(), parsed_domain, str(problem))
-        search, heuristic = ("lazy-gbfs", "ff-lmcount") if planner == "ours" else ("gbfs", "ff")
-        result = plan(task_from_problem(parsed_domain, parsed), search=search, heuristic=heuristic)
+        lazy = planner in ("ours", "ours-noexp")
+        search, heuristic = ("lazy-gbfs", "ff-lmcount") if lazy else ("gbfs", "ff")
+        result = plan(
+            task_from_problem(parsed_domain, parsed),
+            search=search,
+            heuristic=heuristic,
+            exploration=planner == "ours" if lazy else None,
+        )
         steps = [str(step) for step in result.plan] if result.plan is not None else None
         expanded = result.statistics.expanded
     elif planner == "fd":
@@ -268,7 +275,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         cases = suite_problems(args.suite, selection) if args.suite else default_problems(tmp)
         if args.suite and selection is not None:
             found = {(c[0], c[1]) for c in cases}
-            missing = [f"{d}/{n}" for d, names in selection.items() for n in names if (d, n) not in found]
+            missing = [
+                f"{d}/{n}" for d, names in selection.items() for n in names if (d, n) not in found
+            ]
             if missing:
                 parser.error(f"--set ipc13: not in {args.suite}: {', '.join(missing)}")
         if args.domains:

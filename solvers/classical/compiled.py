@@ -11,7 +11,13 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterable
 
+from solvers.classical import jit
 from solvers.classical.task import GroundTask
+
+# a task with this many operators walks its trie in compiled code once the search has asked for
+# this many successor lists (a short search does not pay numba's import)
+JIT_MIN_OPERATORS = 300
+JIT_AFTER_CALLS = 2000
 
 # (pre mask, negative pre mask, add mask, delete mask, conditional effects, cost)
 # conditional effect: (condition mask, negative condition mask, add mask, delete mask)
@@ -77,6 +83,9 @@ class CompiledTask:
         self.strata = [strata[s] for s in sorted(strata)]
         self._root = self._build_trie()
         self.init = self.close(mask(task.init))
+        self._calls = 0
+        self._jit: jit.JitSuccessors | None = None
+        self._jit_pending = len(task.operators) >= JIT_MIN_OPERATORS and jit.available()
 
     def _build_trie(self) -> Trie:
         frequency = Counter(f for op in self.task.operators for f in op.precondition)
@@ -94,7 +103,15 @@ class CompiledTask:
         return freeze(root)
 
     def applicable(self, state: int) -> list[int]:
-        """Indices of the operators applicable in ``state``."""
+        """Indices of the operators applicable in ``state`` (the same list, in the same order,
+        from the compiled trie walk once it is in use)."""
+        if self._jit is not None:
+            return self._jit.applicable(state)
+        if self._jit_pending:
+            self._calls += 1
+            if self._calls >= JIT_AFTER_CALLS:
+                self.use_compiled_successors()
+                return self.applicable(state)
         result: list[int] = []
         stack = [self._root]
         while stack:
@@ -106,6 +123,12 @@ class CompiledTask:
                     stack.append(child)
         operators = self.operators
         return [i for i in result if not state & operators[i][1]]
+
+    def use_compiled_successors(self) -> None:
+        """Walk the trie in compiled code from now on (numba must be installed)."""
+        negative = [tuple(op.negative_precondition) for op in self.task.operators]
+        self._jit = jit.JitSuccessors(self._root, negative, len(self.task.facts))
+        self._jit_pending = False
 
     def successor(self, state: int, index: int) -> int:
         _pre, _neg, add, delete, conditional, _cost = self.operators[index]

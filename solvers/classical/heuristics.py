@@ -39,6 +39,9 @@ ENGINES = ("auto", "python", "numpy", "numba")
 # below this many (precondition + effect) entries the queue-based h_add is always used (the
 # compiled engine's one-off cost, importing numba and loading its code, is about 0.5 s)
 VECTOR_MIN_SIZE = 4000
+# under "auto", a large task switches to the compiled engine once the queue has spent this long
+# [s] (CPU) on it: the same values, without numba's import for searches that end sooner
+JIT_AFTER_SECONDS = 0.3
 
 # "lmcount": landmark count; "ff-lmcount": h_FF and landmark count in alternating queues
 HEURISTICS = ("ff", "add", "max", "blind", "lmcount", "ff-lmcount")
@@ -106,17 +109,37 @@ class RelaxedHeuristic:
         # tasks under "auto" keep the first supporter found (the exploration order's)
         self.canonical = engine != "auto" or size >= VECTOR_MIN_SIZE
         large = engine == "auto" and size >= VECTOR_MIN_SIZE
-        if name != "blind" and (engine == "numba" or (large and jit.available())):
+        self.spent = 0.0  # CPU time of the queue-based engine while the compiled one is pending
+        self.jit_pending = large and name != "blind" and jit.available()
+        if name != "blind" and engine == "numba":
             if not jit.available():
                 raise ParameterError("engine 'numba' needs numba: pip install numba")
-            self.jit = jit.JitRelaxed(
-                count, upre, ueff, ucost, uop, self.pre_of, self.goal, list(costs)
-            )
+            self.use_compiled()
+        elif self.jit_pending:
+            pass
         elif name in ("add", "ff") and (engine == "numpy" or large):
             self.vector = VectorHAdd(count, upre, ueff, ucost)
             if engine == "auto" and not self._vector_is_faster(compiled.init):
                 self.vector = None
-        self.engine = "numba" if self.jit else ("python" if self.vector is None else "numpy")
+        self.engine = (
+            "numba"
+            if self.jit or self.jit_pending
+            else ("python" if self.vector is None else "numpy")
+        )
+
+    def use_compiled(self) -> None:
+        """Evaluate with the compiled engine from now on (numba must be installed)."""
+        self.jit = jit.JitRelaxed(
+            self.count,
+            self.upre,
+            self.ueff,
+            self.ucost,
+            self.uop,
+            self.pre_of,
+            self.goal,
+            list(self.costs),
+        )
+        self.jit_pending = False
 
     def _vector_is_faster(self, state: int) -> bool:
         """Time both h_add engines on ``state`` (best of three runs each)."""
@@ -137,6 +160,13 @@ class RelaxedHeuristic:
     def __call__(self, state: int, preferred: bool = False) -> tuple[float, set[int] | None]:
         if self.name == "blind":
             return (0.0 if state & self.goal_mask == self.goal_mask else self.min_cost), None
+        if self.jit_pending:
+            start = time.process_time()
+            result = self._evaluate_queue(state, preferred)
+            self.spent += time.process_time() - start
+            if self.spent >= JIT_AFTER_SECONDS:
+                self.use_compiled()
+            return result
         if self.jit is not None:
             h, h_ff, operators = self.jit.evaluate(
                 state, self.name == "max", self.name == "ff" or preferred
@@ -146,6 +176,9 @@ class RelaxedHeuristic:
             if h == inf:
                 return inf, None
             return h, (set(operators) if preferred else None)
+        return self._evaluate_queue(state, preferred)
+
+    def _evaluate_queue(self, state: int, preferred: bool) -> tuple[float, set[int] | None]:
         if self.vector is not None:
             if state & self.goal_mask == self.goal_mask:
                 return 0.0, (set() if preferred or self.name == "ff" else None)

@@ -58,6 +58,7 @@ def plan(
     lazy: bool = False,
     time_limit: float | None = None,
     cost_bound: float = math.inf,
+    exploration: bool | None = None,
 ) -> SearchResult:
     """Find a plan for ``task``.
 
@@ -74,6 +75,10 @@ def plan(
     the goal are dropped; the cost never rises); A* plans are returned as found. ``"gbfs"`` adds
     1 to every action cost inside the heuristic (so zero-cost actions still count as steps);
     plan costs are always the true costs.
+    ``exploration``: a type-based exploration queue beside the heuristic queues (greedy lazy
+    search only; None: on for ``"lazy-gbfs"``). It takes successors of random parents grouped
+    by (h, g), so that a search stuck on a plateau still samples the states its heuristic ranks
+    badly (Xie, Mueller and Holte 2014); its random choices are seeded, so runs are repeatable.
     ``time_limit`` [s] covers grounding and search. ``cost_bound``: only plans cheaper than it
     (states whose cost so far reaches it are pruned; the initial state is never pruned).
     """
@@ -81,6 +86,14 @@ def plan(
     _check("heuristic", heuristic, HEURISTICS)
     if not weight >= 1.0:
         raise ParameterError(f"weight must be >= 1; got {weight!r}")
+    greedy_lazy = search == "lazy-gbfs" or (search == "gbfs" and lazy)
+    if exploration is None:
+        exploration = search == "lazy-gbfs"
+    elif exploration and not greedy_lazy:
+        raise ParameterError(
+            "exploration needs greedy lazy search (search='lazy-gbfs', or 'gbfs' with lazy=True);"
+            f" got search={search!r}, lazy={lazy!r}"
+        )
     if time_limit is not None and not time_limit > 0:
         raise ParameterError(f"time_limit must be > 0 seconds or None; got {time_limit!r}")
     start = time.perf_counter()
@@ -90,7 +103,15 @@ def plan(
         return ground_task
     grounded = time.perf_counter()
     outcome = _search(
-        ground_task, search, heuristic, weight, preferred_operators, lazy, deadline, cost_bound
+        ground_task,
+        search,
+        heuristic,
+        weight,
+        preferred_operators,
+        lazy,
+        deadline,
+        cost_bound,
+        exploration,
     )
     searched = time.perf_counter()
     statistics = SearchStatistics(
@@ -122,6 +143,7 @@ def _search(
     lazy: bool,
     deadline: float | None,
     cost_bound: float = math.inf,
+    exploration: bool = False,
 ) -> SearchOutcome:
     if not ground_task.goal_reachable:
         logger.info("goal not relaxed-reachable: unsolvable")
@@ -153,6 +175,7 @@ def _search(
         reopen=search not in ("gbfs", "lazy-gbfs"),
         deadline=deadline,
         cost_bound=cost_bound,
+        exploration=exploration,
     )
     if outcome.status == "solved" and search != "astar":
         shorter = eliminate_redundant_actions(compiled, list(outcome.operators), deadline)

@@ -7,7 +7,8 @@ queue of its own, and with preferred operators a second queue that only takes su
 reached by a preferred operator. The search takes turns between the queues (the one used least
 goes next); each time a heuristic reaches a new best value the preferred queues get 1000 extra
 turns (boosting). Lazy search stores (parent, operator) and evaluates a state only when it is
-taken out of a queue, with its parent's values as the priority.
+taken out of a queue, with its parent's values as the priority. Greedy lazy search can add a
+type-based exploration queue to the rotation (:class:`_TypeBuckets`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from heapq import heappop, heappush
 from math import inf
+from random import Random
 from typing import Any
 
 from solvers.classical.compiled import CompiledTask
@@ -133,6 +135,47 @@ class _Queues:
         return entry
 
 
+class _TypeBuckets:
+    """Type-based exploration (Xie, Mueller, Holte 2014): batches of successors grouped by the
+    type ``(h, g)`` of their parent; a pop takes a random type, then a random successor of a
+    random batch of that type. It samples every region of the open list alike, so a search
+    stuck on a plateau of its heuristic still reaches states the heuristic ranks badly."""
+
+    def __init__(self, seed: int) -> None:
+        self.rng = Random(seed)
+        self.buckets: dict[tuple[float, float], list[list[Any]]] = {}
+        self.keys: list[tuple[float, float]] = []
+
+    def __bool__(self) -> bool:
+        return bool(self.keys)
+
+    def push(self, key: tuple[float, float], origin: int, g: float, operators: list[int]) -> None:
+        bucket = self.buckets.get(key)
+        if bucket is None:
+            bucket = self.buckets[key] = []
+            self.keys.append(key)
+        bucket.append([origin, g, list(operators)])
+
+    def pop(self) -> tuple[int, int, float]:
+        rng = self.rng
+        k = rng.randrange(len(self.keys))
+        key = self.keys[k]
+        bucket = self.buckets[key]
+        b = rng.randrange(len(bucket))
+        origin, g, operators = bucket[b]
+        i = rng.randrange(len(operators))
+        operators[i], operators[-1] = operators[-1], operators[i]
+        op = operators.pop()
+        if not operators:
+            bucket[b] = bucket[-1]
+            bucket.pop()
+            if not bucket:
+                del self.buckets[key]
+                self.keys[k] = self.keys[-1]
+                self.keys.pop()
+        return origin, op, g
+
+
 class _BatchQueues(_Queues):
     """Queues whose entries hold every successor of one expanded state (greedy lazy search).
 
@@ -141,6 +184,12 @@ class _BatchQueues(_Queues):
     (``[priority, h, counter, origin, g, operators, next position]``) taken one operator at a
     time gives the same order as one entry per successor, at a fraction of the heap work.
     """
+
+    def __init__(self, size: int, use_preferred: bool, explore: bool = False) -> None:
+        super().__init__(size, use_preferred)
+        self.typed = _TypeBuckets(seed=0) if explore else None
+        if explore:
+            self.priority.append(0)
 
     def push_batch(
         self,
@@ -153,17 +202,35 @@ class _BatchQueues(_Queues):
         preferred: list[int],
     ) -> None:
         heaps = self.heaps
+        if self.typed is not None and operators:
+            self.typed.push((values[0], g), origin, g, operators)
         for i, h in enumerate(values):
             if operators:
                 heappush(heaps[i], [h_weight * h, h, counter, origin, g, operators, 0])
             if preferred and self.count > self.size:
                 heappush(heaps[self.size + i], [h_weight * h, h, counter, origin, g, preferred, 0])
 
+    def _take_turn(self) -> int:
+        best = -1
+        priority = self.priority
+        for i, heap in enumerate(self.heaps):
+            if heap and (best < 0 or priority[i] < priority[best]):
+                best = i
+        typed = len(self.heaps)
+        if self.typed and (best < 0 or priority[typed] < priority[best]):
+            best = typed
+        if best >= 0:
+            priority[best] += 1
+        return best
+
     def pop_successor(self) -> tuple[int, int, float] | None:
         """``(origin, operator, origin's g)`` of the next successor, or None when empty."""
         best = self._take_turn()
         if best < 0:
             return None
+        if best == len(self.heaps):
+            assert self.typed is not None
+            return self.typed.pop()
         heap = self.heaps[best]
         entry: list[Any] = heap[0]
         operators, position = entry[5], entry[6]
@@ -195,12 +262,27 @@ def best_first_search(
     reopen: bool,
     deadline: float | None,
     cost_bound: float = inf,
+    exploration: bool = False,
 ) -> SearchOutcome:
     """Search from ``compiled.init``; ``reopen`` re-expands states reached more cheaply.
-    States whose cost so far reaches ``cost_bound`` are pruned (only cheaper plans)."""
+    States whose cost so far reaches ``cost_bound`` are pruned (only cheaper plans).
+    ``exploration`` adds a type-based queue (greedy lazy search only, see :class:`_TypeBuckets`)."""
     evaluator = heuristic if isinstance(heuristic, Evaluator) else Evaluator(heuristic, None)
-    run = _lazy if lazy else _eager
-    return run(compiled, evaluator, g_weight, h_weight, preferred, reopen, deadline, cost_bound)
+    if not lazy:
+        return _eager(
+            compiled, evaluator, g_weight, h_weight, preferred, reopen, deadline, cost_bound
+        )
+    return _lazy(
+        compiled,
+        evaluator,
+        g_weight,
+        h_weight,
+        preferred,
+        reopen,
+        deadline,
+        cost_bound,
+        exploration and g_weight == 0.0,
+    )
 
 
 def _eager(
@@ -281,13 +363,14 @@ def _lazy(
     reopen: bool,
     deadline: float | None,
     cost_bound: float,
+    exploration: bool = False,
 ) -> SearchOutcome:
     costs = compiled.costs
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
     evaluate = evaluator.evaluate
     expanded, generated, evaluated = 0, 1, 0
     greedy = g_weight == 0.0  # one queue entry per expansion (see _BatchQueues)
-    queues = _BatchQueues(evaluator.size, preferred)
+    queues = _BatchQueues(evaluator.size, preferred, explore=exploration and greedy)
     init = compiled.init
     if greedy:
         queues.push_batch((0.0,) * evaluator.size, h_weight, 0, -1, 0.0, [-1], [])
