@@ -77,6 +77,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
             heuristic=args.heuristic,
             weight=args.weight,
             time_limit=args.time_limit,
+            exploration=False if args.no_exploration else None,
         )
     stats = result.statistics
     print(f"status: {result.status.value}")
@@ -307,6 +308,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--time-limit", type=TIME_LIMIT.parse, default=None, help="seconds (default: none)"
     )
     plan.add_argument("--unit", action="store_true", help="ignore action costs")
+    plan.add_argument(
+        "--no-exploration",
+        action="store_true",
+        help="lazy-gbfs without its type-based exploration queue (the heuristic queues only)",
+    )
     plan.add_argument(
         "--strict",
         action="store_true",

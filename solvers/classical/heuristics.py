@@ -41,7 +41,7 @@ ENGINES = ("auto", "python", "numpy", "numba")
 VECTOR_MIN_SIZE = 4000
 # under "auto", a large task switches to the compiled engine once the queue has spent this long
 # [s] (CPU) on it: the same values, without numba's import for searches that end sooner
-JIT_AFTER_SECONDS = 0.3
+JIT_AFTER_SECONDS = 0.5
 
 # "lmcount": landmark count; "ff-lmcount": h_FF and landmark count in alternating queues
 HEURISTICS = ("ff", "add", "max", "blind", "lmcount", "ff-lmcount")

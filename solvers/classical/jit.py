@@ -1,4 +1,6 @@
-"""h_max, h_add and h_FF compiled with numba: the same values and relaxed plans, 10-30x faster.
+"""The classical planner's inner loops compiled with numba: the relaxed heuristics (h_max, h_add,
+h_FF: the same values and relaxed plans as the queue-based engine, 5-15x faster per state) and
+the successor generator's trie walk (the same operators in the same order, about 10x faster).
 
 The relaxed task is stored as flat arrays (compressed rows: the preconditions and adds of each
 unary relaxed operator, the relaxed operators of each precondition fact). One call of

@@ -31,6 +31,14 @@ def test_every_search_choice_plans(search: str, capsys: pytest.CaptureFixture[st
     assert "status: solved" in capsys.readouterr().out
 
 
+def test_no_exploration_plans_with_the_heuristic_queues_only(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main([*_sussman(), "--no-exploration"]) == 0
+    out = capsys.readouterr().out
+    assert "status: solved" in out and "length: 6" in out
+
+
 def test_unknown_heuristic_lists_the_choices(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as info:
         main([*_sussman(), "--heuristic", "hm"])

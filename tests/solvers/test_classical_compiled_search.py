@@ -1,0 +1,112 @@
+"""The compiled successor generator, the switch to compiled code mid-search, and the type-based
+exploration queue of greedy lazy search."""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+from classical_helpers import load
+from test_classical_relaxed_engines import _gripper, _states, needs_numba
+
+from sdar_tamp.errors import ParameterError
+from solvers.classical import compiled as compiled_module
+from solvers.classical import ground, heuristics, plan
+from solvers.classical.compiled import CompiledTask
+from solvers.classical.heuristics import RelaxedHeuristic
+from solvers.classical.search import _TypeBuckets
+
+
+@needs_numba
+def test_compiled_successors_list_the_same_operators_in_the_same_order() -> None:
+    for task in (_gripper(100), load("logistics", "three-cities"), load("briefcase", "office")):
+        python = CompiledTask(ground(task))
+        fast = CompiledTask(ground(task))
+        fast.use_compiled_successors()
+        for state in _states(python, 80, seed=11):
+            assert fast.applicable(state) == python.applicable(state)
+
+
+@needs_numba
+def test_compiled_successors_respect_negative_preconditions() -> None:
+    task = load("briefcase", "lights-out")
+    compiled = CompiledTask(ground(task))
+    assert any(op[1] for op in compiled.operators), "the case needs negative preconditions"
+    fast = CompiledTask(ground(task))
+    fast.use_compiled_successors()
+    for state in _states(compiled, 60, seed=5):
+        assert fast.applicable(state) == compiled.applicable(state)
+
+
+@needs_numba
+def test_large_tasks_switch_to_compiled_successors_after_enough_calls(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(compiled_module, "JIT_AFTER_CALLS", 5)
+    compiled = CompiledTask(ground(_gripper(100)))
+    reference = CompiledTask(ground(_gripper(100)))
+    reference._jit_pending = False
+    states = _states(reference, 12, seed=2)
+    lists = [compiled.applicable(state) for state in states]
+    assert compiled._jit is not None
+    assert lists == [reference.applicable(state) for state in states]
+    small = CompiledTask(ground(load("blocksworld", "sussman")))
+    for state in _states(small, 12, seed=2):
+        small.applicable(state)
+    assert small._jit is None
+
+
+@needs_numba
+def test_large_tasks_switch_to_the_compiled_heuristic_after_its_time(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(heuristics, "JIT_AFTER_SECONDS", 0.0)
+    compiled = CompiledTask(ground(_gripper(100)))
+    auto = RelaxedHeuristic(compiled, "ff", compiled.costs)
+    python = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
+    assert auto.jit is None and auto.jit_pending
+    states = _states(compiled, 10, seed=4)
+    assert auto(states[0], True) == python(states[0], True)  # by the queue, then switches
+    assert auto.jit is not None and not auto.jit_pending
+    for state in states[1:]:
+        assert auto(state, True) == python(state, True)
+
+
+def test_type_buckets_pop_every_successor_once() -> None:
+    buckets = _TypeBuckets(seed=1)
+    pushed = set()
+    rng = random.Random(0)
+    for origin in range(30):
+        operators = list(range(rng.randint(1, 6)))
+        buckets.push((float(origin % 4), float(origin % 3)), origin, 0.0, operators)
+        pushed |= {(origin, op) for op in operators}
+    popped = []
+    while buckets:
+        origin, op, g = buckets.pop()
+        assert g == 0.0
+        popped.append((origin, op))
+    assert len(popped) == len(pushed) and set(popped) == pushed
+    assert not buckets.keys and not buckets.buckets
+
+
+@pytest.mark.parametrize(
+    ("domain", "problem"), [("logistics", "three-cities"), ("briefcase", "office")]
+)
+def test_exploration_is_repeatable_and_valid(domain: str, problem: str) -> None:
+    task = load(domain, problem)
+    first = plan(task, search="lazy-gbfs", heuristic="ff-lmcount")
+    again = plan(task, search="lazy-gbfs", heuristic="ff-lmcount")
+    assert first.plan is not None  # plan() validates every plan it returns
+    assert first.plan == again.plan
+    assert first.statistics.expanded == again.statistics.expanded
+    without = plan(task, search="lazy-gbfs", heuristic="ff-lmcount", exploration=False)
+    assert without.plan is not None
+    lazy_gbfs = plan(task, search="gbfs", lazy=True, exploration=True)
+    assert lazy_gbfs.plan is not None
+
+
+@pytest.mark.parametrize(("search", "lazy"), [("astar", False), ("wastar", True), ("gbfs", False)])
+def test_exploration_needs_greedy_lazy_search(search: str, lazy: bool) -> None:
+    task = load("blocksworld", "sussman")
+    with pytest.raises(ParameterError, match="exploration needs greedy lazy search"):
+        plan(task, search=search, lazy=lazy, exploration=True)
