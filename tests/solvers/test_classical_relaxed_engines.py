@@ -188,11 +188,42 @@ def test_auto_engine_compiles_large_tasks_and_agrees() -> None:
     size = sum(map(len, auto.upre)) + sum(map(len, auto.ueff))
     assert size >= VECTOR_MIN_SIZE
     python = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
+    python.canonical = False  # "auto" keeps the exploration order's supporters
     for state in _states(compiled, 60, seed=3):
         assert auto(state, True) == python(state, True)
     # and the planner runs on it (its plan is validated by plan())
     fast = plan(task, search="lazy-gbfs", heuristic="ff-lmcount")
     assert fast.plan is not None and fast.statistics.expanded > 0
+
+
+@needs_numba
+@pytest.mark.parametrize("unit", [True, False])
+@pytest.mark.parametrize("name", ["ff", "add", "max"])
+def test_compiled_engine_follows_the_queue_exploration_order(unit: bool, name: str) -> None:
+    """First-found supporters (the bucket lists' order for whole costs, the heap's otherwise)."""
+    for task in (_gripper(100), load("logistics", "three-cities"), load("briefcase", "office")):
+        compiled = CompiledTask(ground(task))
+        costs = [1.0] * len(compiled.costs) if unit else [c + 0.5 for c in compiled.costs]
+        python = RelaxedHeuristic(compiled, name, costs, engine="python")
+        python.canonical = False
+        fast = RelaxedHeuristic(compiled, name, costs, engine="python")
+        fast.canonical = False
+        fast.use_compiled()
+        assert fast.jit is not None and fast.jit.fifo == unit
+        for state in _states(compiled, 50, seed=9):
+            assert fast(state, True) == python(state, True)
+
+
+@needs_numba
+def test_auto_engine_on_large_tasks_keeps_the_exploration_order() -> None:
+    compiled = CompiledTask(ground(_gripper(100)))
+    auto = RelaxedHeuristic(compiled, "ff", compiled.costs)
+    assert auto.jit_pending and not auto.canonical
+    reference = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
+    reference.canonical = False
+    auto.use_compiled()
+    for state in _states(compiled, 40, seed=6):
+        assert auto(state, True) == reference(state, True)
 
 
 @needs_numba
