@@ -228,7 +228,7 @@ class SampledStrategy:
             direct = planner.direct_path(problem.q_from, problem.q_to)
             if direct is not None:
                 planner.direct_paths += 1
-                return [direct]
+                return [planner.refine_direct(problem, direct)]
         W = sample_path(planner, problem.q_from, problem.q_to, self.options)
         planner.sampled_paths += int(W is not None)
         W = None if W is None else checked_waypoints(planner, W, self.options.curve_samples)

@@ -1,5 +1,6 @@
 """Synchronous motions: limits, exact collision freedom, fallbacks."""
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -315,3 +316,81 @@ def test_lift_follows_clearance(
                                           planner.shape.max_lift), abs=2e-3)  # fmt: skip
     assert raised[0] > down[0] and raised[1] == down[1]
     assert planner.lifts(request, 0.08) == ([0.08, 0.08], [0.08, 0.08])
+
+
+# The lifted ends of a one-arm transfer in M1 whose straight line is blocked and whose direct
+# path is bent (found by search; the right arm waits at home).
+BENT_FROM = np.array([-0.7061157420693194, -0.9699969278267897, 1.5874309412084284,
+    -2.138845293039127, -0.7866195915128875, -0.06986945144194401, 0.0, -2.2, 1.9, -1.383,
+    -1.57, 0.0])  # fmt: skip
+BENT_TO = np.array([-0.011385690495040901, -1.480127490251257, 2.0947252727854395,
+    -2.1853941093290796, -1.5707963267948966, 0.23378877419044874, 0.0, -2.2, 1.9, -1.383,
+    -1.57, 0.0])  # fmt: skip
+
+
+def _bent_transfer(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> tuple[TransferProblem, np.ndarray]:
+    """The transfer between BENT_FROM and BENT_TO, and its bent direct path (3 waypoints)."""
+    for world in (planner.world, planner.margin_world):
+        configure_world(ctx, world, objects, {}, BENT_FROM)
+    bent = planner.direct_path(BENT_FROM, BENT_TO)
+    assert bent is not None and len(bent) == 3, "the case needs a bent direct path"
+    request = MotionRequest(BENT_FROM, BENT_TO, objects)
+    return planner.transfer_problem(request, BENT_FROM, BENT_TO), bent
+
+
+def _duration(planner: DualMotionPlanner, path: np.ndarray) -> float:
+    v, a = planner.limits
+    from streams.timing import time_parameterize
+
+    return time_parameterize(path, v, a).duration
+
+
+def test_a_bent_direct_path_is_refined_when_the_optimiser_makes_it_faster(
+    ctx: WorldContext, objects: dict[str, ObjectBox]
+) -> None:
+    planner = DualMotionPlanner(ctx)
+    assert planner.refine_bent
+    problem, bent = _bent_transfer(ctx, planner, objects)
+    refined = planner.refine_direct(problem, bent)
+    assert refined is not bent and len(refined) > 3
+    assert _duration(planner, refined) < _duration(planner, bent)
+    assert np.allclose(refined[0], bent[0]) and np.allclose(refined[-1], bent[-1])
+    curve = spline_curve(refined, 128)
+    assert validate_trajectory(ctx, planner.margin_world, curve).ok
+    # off: the bent path as it is; a straight path is never handed to the optimiser
+    plain = DualMotionPlanner(ctx, refine_bent=False)
+    assert plain.refine_direct(problem, bent) is bent
+    straight = np.stack([bent[0], bent[-1]])
+    assert planner.refine_direct(problem, straight) is straight
+
+
+def test_a_refinement_that_collides_or_is_slower_keeps_the_bent_path(
+    ctx: WorldContext, objects: dict[str, ObjectBox], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    planner = DualMotionPlanner(ctx)
+    problem, bent = _bent_transfer(ctx, planner, objects)
+    solve = planner.trajopt.solve
+
+    def through_the_table(query: TransferQuery, warm: np.ndarray | None = None) -> object:
+        # faster than the bent path but blocked: the straight line the bent path avoids
+        result = solve(query, warm)
+        return dataclasses.replace(result, path=straight_line(bent[0], bent[-1], 20))
+
+    straight = straight_line(bent[0], bent[-1], 20)
+    assert _duration(planner, straight) < _duration(planner, bent)
+    assert not validate_trajectory(ctx, planner.margin_world, spline_curve(straight, 128)).ok
+    monkeypatch.setattr(planner.trajopt, "solve", through_the_table)
+    assert planner.refine_direct(problem, bent) is bent
+
+    def slower(query: TransferQuery, warm: np.ndarray | None = None) -> object:
+        result = solve(query, warm)
+        return dataclasses.replace(result, path=densify_slow(bent))
+
+    def densify_slow(path: np.ndarray) -> np.ndarray:
+        # the same curve with a detour back and forth: longer to execute
+        return np.concatenate([path[:2], path[:1], path])
+
+    monkeypatch.setattr(planner.trajopt, "solve", slower)
+    assert planner.refine_direct(problem, bent) is bent
