@@ -11,8 +11,11 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterable
 
+from sdar_tamp.logs import get_logger
 from solvers.classical import jit
 from solvers.classical.task import GroundTask
+
+logger = get_logger(__name__)
 
 # a task with this many operators walks its trie in compiled code once the search has asked for
 # this many successor lists (a short search does not pay numba's import)
@@ -110,8 +113,12 @@ class CompiledTask:
         if self._jit_pending:
             self._calls += 1
             if self._calls >= JIT_AFTER_CALLS:
-                self.use_compiled_successors()
-                return self.applicable(state)
+                try:
+                    self.use_compiled_successors()
+                    return self.applicable(state)
+                except jit.CompiledCodeUnavailable as error:
+                    logger.warning("%s; the search goes on without compiled code", error)
+                    self._jit_pending = False
         result: list[int] = []
         stack = [self._root]
         while stack:

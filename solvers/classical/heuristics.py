@@ -33,8 +33,11 @@ import numpy as np
 import numpy.typing as npt
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.logs import get_logger
 from solvers.classical import jit
 from solvers.classical.compiled import CompiledTask, bits
+
+logger = get_logger(__name__)
 
 ENGINES = ("auto", "python", "numpy", "numba")
 # below this many (precondition + effect) entries the queue-based h_add is always used (the
@@ -115,7 +118,7 @@ class RelaxedHeuristic:
         self.canonical = engine != "auto" or (large and not self.jit_pending)
         if name != "blind" and engine == "numba":
             if not jit.available():
-                raise ParameterError("engine 'numba' needs numba: pip install numba")
+                raise ParameterError(f"engine 'numba' is unavailable: {jit.why_unavailable()}")
             self.use_compiled()
         elif self.jit_pending:
             pass
@@ -169,7 +172,11 @@ class RelaxedHeuristic:
             result = self._evaluate_queue(state, preferred)
             self.spent += time.process_time() - start
             if self.spent >= JIT_AFTER_SECONDS:
-                self.use_compiled()
+                try:
+                    self.use_compiled()
+                except jit.CompiledCodeUnavailable as error:
+                    logger.warning("%s; the search goes on without compiled code", error)
+                    self.jit_pending = False
             return result
         if self.jit is not None:
             h, h_ff, operators = self.jit.evaluate(

@@ -25,13 +25,46 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from solvers.classical.errors import BackendUnavailableError
+
 IntArray = npt.NDArray[np.int64]
 FloatArray = npt.NDArray[np.float64]
 
 
+_broken: list[str] = []  # why compiled code failed in this process, if it did
+
+
 def available() -> bool:
-    """Whether numba is installed (the engine can then be built)."""
-    return importlib.util.find_spec("numba") is not None
+    """Whether numba is installed and its code has not failed in this process."""
+    return not _broken and importlib.util.find_spec("numba") is not None
+
+
+def why_unavailable() -> str:
+    """Why :func:`available` is False (for an error message)."""
+    if _broken:
+        return f"numba failed in this process ({_broken[0]})"
+    return "numba is not installed: pip install numba"
+
+
+def _unavailable(what: str, error: Exception) -> CompiledCodeUnavailable:
+    _broken.append(f"{what}: {error}")
+    return CompiledCodeUnavailable(f"numba cannot run {what}: {error}")
+
+
+class CompiledCodeUnavailable(BackendUnavailableError):
+    """numba is installed but its code cannot be loaded or compiled here (a search that
+    switches to compiled code mid-way goes on with the Python engines instead)."""
+
+
+def _compile(function: Any) -> Any:
+    try:
+        import numba  # a heavy import: only for tasks that use this engine
+
+        return numba.njit(cache=True, nogil=True)(function)
+    except Exception as error:  # a broken numba or llvmlite install, an unsupported platform
+        raise CompiledCodeUnavailable(
+            f"numba cannot compile {function.__name__}: {error}"
+        ) from error
 
 
 def _evaluate(
@@ -336,9 +369,7 @@ def _evaluate(
 @lru_cache(maxsize=1)
 def _kernel() -> Any:
     """:func:`_evaluate` compiled (or loaded from numba's cache) on first use."""
-    import numba  # a heavy import: only for tasks that use this engine
-
-    return numba.njit(cache=True, nogil=True)(_evaluate)
+    return _compile(_evaluate)
 
 
 def _rows(rows: list[tuple[int, ...]]) -> tuple[IntArray, IntArray]:
@@ -398,6 +429,10 @@ class JitRelaxed:
             np.asarray(op_cost, dtype=np.float64),
         )
         self.kernel = _kernel()
+        try:  # compiles, or loads from numba's cache, now rather than in the first evaluation
+            self.evaluate(0, False, True)
+        except Exception as error:
+            raise _unavailable("the heuristic", error) from error
 
     def evaluate(
         self, state: int, use_max: bool, want_plan: bool
@@ -464,9 +499,7 @@ def _applicable(
 @lru_cache(maxsize=1)
 def _applicable_kernel() -> Any:
     """:func:`_applicable` compiled (or loaded from numba's cache) on first use."""
-    import numba  # a heavy import: only for tasks that use this engine
-
-    return numba.njit(cache=True, nogil=True)(_applicable)
+    return _compile(_applicable)
 
 
 class JitSuccessors:
@@ -503,6 +536,12 @@ class JitSuccessors:
             neg_flat,
         )
         self.kernel = _applicable_kernel()
+        try:  # compiles, or loads from numba's cache, now rather than in the search
+            self.applicable(0)
+        except Exception as error:
+            raise CompiledCodeUnavailable(
+                f"numba cannot run the successor walk: {error}"
+            ) from error
 
     def applicable(self, state: int) -> list[int]:
         raw = np.frombuffer(state.to_bytes(self.nbytes, "little"), dtype=np.uint8)

@@ -111,3 +111,39 @@ def test_exploration_needs_greedy_lazy_search(search: str, lazy: bool) -> None:
     task = load("blocksworld", "sussman")
     with pytest.raises(ParameterError, match="exploration needs greedy lazy search"):
         plan(task, search=search, lazy=lazy, exploration=True)
+
+
+@needs_numba
+def test_a_broken_numba_leaves_the_search_on_the_python_engines(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Compiled code that fails to load mid-search: a warning, then the same search in Python."""
+    from solvers.classical import jit
+
+    task = _gripper(100)
+    reference = plan(task, search="lazy-gbfs", heuristic="ff-lmcount")
+
+    def broken(*_args: object) -> object:
+        raise OSError("llvmlite: cannot load the shared library")
+
+    monkeypatch.setattr(jit, "_kernel", lambda: broken)
+    monkeypatch.setattr(jit, "_applicable_kernel", lambda: broken)
+    monkeypatch.setattr(jit, "_broken", [])
+    monkeypatch.setattr(heuristics, "JIT_AFTER_SECONDS", 0.0)
+    monkeypatch.setattr(compiled_module, "JIT_AFTER_CALLS", 3)
+    with caplog.at_level("WARNING"):
+        again = plan(task, search="lazy-gbfs", heuristic="ff-lmcount")
+    assert again.plan == reference.plan
+    assert again.statistics.expanded == reference.statistics.expanded
+    assert "numba cannot run the heuristic: llvmlite: cannot load" in caplog.text
+    assert "the search goes on without compiled code" in caplog.text
+    # the failure is remembered: later tasks do not try again, an explicit request is refused
+    assert not jit.available()
+    compiled = CompiledTask(ground(task))
+    assert RelaxedHeuristic(compiled, "ff", compiled.costs).jit_pending is False
+    with pytest.raises(
+        ParameterError,
+        match=r"engine 'numba' is unavailable: numba failed in this process "
+        r"\(the heuristic: llvmlite",
+    ):
+        RelaxedHeuristic(compiled, "ff", compiled.costs, engine="numba")

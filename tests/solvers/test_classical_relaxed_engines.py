@@ -244,7 +244,10 @@ def test_compiled_engine_dead_end_and_goal_states() -> None:
 def test_numba_engine_without_numba_is_an_error(monkeypatch: pytest.MonkeyPatch) -> None:
     compiled = CompiledTask(ground(load("blocksworld", "sussman")))
     monkeypatch.setattr(jit, "available", lambda: False)
-    with pytest.raises(ParameterError, match="engine 'numba' needs numba: pip install numba"):
+    with pytest.raises(
+        ParameterError,
+        match="engine 'numba' is unavailable: numba is not installed: pip install numba",
+    ):
         RelaxedHeuristic(compiled, "ff", compiled.costs, engine="numba")
     # "auto" falls back to the other engines
     task = _gripper(100)
