@@ -4,15 +4,17 @@ the successor generator's trie walk (the same operators in the same order, about
 
 The relaxed task is stored as flat arrays (compressed rows: the preconditions and adds of each
 unary relaxed operator, the relaxed operators of each precondition fact). One call of
-:func:`_evaluate` unpacks the state's bytes, runs the preconditions-left counter algorithm with a
-binary heap ordered by (cost, fact) like :meth:`RelaxedHeuristic._propagate`, and extracts the
-relaxed plan from the lowest-id best supporters, so it returns exactly what the queue-based
-engine returns in its canonical mode.
+:func:`_evaluate` unpacks the state's bytes, runs the preconditions-left counter algorithm as
+:class:`RelaxedHeuristic` does (whole-number costs: first-in first-out lists per cost, as
+``_propagate_buckets``; otherwise a binary heap ordered by (cost, fact), as ``_propagate``), and
+extracts the relaxed plan, with the first-found or (canonical) the lowest-id best supporters: it
+returns exactly what the queue-based engine returns in the same mode.
 
-numba is imported only when this engine is built (it is a dependency, but a platform without a
-numba wheel still plans with the other engines: :func:`available` says whether it loads). The
-machine code is cached beside this module (or in numba's user-wide cache where that folder is not
-writable), so only the first process compiles it (about 2 s).
+numba is imported only when this code is first needed (it is a dependency, but a platform
+without a numba wheel still plans with the other engines: :func:`available` says whether it
+loads; code that fails to load or compile is reported once and not tried again in the process).
+The machine code is cached beside this module (or in numba's user-wide cache where that folder
+is not writable), so only the first process compiles it (about 2 s).
 """
 
 from __future__ import annotations
@@ -62,9 +64,7 @@ def _compile(function: Any) -> Any:
 
         return numba.njit(cache=True, nogil=True)(function)
     except Exception as error:  # a broken numba or llvmlite install, an unsupported platform
-        raise CompiledCodeUnavailable(
-            f"numba cannot compile {function.__name__}: {error}"
-        ) from error
+        raise _unavailable(function.__name__, error) from error
 
 
 def _evaluate(

@@ -4,6 +4,7 @@ exploration queue of greedy lazy search."""
 from __future__ import annotations
 
 import random
+import sys
 
 import pytest
 from classical_helpers import load
@@ -147,3 +148,14 @@ def test_a_broken_numba_leaves_the_search_on_the_python_engines(
         r"\(the heuristic: llvmlite",
     ):
         RelaxedHeuristic(compiled, "ff", compiled.costs, engine="numba")
+
+
+def test_numba_that_cannot_be_imported_is_remembered(monkeypatch: pytest.MonkeyPatch) -> None:
+    from solvers.classical import jit
+
+    monkeypatch.setattr(jit, "_broken", [])
+    monkeypatch.setitem(sys.modules, "numba", None)  # import numba -> ImportError
+    with pytest.raises(jit.CompiledCodeUnavailable, match="numba cannot run _evaluate"):
+        jit._compile(jit._evaluate)
+    assert not jit.available()
+    assert "numba failed in this process (_evaluate:" in jit.why_unavailable()
