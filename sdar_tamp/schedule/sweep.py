@@ -78,7 +78,7 @@ class WorldSweep:
         self.held, self.exempt = {}, {}
         self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
         for e in before:
-            self.apply(e)
+            self.apply(e, check=False)
             self.exempt[e.event.arm] = (e.event.object, e.q_arm)
 
     def run(self, k0: int, q: FloatArray, events: Sequence[TimedEvent]) -> Conflict | None:
@@ -123,8 +123,9 @@ class WorldSweep:
     def allowed(self, p: CollisionPair) -> bool:
         return contact_allowed(p, self.exempt)
 
-    def apply(self, timed: TimedEvent) -> Conflict | None:
-        """Perform one event: a grasp of a resting object, a release onto a free spot."""
+    def apply(self, timed: TimedEvent, check: bool = True) -> Conflict | None:
+        """Perform one event: a grasp of a resting object, a release onto a free spot
+        (``check=False``: an event already known to be valid, whose spot is not tested again)."""
         e, tick = timed.event, timed.tick
         T_world_tcp = self.kins[e.arm].fk_tcp(timed.q_arm)
         if e.type == "grasp":
@@ -141,7 +142,7 @@ class WorldSweep:
         pose = (float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0]))
         size = np.array(self.sizes[e.object][:2])
         shrunk = corners(np.array([pose]), size - 2.0 * POS_TOL)
-        for other, p in self.rest.items():
+        for other, p in self.rest.items() if check else ():
             if overlap_matrix(shrunk, corners(np.array([p]), np.array(self.sizes[other][:2])))[
                 0, 0
             ]:

@@ -311,3 +311,29 @@ def test_a_schedule_the_replay_rejects_is_dropped(
     s = schedule_plan(uneven.plan, uneven.instance, scene)
     assert not s.asynchronous and s.plan is uneven.plan
     assert "replay rejects" in s.reason
+
+
+def test_replaying_known_events_skips_the_free_spot_test_a_new_release_takes(
+    uneven: Solved,
+) -> None:
+    """``reset`` replays events already placed (valid by construction) without testing their
+    landing spots again; a release checked in a stretch still has its spot tested."""
+    scene, plan = uneven.ctx.scene, uneven.plan
+    sweep = WorldSweep(uneven.instance, scene, ScheduleOptions().max_tcp_step)
+
+    def timed(event_index: int, q_from: int | None = None) -> TimedEvent:
+        e = plan.events[event_index]
+        k = int(np.searchsorted(plan.t, (plan.events[q_from] if q_from is not None else e).t))
+        return TimedEvent(k, e, scene.layout.part(plan.q[k], e.arm))
+
+    # left grasps o2, then "releases" it with its arm where it later grasps o0 (o0 rests there)
+    grasp = timed(0)
+    later = next(i for i, e in enumerate(plan.events) if e.arm == "left" and e.object == "o0")
+    onto_o0 = timed(2, q_from=later)
+    sweep.reset([])
+    assert sweep.apply(grasp) is None
+    conflict = sweep.apply(onto_o0)
+    assert conflict is not None and conflict.kind == "release"
+    assert "o2 released onto o0" in conflict.message
+    sweep.reset([grasp, onto_o0])  # no test: the world takes the events as given
+    assert "o2" in sweep.rest and "o2" not in {o for o, _ in sweep.held.values()}
