@@ -10,7 +10,8 @@ rule that a released object lands on a free spot. A stretch that passes here pas
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections import OrderedDict
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +29,9 @@ from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 #: Arrangements whose collision geometry the sweep keeps: placing a block replays the
 #: events before it again and again, so the same arrangements come back.
 SWEEP_GEOMETRIES = 16
+#: Arrangements whose collision answers the sweep remembers (by configuration): each placement
+#: attempt replays the same stretches, so about three checks in four repeat an earlier one.
+SWEEP_MEMOS = 32
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,6 +68,8 @@ class WorldSweep:
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
         self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
         self.checks = 0
+        self._memos: OrderedDict[Hashable, dict[bytes, bool]] = OrderedDict()
+        self._memo: dict[bytes, bool] | None = None  # the current arrangement's; None: unknown
 
     def box(self, name: str, pose: tuple[float, float, float]) -> ObjectBox:
         size = self.sizes[name]
@@ -76,6 +82,7 @@ class WorldSweep:
                 self.world.detach(arm)
         self.rest = dict(self.start)
         self.held, self.exempt = {}, {}
+        self._memo = None
         self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
         for e in before:
             self.apply(e, check=False)
@@ -113,12 +120,30 @@ class WorldSweep:
         for arm, (_, q_event) in list(self.exempt.items()):
             if np.abs(self.scene_layout.part(q, arm) - q_event).max() > STILL_TOL:
                 del self.exempt[arm]
-        if not self.world.in_collision(q):
+        if not self._in_collision(q):
             return None
         pairs = [p for p in self.world.report(q) if not self.allowed(p)]
         if not pairs:
             return None
         return Conflict(tick, "collision", ", ".join(f"{p.first} with {p.second}" for p in pairs))
+
+    def _in_collision(self, q: FloatArray) -> bool:
+        """``world.in_collision(q)``, remembered per arrangement and configuration."""
+        if self._memo is None:
+            key = self.world.arrangement_key()
+            memo = self._memos.get(key)
+            if memo is None:
+                memo = self._memos[key] = {}
+                if len(self._memos) > SWEEP_MEMOS:
+                    self._memos.popitem(last=False)
+            else:
+                self._memos.move_to_end(key)
+            self._memo = memo
+        k = np.ascontiguousarray(q, dtype=np.float64).tobytes()
+        hit = self._memo.get(k)
+        if hit is None:
+            hit = self._memo[k] = self.world.in_collision(q)
+        return hit
 
     def allowed(self, p: CollisionPair) -> bool:
         return contact_allowed(p, self.exempt)
@@ -134,6 +159,7 @@ class WorldSweep:
             T_obj = self.box(e.object, self.rest.pop(e.object)).T_world_obj
             self.held[e.arm] = (e.object, inverse(T_world_tcp) @ T_obj)
             self.world.attach(e.arm, e.object, timed.q_arm)
+            self._memo = None
             return None
         holding = self.held.get(e.arm)
         if holding is None or holding[0] != e.object:
@@ -151,4 +177,5 @@ class WorldSweep:
         self.world.detach(e.arm, timed.q_arm)
         self.world.set_object(e.object, self.box(e.object, pose))
         self.rest[e.object] = pose
+        self._memo = None
         return None

@@ -219,7 +219,7 @@ class CollisionWorld:
 
     def _scene_geometry(self) -> cm.SceneGeometry:
         if self._geometry is None:
-            key = self._arrangement_key()
+            key = self.arrangement_key()
             cached = self._built.get(key)
             if cached is not None:
                 self._built.move_to_end(key)
@@ -237,9 +237,10 @@ class CollisionWorld:
                     self._built.popitem(last=False)
         return self._geometry
 
-    def _arrangement_key(self) -> Hashable:
+    def arrangement_key(self) -> Hashable:
         """What the geometry is built from, exactly: the resting boxes in order, and each
-        arm's held object with its pose in the tool frame."""
+        arm's held object with its pose in the tool frame. Two worlds with equal keys (and
+        the same scene and margins) give the same answer to every query at every ``q``."""
         resting = tuple(
             (n, b.T_world_obj.tobytes(), tuple(b.size)) for n, b in self._resting.items()
         )

@@ -337,3 +337,35 @@ def test_replaying_known_events_skips_the_free_spot_test_a_new_release_takes(
     assert "o2 released onto o0" in conflict.message
     sweep.reset([grasp, onto_o0])  # no test: the world takes the events as given
     assert "o2" in sweep.rest and "o2" not in {o for o, _ in sweep.held.values()}
+
+
+def test_the_sweep_remembers_collision_answers_per_arrangement(
+    uneven: Solved, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A configuration checked again in the same arrangement is not checked again; after an
+    event changes the arrangement it is, and a reset to an earlier arrangement reuses that
+    arrangement's answers."""
+    scene, plan = uneven.ctx.scene, uneven.plan
+    sweep = WorldSweep(uneven.instance, scene, ScheduleOptions().max_tcp_step)
+    asked: list[bytes] = []
+    real = sweep.world.in_collision
+
+    def counting(q: FloatArray | None = None) -> bool:
+        asked.append(np.asarray(q).tobytes())
+        return real(q)
+
+    monkeypatch.setattr(sweep.world, "in_collision", counting)
+    e = plan.events[0]
+    k = int(np.searchsorted(plan.t, e.t))
+    grasp = TimedEvent(k, e, scene.layout.part(plan.q[k], e.arm))
+    q = plan.q[k - 10]
+    sweep.reset([])
+    first = sweep.collide(q, 0)
+    sweep.collide(q, 0)
+    assert len(asked) == 1 and sweep.checks == 2  # the second answer from memory, still counted
+    assert sweep.apply(grasp) is None  # o2 now held: another arrangement
+    sweep.collide(q, 0)
+    assert len(asked) == 2
+    sweep.reset([])  # back to the first arrangement: its answers are remembered
+    assert sweep.collide(q, 0) == first
+    assert len(asked) == 2
