@@ -20,6 +20,7 @@ is not writable), so only the first process compiles it (about 2 s).
 from __future__ import annotations
 
 import importlib.util
+from collections import deque
 from functools import lru_cache
 from math import inf
 from typing import Any
@@ -511,9 +512,9 @@ class JitSuccessors:
 
     def __init__(self, trie: Any, negative: list[tuple[int, ...]], facts: int) -> None:
         nodes: list[Any] = []
-        order = [trie]
+        order = deque([trie])
         while order:  # breadth first: node ids in the order they are listed
-            node = order.pop(0)
+            node = order.popleft()
             nodes.append(node)
             order.extend(child for _bit, child in node[1])
         ids = {id(node): i for i, node in enumerate(nodes)}
