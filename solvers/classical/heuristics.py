@@ -137,7 +137,9 @@ class RelaxedHeuristic:
         )
 
     def use_compiled(self) -> None:
-        """Evaluate with the compiled engine from now on (numba must be installed)."""
+        """Evaluate with the compiled engine from now on (numba must be installed). It settles
+        facts from a heap: first-found supporters then follow the heap's order."""
+        self.heap_order = True
         self.jit = jit.JitRelaxed(
             self.count,
             self.upre,
@@ -148,7 +150,6 @@ class RelaxedHeuristic:
             self.goal,
             list(self.costs),
             canonical=self.canonical,
-            fifo=self.integral and not self.heap_order,
         )
         self.jit_pending = False
 

@@ -4,11 +4,11 @@ the successor generator's trie walk (the same operators in the same order, about
 
 The relaxed task is stored as flat arrays (compressed rows: the preconditions and adds of each
 unary relaxed operator, the relaxed operators of each precondition fact). One call of
-:func:`_evaluate` unpacks the state's bytes, runs the preconditions-left counter algorithm as
-:class:`RelaxedHeuristic` does (whole-number costs: first-in first-out lists per cost, as
-``_propagate_buckets``; otherwise a binary heap ordered by (cost, fact), as ``_propagate``), and
+:func:`_evaluate` unpacks the state's bytes, runs the preconditions-left counter algorithm with
+a binary heap ordered by (cost, fact), as :meth:`RelaxedHeuristic._propagate` does, and
 extracts the relaxed plan, with the first-found or (canonical) the lowest-id best supporters: it
-returns exactly what the queue-based engine returns in the same mode.
+returns exactly what the queue-based engine returns from its heap in the same mode (in
+canonical mode the queue's order does not matter, so its bucket lists give the same too).
 
 numba is imported only when this code is first needed (it is a dependency, but a platform
 without a numba wheel still plans with the other engines: :func:`available` says whether it
@@ -86,7 +86,6 @@ def _evaluate(
     is_goal: npt.NDArray[np.bool_],
     op_cost: FloatArray,
     canonical: bool,
-    fifo: bool,
 ) -> tuple[float, float, IntArray]:
     units = ucost.shape[0]
     cost = np.full(count, np.inf)
@@ -133,191 +132,98 @@ def _evaluate(
                 fired[n_fired] = u
                 n_fired += 1
     capacity = eff_flat.shape[0] + count + 1
-    if fifo:
-        # whole-number costs, as RelaxedHeuristic._propagate_buckets: one first-in first-out
-        # list per cost (head, tail, link), read in order of cost, entries appended to the list
-        # being read (zero-cost operators) read in the same pass
-        n_buckets = 32
-        head = np.full(n_buckets, -1, dtype=np.int64)
-        tail = np.full(n_buckets, -1, dtype=np.int64)
-        link = np.empty(capacity, dtype=np.int64)
-        entry_fact = np.empty(capacity, dtype=np.int64)
-        n_entries = 0
-        for i in range(n_fired):
-            u = fired[i]
-            value = acc[u]
-            for k in range(eff_start[u], eff_start[u + 1]):
-                g = eff_flat[k]
-                if value < cost[g]:
-                    cost[g] = value
-                    supporter[g] = u
-                    iv = int(value)
-                    if iv >= n_buckets:
-                        size = max(2 * n_buckets, iv + 1)
-                        grown = np.full(size, -1, dtype=np.int64)
-                        grown[:n_buckets] = head
-                        head = grown
-                        grown = np.full(size, -1, dtype=np.int64)
-                        grown[:n_buckets] = tail
-                        tail = grown
-                        n_buckets = size
-                    entry_fact[n_entries] = g
-                    link[n_entries] = -1
-                    if tail[iv] < 0:
-                        head[iv] = n_entries
-                    else:
-                        link[tail[iv]] = n_entries
-                    tail[iv] = n_entries
-                    n_entries += 1
-                elif canonical and value == cost[g] and u < supporter[g]:
-                    supporter[g] = u
-        current = 0
-        done = False
-        while current < n_buckets and not done:
-            entry = head[current]
-            value = float(current)
-            while entry >= 0:
-                fact = entry_fact[entry]
-                entry = link[entry]
-                if cost[fact] != value:
-                    continue
-                if is_goal[fact]:
-                    goals_left -= 1
-                    if goals_left == 0 and not canonical:
-                        done = True
+    heap_value = np.empty(capacity, dtype=np.float64)
+    heap_fact = np.empty(capacity, dtype=np.int64)
+    size = 0
+    for i in range(n_fired):
+        u = fired[i]
+        value = acc[u] + ucost[u] if use_max else acc[u]
+        for k in range(eff_start[u], eff_start[u + 1]):
+            g = eff_flat[k]
+            if value < cost[g]:
+                cost[g] = value
+                supporter[g] = u
+                # push (value, g)
+                j = size
+                size += 1
+                while j > 0:
+                    parent = (j - 1) >> 1
+                    pv = heap_value[parent]
+                    if pv < value or (pv == value and heap_fact[parent] <= g):
                         break
-                for k in range(of_start[fact], of_start[fact + 1]):
-                    u = of_flat[k]
-                    acc[u] += value
-                    left[u] -= 1
-                    if left[u] == 0:
-                        new = acc[u]
-                        for e in range(eff_start[u], eff_start[u + 1]):
-                            g = eff_flat[e]
-                            if new < cost[g]:
-                                cost[g] = new
-                                supporter[g] = u
-                                iv = int(new)
-                                if iv >= n_buckets:
-                                    size = max(2 * n_buckets, iv + 1)
-                                    grown = np.full(size, -1, dtype=np.int64)
-                                    grown[:n_buckets] = head
-                                    head = grown
-                                    grown = np.full(size, -1, dtype=np.int64)
-                                    grown[:n_buckets] = tail
-                                    tail = grown
-                                    n_buckets = size
-                                entry_fact[n_entries] = g
-                                link[n_entries] = -1
-                                if tail[iv] < 0:
-                                    head[iv] = n_entries
-                                else:
-                                    link[tail[iv]] = n_entries
-                                tail[iv] = n_entries
-                                if entry < 0 and iv == current:
-                                    entry = n_entries  # appended to the list being read
-                                n_entries += 1
-                            elif canonical and new == cost[g] and u < supporter[g]:
-                                supporter[g] = u
+                    heap_value[j] = pv
+                    heap_fact[j] = heap_fact[parent]
+                    j = parent
+                heap_value[j] = value
+                heap_fact[j] = g
+            elif canonical and value == cost[g] and u < supporter[g]:
+                supporter[g] = u
+    limit = np.inf
+    while size > 0:
+        value = heap_value[0]
+        fact = heap_fact[0]
+        # pop: move the last entry down from the root
+        size -= 1
+        last_value = heap_value[size]
+        last_fact = heap_fact[size]
+        j = 0
+        while True:
+            child = 2 * j + 1
+            if child >= size:
+                break
+            right = child + 1
+            if right < size and (
+                heap_value[right] < heap_value[child]
+                or (heap_value[right] == heap_value[child] and heap_fact[right] < heap_fact[child])
+            ):
+                child = right
+            cv = heap_value[child]
+            if last_value < cv or (last_value == cv and last_fact <= heap_fact[child]):
+                break
+            heap_value[j] = cv
+            heap_fact[j] = heap_fact[child]
+            j = child
+        heap_value[j] = last_value
+        heap_fact[j] = last_fact
+        if value > cost[fact]:
+            continue
+        if value > limit:
+            break
+        if is_goal[fact]:
+            goals_left -= 1
             if goals_left == 0:
-                break
-            current += 1
-    else:
-        heap_value = np.empty(capacity, dtype=np.float64)
-        heap_fact = np.empty(capacity, dtype=np.int64)
-        size = 0
-        for i in range(n_fired):
-            u = fired[i]
-            value = acc[u] + ucost[u] if use_max else acc[u]
-            for k in range(eff_start[u], eff_start[u + 1]):
-                g = eff_flat[k]
-                if value < cost[g]:
-                    cost[g] = value
-                    supporter[g] = u
-                    # push (value, g)
-                    j = size
-                    size += 1
-                    while j > 0:
-                        parent = (j - 1) >> 1
-                        pv = heap_value[parent]
-                        if pv < value or (pv == value and heap_fact[parent] <= g):
-                            break
-                        heap_value[j] = pv
-                        heap_fact[j] = heap_fact[parent]
-                        j = parent
-                    heap_value[j] = value
-                    heap_fact[j] = g
-                elif canonical and value == cost[g] and u < supporter[g]:
-                    supporter[g] = u
-        limit = np.inf
-        while size > 0:
-            value = heap_value[0]
-            fact = heap_fact[0]
-            # pop: move the last entry down from the root
-            size -= 1
-            last_value = heap_value[size]
-            last_fact = heap_fact[size]
-            j = 0
-            while True:
-                child = 2 * j + 1
-                if child >= size:
+                if not canonical:
                     break
-                right = child + 1
-                if right < size and (
-                    heap_value[right] < heap_value[child]
-                    or (
-                        heap_value[right] == heap_value[child]
-                        and heap_fact[right] < heap_fact[child]
-                    )
-                ):
-                    child = right
-                cv = heap_value[child]
-                if last_value < cv or (last_value == cv and last_fact <= heap_fact[child]):
-                    break
-                heap_value[j] = cv
-                heap_fact[j] = heap_fact[child]
-                j = child
-            heap_value[j] = last_value
-            heap_fact[j] = last_fact
-            if value > cost[fact]:
-                continue
-            if value > limit:
-                break
-            if is_goal[fact]:
-                goals_left -= 1
-                if goals_left == 0:
-                    if not canonical:
-                        break
-                    limit = value
-            for k in range(of_start[fact], of_start[fact + 1]):
-                u = of_flat[k]
-                if use_max:
-                    if value > acc[u]:
-                        acc[u] = value
-                else:
-                    acc[u] += value
-                left[u] -= 1
-                if left[u] == 0:
-                    new = acc[u] + ucost[u] if use_max else acc[u]
-                    for e in range(eff_start[u], eff_start[u + 1]):
-                        g = eff_flat[e]
-                        if new < cost[g]:
-                            cost[g] = new
-                            supporter[g] = u
-                            j = size
-                            size += 1
-                            while j > 0:
-                                parent = (j - 1) >> 1
-                                pv = heap_value[parent]
-                                if pv < new or (pv == new and heap_fact[parent] <= g):
-                                    break
-                                heap_value[j] = pv
-                                heap_fact[j] = heap_fact[parent]
-                                j = parent
-                            heap_value[j] = new
-                            heap_fact[j] = g
-                        elif canonical and new == cost[g] and u < supporter[g]:
-                            supporter[g] = u
+                limit = value
+        for k in range(of_start[fact], of_start[fact + 1]):
+            u = of_flat[k]
+            if use_max:
+                if value > acc[u]:
+                    acc[u] = value
+            else:
+                acc[u] += value
+            left[u] -= 1
+            if left[u] == 0:
+                new = acc[u] + ucost[u] if use_max else acc[u]
+                for e in range(eff_start[u], eff_start[u + 1]):
+                    g = eff_flat[e]
+                    if new < cost[g]:
+                        cost[g] = new
+                        supporter[g] = u
+                        j = size
+                        size += 1
+                        while j > 0:
+                            parent = (j - 1) >> 1
+                            pv = heap_value[parent]
+                            if pv < new or (pv == new and heap_fact[parent] <= g):
+                                break
+                            heap_value[j] = pv
+                            heap_fact[j] = heap_fact[parent]
+                            j = parent
+                        heap_value[j] = new
+                        heap_fact[j] = g
+                    elif canonical and new == cost[g] and u < supporter[g]:
+                        supporter[g] = u
     # the goal value: sum (h_add) or max (h_max) of the goal costs
     h = 0.0
     for i in range(goal.shape[0]):
@@ -385,9 +291,7 @@ class JitRelaxed:
     """The relaxed task as arrays and the compiled evaluator over it.
 
     ``canonical``: best supporters of lowest relaxed-operator id among those of least cost (else
-    the first found, as the queue-based engine's exploration order finds it). ``fifo``: the
-    costs are whole numbers, read from first-in first-out lists per cost (as the queue-based
-    engine reads them; h_add only), else from the binary heap.
+    the first found, as the queue-based engine's heap finds it).
     ``evaluate(state, use_max, want_plan)`` returns ``(h, h_ff, relaxed-plan operators)``: ``h``
     is h_add (or h_max with ``use_max``), ``inf`` at a dead end; ``h_ff`` and the operators are
     only computed with ``want_plan`` (else 0 and empty).
@@ -404,11 +308,9 @@ class JitRelaxed:
         goal: list[int],
         op_cost: list[float],
         canonical: bool = True,
-        fifo: bool = False,
     ) -> None:
         self.count = count
         self.canonical = canonical
-        self.fifo = fifo
         self.nbytes = count // 8 + 1
         pre_start, pre_flat = _rows(upre)
         eff_start, eff_flat = _rows(ueff)
@@ -446,7 +348,6 @@ class JitRelaxed:
             want_plan,
             *self.arrays,
             self.canonical,
-            self.fifo and not use_max,
         )
         if h == inf:
             return inf, inf, []
