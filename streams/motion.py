@@ -273,30 +273,24 @@ class DualMotionPlanner:
         and its timed curve passes the same check in ``margin_world``."""
         if not self.refine_bent or len(direct) < 3:
             return direct
-        q_a, q_b = direct[0], direct[-1]
-        still = self._still(q_a, q_b)
-        fixed = tuple(_flag(fixed, i) or still[i] for i in range(len(still)))
-        K = self._build.options.knots
-        dense = spline_curve(direct, 4 * K)
-        warm = dense[np.round(np.linspace(0.0, 1.0, K) * (4 * K - 1)).astype(int)]
-        query = TransferQuery(
-            q_a, q_b, problem.held, problem.obstacles, self.nominal_duration(q_a, q_b), fixed
-        )
-        result = self.trajopt.solve(query, warm)
-        self.optimisation_time += result.solve_time
-        self.ipopt_solves += int(result.rounds > 0)
-        if not result.success or result.path is None:
+        path = self.optimise(problem, direct[0], direct[-1], self.warm_start_along(direct), fixed)
+        if path is None:
             return direct
         v, a = self.limits
-        if (
-            time_parameterize(result.path, v, a).duration
-            >= time_parameterize(direct, v, a).duration
-        ):
+        if time_parameterize(path, v, a).duration >= time_parameterize(direct, v, a).duration:
             return direct
-        curve = spline_curve(result.path, max(DIRECT_SAMPLES, 2 * len(result.path)))
+        curve = spline_curve(path, max(DIRECT_SAMPLES, 2 * len(path)))
         if not validate_trajectory(self.ctx, self.margin_world, curve).ok:
             return direct
-        return result.path
+        return path
+
+    def warm_start_along(self, waypoints: FloatArray) -> FloatArray:
+        """The optimiser's knots ``(K, dof)``, evenly spaced along the curve the time
+        parameterisation follows through ``waypoints``."""
+        K = self._build.options.knots
+        dense = spline_curve(waypoints, 4 * K)
+        picked: FloatArray = dense[np.round(np.linspace(0.0, 1.0, K) * (4 * K - 1)).astype(int)]
+        return picked
 
     def _still(self, q_a: FloatArray, q_b: FloatArray) -> list[bool]:
         """Per arm: its joints are the same at ``q_a`` and ``q_b``."""

@@ -235,9 +235,7 @@ class SampledStrategy:
         if W is None:
             return None
         if self.refine:
-            K = planner.build.options.knots
-            s = np.linspace(0.0, 1.0, K)
-            warm = spline_curve(W, 4 * K)[np.round(s * (4 * K - 1)).astype(int)]
+            warm = planner.warm_start_along(W)
             refined = planner.optimise(problem, problem.q_from, problem.q_to, warm)
             if (
                 refined is not None
