@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
 
@@ -108,6 +108,7 @@ def parse_typed_list(
     types: frozenset[str] | None,
     variables: bool,
     repeats: list[tuple[str, SourceLocation]] | None = None,
+    either: Callable[[tuple[str, ...]], str] | None = None,
 ) -> list[tuple[str, str, Symbol]]:
     """Parse ``a b - t c`` into ``[(a, t), (b, t), (c, object)]``, each with its name's token
     (``token.location`` says where it is: worked out only when asked for).
@@ -115,6 +116,8 @@ def parse_typed_list(
     ``types`` None means the caller does not check types (type declarations themselves).
     ``variables`` requires every name to start with ``?``; otherwise none may. A name that
     appears twice is an error, unless ``repeats`` is given: then it is kept and noted there.
+    ``either`` maps the member types of ``(either t1 t2 ...)`` to the type to use for them;
+    without it such a type is an error.
     """
     result: list[tuple[str, str, Symbol]] = []
     pending: list[Symbol] = []
@@ -128,15 +131,14 @@ def parse_typed_list(
             if index + 1 >= count:
                 raise PddlSyntaxError(f"expected a type name after '-' in {what}", token.location)
             type_node = items[index + 1]
-            if isinstance(type_node, SList):
-                raise UnsupportedFeatureError(
-                    "'(either ...)' types are not supported: declare a common supertype",
-                    type_node.location,
-                )
             if not pending:
                 raise PddlSyntaxError(f"expected a name before '-' in {what}", token.location)
-            check_type(type_node, types)
-            result.extend((name.text, type_node.text, name) for name in pending)
+            if isinstance(type_node, SList):
+                type_name = _either_type(type_node, what, types, either)
+            else:
+                check_type(type_node, types)
+                type_name = type_node.text
+            result.extend((name.text, type_name, name) for name in pending)
             pending = []
             index += 2
             continue
@@ -178,6 +180,32 @@ def parse_number(token: Symbol, what: str) -> float:
             token.location,
         )
     return value
+
+
+def _either_type(
+    node: SList,
+    what: str,
+    types: frozenset[str] | None,
+    either: Callable[[tuple[str, ...]], str] | None,
+) -> str:
+    """The type standing for ``(either t1 t2 ...)`` in ``what`` (see :func:`parse_typed_list`)."""
+    head = node.items[0] if node.items else None
+    if not (isinstance(head, Symbol) and head.text == "either") or len(node.items) < 2:
+        raise PddlSyntaxError(
+            f"expected a type name or '(either TYPE ...)' in {what}", node.location
+        )
+    if either is None:
+        raise UnsupportedFeatureError(
+            f"'(either ...)' types are supported in predicate and function declarations, not "
+            f"in {what}: declare a common supertype",
+            node.location,
+        )
+    members = []
+    for item in node.items[1:]:
+        member = expect_symbol(item, "a type name in '(either ...)'")
+        check_type(member, types)
+        members.append(member.text)
+    return either(tuple(members))
 
 
 def check_type(node: Symbol, types: frozenset[str] | None) -> None:

@@ -13,6 +13,10 @@ logged), and reject it only with ``strict=True`` (:class:`StrictModeError`). The
     declared with the arity of its first use (a later use with another arity is still an error).
 ``duplicate-predicate``
     a predicate declared twice with the same arity (the first declaration is kept).
+``duplicate-type``
+    a type declared twice in ``:types``, with the same parent or once under ``object`` (IPC's
+    storage domain: ``area - object`` and ``area - surface``); the more specific parent is kept
+    (two different parents other than ``object`` are still an error).
 ``undeclared-parent-type``
     ``(:types a - b)`` where ``b`` is never declared: ``b`` becomes a subtype of ``object``.
 ``free-variable``
@@ -42,6 +46,7 @@ GLUED_VARIABLE = "glued-variable"
 REPEATED_VARIABLE = "repeated-variable"
 IMPLICIT_PREDICATE = "implicit-predicate"
 DUPLICATE_PREDICATE = "duplicate-predicate"
+DUPLICATE_TYPE = "duplicate-type"
 UNDECLARED_PARENT_TYPE = "undeclared-parent-type"
 INIT_TYPE = "init-type"
 FREE_VARIABLE = "free-variable"
@@ -51,6 +56,7 @@ KINDS = (
     REPEATED_VARIABLE,
     IMPLICIT_PREDICATE,
     DUPLICATE_PREDICATE,
+    DUPLICATE_TYPE,
     UNDECLARED_PARENT_TYPE,
     INIT_TYPE,
     FREE_VARIABLE,

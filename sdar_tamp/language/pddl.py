@@ -35,6 +35,7 @@ from sdar_tamp.language.grammar import (
 )
 from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
+    DUPLICATE_TYPE,
     FREE_VARIABLE,
     IMPLICIT_PREDICATE,
     INIT_TYPE,
@@ -156,7 +157,9 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
                 constants[const] = type_name
         elif keyword == ":predicates":
             for node in body:
-                predicate = _declaration(node, reader, "a predicate declaration", log)
+                predicate = _declaration(
+                    node, reader, "a predicate declaration", log, parents=parents
+                )
                 if predicate.name in vocabulary.types:
                     raise DuplicateError(
                         f"predicate {predicate.name!r} has the name of a type", node.location
@@ -179,7 +182,7 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
                 predicates[predicate.name] = predicate
                 vocabulary.predicates[predicate.name] = predicate.arity
         elif keyword == ":functions":
-            _declare_functions(body, reader, functions)
+            _declare_functions(body, reader, functions, parents)
         else:
             pending.append((keyword, section))
     vocabulary.derived = frozenset(
@@ -221,11 +224,26 @@ def _derived_name(section: SList) -> str:
 
 
 def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str], log: LeniencyLog) -> None:
-    for child, parent, token in parse_typed_list(body, "the types", None, variables=False):
+    repeats: list[tuple[str, SourceLocation]] = []
+    declared = parse_typed_list(body, "the types", None, variables=False, repeats=repeats)
+    for child, parent, token in declared:
         if child == OBJECT_TYPE:
             continue
-        if child in parents:
-            raise DuplicateError(f"type {child!r} is declared twice", token.location)
+        earlier = parents.get(child)
+        if earlier is not None and OBJECT_TYPE not in (earlier, parent) and earlier != parent:
+            raise DuplicateError(
+                f"type {child!r} is declared twice, as a subtype of {earlier!r} and of "
+                f"{parent!r}",
+                token.location,
+            )
+        if earlier is not None:
+            kept = earlier if parent == OBJECT_TYPE else parent
+            log.add(
+                DUPLICATE_TYPE,
+                f"type {child!r} is declared twice; kept as a subtype of {kept!r}",
+                token.location,
+            )
+            parent = kept
         parents[child] = parent
     noted: set[str] = set()
     for dash, node in itertools.pairwise(body):
@@ -258,10 +276,24 @@ def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str], log: Lenien
             parent = parents[parent]
 
 
+def common_supertype(members: tuple[str, ...], parents: Mapping[str, str]) -> str:
+    """The most specific type that every one of ``members`` is a subtype of (given the
+    ``parents`` of the declared types)."""
+    chains = [TypeHierarchy(parents).ancestors(member) for member in members]
+    return next(t for t in chains[0] if all(t in chain for chain in chains[1:]))
+
+
 def _declaration(
-    node: SExpr, reader: FormulaReader, what: str, log: LeniencyLog | None = None
+    node: SExpr,
+    reader: FormulaReader,
+    what: str,
+    log: LeniencyLog | None = None,
+    parents: Mapping[str, str] | None = None,
 ) -> Predicate:
-    """``(name ?a - t ?b)``; with ``log``, a repeated variable name is noted, not an error."""
+    """``(name ?a - t ?b)``; with ``log``, a repeated variable name is noted, not an error.
+    With ``parents`` (predicate and function declarations, whose types only describe the
+    arguments), ``?a - (either t1 t2)`` is read as the most specific common supertype of its
+    members."""
     lst = expect_list(node, what)
     head = expect_symbol(lst.items[0] if lst.items else lst, "a name")
     repeats: list[tuple[str, SourceLocation]] = []
@@ -271,6 +303,7 @@ def _declaration(
         reader.vocabulary.types,
         variables=True,
         repeats=repeats if log is not None else None,
+        either=None if parents is None else (lambda members: common_supertype(members, parents)),
     )
     if log is not None:
         for variable, location in repeats:
@@ -283,7 +316,10 @@ def _declaration(
 
 
 def _declare_functions(
-    body: tuple[SExpr, ...], reader: FormulaReader, functions: dict[str, Function]
+    body: tuple[SExpr, ...],
+    reader: FormulaReader,
+    functions: dict[str, Function],
+    parents: Mapping[str, str],
 ) -> None:
     index = 0
     while index < len(body):
@@ -291,7 +327,7 @@ def _declare_functions(
         if isinstance(node, Symbol) and node.text == "-":
             index += 2  # "- number": the only function type
             continue
-        declaration = _declaration(node, reader, "a function declaration")
+        declaration = _declaration(node, reader, "a function declaration", parents=parents)
         functions[declaration.name] = Function(declaration.name, declaration.parameters)
         reader.vocabulary.functions[declaration.name] = declaration.arity
         index += 1

@@ -140,9 +140,29 @@ def test_negative_action_cost() -> None:
     assert "non-negative" in str(error)
 
 
-def test_either_type_is_refused() -> None:
+def test_either_type_is_refused_in_action_parameters() -> None:
     error = domain_error(" (:action a :parameters (?x - (either block)) :effect (clear ?x))")
     assert isinstance(error, UnsupportedFeatureError)
+    assert "d.pddl:3:31" in str(error) and "not in the parameters of action 'a'" in str(error)
+
+
+def test_either_type_with_an_undeclared_member() -> None:
+    text = BASE + " (:predicates (on ?x - (either block ghost)))\n)"
+    with pytest.raises(UndeclaredError, match=r"d\.pddl:2:38: undeclared type 'ghost'"):
+        parse_domain(text, "d.pddl")
+
+
+def test_either_type_without_members() -> None:
+    text = BASE + " (:predicates (on ?x - (either)))\n)"
+    with pytest.raises(PddlSyntaxError, match=r"d\.pddl:2:24: expected a type name or"):
+        parse_domain(text, "d.pddl")
+
+
+def test_type_declared_under_two_parents() -> None:
+    text = "(define (domain d) (:types a b - object c - a\n c - b))"
+    with pytest.raises(DuplicateError, match=r"d\.pddl:2:2: type 'c' is declared twice, as a "
+                       "subtype of 'a' and of 'b'"):  # fmt: skip
+        parse_domain(text, "d.pddl")
 
 
 def test_problem_for_another_domain() -> None:

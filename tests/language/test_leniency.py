@@ -20,6 +20,7 @@ from sdar_tamp.language import (
 from sdar_tamp.language.errors import UnboundVariableError
 from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
+    DUPLICATE_TYPE,
     FREE_VARIABLE,
     GLUED_VARIABLE,
     IMPLICIT_PREDICATE,
@@ -163,6 +164,46 @@ def test_repeated_variable_in_a_predicate_declaration() -> None:
 def test_repeated_action_parameter_is_still_an_error() -> None:
     with pytest.raises(DuplicateError, match="appears twice"):
         parse_domain("(define (domain u) (:action a :parameters (?x ?x) :effect (and)))")
+
+
+STORAGE_TYPES = """(define (domain s) (:requirements :typing)
+ (:types hoist surface place area - object
+  container depot - place
+  storearea transitarea - area
+  area crate - surface)
+ (:predicates (in ?x - (either storearea crate) ?p - place) (at ?h - hoist ?a - area)))
+"""
+
+
+def test_type_declared_twice_keeps_the_specific_parent() -> None:
+    domain = parse_domain(STORAGE_TYPES, "s.pddl")
+    assert domain.types.parents["area"] == "surface"
+    assert domain.types.is_subtype("storearea", "surface")
+    assert [(i.kind, str(i.location)) for i in domain.leniencies] == [
+        (DUPLICATE_TYPE, "s.pddl:5:3")
+    ]
+    with pytest.raises(StrictModeError, match=r"s\.pddl:5:3: type 'area' is declared twice"):
+        parse_domain(STORAGE_TYPES, "s.pddl", strict=True)
+    again = parse_domain("(define (domain u) (:types a - b a - b b))", "u.pddl")
+    assert again.types.parents["a"] == "b"
+    assert [i.kind for i in again.leniencies] == [DUPLICATE_TYPE]
+
+
+def test_either_type_in_a_predicate_declaration_reads_as_the_common_supertype() -> None:
+    domain = parse_domain(STORAGE_TYPES, "s.pddl")
+    assert [p.type for p in domain.predicates["in"].parameters] == ["surface", "place"]
+    text = STORAGE_TYPES.replace("(either storearea crate)", "(either storearea hoist)")
+    assert parse_domain(text).predicates["in"].parameters[0].type == "object"
+    text = STORAGE_TYPES.replace("(either storearea crate)", "(either storearea transitarea)")
+    assert parse_domain(text).predicates["in"].parameters[0].type == "area"
+    parsed = parse_problem(
+        "(define (problem p) (:domain s) (:objects s1 - storearea c1 - crate d - depot)"
+        " (:init (in s1 d) (in c1 d)) (:goal (in c1 d)))",
+        domain,
+        "p.pddl",
+        strict=True,
+    )
+    assert parsed.leniencies == ()
 
 
 def test_predicate_declared_twice_with_the_same_arity() -> None:
