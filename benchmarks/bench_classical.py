@@ -10,10 +10,12 @@ problem solved in 0.3 s mostly measures start-up). Planners:
 - ``fd``: Fast Downward's ``lama-first`` (``pip install sdar-tamp[fd]``; skipped if missing)
 - ``pyperplan``: GBFS + h_FF (``pip install pyperplan``; skipped if missing)
 
-Problems: ``--suite DIR`` with one folder per domain holding ``domain.pddl`` and problem files
-(the layout of the IPC benchmark collections; no network is used), else seeded blocksworld
+Problems: ``--suite DIR`` with one folder per domain holding ``domain.pddl`` (or one domain file
+per problem, see :func:`domain_file`) and problem files (the layout of the IPC benchmark
+collections; no network is used), else seeded blocksworld
 problems and the shipped teaching problems. Every plan is checked by VAL (``pip install
-sdar-tamp[val]``); without it, by this package's own validator (reported as such). Prints a
+sdar-tamp[val]``); without it, or where VAL cannot read the domain, by this package's own
+validator (reported as such). Prints a
 coverage table per domain, geometric-mean time ratios, then one JSON line.
 
     python benchmarks/bench_classical.py --suite /path/to/ipc [--time-limit 60] [--planners ...]
@@ -166,8 +168,14 @@ def _val_binary() -> Path | None:
     return binary if binary.is_file() else None
 
 
-def validate(domain: Path, problem: Path, plan_file: Path) -> bool:
-    """VAL's verdict on a plan file; this package's validator when VAL is not installed."""
+#: What VAL prints when it cannot read the domain or the problem (no verdict on the plan).
+VAL_UNREADABLE = ("Problem in domain definition", "Problem in problem definition")
+
+
+def validate(domain: Path, problem: Path, plan_file: Path) -> tuple[bool, str]:
+    """The verdict on a plan file and who gave it: VAL, or this package's validator when VAL
+    is not installed or cannot read the domain or problem (VAL's parser refuses some IPC
+    domains, e.g. data-network's)."""
     binary = _val_binary()
     if binary is not None:
         check = subprocess.run(
@@ -176,7 +184,13 @@ def validate(domain: Path, problem: Path, plan_file: Path) -> bool:
             text=True,
             check=False,
         )
-        return check.returncode == 0 and "Plan valid" in check.stdout
+        if not any(text in check.stdout for text in VAL_UNREADABLE):
+            return check.returncode == 0 and "Plan valid" in check.stdout, "VAL"
+    return own_validation(domain, problem, plan_file), "own"
+
+
+def own_validation(domain: Path, problem: Path, plan_file: Path) -> bool:
+    """This package's validator on a plan file."""
     sys.path.insert(0, str(ROOT))
     from sdar_tamp.language import parse_domain, parse_problem
     from solvers.classical import GroundAction, task_from_problem, validated_plan_cost
@@ -201,19 +215,36 @@ def _natural(name: str) -> list[Any]:
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
 
 
+def domain_file(problem: Path) -> Path | None:
+    """The domain file of an IPC problem file: ``domain.pddl`` beside it, or one of the
+    per-problem names of the IPC collections (``domain_p01.pddl``, ``domain-p01.pddl`` or
+    ``p01-domain.pddl`` for ``p01.pddl``, ``p01-domain.pddl`` for ``p01-airport1-p1.pddl``)."""
+    folder, name, stem = problem.parent, problem.name, problem.stem
+    candidates = [
+        folder / f"domain_{name}",
+        folder / f"domain-{name}",
+        folder / f"{stem.split('-')[0]}-domain.pddl",
+        folder / "domain.pddl",
+    ]
+    return next((c for c in candidates if c.is_file()), None)
+
+
 def suite_problems(
     suite: Path, selection: dict[str, tuple[str, ...]] | None = None
 ) -> list[tuple[str, str, Path, Path]]:
-    """Every problem of every domain folder of ``suite``, or only those named in ``selection``."""
+    """Every problem (with a domain file, see :func:`domain_file`) of every domain folder of
+    ``suite``, or only those named in ``selection``."""
     cases = []
-    for folder in sorted(p for p in suite.iterdir() if (p / "domain.pddl").is_file()):
+    for folder in sorted(p for p in suite.iterdir() if p.is_dir()):
         if selection is not None and folder.name not in selection:
             continue
         problems = [p for p in folder.glob("*.pddl") if "domain" not in p.name]
         if selection is not None:
             problems = [p for p in problems if p.stem in selection[folder.name]]
         for problem in sorted(problems, key=lambda p: _natural(p.name)):
-            cases.append((folder.name, problem.stem, folder / "domain.pddl", problem))
+            domain = domain_file(problem)
+            if domain is not None:
+                cases.append((folder.name, problem.stem, domain, problem))
     return cases
 
 
@@ -268,6 +299,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     planners = [p for p in args.planners if available.get(p, True)]
     skipped = [p for p in args.planners if p not in planners]
     validator = "VAL" if _val_binary() is not None else "own validator (VAL not installed)"
+    own_checked: list[str] = []
     rows: list[dict[str, Any]] = []
     with tempfile.TemporaryDirectory(prefix="bench-classical-") as folder:
         tmp = Path(folder)
@@ -287,7 +319,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             for planner in planners:
                 result = run(planner, domain, problem, args.time_limit, tmp)
                 if result["plan"] is not None:
-                    result["valid"] = validate(domain, problem, result["plan"])
+                    result["valid"], judge = validate(domain, problem, result["plan"])
+                    if judge == "own" and validator == "VAL":
+                        own_checked.append(f"{domain_name}/{name} ({planner})")
                     if not result["valid"]:
                         result["status"] = "invalid"
                     result["length"] = sum(
@@ -338,6 +372,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
                 f"{ratios[planner]['geomean_ratio_over_1s']:.2f}x on the {len(hard)} where "
                 f"{reference} needs > 1 s"
             )
+    if own_checked:
+        print(f"VAL cannot read these; checked by our own validator: {', '.join(own_checked)}")
     if skipped:
         print(f"not installed, skipped: {', '.join(skipped)}")
     summary = {
@@ -345,6 +381,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "problems": len(rows),
         "time_limit_cpu_s": args.time_limit,
         "validator": validator,
+        "own_validator_for": own_checked,
         "solved": totals,
         "invalid": {p: sum(r[p]["status"] == "invalid" for r in rows) for p in planners},
         "ratios_vs_fd": ratios,

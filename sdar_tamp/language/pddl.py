@@ -232,8 +232,7 @@ def _declare_types(body: tuple[SExpr, ...], parents: dict[str, str], log: Lenien
         earlier = parents.get(child)
         if earlier is not None and OBJECT_TYPE not in (earlier, parent) and earlier != parent:
             raise DuplicateError(
-                f"type {child!r} is declared twice, as a subtype of {earlier!r} and of "
-                f"{parent!r}",
+                f"type {child!r} is declared twice, as a subtype of {earlier!r} and of {parent!r}",
                 token.location,
             )
         if earlier is not None:

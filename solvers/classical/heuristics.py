@@ -35,7 +35,8 @@ import numpy.typing as npt
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
 from solvers.classical import jit
-from solvers.classical.compiled import CompiledTask, bits
+from solvers.classical.compiled import CompiledTask, bits, mask
+from solvers.classical.complements import complements
 
 logger = get_logger(__name__)
 
@@ -68,25 +69,31 @@ class RelaxedHeuristic:
         self.name = name
         self.costs = costs
         task = compiled.task
+        self.complements = comp = complements(task)
         upre: list[tuple[int, ...]] = []
         ueff: list[tuple[int, ...]] = []
         ucost: list[float] = []
         uop: list[int] = []
         for index, op in enumerate(task.operators):
-            groups = [(op.precondition, op.adds)]
-            groups += [(op.precondition + c.condition, c.adds) for c in op.conditional]
-            for pre, adds in groups:
+            pre = comp.positive(op.precondition, op.negative_precondition)
+            groups = [(pre, op.adds)]
+            groups += [
+                (pre + comp.positive(c.condition, c.negative_condition), c.adds)
+                for c in op.conditional
+            ]
+            for condition, adds in groups:
                 if adds:
-                    upre.append(tuple(sorted(set(pre))))
+                    upre.append(tuple(sorted(set(condition))))
                     ueff.append(adds)
                     ucost.append(costs[index])
                     uop.append(index)
-        for axiom in task.axioms:
-            upre.append(tuple(sorted(set(axiom.body))))
-            ueff.append((axiom.head,))
+        rules = [(comp.positive(a.body, a.negative_body), a.head) for a in task.axioms]
+        for body, head in [*rules, *comp.rules]:
+            upre.append(tuple(sorted(set(body))))
+            ueff.append((head,))
             ucost.append(0.0)
             uop.append(-1)
-        count = len(task.facts)
+        count = comp.count
         pre_of: list[list[int]] = [[] for _ in range(count)]
         for u, pre in enumerate(upre):
             for fact in pre:
@@ -95,8 +102,8 @@ class RelaxedHeuristic:
         self.upre, self.ueff, self.ucost, self.uop = upre, ueff, ucost, uop
         self.left = [len(pre) for pre in upre]
         self.no_pre = [u for u, pre in enumerate(upre) if not pre]
-        self.goal = sorted(set(task.goal))
-        self.goal_mask = compiled.goal_mask
+        self.goal = sorted(set(comp.positive(task.goal, task.negative_goal)))
+        self.goal_mask = mask(self.goal)
         self.is_goal = [False] * count
         for fact in self.goal:
             self.is_goal[fact] = True
@@ -128,7 +135,7 @@ class RelaxedHeuristic:
             pass
         elif name in ("add", "ff") and (engine == "numpy" or large):
             self.vector = VectorHAdd(count, upre, ueff, ucost)
-            if engine == "auto" and not self._vector_is_faster(compiled.init):
+            if engine == "auto" and not self._vector_is_faster(comp.extend(compiled.init)):
                 self.vector = None
         self.engine = (
             "numba"
@@ -170,6 +177,7 @@ class RelaxedHeuristic:
         return self._propagate(state, self.name == "max")
 
     def __call__(self, state: int, preferred: bool = False) -> tuple[float, set[int] | None]:
+        state = self.complements.extend(state)
         if self.name == "blind":
             return (0.0 if state & self.goal_mask == self.goal_mask else self.min_cost), None
         if self.jit_pending:

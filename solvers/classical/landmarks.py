@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections import deque
 
 from solvers.classical.compiled import CompiledTask, bits, mask
+from solvers.classical.complements import complements
 
 
 class LandmarkCount:
@@ -26,22 +27,28 @@ class LandmarkCount:
 
     def __init__(self, compiled: CompiledTask) -> None:
         task = compiled.task
-        count = len(task.facts)
+        comp = complements(task)
+        count = comp.count
         upre: list[tuple[int, ...]] = []
         ueff: list[tuple[int, ...]] = []
         for op in task.operators:
-            groups = [(op.precondition, op.adds)]
-            groups += [(op.precondition + c.condition, c.adds) for c in op.conditional]
-            upre += [tuple(set(pre)) for pre, adds in groups if adds]
-            ueff += [adds for _pre, adds in groups if adds]
-        for axiom in task.axioms:
-            upre.append(tuple(set(axiom.body)))
-            ueff.append((axiom.head,))
+            pre = comp.positive(op.precondition, op.negative_precondition)
+            groups = [(pre, op.adds)]
+            groups += [
+                (pre + comp.positive(c.condition, c.negative_condition), c.adds)
+                for c in op.conditional
+            ]
+            upre += [tuple(set(condition)) for condition, adds in groups if adds]
+            ueff += [adds for _condition, adds in groups if adds]
+        rules = [(comp.positive(a.body, a.negative_body), a.head) for a in task.axioms]
+        for body, head in [*rules, *comp.rules]:
+            upre.append(tuple(set(body)))
+            ueff.append((head,))
         pre_of: list[list[int]] = [[] for _ in range(count)]
         for u, pre in enumerate(upre):
             for fact in pre:
                 pre_of[fact].append(u)
-        init = compiled.init
+        init = comp.extend(compiled.init)
         label: list[int | None] = [None] * count
         for fact in bits(init):
             label[fact] = 1 << fact
@@ -76,13 +83,16 @@ class LandmarkCount:
                             if not queued[v]:
                                 queued[v] = True
                                 queue.append(v)
-        self.reachable = all(label[g] is not None for g in task.goal)
+        goal = comp.positive(task.goal, task.negative_goal)
+        self.reachable = all(label[g] is not None for g in goal)
         landmarks = 0
-        for g in task.goal:
+        for g in goal:
             landmarks |= label[g] or 0
+        # complements are not part of search states: only the task's facts are tracked
+        landmarks &= (1 << comp.base) - 1
         self.landmarks = landmarks
         self.goal_mask = compiled.goal_mask
-        self.init_mask = init
+        self.init_mask = compiled.init
         # parents: every landmark ordered before p (natural orderings, from the labels)
         self.parents: dict[int, int] = {}
         children_gn: dict[int, int] = {}

@@ -1,0 +1,206 @@
+"""Complements of derived facts, so that the delete relaxation sees negated derived conditions.
+
+A condition ``not A`` on a derived fact ``A`` (from ``(not (exists ...))``, ``(forall ...)``
+or ``(imply ...)`` in ADL domains) holds when no rule of ``A`` applies. The delete relaxation
+ignores negative conditions, so such a condition costs nothing there and a heuristic can miss
+everything it asks for: in IPC's assembly domain, ``complete ?whole`` needs every part of the
+whole incorporated, yet h_FF of the initial state is 1.
+
+Here ``not A`` gets a fact of its own, the *complement* ``~A``, with rules that derive it when
+every rule of ``A`` is blocked: a rule is blocked by the negation of one of its literals, so the
+complement's rules are the conjunctions that pick one negated literal from every rule (CNF to
+DNF). In the relaxation a negated fluent ``not p`` is free (negative conditions are ignored), so
+a rule with a positive fluent literal never needs blocking; ``not q`` is blocked by ``q``; a
+derived literal ``B`` by ``~B`` unless ``B`` depends on ``A`` in turn (then it counts as
+free, which keeps the relaxation an over-approximation under recursion); ``not B`` by ``B``.
+A rule with an empty body makes ``A`` always true, so ``~A`` has no rules. When the
+conjunctions would number more than ``max_rules``, ``not A`` stays ignored.
+
+A state's complements are the complements of its false derived facts (:meth:`Complements.extend`);
+from there the relaxed exploration may derive more. Every complement that holds in a state
+reachable from it is reachable in the relaxation, so heuristics stay as safe about dead ends
+as before, and better informed.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+from solvers.classical.compiled import bits
+from solvers.classical.task import GroundTask
+
+#: The most rules one complement may get (the CNF-to-DNF product can grow exponentially).
+MAX_RULES = 64
+
+
+@dataclass(frozen=True)
+class Complements:
+    """Complement facts numbered from ``base`` (the task's fact count): ``of`` maps a derived
+    fact to its complement, ``rules`` are ``(body, complement)`` pairs (bodies of fact ids,
+    complements included)."""
+
+    base: int
+    of: dict[int, int]
+    rules: tuple[tuple[tuple[int, ...], int], ...]
+    _mask: int = field(default=0, init=False, repr=False)  # the derived facts with complements
+    _all: int = field(default=0, init=False, repr=False)  # every complement
+
+    @property
+    def count(self) -> int:
+        """Facts of the relaxed task: the task's, then the complements."""
+        return self.base + len(self.of)
+
+    def positive(self, positive: tuple[int, ...], negative: tuple[int, ...]) -> tuple[int, ...]:
+        """A condition's positive facts with the complements of its negated derived facts."""
+        extra = tuple(self.of[f] for f in negative if f in self.of)
+        return positive + extra if extra else positive
+
+    def extend(self, state: int) -> int:
+        """``state`` with the complement of every derived fact false in it."""
+        if not self.of:
+            return state
+        out = state | self._all
+        for fact in bits(state & self._mask):
+            out ^= 1 << self.of[fact]
+        return out
+
+    def __post_init__(self) -> None:
+        mask = all_ = 0
+        for fact, complement in self.of.items():
+            mask |= 1 << fact
+            all_ |= 1 << complement
+        object.__setattr__(self, "_mask", mask)
+        object.__setattr__(self, "_all", all_)
+
+
+def complements(task: GroundTask, max_rules: int = MAX_RULES) -> Complements:
+    """The complements of the derived facts that some condition of ``task`` negates (see the
+    module docstring), and of those their rules need in turn."""
+    base = len(task.facts)
+    if not task.axioms:
+        return Complements(base, {}, ())
+    rules_of: dict[int, list[tuple[tuple[int, ...], tuple[int, ...]]]] = {}
+    for axiom in task.axioms:
+        rules_of.setdefault(axiom.head, []).append((axiom.body, axiom.negative_body))
+    derived = task.derived
+    component = _components(
+        {h: {f for body, _ in rules for f in body if f in derived} for h, rules in rules_of.items()}
+    )
+    wanted = [f for op in task.operators for f in op.negative_precondition if f in derived]
+    wanted += [
+        f for op in task.operators for c in op.conditional for f in c.negative_condition
+        if f in derived
+    ]  # fmt: skip
+    wanted += [f for a in task.axioms for f in a.negative_body if f in derived]
+    wanted += [f for f in task.negative_goal if f in derived]
+    # each complement's rules as sets of literals: ("fact", f) needs f, ("not", B) needs ~B
+    bodies: dict[int, list[frozenset[tuple[str, int]]] | None] = {}
+    todo = list(dict.fromkeys(wanted))
+    while todo:
+        head = todo.pop()
+        if head in bodies:
+            continue
+        disjuncts = _negated(head, rules_of.get(head, []), component, derived, max_rules)
+        bodies[head] = disjuncts
+        if disjuncts is not None:
+            todo.extend(b for d in disjuncts for kind, b in d if kind == "not" and b not in bodies)
+    # a complement whose rules need one that could not be built is dropped too, to a fixpoint
+    changed = True
+    while changed:
+        changed = False
+        for head, disjuncts in bodies.items():
+            if disjuncts is not None and any(
+                kind == "not" and bodies.get(b) is None for d in disjuncts for kind, b in d
+            ):
+                bodies[head] = None
+                changed = True
+    of: dict[int, int] = {}
+    for head in sorted(h for h, d in bodies.items() if d is not None):
+        of[head] = base + len(of)
+    rules = tuple(
+        (tuple(sorted(f if kind == "fact" else of[f] for kind, f in d)), of[head])
+        for head in sorted(of)
+        for d in bodies[head] or ()
+    )
+    return Complements(base, of, rules)
+
+
+def _components(edges: dict[int, set[int]]) -> dict[int, int]:
+    """Strongly connected components of a graph (node -> successors): a component number per
+    node (iterative Tarjan)."""
+    index: dict[int, int] = {}
+    low: dict[int, int] = {}
+    component: dict[int, int] = {}
+    stack: list[int] = []
+    on_stack: set[int] = set()
+    count = 0
+    for root in edges:
+        if root in index:
+            continue
+        work = [(root, iter(edges.get(root, ())))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, successors = work[-1]
+            for nxt in successors:
+                if nxt not in index:
+                    index[nxt] = low[nxt] = len(index)
+                    stack.append(nxt)
+                    on_stack.add(nxt)
+                    work.append((nxt, iter(edges.get(nxt, ()))))
+                    break
+                if nxt in on_stack:
+                    low[node] = min(low[node], index[nxt])
+            else:
+                work.pop()
+                if work:
+                    parent = work[-1][0]
+                    low[parent] = min(low[parent], low[node])
+                if low[node] == index[node]:
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component[member] = count
+                        if member == node:
+                            break
+                    count += 1
+    return component
+
+
+def _negated(
+    head: int,
+    rules: list[tuple[tuple[int, ...], tuple[int, ...]]],
+    component: dict[int, int],
+    derived: frozenset[int],
+    max_rules: int,
+) -> list[frozenset[tuple[str, int]]] | None:
+    """The rules of ``~head`` (a list of literal sets, one per rule; empty: never derivable),
+    or None when they would be more than ``max_rules``."""
+    options: list[list[tuple[str, int]]] = []
+    for body, negative_body in rules:
+        choices: list[tuple[str, int]] = []
+        free = False
+        for fact in body:
+            if fact not in derived or component.get(fact) == component.get(head):
+                free = True  # not p is free in the relaxation (or unsafe to use: recursion)
+                break
+            choices.append(("not", fact))
+        if free:
+            continue
+        choices += [("fact", fact) for fact in negative_body]
+        if not choices:
+            return []  # a rule with an empty body: head is always true
+        options.append(choices)
+    total = 1
+    for choices in options:
+        total *= len(choices)
+        if total > max_rules:
+            return None
+    disjuncts = {frozenset(pick) for pick in itertools.product(*options)}
+    # keep the minimal ones: a superset asks for more and derives nothing new
+    return sorted(
+        (d for d in disjuncts if not any(o < d for o in disjuncts)),
+        key=lambda d: sorted(d),
+    )
