@@ -184,7 +184,8 @@ def validate(domain: Path, problem: Path, plan_file: Path) -> tuple[bool, str]:
             text=True,
             check=False,
         )
-        if not any(text in check.stdout for text in VAL_UNREADABLE):
+        said = check.stdout + check.stderr
+        if not any(text in said for text in VAL_UNREADABLE):
             return check.returncode == 0 and "Plan valid" in check.stdout, "VAL"
     return own_validation(domain, problem, plan_file), "own"
 

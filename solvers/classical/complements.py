@@ -1,25 +1,29 @@
-"""Complements of derived facts, so that the delete relaxation sees negated derived conditions.
+"""Complements of negated facts, so that the delete relaxation sees negative conditions.
 
-A condition ``not A`` on a derived fact ``A`` (from ``(not (exists ...))``, ``(forall ...)``
-or ``(imply ...)`` in ADL domains) holds when no rule of ``A`` applies. The delete relaxation
-ignores negative conditions, so such a condition costs nothing there and a heuristic can miss
-everything it asks for: in IPC's assembly domain, ``complete ?whole`` needs every part of the
-whole incorporated, yet h_FF of the initial state is 1.
+The delete relaxation ignores negative conditions, so ``(not p)`` costs nothing there and a
+heuristic can miss everything it asks for. Two cases, as Fast Downward's translation into
+binary variables treats them:
 
-Here ``not A`` gets a fact of its own, the *complement* ``~A``, with rules that derive it when
-every rule of ``A`` is blocked: a rule is blocked by the negation of one of its literals, so the
-complement's rules are the conjunctions that pick one negated literal from every rule (CNF to
-DNF). In the relaxation a negated fluent ``not p`` is free (negative conditions are ignored), so
-a rule with a positive fluent literal never needs blocking; ``not q`` is blocked by ``q``; a
-derived literal ``B`` by ``~B`` unless ``B`` depends on ``A`` in turn (then it counts as
-free, which keeps the relaxation an over-approximation under recursion); ``not B`` by ``B``.
-A rule with an empty body makes ``A`` always true, so ``~A`` has no rules. When the
-conjunctions would number more than ``max_rules``, ``not A`` stays ignored.
+* **A fluent** ``p`` that some condition or the goal negates gets a fact of its own, the
+  *complement* ``~p``: true where ``p`` is false, and achieved by every effect that deletes
+  ``p`` (and does not add it). IPC's quantum-layout has only negative goals: without them
+  every state looks like a goal to h_FF.
+* **A derived fact** ``A`` (``(not (exists ...))``, ``(forall ...)``, ``(imply ...)`` in ADL
+  domains) holds when no rule of ``A`` applies. ``~A`` gets rules that derive it when every
+  rule of ``A`` is blocked: a rule is blocked by the negation of one of its literals, so the
+  complement's rules are the conjunctions that pick one negated literal from every rule (CNF to
+  DNF). A rule with a positive fluent literal never needs blocking here (its negation counts
+  as free); ``not q`` is blocked by ``q``; a derived literal ``B`` by ``~B`` unless ``B``
+  depends on ``A`` in turn (then it counts as free, which keeps the relaxation an
+  over-approximation under recursion); ``not B`` by ``B``. A rule with an empty body makes
+  ``A`` always true, so ``~A`` has no rules. When the conjunctions would number more than
+  ``max_rules``, ``not A`` stays ignored. In IPC's assembly, ``complete ?whole`` needs every
+  part of the whole incorporated: h_FF of the initial state goes from 1 to 24.
 
-A state's complements are the complements of its false derived facts (:meth:`Complements.extend`);
-from there the relaxed exploration may derive more. Every complement that holds in a state
-reachable from it is reachable in the relaxation, so heuristics stay as safe about dead ends
-as before, and better informed.
+A state's complements are those of its false facts (:meth:`Complements.extend`); from there the
+relaxed exploration may reach more. Every complement that holds in a state reachable from it is
+reachable in the relaxation, so heuristics stay as safe about dead ends as before, and better
+informed.
 """
 
 from __future__ import annotations
@@ -56,8 +60,12 @@ class Complements:
         extra = tuple(self.of[f] for f in negative if f in self.of)
         return positive + extra if extra else positive
 
+    def deleted(self, deletes: tuple[int, ...], adds: tuple[int, ...]) -> tuple[int, ...]:
+        """The complements an effect achieves: of the facts it deletes and does not add."""
+        return tuple(self.of[f] for f in deletes if f in self.of and f not in adds)
+
     def extend(self, state: int) -> int:
-        """``state`` with the complement of every derived fact false in it."""
+        """``state`` with the complement of every fact false in it."""
         if not self.of:
             return state
         out = state | self._all
@@ -75,11 +83,37 @@ class Complements:
 
 
 def complements(task: GroundTask, max_rules: int = MAX_RULES) -> Complements:
-    """The complements of the derived facts that some condition of ``task`` negates (see the
-    module docstring), and of those their rules need in turn."""
+    """The complements of the facts that some condition of ``task`` negates (see the module
+    docstring), and of the derived facts their rules need in turn."""
     base = len(task.facts)
-    if not task.axioms:
-        return Complements(base, {}, ())
+    derived = task.derived
+    negated = [f for op in task.operators for f in op.negative_precondition]
+    negated += [f for op in task.operators for c in op.conditional for f in c.negative_condition]
+    negated += [f for a in task.axioms for f in a.negative_body]
+    negated += list(task.negative_goal)
+    fluents = sorted({f for f in negated if f not in derived})
+    bodies = _derived_bodies(task, [f for f in negated if f in derived], max_rules)
+    of: dict[int, int] = {}
+    for head in sorted(h for h, d in bodies.items() if d is not None):
+        of[head] = base + len(of)
+    for fact in fluents:
+        of[fact] = base + len(of)
+    rules = tuple(
+        (tuple(sorted(f if kind == "fact" else of[f] for kind, f in d)), of[head])
+        for head in sorted(h for h in of if h in bodies)
+        for d in bodies[head] or ()
+    )
+    return Complements(base, of, rules)
+
+
+def _derived_bodies(
+    task: GroundTask, wanted: list[int], max_rules: int
+) -> dict[int, list[frozenset[tuple[str, int]]] | None]:
+    """The rules of the complements of the derived facts ``wanted`` and of those their rules
+    need, as sets of literals (``("fact", f)`` needs ``f``, ``("not", B)`` needs ``~B``); None
+    for a complement that is not built."""
+    if not wanted:
+        return {}
     rules_of: dict[int, list[tuple[tuple[int, ...], tuple[int, ...]]]] = {}
     for axiom in task.axioms:
         rules_of.setdefault(axiom.head, []).append((axiom.body, axiom.negative_body))
@@ -87,14 +121,6 @@ def complements(task: GroundTask, max_rules: int = MAX_RULES) -> Complements:
     component = _components(
         {h: {f for body, _ in rules for f in body if f in derived} for h, rules in rules_of.items()}
     )
-    wanted = [f for op in task.operators for f in op.negative_precondition if f in derived]
-    wanted += [
-        f for op in task.operators for c in op.conditional for f in c.negative_condition
-        if f in derived
-    ]  # fmt: skip
-    wanted += [f for a in task.axioms for f in a.negative_body if f in derived]
-    wanted += [f for f in task.negative_goal if f in derived]
-    # each complement's rules as sets of literals: ("fact", f) needs f, ("not", B) needs ~B
     bodies: dict[int, list[frozenset[tuple[str, int]]] | None] = {}
     todo = list(dict.fromkeys(wanted))
     while todo:
@@ -115,15 +141,7 @@ def complements(task: GroundTask, max_rules: int = MAX_RULES) -> Complements:
             ):
                 bodies[head] = None
                 changed = True
-    of: dict[int, int] = {}
-    for head in sorted(h for h, d in bodies.items() if d is not None):
-        of[head] = base + len(of)
-    rules = tuple(
-        (tuple(sorted(f if kind == "fact" else of[f] for kind, f in d)), of[head])
-        for head in sorted(of)
-        for d in bodies[head] or ()
-    )
-    return Complements(base, of, rules)
+    return bodies
 
 
 def _components(edges: dict[int, set[int]]) -> dict[int, int]:

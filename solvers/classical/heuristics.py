@@ -76,9 +76,12 @@ class RelaxedHeuristic:
         uop: list[int] = []
         for index, op in enumerate(task.operators):
             pre = comp.positive(op.precondition, op.negative_precondition)
-            groups = [(pre, op.adds)]
+            groups = [(pre, op.adds + comp.deleted(op.deletes, op.adds))]
             groups += [
-                (pre + comp.positive(c.condition, c.negative_condition), c.adds)
+                (
+                    pre + comp.positive(c.condition, c.negative_condition),
+                    c.adds + comp.deleted(c.deletes, c.adds),
+                )
                 for c in op.conditional
             ]
             for condition, adds in groups:

@@ -33,9 +33,12 @@ class LandmarkCount:
         ueff: list[tuple[int, ...]] = []
         for op in task.operators:
             pre = comp.positive(op.precondition, op.negative_precondition)
-            groups = [(pre, op.adds)]
+            groups = [(pre, op.adds + comp.deleted(op.deletes, op.adds))]
             groups += [
-                (pre + comp.positive(c.condition, c.negative_condition), c.adds)
+                (
+                    pre + comp.positive(c.condition, c.negative_condition),
+                    c.adds + comp.deleted(c.deletes, c.adds),
+                )
                 for c in op.conditional
             ]
             upre += [tuple(set(condition)) for condition, adds in groups if adds]
@@ -88,11 +91,10 @@ class LandmarkCount:
         landmarks = 0
         for g in goal:
             landmarks |= label[g] or 0
-        # complements are not part of search states: only the task's facts are tracked
-        landmarks &= (1 << comp.base) - 1
         self.landmarks = landmarks
-        self.goal_mask = compiled.goal_mask
-        self.init_mask = compiled.init
+        self.goal_mask = mask(goal)
+        self.complements = comp
+        self._last = (-1, -1)  # the last state extended with its complements, and the result
         # parents: every landmark ordered before p (natural orderings, from the labels)
         self.parents: dict[int, int] = {}
         children_gn: dict[int, int] = {}
@@ -106,12 +108,19 @@ class LandmarkCount:
     def __len__(self) -> int:
         return self.landmarks.bit_count()
 
+    def _extended(self, state: int) -> int:
+        """``state`` with its complements (landmarks may be complements of facts)."""
+        if self._last[0] != state:
+            self._last = (state, self.complements.extend(state))
+        return self._last[1]
+
     def initial(self, state: int) -> int:
         """The accepted set of the initial state: the landmarks true in it."""
-        return state & self.landmarks
+        return self._extended(state) & self.landmarks
 
     def update(self, reached: int, state: int) -> int:
         """The accepted set of ``state``, reached from a state whose accepted set is ``reached``."""
+        state = self._extended(state)
         new = state & self.landmarks & ~reached
         if not new:
             return reached
@@ -126,6 +135,7 @@ class LandmarkCount:
 
     def value(self, reached: int, state: int) -> int:
         """Landmarks not accepted, plus accepted ones needed again."""
+        state = self._extended(state)
         h = (self.landmarks & ~reached).bit_count()
         lost = reached & ~state
         if not lost:

@@ -52,9 +52,9 @@ def test_domain_files_of_the_ipc_layouts(bench: ModuleType, tmp_path: Path) -> N
     assert [(d, p) for d, p, _, _ in selected] == [("shared", "p02")]
 
 
-def _fake_val(folder: Path, output: str, status: int) -> Path:
+def _fake_val(folder: Path, output: str, status: int, stream: str = "") -> Path:
     script = folder / "Validate"
-    script.write_text(f"#!/bin/sh\necho '{output}'\nexit {status}\n")
+    script.write_text(f"#!/bin/sh\necho '{output}' {stream}\nexit {status}\n")
     script.chmod(script.stat().st_mode | stat.S_IEXEC)
     return script
 
@@ -89,7 +89,7 @@ def test_own_validator_decides_where_val_cannot_read_the_domain(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:  # fmt: skip
     domain, problem, good, bad = blocks
-    unreadable = _fake_val(tmp_path, "Problem in domain definition!", 255)
+    unreadable = _fake_val(tmp_path, "Problem in domain definition!", 255, ">&2")
     monkeypatch.setattr(bench, "_val_binary", lambda: unreadable)
     assert bench.validate(domain, problem, good) == (True, "own")
     assert bench.validate(domain, problem, bad) == (False, "own")

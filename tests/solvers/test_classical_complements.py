@@ -50,7 +50,58 @@ def test_landmarks_see_through_the_complement() -> None:
     landmarks = LandmarkCount(CompiledTask(task))
     found = {str(task.facts[i]) for i in range(len(task.facts)) if landmarks.landmarks >> i & 1}
     assert {"(fitted a w)", "(fitted b w)", "(fitted c w)", "(done w)"} <= found
-    assert len(landmarks) == len(found)  # complements themselves are never landmarks
+    # the complement of (loose w) is one too, reached once the parts are fitted
+    comp = complements(task)
+    assert landmarks.landmarks >> comp.of[_fact(task, "(loose w)")] & 1
+    compiled = CompiledTask(task)
+    start = landmarks.initial(compiled.init)
+    assert landmarks.value(start, compiled.init) == 6  # the parts, the two complements, done
+    fitted = compiled.close(compiled.init | sum(1 << _fact(task, f"(fitted {p} w)") for p in "abc"))
+    # LAMA's rule: a landmark is accepted once its predecessors were, in an earlier state
+    reached = landmarks.update(start, fitted)
+    assert landmarks.value(reached, fitted) == 3  # the complements wait for the parts
+    assert landmarks.value(landmarks.update(reached, fitted), fitted) == 2  # ~(~aux0 w) first
+    reached = landmarks.update(landmarks.update(reached, fitted), fitted)
+    assert landmarks.value(reached, fitted) == 1  # only (done w) left
+
+
+QUBITS = """(define (domain q) (:requirements :strips :negative-preconditions)
+ (:predicates (pending ?g) (free ?q) (after ?g ?h))
+ (:action apply :parameters (?g ?q) :precondition (and (pending ?g) (free ?q))
+  :effect (and (not (pending ?g)) (not (free ?q)))))
+"""
+
+
+def test_negative_goals_on_fluents_count() -> None:
+    # only negative goals: without complements every state looks like a goal to h_FF
+    problem = """(define (problem p) (:domain q) (:objects g1 g2 g3 q1 q2 q3)
+     (:init (pending g1) (pending g2) (pending g3) (free q1) (free q2) (free q3))
+     (:goal (and (not (pending g1)) (not (pending g2)) (not (pending g3)))))"""
+    task = _task(QUBITS, problem)
+    compiled = CompiledTask(task)
+    comp = complements(task)
+    assert sorted(str(task.facts[f]) for f in comp.of) == [
+        "(pending g1)", "(pending g2)", "(pending g3)",
+    ]  # fmt: skip
+    assert comp.rules == ()  # fluent complements come from the deleting effects
+    assert RelaxedHeuristic(compiled, "ff", compiled.costs)(compiled.init)[0] == 3.0
+    landmarks = LandmarkCount(compiled)
+    assert len(landmarks) == 6  # the three goals, and the pending facts they need deleted
+    assert landmarks.value(landmarks.initial(compiled.init), compiled.init) == 3
+    parsed = parse_domain(QUBITS)
+    result = plan(task_from_problem(parsed, parse_problem(problem, parsed)))
+    assert result.plan is not None and len(result.plan) == 3
+
+
+def test_an_effect_that_deletes_and_adds_a_fact_achieves_no_complement() -> None:
+    domain = QUBITS.replace(
+        "(not (pending ?g)) (not (free ?q))", "(not (pending ?g)) (pending ?g) (not (free ?q))"
+    )
+    problem = """(define (problem p) (:domain q) (:objects g1 q1)
+     (:init (pending g1) (free q1)) (:goal (not (pending g1))))"""
+    task = _task(domain, problem)
+    compiled = CompiledTask(task)
+    assert RelaxedHeuristic(compiled, "ff", compiled.costs)(compiled.init)[0] == float("inf")
 
 
 def test_the_plan_is_found_and_fits_every_part() -> None:
@@ -67,8 +118,10 @@ def test_extend_adds_the_complements_of_false_derived_facts() -> None:
     comp = complements(task)
     loose_w, loose_v = _fact(task, "(loose w)"), _fact(task, "(loose v)")
     some_w = _fact(task, "(~aux0 w)")  # the existential loose w is defined by
-    assert set(comp.of) == {loose_w, loose_v, some_w, _fact(task, "(~aux0 v)")}
-    assert comp.count == len(task.facts) + 4
+    fitted = {_fact(task, f"(fitted {p} {w})") for p, w in ("aw", "bw", "cw", "av")}
+    # the derived facts, and the fluents negated in the existential's rules
+    assert set(comp.of) == {loose_w, loose_v, some_w, _fact(task, "(~aux0 v)")} | fitted
+    assert comp.count == len(task.facts) + 8
     everything = sum(1 << c for c in comp.of.values())
     assert comp.extend(0) == everything
     state = 1 << loose_w | 1 << some_w

@@ -12,6 +12,7 @@ from classical_helpers import load
 from sdar_tamp.errors import ParameterError
 from solvers.classical import ground, jit
 from solvers.classical.compiled import CompiledTask, bits
+from solvers.classical.complements import complements
 from solvers.classical.heuristics import VECTOR_MIN_SIZE, RelaxedHeuristic
 from solvers.classical.problem import PlanningTask
 
@@ -31,19 +32,29 @@ CASES = [
 def _reference(
     compiled: CompiledTask, costs: list[float], state: int, use_max: bool
 ) -> tuple[list[float], list[int], list[tuple[tuple[int, ...], tuple[int, ...], int]]]:
-    """Costs by repeated sweeps to a fixpoint; best supporter = lowest relaxed-operator id."""
+    """Costs by repeated sweeps to a fixpoint; best supporter = lowest relaxed-operator id.
+    The relaxed task has the complements of negated facts (``solvers.classical.complements``)."""
     task = compiled.task
+    comp = complements(task)
     relaxed: list[tuple[tuple[int, ...], tuple[int, ...], float, int]] = []
     for index, op in enumerate(task.operators):
-        for pre, adds in [(op.precondition, op.adds)] + [
-            (op.precondition + c.condition, c.adds) for c in op.conditional
-        ]:
+        pre = comp.positive(op.precondition, op.negative_precondition)
+        effects = [(pre, op.adds + comp.deleted(op.deletes, op.adds))]
+        effects += [
+            (pre + comp.positive(c.condition, c.negative_condition),
+             c.adds + comp.deleted(c.deletes, c.adds))
+            for c in op.conditional
+        ]  # fmt: skip
+        for condition, adds in effects:
             if adds:
-                relaxed.append((tuple(set(pre)), adds, costs[index], index))
+                relaxed.append((tuple(set(condition)), adds, costs[index], index))
     for axiom in task.axioms:
-        relaxed.append((tuple(set(axiom.body)), (axiom.head,), 0.0, -1))
-    cost = [inf] * len(task.facts)
-    for fact in bits(state):
+        body = comp.positive(axiom.body, axiom.negative_body)
+        relaxed.append((tuple(set(body)), (axiom.head,), 0.0, -1))
+    for body, head in comp.rules:
+        relaxed.append((tuple(set(body)), (head,), 0.0, -1))
+    cost = [inf] * comp.count
+    for fact in bits(comp.extend(state)):
         cost[fact] = 0.0
     changed = True
     while changed:
@@ -55,7 +66,7 @@ def _reference(
                 if value < cost[g]:
                     cost[g] = value
                     changed = True
-    supporter = [-1] * len(task.facts)
+    supporter = [-1] * comp.count
     for u, (pre, adds, c, _op) in enumerate(relaxed):
         pre_costs = [cost[p] for p in pre]
         value = c + (max(pre_costs, default=0.0) if use_max else sum(pre_costs))
@@ -68,7 +79,8 @@ def _reference(
 def _reference_values(
     compiled: CompiledTask, costs: list[float], state: int
 ) -> dict[str, tuple[float, frozenset[int]]]:
-    goal = sorted(set(compiled.task.goal))
+    task = compiled.task
+    goal = sorted(set(complements(task).positive(task.goal, task.negative_goal)))
     result: dict[str, tuple[float, frozenset[int]]] = {}
     for name in ("add", "max"):
         cost, supporter, relaxed = _reference(compiled, costs, state, name == "max")
