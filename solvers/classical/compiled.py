@@ -13,7 +13,7 @@ from collections.abc import Iterable
 
 from sdar_tamp.logs import get_logger
 from solvers.classical import jit
-from solvers.classical.task import GroundTask
+from solvers.classical.task import GroundAxiom, GroundTask
 
 logger = get_logger(__name__)
 
@@ -55,6 +55,55 @@ class _Node:
         self.children: dict[int, _Node] = {}
 
 
+#: Strata with at least this many rules are closed by :class:`_CountedStratum`.
+COUNTED_STRATUM = 64
+
+
+class _CountedStratum:
+    """One stratum's rules, closed by counting (semi-naive): every rule starts with the number
+    of its body facts false in the state; a head that becomes true lowers the count of the
+    rules of this stratum that need it, and a rule whose count reaches zero (with its negative
+    body false, which lower strata and fluents fix) makes its head true."""
+
+    def __init__(self, axioms: list[GroundAxiom]) -> None:
+        self.heads = [a.head for a in axioms]
+        self.bodies = [a.body for a in axioms]
+        self.negatives = [a.negative_body for a in axioms]
+        own = set(self.heads)
+        watchers: dict[int, list[int]] = {}
+        for i, body in enumerate(self.bodies):
+            for fact in set(body):
+                if fact in own:
+                    watchers.setdefault(fact, []).append(i)
+        self.watchers = watchers
+
+    def close(self, state: int) -> int:
+        true = set(bits(state))
+        missing = [0] * len(self.heads)
+        queue: list[int] = []
+        heads, watchers = self.heads, self.watchers
+        for i, (body, negative) in enumerate(zip(self.bodies, self.negatives, strict=True)):
+            if any(f in true for f in negative):
+                missing[i] = -1  # blocked for good in this stratum
+                continue
+            count = len({f for f in body if f not in true})
+            missing[i] = count
+            if count == 0 and heads[i] not in true:
+                true.add(heads[i])
+                queue.append(heads[i])
+        added = list(queue)
+        while queue:
+            fact = queue.pop()
+            for i in watchers.get(fact, ()):
+                if missing[i] > 0:
+                    missing[i] -= 1
+                    if missing[i] == 0 and heads[i] not in true:
+                        true.add(heads[i])
+                        queue.append(heads[i])
+                        added.append(heads[i])
+        return state | mask(added)
+
+
 class CompiledTask:
     """Masks, successor generator and axiom evaluator of a :class:`GroundTask`."""
 
@@ -79,11 +128,19 @@ class CompiledTask:
         self.negative_goal_mask = mask(task.negative_goal)
         self.derived_mask = mask(task.derived)
         strata: dict[int, list[tuple[int, int, int]]] = {}
+        grouped: dict[int, list[GroundAxiom]] = {}
         for axiom in task.axioms:
             strata.setdefault(axiom.stratum, []).append(
                 (1 << axiom.head, mask(axiom.body), mask(axiom.negative_body))
             )
+            grouped.setdefault(axiom.stratum, []).append(axiom)
         self.strata = [strata[s] for s in sorted(strata)]
+        # large strata are closed by counting each rule's missing body facts (linear in the
+        # rules' size) instead of sweeping the rules until nothing changes
+        self.counted = [
+            _CountedStratum(grouped[s]) if len(grouped[s]) >= COUNTED_STRATUM else None
+            for s in sorted(grouped)
+        ]
         self._root = self._build_trie()
         self.init = self.close(mask(task.init))
         self._calls = 0
@@ -154,7 +211,10 @@ class CompiledTask:
         if not self.strata:
             return state
         state &= ~self.derived_mask
-        for layer in self.strata:
+        for layer, counted in zip(self.strata, self.counted, strict=True):
+            if counted is not None:
+                state = counted.close(state)
+                continue
             pending = layer
             while pending:
                 waiting = []

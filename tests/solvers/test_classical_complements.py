@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import random
+
 import pytest
 
 from sdar_tamp.language import parse_domain, parse_problem
+from solvers.classical import compiled as compiled_module
 from solvers.classical import ground, plan, task_from_problem
 from solvers.classical.compiled import CompiledTask
 from solvers.classical.complements import complements
@@ -194,3 +197,35 @@ def test_recursive_rules_count_as_free() -> None:
     result = plan(task_from_problem(parsed, parse_problem(problem, parsed)))
     assert result.plan is not None
     assert [str(s) for s in result.plan] == ["(close x y)", "(isolate y)"]
+
+
+def test_counted_closure_equals_the_sweep(monkeypatch: pytest.MonkeyPatch) -> None:
+    # reach over a ring of 10 rooms with doors that open and close: 21 rules in one stratum
+    rooms = [f"r{i}" for i in range(10)]
+    domain = """(define (domain ring) (:requirements :adl :derived-predicates)
+     (:predicates (door ?a ?b) (open ?a ?b) (reach ?a) (start ?a) (lit ?a))
+     (:derived (reach ?b) (or (start ?b) (exists (?a) (and (reach ?a) (door ?a ?b) (open ?a ?b)))))
+     (:action shut :parameters (?a ?b) :precondition (open ?a ?b) :effect (not (open ?a ?b)))
+     (:action unshut :parameters (?a ?b) :precondition (and (door ?a ?b) (not (open ?a ?b)))
+      :effect (open ?a ?b))
+     (:action light :parameters (?a) :precondition (not (reach ?a)) :effect (lit ?a)))"""
+    doors = " ".join(
+        f"(door {a} {b}) (open {a} {b})"
+        for i, a in enumerate(rooms)
+        for b in (rooms[(i + 1) % 10], rooms[(i + 3) % 10])
+    )
+    problem = f"""(define (problem p) (:domain ring) (:objects {" ".join(rooms)})
+     (:init (start r0) {doors}) (:goal (lit r5)))"""
+    task = _task(domain, problem)
+    monkeypatch.setattr(compiled_module, "COUNTED_STRATUM", 16)
+    compiled = CompiledTask(task)
+    assert [c is not None for c in compiled.counted] == [True]  # one stratum, counted
+    rng = random.Random(3)
+    state, states = compiled.init, []
+    for _ in range(200):
+        state = compiled.successor(state, rng.choice(compiled.applicable(state)))
+        states.append(state)
+    counted = [compiled.close(s) for s in states]
+    compiled.counted = [None]  # the sweep to a fixpoint
+    assert counted == [compiled.close(s) for s in states]
+    assert len({c & compiled.derived_mask for c in counted}) > 10  # the walk changes reach
