@@ -12,6 +12,14 @@ it (a landmark is accepted when it becomes true after all its predecessors were 
 ``h = |not accepted| + |accepted but needed again|``, where a landmark is needed again when it is
 false now and is a goal, or greedy-necessary for a landmark not yet accepted. All sets are
 Python ``int`` bitsets over fact ids, so an update costs a few big-integer operations.
+
+The propagation runs on the relaxed task with the complements of negated facts
+(:mod:`solvers.classical.complements`), so a complement can be a landmark (a negative goal, a
+negated precondition every achiever shares). *Disjunctive landmarks* (Richter, Helmert and
+Westphal 2008, one level deep): when every achiever of a landmark has a precondition of one
+predicate, one of those facts (at most :data:`MAX_DISJUNCTION`) must hold first; they get bits
+after the facts and are accepted once any of their facts holds. Landmark states carry their
+complements and satisfied disjunctions.
 """
 
 from __future__ import annotations
@@ -20,12 +28,16 @@ from collections import deque
 
 from solvers.classical.compiled import CompiledTask, bits, mask
 from solvers.classical.complements import complements
+from solvers.classical.task import GroundTask
+
+#: The largest disjunctive landmark kept (as in Fast Downward's RHW landmarks).
+MAX_DISJUNCTION = 4
 
 
 class LandmarkCount:
     """Landmarks of a compiled task and the count heuristic over accepted-landmark sets."""
 
-    def __init__(self, compiled: CompiledTask) -> None:
+    def __init__(self, compiled: CompiledTask, disjunctive: bool = True) -> None:
         task = compiled.task
         comp = complements(task)
         count = comp.count
@@ -104,14 +116,80 @@ class LandmarkCount:
                 children_gn[q] = children_gn.get(q, 0) | 1 << p
         self.children_gn = children_gn
         self.gn_sources = mask(children_gn)
+        # disjunctive landmarks, numbered after the facts: (their facts, their bit)
+        self.disjunctions: list[tuple[int, int]] = []
+        self._members = 0  # every fact of a disjunctive landmark
+        self._of_member: dict[int, int] = {}  # such a fact -> the bits of its disjunctions
+        if disjunctive:
+            self._disjunctions(task, upre, ueff, label, init, count)
+
+    def _disjunctions(
+        self,
+        task: GroundTask,
+        upre: list[tuple[int, ...]],
+        ueff: list[tuple[int, ...]],
+        label: list[int | None],
+        init: int,
+        count: int,
+    ) -> None:
+        """Disjunctive landmarks (Richter, Helmert and Westphal 2008, one level): for a fact
+        landmark false initially, if every reachable achiever has a precondition of predicate
+        P, one of those facts must hold before the landmark first does. Kept when they are at
+        most :data:`MAX_DISJUNCTION` facts, none true initially and none a fact landmark; each
+        is ordered before its landmark."""
+        base = len(task.facts)
+        achievers: dict[int, list[int]] = {}
+        for u, adds in enumerate(ueff):
+            if all(label[p] is not None for p in upre[u]):
+                for fact in adds:
+                    achievers.setdefault(fact, []).append(u)
+        found: dict[int, int] = {}  # members mask -> bit
+        for fact in bits(self.landmarks):
+            if init >> fact & 1 or fact >= base or not achievers.get(fact):
+                continue
+            groups: dict[str, int] | None = None
+            for u in achievers[fact]:
+                mine: dict[str, int] = {}
+                for p in upre[u]:
+                    if p < base:
+                        name = task.facts[p].predicate
+                        mine[name] = mine.get(name, 0) | 1 << p
+                if groups is None:
+                    groups = mine
+                else:
+                    groups = {k: v | mine[k] for k, v in groups.items() if k in mine}
+                if not groups:
+                    break
+            for members in (groups or {}).values():
+                size = members.bit_count()
+                if not 2 <= size <= MAX_DISJUNCTION or members & (init | self.landmarks):
+                    continue
+                bit = found.get(members)
+                if bit is None:
+                    bit = 1 << (count + len(found))
+                    found[members] = bit
+                    self.disjunctions.append((members, bit))
+                    self.parents[bit.bit_length() - 1] = 0
+                    self.landmarks |= bit
+                self.parents[fact] |= bit
+        for members, bit in self.disjunctions:
+            self._members |= members
+            for fact in bits(members):
+                self._of_member[fact] = self._of_member.get(fact, 0) | bit
 
     def __len__(self) -> int:
         return self.landmarks.bit_count()
 
     def _extended(self, state: int) -> int:
-        """``state`` with its complements (landmarks may be complements of facts)."""
+        """``state`` with its complements (landmarks may be complements of facts) and the bits
+        of the disjunctive landmarks it satisfies."""
         if self._last[0] != state:
-            self._last = (state, self.complements.extend(state))
+            extended = self.complements.extend(state)
+            if self.disjunctions:
+                of_member = self._of_member
+                for fact in bits(state & self._members):
+                    extended |= of_member[fact]
+            self._last = (state, extended)
         return self._last[1]
 
     def initial(self, state: int) -> int:

@@ -8,8 +8,9 @@ from classical_helpers import load
 from sdar_tamp.language import parse_domain, parse_problem
 from sdar_tamp.language.model import Atom
 from solvers.classical import PlanStatus, ground, plan, task_from_problem
-from solvers.classical.compiled import CompiledTask, mask
+from solvers.classical.compiled import CompiledTask, bits, mask
 from solvers.classical.landmarks import LandmarkCount
+from solvers.classical.task import GroundTask
 
 VISIT = """
 (define (domain visit)
@@ -128,3 +129,61 @@ def test_landmarks_cut_the_search_on_a_visit_grid() -> None:
     assert count_only.plan is not None and blind.plan is not None
     # the count alone is an informed heuristic here: far fewer expansions than blind search
     assert 2 * count_only.statistics.expanded < blind.statistics.expanded
+
+
+# two trucks can bring the parcel: "in one of the trucks" and "one truck at B" must each hold
+# before it is at B, though no single fact must
+TRUCKS = """(define (domain trucks) (:requirements :strips)
+ (:predicates (at ?x ?l) (in ?p ?t) (truck ?t) (parcel ?p))
+ (:action load :parameters (?p ?t ?l)
+  :precondition (and (parcel ?p) (truck ?t) (at ?p ?l) (at ?t ?l))
+  :effect (and (in ?p ?t) (not (at ?p ?l))))
+ (:action unload :parameters (?p ?t ?l) :precondition (and (in ?p ?t) (at ?t ?l))
+  :effect (and (at ?p ?l) (not (in ?p ?t))))
+ (:action drive :parameters (?t ?a ?b) :precondition (and (truck ?t) (at ?t ?a))
+  :effect (and (at ?t ?b) (not (at ?t ?a)))))
+"""
+TRUCKS_PROBLEM = """(define (problem two) (:domain trucks) (:objects p t1 t2 a b)
+ (:init (parcel p) (truck t1) (truck t2) (at p a) (at t1 a) (at t2 a)) (:goal (at p b)))
+"""
+
+
+def _trucks() -> tuple[GroundTask, CompiledTask]:
+    domain = parse_domain(TRUCKS)
+    task = ground(task_from_problem(domain, parse_problem(TRUCKS_PROBLEM, domain)))
+    return task, CompiledTask(task)
+
+
+def test_disjunctive_landmarks_of_every_achiever() -> None:
+    task, compiled = _trucks()
+    landmarks = LandmarkCount(compiled)
+    found = sorted(
+        sorted(str(task.facts[f]) for f in bits(members)) for members, _ in landmarks.disjunctions
+    )
+    assert found == [["(at t1 b)", "(at t2 b)"], ["(in p t1)", "(in p t2)"]]
+    goal = task.facts.index(Atom("at", ("p", "b")))
+    for _members, bit in landmarks.disjunctions:
+        assert landmarks.parents[goal] & bit  # ordered before the goal
+    plain = LandmarkCount(compiled, disjunctive=False)
+    assert plain.disjunctions == [] and len(landmarks) == len(plain) + 2
+    start = landmarks.initial(compiled.init)
+    assert (
+        landmarks.value(start, compiled.init)
+        == plain.value(plain.initial(compiled.init), compiled.init) + 2
+    )
+
+
+def test_a_disjunctive_landmark_is_reached_by_any_of_its_facts() -> None:
+    task, compiled = _trucks()
+    landmarks = LandmarkCount(compiled)
+    ops = {str(op.action): i for i, op in enumerate(task.operators)}
+    start = landmarks.initial(compiled.init)
+    h0 = landmarks.value(start, compiled.init)
+    loaded = compiled.successor(compiled.init, ops["(load p t2 a)"])
+    reached = landmarks.update(start, loaded)
+    assert landmarks.value(reached, loaded) == h0 - 1  # "in one of the trucks" is done
+    moved = compiled.successor(loaded, ops["(drive t2 a b)"])
+    reached = landmarks.update(reached, moved)
+    assert landmarks.value(reached, moved) == h0 - 2
+    done = compiled.successor(moved, ops["(unload p t2 b)"])
+    assert landmarks.value(landmarks.update(reached, done), done) == 0
