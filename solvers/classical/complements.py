@@ -40,14 +40,14 @@ MAX_RULES = 64
 
 @dataclass(frozen=True)
 class Complements:
-    """Complement facts numbered from ``base`` (the task's fact count): ``of`` maps a derived
-    fact to its complement, ``rules`` are ``(body, complement)`` pairs (bodies of fact ids,
-    complements included)."""
+    """Complement facts numbered from ``base`` (the task's fact count): ``of`` maps a negated
+    fact (derived or fluent) to its complement; ``rules`` are the derived complements'
+    ``(body, complement)`` pairs (bodies of fact ids, complements included)."""
 
     base: int
     of: dict[int, int]
     rules: tuple[tuple[tuple[int, ...], int], ...]
-    _mask: int = field(default=0, init=False, repr=False)  # the derived facts with complements
+    _mask: int = field(default=0, init=False, repr=False)  # the facts with complements
     _all: int = field(default=0, init=False, repr=False)  # every complement
 
     @property
@@ -56,7 +56,8 @@ class Complements:
         return self.base + len(self.of)
 
     def positive(self, positive: tuple[int, ...], negative: tuple[int, ...]) -> tuple[int, ...]:
-        """A condition's positive facts with the complements of its negated derived facts."""
+        """A condition's positive facts with the complements of its negated facts (those that
+        have one)."""
         extra = tuple(self.of[f] for f in negative if f in self.of)
         return positive + extra if extra else positive
 

@@ -2,7 +2,10 @@
 
 Every operator becomes one *unary* relaxed operator per add group: its unconditional adds under
 its precondition, and each conditional effect under precondition + condition. Axioms are relaxed
-operators of cost 0. Negative literals are ignored (the relaxation stays an over-approximation).
+operators of cost 0. A negative literal becomes a positive condition on the fact's complement
+(:mod:`solvers.classical.complements`: achieved by the effects that delete a fluent, derived by
+rules for a derived fact; states are extended with the complements of their false facts), or is
+ignored where there is none; the relaxation stays an over-approximation.
 
 Costs are propagated with the preconditions-left counter algorithm: a relaxed operator fires when
 its counter of unreached preconditions drops to 0, and facts are settled cheapest first from a
