@@ -50,6 +50,17 @@ def test_domain_files_of_the_ipc_layouts(bench: ModuleType, tmp_path: Path) -> N
     }
     selected = bench.suite_problems(tmp_path, {"shared": ("p02",)})
     assert [(d, p) for d, p, _, _ in selected] == [("shared", "p02")]
+    first = bench.first_per_domain(cases, 1)
+    assert [(d, p) for d, p, _, _ in first] == [
+        ("airport", "p01-airport1-p1"), ("dash", "p01"), ("shared", "p01"), ("under", "p01"),
+    ]  # fmt: skip
+
+
+def test_per_domain_must_be_positive(bench: ModuleType, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        bench.main(["--per-domain", "0"])
+    assert info.value.code == 2
+    assert "--per-domain: expected an integer >= 1, got 0" in capsys.readouterr().err
 
 
 def _fake_val(folder: Path, output: str, status: int, stream: str = "") -> Path:
