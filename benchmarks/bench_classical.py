@@ -362,11 +362,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     print(f"coverage (CPU limit {args.time_limit:g} s, plans checked by {validator})")
     domains = list(dict.fromkeys(r["domain"] for r in rows))
     width = max([26, *(len(d) + 2 for d in domains)])
-    print(f"{'domain':<{width}}" + "".join(f"{p:>11}" for p in planners))
+    print(f"{'domain':<{width}}" + "".join(f"{p:>12}" for p in planners))
     for domain_name in domains:
         mine = [r for r in rows if r["domain"] == domain_name]
         counts = [sum(r[p]["status"] == "solved" for r in mine) for p in planners]
-        print(f"{domain_name:<{width}}" + "".join(f"{c:>8}/{len(mine):<2}" for c in counts))
+        print(f"{domain_name:<{width}}" + "".join(f"{c:>8}/{len(mine):<3}" for c in counts))
     totals = {p: sum(r[p]["status"] == "solved" for r in rows) for p in planners}
     print(f"{'total':<{width}}" + "".join(f"{totals[p]:>8}/{len(rows):<3}" for p in planners))
 
