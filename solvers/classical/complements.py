@@ -83,6 +83,31 @@ class Complements:
         object.__setattr__(self, "_all", all_)
 
 
+def relaxed_operators(
+    task: GroundTask, comp: Complements
+) -> list[tuple[tuple[int, ...], tuple[int, ...], int]]:
+    """The delete relaxation of ``task`` with the complements ``comp``, as unary operators
+    ``(condition, adds, operator index)``: per operator, its unconditional adds under its
+    precondition and each conditional effect under precondition + condition (groups without
+    adds dropped), then the axioms and the complements' rules (index -1). Conditions are
+    sorted and free of repeats; negated facts become their complements, deletes add them."""
+    out: list[tuple[tuple[int, ...], tuple[int, ...], int]] = []
+    for index, op in enumerate(task.operators):
+        pre = comp.positive(op.precondition, op.negative_precondition)
+        groups = [(pre, op.adds + comp.deleted(op.deletes, op.adds))]
+        groups += [
+            (
+                pre + comp.positive(c.condition, c.negative_condition),
+                c.adds + comp.deleted(c.deletes, c.adds),
+            )
+            for c in op.conditional
+        ]
+        out += [(tuple(sorted(set(cond))), adds, index) for cond, adds in groups if adds]
+    rules = [(comp.positive(a.body, a.negative_body), a.head) for a in task.axioms]
+    out += [(tuple(sorted(set(body))), (head,), -1) for body, head in [*rules, *comp.rules]]
+    return out
+
+
 def complements(task: GroundTask, max_rules: int = MAX_RULES) -> Complements:
     """The complements of the facts that some condition of ``task`` negates (see the module
     docstring), and of the derived facts their rules need in turn."""

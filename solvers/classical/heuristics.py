@@ -39,7 +39,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
 from solvers.classical import jit
 from solvers.classical.compiled import CompiledTask, bits, mask
-from solvers.classical.complements import complements
+from solvers.classical.complements import complements, relaxed_operators
 
 logger = get_logger(__name__)
 
@@ -73,32 +73,11 @@ class RelaxedHeuristic:
         self.costs = costs
         task = compiled.task
         self.complements = comp = complements(task)
-        upre: list[tuple[int, ...]] = []
-        ueff: list[tuple[int, ...]] = []
-        ucost: list[float] = []
-        uop: list[int] = []
-        for index, op in enumerate(task.operators):
-            pre = comp.positive(op.precondition, op.negative_precondition)
-            groups = [(pre, op.adds + comp.deleted(op.deletes, op.adds))]
-            groups += [
-                (
-                    pre + comp.positive(c.condition, c.negative_condition),
-                    c.adds + comp.deleted(c.deletes, c.adds),
-                )
-                for c in op.conditional
-            ]
-            for condition, adds in groups:
-                if adds:
-                    upre.append(tuple(sorted(set(condition))))
-                    ueff.append(adds)
-                    ucost.append(costs[index])
-                    uop.append(index)
-        rules = [(comp.positive(a.body, a.negative_body), a.head) for a in task.axioms]
-        for body, head in [*rules, *comp.rules]:
-            upre.append(tuple(sorted(set(body))))
-            ueff.append((head,))
-            ucost.append(0.0)
-            uop.append(-1)
+        relaxed = relaxed_operators(task, comp)
+        upre = [condition for condition, _adds, _op in relaxed]
+        ueff = [adds for _condition, adds, _op in relaxed]
+        uop = [op for _condition, _adds, op in relaxed]
+        ucost = [costs[op] if op >= 0 else 0.0 for op in uop]
         count = comp.count
         pre_of: list[list[int]] = [[] for _ in range(count)]
         for u, pre in enumerate(upre):

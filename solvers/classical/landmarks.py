@@ -27,7 +27,7 @@ from __future__ import annotations
 from collections import deque
 
 from solvers.classical.compiled import CompiledTask, bits, mask
-from solvers.classical.complements import complements
+from solvers.classical.complements import complements, relaxed_operators
 from solvers.classical.task import GroundTask
 
 #: The largest disjunctive landmark kept (as in Fast Downward's RHW landmarks).
@@ -41,24 +41,9 @@ class LandmarkCount:
         task = compiled.task
         comp = complements(task)
         count = comp.count
-        upre: list[tuple[int, ...]] = []
-        ueff: list[tuple[int, ...]] = []
-        for op in task.operators:
-            pre = comp.positive(op.precondition, op.negative_precondition)
-            groups = [(pre, op.adds + comp.deleted(op.deletes, op.adds))]
-            groups += [
-                (
-                    pre + comp.positive(c.condition, c.negative_condition),
-                    c.adds + comp.deleted(c.deletes, c.adds),
-                )
-                for c in op.conditional
-            ]
-            upre += [tuple(set(condition)) for condition, adds in groups if adds]
-            ueff += [adds for _condition, adds in groups if adds]
-        rules = [(comp.positive(a.body, a.negative_body), a.head) for a in task.axioms]
-        for body, head in [*rules, *comp.rules]:
-            upre.append(tuple(set(body)))
-            ueff.append((head,))
+        relaxed = relaxed_operators(task, comp)
+        upre = [condition for condition, _adds, _op in relaxed]
+        ueff = [adds for _condition, adds, _op in relaxed]
         pre_of: list[list[int]] = [[] for _ in range(count)]
         for u, pre in enumerate(upre):
             for fact in pre:
