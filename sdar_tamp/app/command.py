@@ -20,7 +20,7 @@ from sdar_tamp.app.config import (
     PlannerConfig,
     check_choice,
 )
-from sdar_tamp.app.execution import schedule_plan
+from sdar_tamp.app.execution import schedule_and_validate
 from sdar_tamp.app.plan_export import decoder_of, motion_levels, plan_file_from_solution
 from sdar_tamp.app.problem import rearrangement_problem
 from sdar_tamp.app.records import RunFigures, SolveOutcome, task_records
@@ -121,11 +121,15 @@ def solve_instance(
         if stage is not None:
             stage("scheduling")
         started = time.perf_counter()
-        plan = schedule_plan(plan, instance, rearrangement.ctx.scene, world.planner.shape).plan
+        schedule, report = schedule_and_validate(
+            plan, instance, rearrangement.ctx.scene, world.planner.shape, stage=stage
+        )
+        plan = schedule.plan
         figures = dataclasses.replace(figures, schedule_time=time.perf_counter() - started)
-    if stage is not None:
-        stage("validating")
-    report = validate_plan(instance, plan, rearrangement.ctx.scene)
+    else:
+        if stage is not None:
+            stage("validating")
+        report = validate_plan(instance, plan, rearrangement.ctx.scene)
     violation = "" if report.ok or report.violation is None else describe(report.violation)
     return SolveOutcome(instance, "solved", plan, report.ok, violation, figures)
 

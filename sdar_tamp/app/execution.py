@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from collections.abc import Callable
 
 from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.replay import validate_plan
+from sdar_tamp.replay import ReplayReport, validate_plan
 from sdar_tamp.schedule import Schedule, ScheduleOptions, schedule_async
 from sdar_tamp.schedule.retiming import PathTimer
 from sdar_tamp.world.instance import Instance
@@ -59,17 +60,33 @@ def schedule_plan(
     :func:`execution_options`), and the result replayed by the independent validator: a
     schedule it rejects is dropped for the synchronous plan (and logged), so the plan returned
     is never longer than ``plan`` and valid whenever ``plan`` is."""
+    return schedule_and_validate(plan, instance, scene, shape, options)[0]
+
+
+def schedule_and_validate(
+    plan: PlanFile,
+    instance: Instance,
+    scene: Scene,
+    shape: ShapeOptions | None = None,
+    options: ScheduleOptions | None = None,
+    stage: Callable[[str], None] | None = None,
+) -> tuple[Schedule, ReplayReport]:
+    """:func:`schedule_plan`, and the independent replay's report on the plan it returns: the
+    schedule's own replay when the schedule is kept, else a replay of ``plan`` (each plan is
+    replayed once). ``stage("validating")`` is called when the first replay starts."""
     options = options or execution_options(scene, shape)
     result = schedule_async(plan, instance, scene, options)
-    if not result.asynchronous:
-        return result
-    report = validate_plan(instance, result.plan, scene)
-    if report.ok:
-        return result
-    why = "the replay rejects the schedule" + (
-        f" at t={report.violation.t:.3f} s: {report.violation.kind}: {report.violation.message}"
-        if report.violation is not None
-        else ""
-    )
-    _log.warning("%s: %s; the synchronous plan is kept", instance.name, why)
-    return dataclasses.replace(result, plan=plan, asynchronous=False, reason=why)
+    if stage is not None:
+        stage("validating")
+    if result.asynchronous:
+        report = validate_plan(instance, result.plan, scene)
+        if report.ok:
+            return result, report
+        why = "the replay rejects the schedule" + (
+            f" at t={report.violation.t:.3f} s: {report.violation.kind}: {report.violation.message}"
+            if report.violation is not None
+            else ""
+        )
+        _log.warning("%s: %s; the synchronous plan is kept", instance.name, why)
+        result = dataclasses.replace(result, plan=plan, asynchronous=False, reason=why)
+    return result, validate_plan(instance, plan, scene)

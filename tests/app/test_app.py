@@ -297,9 +297,12 @@ def test_the_command_line_reaches_the_planner_config(
     assert "argument --grasps: expected an integer >= 1" in capsys.readouterr().err
 
 
-def test_an_asynchronous_run_is_scheduled_validated_and_reported(tmp_path: Path) -> None:
+def test_an_asynchronous_run_is_scheduled_validated_and_reported(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """``execution="async"``: the solved plan goes through the scheduler before the replay;
     the run reports the scheduling time, and the plan says which execution it holds."""
+    from sdar_tamp.app import execution
     from sdar_tamp.app.command import solve_instance
     from sdar_tamp.app.summary import format_summary
     from sdar_tamp.world.instance import save_instance
@@ -308,11 +311,21 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(tmp_path: Path)
     b = ObjectSpec("b", SQUARE, Pose2D(0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.0))
     path = save_instance(Instance("two", WORKSPACE, (a, b)), tmp_path / "two.yaml")
     stages: list[str] = []
+    replays: list[object] = []
+    real = execution.validate_plan
+
+    def counting(*args: Any, **kwargs: Any) -> Any:
+        replays.append(args[1])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr("sdar_tamp.app.execution.validate_plan", counting)
+    monkeypatch.setattr("sdar_tamp.app.command.validate_plan", counting)
     outcome = solve_instance(
         path, PlannerConfig(execution="async"), time_limit=BUDGET, stage=stages.append
     )
     assert outcome.plan is not None and outcome.valid, outcome.violation
     assert stages == ["scheduling", "validating"]  # named as they start
+    assert replays == [outcome.plan]  # the plan kept is replayed once
     assert outcome.figures.schedule_time > 0.0
     metrics = outcome.plan.metrics
     if metrics.get("execution") == "async":

@@ -12,11 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sdar_tamp.app.execution import execution_options, schedule_plan
+from sdar_tamp.app import execution
+from sdar_tamp.app.execution import execution_options, schedule_and_validate, schedule_plan
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile, load_plan, save_plan
 from sdar_tamp.plan_rules import STILL_TOL, check_timeline
-from sdar_tamp.replay import validate_plan
+from sdar_tamp.replay import ReplayReport, validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule.pieces import arm_blocks, arm_columns, on_ticks
 from sdar_tamp.schedule.scheduler import Schedule, _Placement, groups
@@ -311,6 +312,27 @@ def test_a_schedule_the_replay_rejects_is_dropped(
     s = schedule_plan(uneven.plan, uneven.instance, scene)
     assert not s.asynchronous and s.plan is uneven.plan
     assert "replay rejects" in s.reason
+    # with its report: the one on the synchronous plan kept, which the replay accepts
+    replayed: list[PlanFile] = []
+    real = execution.validate_plan
+
+    def counting(instance: Instance, plan: PlanFile, *args: object) -> ReplayReport:
+        replayed.append(plan)
+        return real(instance, plan, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr("sdar_tamp.app.execution.validate_plan", counting)
+    s, report = schedule_and_validate(uneven.plan, uneven.instance, scene)
+    assert s.plan is uneven.plan and report.ok
+    assert replayed == [bad.plan, uneven.plan]
+
+
+def test_a_kept_schedule_is_replayed_once_and_its_report_returned(uneven: Solved) -> None:
+    stages: list[str] = []
+    s, report = schedule_and_validate(
+        uneven.plan, uneven.instance, uneven.ctx.scene, stage=stages.append
+    )
+    assert s.asynchronous and report.ok and stages == ["validating"]
+    assert report.checks > 0
 
 
 def test_replaying_known_events_skips_the_free_spot_test_a_new_release_takes(
