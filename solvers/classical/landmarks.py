@@ -20,6 +20,12 @@ Westphal 2008, one level deep): when every achiever of a landmark has a precondi
 predicate, one of those facts (at most :data:`MAX_DISJUNCTION`) must hold first; they get bits
 after the facts and are accepted once any of their facts holds. Landmark states carry their
 complements and satisfied disjunctions.
+
+*Reasonable orderings* (Hoffmann, Porteous and Sebastia 2004) use the mutex groups of
+:mod:`solvers.classical.invariants`: when achieving ``a`` destroys ``b`` and both are goals, or
+both must hold together to first achieve a third landmark, ``b`` is accepted only after ``a``
+(achieving ``b`` first would be undone). Without them, greedy search on depot spends its time
+stacking crates that a later goal has to unstack again.
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ from collections import deque
 
 from solvers.classical.compiled import CompiledTask, bits, mask
 from solvers.classical.complements import complements, relaxed_operators
+from solvers.classical.invariants import MutexGroups, mutex_groups
 from solvers.classical.task import GroundTask
 
 #: The largest disjunctive landmark kept (as in Fast Downward's RHW landmarks).
@@ -37,7 +44,9 @@ MAX_DISJUNCTION = 4
 class LandmarkCount:
     """Landmarks of a compiled task and the count heuristic over accepted-landmark sets."""
 
-    def __init__(self, compiled: CompiledTask, disjunctive: bool = True) -> None:
+    def __init__(
+        self, compiled: CompiledTask, disjunctive: bool = True, mutexes: bool = True
+    ) -> None:
         task = compiled.task
         comp = complements(task)
         count = comp.count
@@ -101,12 +110,102 @@ class LandmarkCount:
                 children_gn[q] = children_gn.get(q, 0) | 1 << p
         self.children_gn = children_gn
         self.gn_sources = mask(children_gn)
+        self.reasonable = 0  # orderings added by :meth:`_reasonable_orders`
+        if mutexes and self.reachable:
+            self._reasonable_orders(task, mutex_groups(task), relaxed, label, init)
         # disjunctive landmarks, numbered after the facts: (their facts, their bit)
         self.disjunctions: list[tuple[int, int]] = []
         self._members = 0  # every fact of a disjunctive landmark
         self._of_member: dict[int, int] = {}  # such a fact -> the bits of its disjunctions
         if disjunctive:
             self._disjunctions(task, upre, ueff, label, init, count)
+
+    def _ancestors(self, fact: int) -> int:
+        """Every landmark ordered (transitively) before ``fact``."""
+        seen = 0
+        stack = [fact]
+        while stack:
+            for q in bits(self.parents.get(stack.pop(), 0) & ~seen):
+                seen |= 1 << q
+                stack.append(q)
+        return seen
+
+    def _reasonable_orders(
+        self,
+        task: GroundTask,
+        groups: MutexGroups,
+        relaxed: list[tuple[tuple[int, ...], tuple[int, ...], int]],
+        label: list[int | None],
+        init: int,
+    ) -> None:
+        """Reasonable orderings (Hoffmann, Porteous and Sebastia 2004, as LAMA approximates
+        them): ``a`` before ``b`` when achieving ``a`` destroys ``b`` and both are goals, or
+        both must hold together when a third landmark is first achieved (greedy-necessary for
+        it). ``b`` is then accepted only after ``a``. Achieving ``a`` destroys ``b`` when they
+        are mutex, every first achiever of ``a`` deletes ``b``, the first achievers share an
+        add mutex with ``b``, or a greedy-necessary predecessor of ``a`` is mutex with ``b``."""
+        base = len(task.facts)
+        first: dict[int, list[int]] = {}  # landmark -> operators that can first achieve it
+        wanted = {f for f in bits(self.landmarks) if f < base}
+        for condition, adds, index in relaxed:
+            if index < 0:
+                continue
+            for fact in adds:
+                if fact in wanted and all(
+                    (label[p] or 0) >> fact & 1 == 0 and label[p] is not None for p in condition
+                ):
+                    first.setdefault(fact, []).append(index)
+        gn_parents: dict[int, int] = {}
+        for q, children in self.children_gn.items():
+            for p in bits(children):
+                gn_parents[p] = gn_parents.get(p, 0) | 1 << q
+        operators = task.operators
+        destroys: dict[int, tuple[set[tuple[int, int]], set[int]]] = {}
+
+        def destroyed(a: int, among: frozenset[int]) -> set[int]:
+            """The facts of ``among`` that achieving ``a`` destroys."""
+            found = destroys.get(a)
+            if found is None:
+                # what is mutex with a, with an add its first achievers share, or with one of
+                # its greedy-necessary predecessors (groups, each with the fact it is kin of);
+                # and what every first achiever deletes
+                kin = {(g, a) for g in groups.of(a)}
+                deleted: set[int] = set()
+                ops = [operators[i] for i in sorted(set(first.get(a, ())))]
+                if ops:
+                    deleted = set(ops[0].deletes).difference(ops[0].adds)
+                    shared = set(ops[0].adds)
+                    for op in ops[1:]:
+                        deleted.intersection_update(op.deletes)
+                        deleted.difference_update(op.adds)
+                        shared.intersection_update(op.adds)
+                    kin.update((g, e) for e in shared for g in groups.of(e))
+                for x in bits(gn_parents.get(a, 0)):
+                    if x < base:
+                        kin.update((g, x) for g in groups.of(x))
+                found = destroys[a] = (kin, deleted)
+            kin, deleted = found
+            out = deleted & among
+            for g, fact in kin:
+                out |= (groups.groups[g] & among) - {fact}
+            out.discard(a)
+            return out
+
+        pairs: set[tuple[int, int]] = set()
+        goals = frozenset(f for f in bits(self.goal_mask & self.landmarks) if f < base)
+        pairs.update((a, b) for a in goals for b in destroyed(a, goals))
+        for q in sorted(gn_parents):
+            together = frozenset(p for p in bits(gn_parents[q]) if p < base)
+            pairs.update((a, b) for a in together for b in destroyed(a, together))
+        for a, b in sorted(pairs):
+            if init >> b & 1 and not self.goal_mask >> b & 1:
+                continue
+            if self.parents[b] >> a & 1:
+                continue
+            if self._ancestors(a) >> b & 1:
+                continue  # b is ordered before a already: no cycle
+            self.parents[b] |= 1 << a
+            self.reasonable += 1
 
     def _disjunctions(
         self,
