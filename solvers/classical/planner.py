@@ -158,7 +158,12 @@ def _search(
     relaxed = None if relaxed_name == "lmcount" else RelaxedHeuristic(compiled, relaxed_name, costs)
     landmarks = LandmarkCount(compiled) if heuristic.endswith("lmcount") else None
     if landmarks is not None:
-        logger.info("%d fact landmarks", len(landmarks))
+        logger.info(
+            "%d landmarks (%d disjunctive), %d reasonable orderings",
+            len(landmarks),
+            len(landmarks.disjunctions),
+            landmarks.reasonable,
+        )
     g_weight, h_weight = {
         "gbfs": (0.0, 1.0),
         "lazy-gbfs": (0.0, 1.0),
