@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from itertools import permutations
 
 from solvers.classical.task import GroundTask
@@ -48,18 +48,20 @@ class MutexGroups:
 
     groups: tuple[frozenset[int], ...]
     invariants: tuple[Candidate, ...]
+    _of: dict[int, tuple[int, ...]] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         of: dict[int, list[int]] = {}
         for index, group in enumerate(self.groups):
             for fact in group:
                 of.setdefault(fact, []).append(index)
-        object.__setattr__(self, "_of", {f: tuple(g) for f, g in of.items()})
+        self._of.update((f, tuple(g)) for f, g in of.items())
 
     def of(self, fact: int) -> tuple[int, ...]:
         """The indices of the groups that contain ``fact``."""
-        found: tuple[int, ...] = self._of.get(fact, ())  # type: ignore[attr-defined]
-        return found
+        return self._of.get(fact, ())
 
     def mutex(self, a: int, b: int) -> bool:
         """Whether facts ``a`` and ``b`` (distinct) can never hold together."""

@@ -197,15 +197,19 @@ class LandmarkCount:
         for q in sorted(gn_parents):
             together = frozenset(p for p in bits(gn_parents[q]) if p < base)
             pairs.update((a, b) for a in together for b in destroyed(a, together))
+        ancestors: dict[int, int] = {}  # cleared whenever an ordering is added
         for a, b in sorted(pairs):
             if init >> b & 1 and not self.goal_mask >> b & 1:
                 continue
             if self.parents[b] >> a & 1:
                 continue
-            if self._ancestors(a) >> b & 1:
+            if a not in ancestors:
+                ancestors[a] = self._ancestors(a)
+            if ancestors[a] >> b & 1:
                 continue  # b is ordered before a already: no cycle
             self.parents[b] |= 1 << a
             self.reasonable += 1
+            ancestors.clear()
 
     def _disjunctions(
         self,
