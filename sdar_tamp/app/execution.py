@@ -60,7 +60,7 @@ def schedule_plan(
     :func:`execution_options`), and the result replayed by the independent validator: a
     schedule it rejects is dropped for the synchronous plan (and logged), so the plan returned
     is never longer than ``plan`` and valid whenever ``plan`` is."""
-    return schedule_and_validate(plan, instance, scene, shape, options)[0]
+    return _checked_schedule(plan, instance, scene, shape, options, None)[0]
 
 
 def schedule_and_validate(
@@ -74,19 +74,33 @@ def schedule_and_validate(
     """:func:`schedule_plan`, and the independent replay's report on the plan it returns: the
     schedule's own replay when the schedule is kept, else a replay of ``plan`` (each plan is
     replayed once). ``stage("validating")`` is called when the first replay starts."""
+    result, report = _checked_schedule(plan, instance, scene, shape, options, stage)
+    return result, report or validate_plan(instance, result.plan, scene)
+
+
+def _checked_schedule(
+    plan: PlanFile,
+    instance: Instance,
+    scene: Scene,
+    shape: ShapeOptions | None,
+    options: ScheduleOptions | None,
+    stage: Callable[[str], None] | None,
+) -> tuple[Schedule, ReplayReport | None]:
+    """The schedule with the replay's report when the schedule is kept; the synchronous plan
+    and None (not replayed) when there is none or the replay rejects it."""
     options = options or execution_options(scene, shape)
     result = schedule_async(plan, instance, scene, options)
     if stage is not None:
         stage("validating")
-    if result.asynchronous:
-        report = validate_plan(instance, result.plan, scene)
-        if report.ok:
-            return result, report
-        why = "the replay rejects the schedule" + (
-            f" at t={report.violation.t:.3f} s: {report.violation.kind}: {report.violation.message}"
-            if report.violation is not None
-            else ""
-        )
-        _log.warning("%s: %s; the synchronous plan is kept", instance.name, why)
-        result = dataclasses.replace(result, plan=plan, asynchronous=False, reason=why)
-    return result, validate_plan(instance, plan, scene)
+    if not result.asynchronous:
+        return result, None
+    report = validate_plan(instance, result.plan, scene)
+    if report.ok:
+        return result, report
+    why = "the replay rejects the schedule" + (
+        f" at t={report.violation.t:.3f} s: {report.violation.kind}: {report.violation.message}"
+        if report.violation is not None
+        else ""
+    )
+    _log.warning("%s: %s; the synchronous plan is kept", instance.name, why)
+    return dataclasses.replace(result, plan=plan, asynchronous=False, reason=why), None
