@@ -19,7 +19,9 @@ trajectory that passes is returned as a success. Strategies, tried in order unti
 passes:
 
 * ``plain`` (:class:`PlainStrategy`): one synchronous optimisation, warm-started from the
-  straight line, then from a lifted via-point;
+  straight line, then from a lifted via-point (SDAR-M's stream map, where OMPL is installed,
+  tries a sampled collision-free path's warm start in between:
+  :func:`streams.sampling.warm_started_strategies`);
 * ``untangle`` (:class:`UntangleStrategy`, rules in ``docs/arm_untangling.md``): the arm that
   reaches deeper into the other arm's half yields: it moves to a lifted park pose above its
   own half while the other arm goes straight to its goal; then it moves to its own goal while
@@ -36,7 +38,7 @@ while the other waits at its retract pose).
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -594,17 +596,30 @@ def _chain(paths: list[FloatArray]) -> list[FloatArray]:
 
 
 # -- strategies ---------------------------------------------------------------------------
+#: A further attempt at a transfer: the optimised path, or None.
+Rescue = Callable[["DualMotionPlanner", "TransferProblem"], "FloatArray | None"]
+
+
 @dataclass(frozen=True)
 class PlainStrategy:
-    """One synchronous optimisation: straight-line warm start, then a lifted via-point."""
+    """One synchronous optimisation: straight-line warm start, then ``rescue`` (if any),
+    then a lifted via-point.
+
+    ``rescue`` is tried between the two warm starts; SDAR-M's is
+    :func:`streams.sampling.sampled_warm_start` (a sampled path warm-starts the optimiser).
+    It should succeed with an optimised path or not at all: a failure of this rung is what
+    lets SDAR-M try another grounding first."""
 
     name: str = "plain"
     lifted_warm_start: bool = True
+    rescue: Rescue | None = None
 
     def __call__(
         self, planner: DualMotionPlanner, problem: TransferProblem
     ) -> list[FloatArray] | None:
         path = planner.optimise(problem, problem.q_from, problem.q_to)
+        if path is None and self.rescue is not None:
+            path = self.rescue(planner, problem)
         if path is None and self.lifted_warm_start:
             ws = planner.lifted_via(problem.q_from, problem.q_to)
             path = planner.optimise(problem, problem.q_from, problem.q_to, ws)

@@ -24,6 +24,7 @@ result kept when it executes faster.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import threading
 import zlib
@@ -36,6 +37,7 @@ from sdar_tamp.errors import ParameterError, SdarError
 from sdar_tamp.world.transforms import FloatArray
 from streams.motion import (
     DualMotionPlanner,
+    PlainStrategy,
     SequentialStrategy,
     TransferProblem,
     TransferStrategy,
@@ -244,6 +246,37 @@ class SampledStrategy:
             ):
                 return [refined]
         return [W]
+
+
+def sampled_warm_start(
+    planner: DualMotionPlanner, problem: TransferProblem, options: SamplingOptions | None = None
+) -> FloatArray | None:
+    """The optimiser's transfer warm-started from a sampled path (:func:`sample_path`, its
+    timed curve checked), kept only when the optimiser succeeds and the optimised path's
+    timed curve passes the same check; None otherwise. The first rung of SDAR-M's ladder
+    (:class:`streams.motion.PlainStrategy`) tries it after the straight line."""
+    o = options or SamplingOptions()
+    W = sample_path(planner, problem.q_from, problem.q_to, o)
+    planner.sampled_paths += int(W is not None)
+    W = None if W is None else checked_waypoints(planner, W, o.curve_samples)
+    if W is None:
+        return None
+    warm = planner.warm_start_along(W)
+    path = planner.optimise(problem, problem.q_from, problem.q_to, warm)
+    if path is None or checked_waypoints(planner, path, o.curve_samples) is None:
+        return None
+    return path
+
+
+def warm_started_strategies(
+    fallbacks: bool = True, options: SamplingOptions | None = None
+) -> tuple[TransferStrategy, ...]:
+    """SDAR-M's ladder (:func:`streams.motion.default_strategies`) whose first rung tries a
+    sampled path's warm start (:func:`sampled_warm_start` with ``options``) after the
+    straight line's and before the lifted via-point's; the first rung alone unless
+    ``fallbacks``."""
+    plain = PlainStrategy(rescue=functools.partial(sampled_warm_start, options=options))
+    return (plain,) if not fallbacks else (plain, UntangleStrategy(), SequentialStrategy())
 
 
 def _duration(planner: DualMotionPlanner, path: FloatArray) -> float:

@@ -43,7 +43,12 @@ from streams.motion import (
     default_strategies,
     plan_dual_motion,
 )
-from streams.sampling import SamplingOptions
+from streams.sampling import (
+    OmplUnavailableError,
+    SamplingOptions,
+    ompl_available,
+    warm_started_strategies,
+)
 from streams.validate import HeldObject
 
 LOG = get_logger(__name__)
@@ -144,11 +149,19 @@ class DualArmStreams:
         motion: str = "sdar",
         grasps: GraspOptions = DEFAULT_GRASPS,
         half_turns: bool = True,
+        sampling: bool | None = None,
     ) -> None:
         if motion not in MOTION_PLANNERS:
             raise ParameterError(
                 f"motion planner must be one of {', '.join(MOTION_PLANNERS)}; got {motion!r}"
             )
+        if sampling and not ompl_available():
+            raise OmplUnavailableError(
+                "sampling=True: the sampled warm start needs OMPL: pip install 'sdar-tamp[ompl]'"
+            )
+        #: SDAR-M's first rung also warm-starts the optimiser from a sampled path (default:
+        #: where OMPL is installed; :func:`streams.sampling.warm_started_strategies`)
+        self.sampling = ompl_available() if sampling is None else sampling
         self.ctx = ctx
         self.sizes = dict(sizes)
         self.seed = seed
@@ -346,16 +359,18 @@ class DualArmStreams:
         approach = tuple(a.pre is not None for a in q2.arms)
         request = MotionRequest(q1.q, q2.q, objects, held, retreat, approach)
         strategies: tuple[TransferStrategy, ...] | None = None
+        ladder = self.motion == "sdar" and not quick
         if self.motion == "ompl":
             from streams.sampling import SampledStrategy
 
             strategies = (SampledStrategy(options=SamplingOptions(seed=self.seed)),)
+        elif self.motion == "sdar" and self.sampling:
+            strategies = warm_started_strategies(ladder, SamplingOptions(seed=self.seed))
         key = _motion_key(q1, q2, fluents)
-        ladder = self.motion == "sdar" and not quick
         if ladder and key in self._plain_failed:
             # the quick stream (the ladder's first rung alone, deterministic) failed on this
             # very motion: the ladder starts at its second rung
-            strategies = default_strategies()[1:]
+            strategies = (strategies or default_strategies())[1:]
         result = plan_dual_motion(
             self.planner,
             request,
@@ -473,6 +488,7 @@ def make_stream_map(
     reserved: Mapping[str, Pose2D] | None = None,
     motion: str = "sdar",
     grasps: GraspOptions = DEFAULT_GRASPS,
+    sampling: bool | None = None,
 ) -> dict[str, Callable[..., Any]]:
     """Bind every stream of ``stream.pddl`` by name (see the module docstring).
 
@@ -482,9 +498,12 @@ def make_stream_map(
     ``reserved``: poses buffers keep clear of (the goals); ``motion``: ``sdar`` (optimisation,
     untangling, one arm at a time), ``plain`` (optimisation only), ``sequential`` or ``ompl``
     (RRTConnect, shortcut; needs the ``ompl`` extra); ``grasps``: the grasp set of
-    ``sample-grasp``.
+    ``sample-grasp``; ``sampling``: with ``sdar``, a sampled path warm-starts the optimiser
+    when the straight line does not lead to a transfer (default: where OMPL is installed).
     """
-    s = DualArmStreams(world_context, sizes or {}, seed, planner, reserved, motion, grasps)
+    s = DualArmStreams(
+        world_context, sizes or {}, seed, planner, reserved, motion, grasps, sampling=sampling
+    )
     return {
         "sample-grasp": s.sample_grasp,
         "inverse-kinematics": s.inverse_kinematics,

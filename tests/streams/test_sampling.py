@@ -121,3 +121,96 @@ def test_missing_ompl_is_a_clear_error(
     q = np.concatenate([ctx.home(a) for a in ctx.arm_names])
     with pytest.raises(OmplUnavailableError, match=r"pip install 'sdar-tamp\[ompl\]'"):
         sample_path(planner, q, q + 0.1)
+
+
+@needs_ompl
+def test_a_sampled_path_warm_starts_the_optimiser(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    request = _blocked(objects)
+    configure_world(ctx, planner.world, objects, {}, BLOCKED_START)
+    configure_world(ctx, planner.margin_world, objects, {}, BLOCKED_START)
+    retreat, approach = planner.phases(request) or (None, None)
+    assert retreat is not None and approach is not None
+    problem = planner.transfer_problem(request, retreat[-1][-1], approach[0][0])
+    planner.sampled_paths = planner.ipopt_solves = 0
+    path = sampling.sampled_warm_start(planner, problem)
+    assert path is not None and planner.sampled_paths == 1 and planner.ipopt_solves == 1
+    assert path.shape == (planner.build.options.knots, len(BLOCKED_START))
+    np.testing.assert_allclose(path[[0, -1]], np.stack([problem.q_from, problem.q_to]))
+    # the optimised knots, not the sampled waypoints, and their timed curve is clear
+    assert sampling.checked_waypoints(planner, path, SamplingOptions().curve_samples) is not None
+    # no sampled path within the budget: nothing, and no optimisation
+    tiny = SamplingOptions(max_checks=1)
+    planner.sampled_paths = planner.ipopt_solves = 0
+    assert sampling.sampled_warm_start(planner, problem, tiny) is None
+    assert planner.sampled_paths == 0 and planner.ipopt_solves == 0
+
+
+class _StubPlanner:
+    """Records the warm starts the plain rung asks the optimiser for."""
+
+    def __init__(self, succeed_with: str) -> None:
+        self.succeed_with = succeed_with
+        self.calls: list[str] = []
+
+    def optimise(self, problem: object, q_a: object, q_b: object, warm_start: object = None,
+                 fixed: object = ()) -> np.ndarray | None:  # fmt: skip
+        kind = "straight" if warm_start is None else str(warm_start)
+        self.calls.append(kind)
+        return np.zeros((2, 12)) if kind == self.succeed_with else None
+
+    def lifted_via(self, q_a: object, q_b: object) -> str:
+        return "lifted"
+
+
+class _StubProblem:
+    q_from = np.zeros(12)
+    q_to = np.ones(12)
+
+
+@pytest.mark.parametrize(
+    ("rescue", "succeed_with", "calls"),
+    [
+        (True, "straight", ["straight"]),
+        (True, "sampled", ["straight", "sampled"]),
+        (True, "lifted", ["straight", "sampled", "lifted"]),
+        (True, "nothing", ["straight", "sampled", "lifted"]),
+        (False, "lifted", ["straight", "lifted"]),  # the ladder without OMPL
+    ],
+)
+def test_the_plain_rung_tries_its_rescue_between_straight_and_lifted(
+    rescue: bool, succeed_with: str, calls: list[str]
+) -> None:
+    from streams.motion import PlainStrategy
+
+    stub = _StubPlanner(succeed_with)
+
+    def sampled(planner: _StubPlanner, problem: object) -> np.ndarray | None:
+        return planner.optimise(problem, None, None, "sampled")
+
+    strategy = PlainStrategy(rescue=sampled if rescue else None)  # type: ignore[arg-type]
+    result = strategy(stub, _StubProblem())  # type: ignore[arg-type]
+    assert stub.calls == calls
+    assert (result is None) == (succeed_with == "nothing")
+
+
+def test_sdar_m_warm_starts_from_a_sampled_path_where_ompl_is_installed(
+    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from streams import stream_map
+    from streams.motion import PlainStrategy
+
+    ladder = sampling.warm_started_strategies(options=SamplingOptions(seed=3))
+    assert [s.name for s in ladder] == ["plain", "untangle", "sequential"]
+    first = ladder[0]
+    assert isinstance(first, PlainStrategy) and first.rescue is not None
+    assert first.rescue.keywords == {"options": SamplingOptions(seed=3)}  # type: ignore[attr-defined]
+    assert len(sampling.warm_started_strategies(fallbacks=False)) == 1
+    streams = stream_map.DualArmStreams(ctx, {}, planner=planner)
+    assert streams.sampling == sampling.ompl_available()
+    assert not stream_map.DualArmStreams(ctx, {}, planner=planner, sampling=False).sampling
+    monkeypatch.setattr(stream_map, "ompl_available", lambda: False)
+    assert not stream_map.DualArmStreams(ctx, {}, planner=planner).sampling
+    with pytest.raises(OmplUnavailableError, match=r"sampling=True: .*pip install"):
+        stream_map.DualArmStreams(ctx, {}, planner=planner, sampling=True)

@@ -170,13 +170,16 @@ def test_other_arm_needs_two_arms(ctx: WorldContext) -> None:
     assert three.split(np.arange(18.0))["middle"].tolist() == list(range(12, 18))
 
 
+@pytest.mark.parametrize("sampling", [False, True])
 def test_the_full_motion_skips_the_rung_the_quick_stream_failed(
-    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch, sampling: bool
 ) -> None:
     """The quick stream is the ladder's first rung alone (deterministic): after it failed on
     a motion, the full stream starts that same motion at the second rung."""
     import streams.stream_map as stream_map
 
+    if sampling and not stream_map.ompl_available():
+        pytest.skip("OMPL not installed")
     calls: list[tuple[bool, tuple[str, ...] | None]] = []
 
     def failing(planner: Any, request: Any, fallbacks: bool = True, sequential_only: bool = False,
@@ -186,7 +189,7 @@ def test_the_full_motion_skips_the_rung_the_quick_stream_failed(
                             reason="plain: optimisation failed")  # fmt: skip
 
     monkeypatch.setattr(stream_map, "plan_dual_motion", failing)
-    sm = make_stream_map(ctx, planner=planner)
+    sm = make_stream_map(ctx, planner=planner, sampling=sampling)
     home = [ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in ctx.arm_names]
     d1 = DualConf(*home)
     d2 = DualConf(ArmConf(home[0].arm, tuple(x + 0.1 for x in home[0].q)), home[1])
@@ -195,4 +198,8 @@ def test_the_full_motion_skips_the_rung_the_quick_stream_failed(
     assert not list(sm["plan-dual-motion-quick"](d1, d2, here))
     assert not list(sm["plan-dual-motion"](d1, d2, here))
     assert not list(sm["plan-dual-motion"](d1, d2, there))  # another motion: the whole ladder
-    assert calls == [(False, None), (True, ("untangle", "sequential")), (True, None)]
+    if sampling:  # the ladder is passed: its first rung has the sampled warm start
+        ladder = ("plain", "untangle", "sequential")
+        assert calls == [(False, ("plain",)), (True, ladder[1:]), (True, ladder)]
+    else:
+        assert calls == [(False, None), (True, ("untangle", "sequential")), (True, None)]
