@@ -72,7 +72,7 @@ def hard_set(instance: str, seed: int, count: int) -> None:
     ladder = DualMotionPlanner(ctx)
     alone = DualMotionPlanner(ctx, direct=False)
     planners = {
-        "optimiser": (alone, (PlainStrategy(lifted_warm_start=False, sampled_warm_start=False),)),
+        "optimiser": (alone, (PlainStrategy(lifted_warm_start=False),)),
         "ompl": (ladder, (SampledStrategy(),)),
         "ladder": (ladder, sampled_strategies()),
         "sdar-m": (ladder, warm_started_strategies()),
