@@ -17,7 +17,7 @@ Prints a line per 20 segments, then one JSON object on the last line.
 
 ``--hard N``: instead, N transfers whose straight joint-space line collides, for one arm
 (the other waits at home) and for both arms (N each): each arm goes from a grasp of one
-resting object to a grasp of another (retreat and approach included). Three motion planners
+resting object to a grasp of another (retreat and approach included). Four motion planners
 side by side on the same requests: the optimiser alone (no direct paths, no fallbacks), the
 OMPL stream alone (RRTConnect, shortcut), the ladder with a sampled first rung (direct paths,
 sampled path refined by the optimiser, untangling, one arm at a time) and SDAR-M's own ladder
