@@ -231,19 +231,12 @@ class SampledStrategy:
             if direct is not None:
                 planner.direct_paths += 1
                 return [planner.refine_direct(problem, direct)]
-        W = sample_path(planner, problem.q_from, problem.q_to, self.options)
-        planner.sampled_paths += int(W is not None)
-        W = None if W is None else checked_waypoints(planner, W, self.options.curve_samples)
+        W = _checked_sample(planner, problem, self.options)
         if W is None:
             return None
         if self.refine:
-            warm = planner.warm_start_along(W)
-            refined = planner.optimise(problem, problem.q_from, problem.q_to, warm)
-            if (
-                refined is not None
-                and _duration(planner, refined) < _duration(planner, W)
-                and checked_waypoints(planner, refined, self.options.curve_samples) is not None
-            ):
+            refined = _optimised_along(planner, problem, W, self.options)
+            if refined is not None and _duration(planner, refined) < _duration(planner, W):
                 return [refined]
         return [W]
 
@@ -256,13 +249,26 @@ def sampled_warm_start(
     timed curve passes the same check; None otherwise. The first rung of SDAR-M's ladder
     (:class:`streams.motion.PlainStrategy`) tries it after the straight line."""
     o = options or SamplingOptions()
+    W = _checked_sample(planner, problem, o)
+    return None if W is None else _optimised_along(planner, problem, W, o)
+
+
+def _checked_sample(
+    planner: DualMotionPlanner, problem: TransferProblem, o: SamplingOptions
+) -> FloatArray | None:
+    """A sampled path for ``problem`` (counted in ``planner.sampled_paths``) whose timed curve
+    passes the exact check (:func:`checked_waypoints`), or None."""
     W = sample_path(planner, problem.q_from, problem.q_to, o)
     planner.sampled_paths += int(W is not None)
-    W = None if W is None else checked_waypoints(planner, W, o.curve_samples)
-    if W is None:
-        return None
-    warm = planner.warm_start_along(W)
-    path = planner.optimise(problem, problem.q_from, problem.q_to, warm)
+    return None if W is None else checked_waypoints(planner, W, o.curve_samples)
+
+
+def _optimised_along(
+    planner: DualMotionPlanner, problem: TransferProblem, W: FloatArray, o: SamplingOptions
+) -> FloatArray | None:
+    """The optimiser's path warm-started along ``W``, if it succeeds and its timed curve
+    passes the same check; else None."""
+    path = planner.optimise(problem, problem.q_from, problem.q_to, planner.warm_start_along(W))
     if path is None or checked_waypoints(planner, path, o.curve_samples) is None:
         return None
     return path

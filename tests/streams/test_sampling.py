@@ -36,16 +36,24 @@ def _blocked(objects: dict[str, ObjectBox]) -> MotionRequest:
                          approach=(True, True), lift=0.08)  # fmt: skip
 
 
-@needs_ompl
-def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
+def _blocked_transfer(
     ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
-) -> None:
+) -> tuple[MotionRequest, np.ndarray, np.ndarray]:
+    """The blocked request with both worlds configured, and its transfer's ends (after the
+    retreat, before the approach)."""
     request = _blocked(objects)
     configure_world(ctx, planner.world, objects, {}, BLOCKED_START)
     configure_world(ctx, planner.margin_world, objects, {}, BLOCKED_START)
     retreat, approach = planner.phases(request) or (None, None)
     assert retreat is not None and approach is not None
-    q_a, q_b = retreat[-1][-1], approach[0][0]
+    return request, retreat[-1][-1], approach[0][0]
+
+
+@needs_ompl
+def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
+    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+) -> None:
+    _, q_a, q_b = _blocked_transfer(ctx, planner, objects)
     straight = np.linspace(0.0, 1.0, 30)[:, None] * (q_b - q_a)[None] + q_a[None]
     assert not validate_trajectory(ctx, planner.world, straight).ok
     W = sample_path(planner, q_a, q_b)
@@ -127,12 +135,8 @@ def test_missing_ompl_is_a_clear_error(
 def test_a_sampled_path_warm_starts_the_optimiser(
     ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
-    request = _blocked(objects)
-    configure_world(ctx, planner.world, objects, {}, BLOCKED_START)
-    configure_world(ctx, planner.margin_world, objects, {}, BLOCKED_START)
-    retreat, approach = planner.phases(request) or (None, None)
-    assert retreat is not None and approach is not None
-    problem = planner.transfer_problem(request, retreat[-1][-1], approach[0][0])
+    request, q_a, q_b = _blocked_transfer(ctx, planner, objects)
+    problem = planner.transfer_problem(request, q_a, q_b)
     planner.sampled_paths = planner.ipopt_solves = 0
     path = sampling.sampled_warm_start(planner, problem)
     assert path is not None and planner.sampled_paths == 1 and planner.ipopt_solves == 1
