@@ -145,26 +145,39 @@ def build_scene_geometry(
         geometry.addGeometryObject(
             pin.GeometryObject(f"held:{name}", arms.wrist_joint[arm], placement, _coal.box(size))
         )
-    # one pass over the names (indexing geometryObjects copies a Python proxy per access)
+    # pairs, names and margins as index matrices: one C++ call each instead of a Python
+    # loop over hundreds of pairs (indexing geometryObjects copies a Python proxy per access)
     all_names = [str(obj.name) for obj in geometry.geometryObjects]
     ids = {name: k for k, name in enumerate(all_names)}
-    for a, b in pairs:
-        geometry.addCollisionPair(pin.CollisionPair(ids[a], ids[b]))
-    names = tuple((all_names[p.first], all_names[p.second]) for p in geometry.collisionPairs)
+    n = len(all_names)
+    first = np.array([ids[a] for a, _ in pairs], dtype=np.intp)
+    second = np.array([ids[b] for _, b in pairs], dtype=np.intp)
+    active = np.zeros((n, n), dtype=bool)
+    active[np.minimum(first, second), np.maximum(first, second)] = True
+    geometry.setCollisionPairs(active, True)
+    flipped = np.zeros((n, n), dtype=bool)  # named the other way round in ``pairs``
+    flipped[second, first] = first > second
+    rows, cols = np.nonzero(active)  # row-major: the order the pairs were added in
+    names = tuple(
+        (all_names[j], all_names[i]) if flipped[i, j] else (all_names[i], all_names[j])
+        for i, j in zip(rows.tolist(), cols.tolist(), strict=True)
+    )
     data = geometry.createData()
     if arm_margin > 0.0:
-        owner = [_arm_of(a, arms) for a in all_names]
-        for k, p in enumerate(geometry.collisionPairs):
-            first, second = owner[p.first], owner[p.second]
-            if first is not None and second is not None and first != second:
-                data.collisionRequests[k].security_margin = arm_margin
+        owner = np.array([_arm_index(a, arms) for a in all_names])
+        margins = np.where(
+            active & (owner[:, None] >= 0) & (owner[None, :] >= 0)
+            & (owner[:, None] != owner[None, :]),
+            arm_margin, 0.0,
+        )  # fmt: skip
+        data.setSecurityMargins(geometry, margins, True, False)
     manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(arms.model, geometry, data)
     return SceneGeometry(geometry, data, manager, names)
 
 
-def _arm_of(shape: str, arms: DualArmModel) -> str | None:
-    """The arm a link or gripper shape belongs to (its name's prefix), else None."""
-    return next((arm for arm in arms.wrist_joint if shape.startswith(f"{arm}_")), None)
+def _arm_index(shape: str, arms: DualArmModel) -> int:
+    """The index of the arm a link or gripper shape belongs to (its name's prefix), else -1."""
+    return next((k for k, arm in enumerate(arms.wrist_joint) if shape.startswith(f"{arm}_")), -1)
 
 
 def any_collision(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> bool:

@@ -93,3 +93,21 @@ def test_chords_beside_a_close_sample_are_checked_finely(ctx: WorldContext) -> N
     assert not report.ok and report.reason == "collision" and report.index == 0
     far = _Band(5.0, 6.0)  # no sample close: no fine check, the graze stays unseen
     assert validate_trajectory(ctx, world, traj, max_tcp_step=10.0, near=far).ok  # type: ignore[arg-type]
+
+
+def test_samples_free_with_the_safety_distance_are_not_queried_again(ctx: WorldContext) -> None:
+    """``near`` holds every collision of ``world`` (it adds a distance): a sample free there
+    costs one query; a sample close in ``near`` is decided by ``world``."""
+    q0 = _home12(ctx)
+    q0[0] = 0.0
+    q1 = q0.copy()
+    q1[0] = 1.0
+    traj = np.stack([q0, q1])
+    world, far = _Band(0.45, 0.55), _Band(5.0, 6.0)
+    report = validate_trajectory(ctx, world, traj, max_tcp_step=10.0, near=far)  # type: ignore[arg-type]
+    assert report.ok and report.checks == 2
+    assert world.queries == 0 and far.queries == 2
+    hit, around = _Band(0.9, 1.1), _Band(0.8, 1.2)  # q1 collides in both worlds
+    report = validate_trajectory(ctx, hit, traj, max_tcp_step=10.0, near=around)  # type: ignore[arg-type]
+    assert not report.ok and report.reason == "collision" and report.index == 1
+    assert hit.queries == 1 and around.queries == 2

@@ -238,6 +238,26 @@ def test_pair_names_follow_the_pairs_activated(scene: Scene) -> None:
     assert len(names) == len(world._pairs())
 
 
+def test_pair_names_are_aligned_with_the_geometry_pairs(scene: Scene, kins: dict) -> None:
+    """``pair_names[k]`` names the shapes of the ``k``-th pair of the geometry (the index
+    :func:`colliding_pairs` reports), each pair oriented as :meth:`_pairs` lists it."""
+    world = CollisionWorld(scene, arm_margin=0.002)
+    world.set_objects({"o": _box(-0.2, 0.0), "p": _box(0.2, 0.1)})
+    world.attach("left", "o")
+    world.in_collision()
+    geometry = world._geometry  # type: ignore[union-attr]
+    assert geometry is not None
+    objects = geometry.geometry.geometryObjects
+    for k, pair in enumerate(geometry.geometry.collisionPairs):
+        shapes = {str(objects[pair.first].name), str(objects[pair.second].name)}
+        assert set(geometry.pair_names[k]) == shapes
+    assert set(geometry.pair_names) == set(world._pairs())
+    margins = [r.security_margin for r in geometry.data.collisionRequests]
+    for (a, b), margin in zip(geometry.pair_names, margins, strict=True):
+        two_arms = {a.split("_")[0], b.split("_")[0]} == {"left", "right"}
+        assert margin == (0.002 if two_arms else 0.0), (a, b)
+
+
 def test_base_pose_is_a_copy(scene: Scene) -> None:
     arm = scene.arms[0]
     T = arm.T_world_base
