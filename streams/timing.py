@@ -65,15 +65,46 @@ def natural_spline(s: FloatArray, y: FloatArray) -> FloatArray:
     if N < 3:
         return M
     h = np.diff(s)
-    A = np.zeros((N - 2, N - 2))
-    idx = np.arange(N - 2)
-    A[idx, idx] = 2.0 * (h[:-1] + h[1:])
-    A[idx[1:], idx[:-1]] = h[1:-1]
-    A[idx[:-1], idx[1:]] = h[1:-1]
     d = np.diff(y, axis=0) / h[:, None]
-    rhs = 6.0 * (d[1:] - d[:-1])
-    M[1:-1] = np.linalg.solve(A, rhs)
+    M[1:-1] = tridiagonal_solve(h[1:-1], 2.0 * (h[:-1] + h[1:]), 6.0 * (d[1:] - d[:-1]))
     return M
+
+
+def tridiagonal_solve(off: FloatArray, diag: FloatArray, rhs: FloatArray) -> FloatArray:
+    """``X`` ``(m, n)`` with ``A X = rhs`` for the symmetric tridiagonal ``A`` of diagonal
+    ``diag`` ``(m,)`` and off-diagonal ``off`` ``(m - 1,)``, diagonally dominant (a spline's
+    system): Gaussian elimination without pivoting in O(m). The pivots are a scalar loop; the
+    two sweeps over the right-hand sides are first-order linear recurrences, each evaluated
+    as a parallel prefix in log2(m) array operations (the products of the recurrence's
+    coefficients, all of modulus below one, only shrink)."""
+    m = len(diag)
+    d, o = diag.tolist(), off.tolist()
+    pivot, ratio = [0.0] * m, [0.0] * m  # ratio[i]: off[i] / pivot[i], the back sweep's
+    pivot[0] = d[0]
+    for i in range(1, m):
+        ratio[i - 1] = o[i - 1] / pivot[i - 1]
+        pivot[i] = d[i] - o[i - 1] * ratio[i - 1]
+    p = np.array(pivot)
+    forward = np.zeros(m)
+    forward[1:] = -off / p[1:]
+    z = _linear_recurrence(forward, rhs / p[:, None])  # z_i = rhs_i / p_i - off z_{i-1} / p_i
+    backward = -np.array(ratio)[::-1]  # x_i = z_i - ratio_i x_{i+1}, from the last row
+    out: FloatArray = _linear_recurrence(backward, z[::-1])[::-1]
+    return out
+
+
+def _linear_recurrence(a: FloatArray, b: FloatArray) -> FloatArray:
+    """``x`` ``(m, n)`` with ``x_0 = b_0`` and ``x_i = a_i x_{i-1} + b_i`` (Hillis-Steele
+    prefix: after the pass of stride ``k`` each ``x_i`` holds the sum over its last ``2k``
+    terms and ``p_i`` the product of their coefficients)."""
+    x, p = np.array(b, dtype=np.float64), np.array(a, dtype=np.float64)
+    p[0] = 0.0
+    k = 1
+    while k < len(p):
+        x[k:] = x[k:] + p[k:, None] * x[:-k]
+        p[k:] = p[k:] * p[:-k]
+        k *= 2
+    return x
 
 
 def spline_eval(

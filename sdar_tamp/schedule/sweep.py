@@ -18,7 +18,7 @@ import numpy as np
 
 from sdar_tamp.plan_file import PlanEvent
 from sdar_tamp.plan_rules import STILL_TOL
-from sdar_tamp.replay import POS_TOL, contact_allowed, tcp_subdivisions
+from sdar_tamp.replay import POS_TOL, contact_allowed, interval_subdivisions
 from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Instance
@@ -32,6 +32,9 @@ SWEEP_GEOMETRIES = 16
 #: Arrangements whose collision answers the sweep remembers (by configuration): each placement
 #: attempt replays the same stretches, so about three checks in four repeat an earlier one.
 SWEEP_MEMOS = 32
+#: Intervals whose replay subdivision the sweep remembers (by their two ends; about 0.3 kB
+#: each): the stretches replayed again share most of their intervals.
+SWEEP_INTERVALS = 50_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,6 +71,8 @@ class WorldSweep:
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
         self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
         self.checks = 0
+        self._columns = {a: scene.layout.slice(a) for a in self.names}
+        self._intervals: dict[bytes, int] = {}
         self._memos: OrderedDict[Hashable, dict[bytes, bool]] = OrderedDict()
         self._memo: dict[bytes, bool] | None = None  # the current arrangement's; None: unknown
 
@@ -91,9 +96,7 @@ class WorldSweep:
     def run(self, k0: int, q: FloatArray, events: Sequence[TimedEvent]) -> Conflict | None:
         """Check the configurations ``q`` ``(m, dof)`` at ticks ``k0 .. k0 + m - 1`` and the
         ``events`` among them (in time order); the first conflict, or None."""
-        counts = (
-            tcp_subdivisions(q, self.kins, self.scene_layout, self.step) if len(q) > 1 else None
-        )
+        counts = self.subdivisions(q) if len(q) > 1 else None
         pending = list(events)
         for k in range(len(q)):
             group = [e for e in pending if e.tick <= k0 + k]
@@ -108,18 +111,39 @@ class WorldSweep:
             if found is not None:
                 return found
             if counts is not None and k + 1 < len(q):
-                n = int(counts[k])
+                n = counts[k]
                 for s in range(1, n):
                     found = self.collide(q[k] + (q[k + 1] - q[k]) * (s / n), k0 + k)
                     if found is not None:
                         return found
         return None
 
+    def subdivisions(self, q: FloatArray) -> list[int]:
+        """The replay's subdivision of every interval of ``q`` ``(m, dof)``
+        (:func:`~sdar_tamp.replay.tcp_subdivisions`), remembered by interval."""
+        q = np.ascontiguousarray(q, dtype=np.float64)
+        width = q.shape[1] * q.itemsize
+        raw = q.tobytes()
+        keys = [raw[k * width : (k + 2) * width] for k in range(len(q) - 1)]
+        known = self._intervals
+        missing = [k for k, key in enumerate(keys) if key not in known]
+        if missing:
+            if len(known) + len(missing) > SWEEP_INTERVALS:
+                known.clear()
+                missing = list(range(len(keys)))
+            rows = np.array(missing)
+            counts = interval_subdivisions(
+                q[rows], q[rows + 1], self.kins, self.scene_layout, self.step
+            )
+            known.update(zip((keys[k] for k in missing), counts.tolist(), strict=True))
+        return [known[key] for key in keys]
+
     def collide(self, q: FloatArray, tick: int) -> Conflict | None:
         self.checks += 1
-        for arm, (_, q_event) in list(self.exempt.items()):
-            if np.abs(self.scene_layout.part(q, arm) - q_event).max() > STILL_TOL:
-                del self.exempt[arm]
+        if self.exempt:
+            for arm, (_, q_event) in list(self.exempt.items()):
+                if np.abs(q[self._columns[arm]] - q_event).max() > STILL_TOL:
+                    del self.exempt[arm]
         if not self._in_collision(q):
             return None
         pairs = [p for p in self.world.report(q) if not self.allowed(p)]

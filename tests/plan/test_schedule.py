@@ -17,8 +17,9 @@ from sdar_tamp.app.execution import execution_options, schedule_and_validate, sc
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile, load_plan, save_plan
 from sdar_tamp.plan_rules import STILL_TOL, check_timeline
-from sdar_tamp.replay import ReplayReport, validate_plan
+from sdar_tamp.replay import ReplayReport, tcp_subdivisions, validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
+from sdar_tamp.schedule import sweep as sweep_module
 from sdar_tamp.schedule.pieces import arm_blocks, arm_columns, on_ticks
 from sdar_tamp.schedule.scheduler import Schedule, _Placement, groups
 from sdar_tamp.schedule.spline import ClampedSpline, retime
@@ -391,3 +392,25 @@ def test_the_sweep_remembers_collision_answers_per_arrangement(
     sweep.reset([])  # back to the first arrangement: its answers are remembered
     assert sweep.collide(q, 0) == first
     assert len(asked) == 2
+
+
+def test_the_sweep_subdivides_as_the_replay_and_remembers_intervals(uneven: Solved) -> None:
+    """The sweep's subdivision of a stretch is the replay's (:func:`tcp_subdivisions`), also
+    for a stretch overlapping one replayed before (its intervals then come from memory), and
+    once the memory is full and starts again."""
+    scene = uneven.ctx.scene
+    sweep = WorldSweep(uneven.instance, scene, 0.005)
+    q = uneven.plan.q
+    for a, b in ((0, 120), (60, 200), (0, 200)):
+        stretch = q[a:b]
+        expected = tcp_subdivisions(stretch, sweep.kins, scene.layout, 0.005)
+        assert sweep.subdivisions(stretch) == expected.tolist()
+    assert len(sweep._intervals) == len({q[k : k + 2].tobytes() for k in range(199)})
+    small = sweep_module.SWEEP_INTERVALS
+    try:
+        sweep_module.SWEEP_INTERVALS = 150
+        expected = tcp_subdivisions(q[150:300], sweep.kins, scene.layout, 0.005)
+        assert sweep.subdivisions(q[150:300]) == expected.tolist()
+        assert len(sweep._intervals) <= 150
+    finally:
+        sweep_module.SWEEP_INTERVALS = small

@@ -9,6 +9,7 @@ from streams.timing import (
     spline_curve,
     spline_eval,
     time_parameterize,
+    tridiagonal_solve,
 )
 
 V = np.full(12, np.pi)
@@ -52,6 +53,33 @@ def test_spline_interpolates_waypoints() -> None:
     M = natural_spline(s, y)
     val, _, _ = spline_eval(s, y, M, s)
     np.testing.assert_allclose(val, y, atol=1e-12)
+
+
+@pytest.mark.parametrize("m", [1, 2, 3, 17, 64, 300])
+def test_tridiagonal_solve_agrees_with_a_dense_solve(m: int) -> None:
+    """The spline's system with uneven spacing (steps a thousand times apart), several
+    right-hand sides: the same solution as a dense solve, to rounding."""
+    rng = np.random.default_rng(m)
+    h = rng.uniform(0.001, 1.0, m + 1)
+    off, diag = h[1:-1], 2.0 * (h[:-1] + h[1:])
+    rhs = rng.normal(size=(m, 5))
+    dense = np.diag(diag) + np.diag(off, 1) + np.diag(off, -1)
+    np.testing.assert_allclose(tridiagonal_solve(off, diag, rhs), np.linalg.solve(dense, rhs),
+                               rtol=1e-9, atol=1e-12)  # fmt: skip
+
+
+def test_natural_spline_has_zero_curvature_at_its_ends_and_matches_slopes() -> None:
+    """Many uneven waypoints: second derivatives vanish at both ends and the first
+    derivative is continuous at every interior waypoint (what the tridiagonal system asks)."""
+    rng = np.random.default_rng(3)
+    s = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.5, 199))])
+    y = np.cumsum(rng.normal(size=(200, 3)), axis=0)
+    M = natural_spline(s, y)
+    assert np.abs(M[[0, -1]]).max() == 0.0
+    eps = 1e-9
+    _, left, _ = spline_eval(s, y, M, s[1:-1] - eps)
+    _, right, _ = spline_eval(s, y, M, s[1:-1] + eps)
+    np.testing.assert_allclose(left, right, atol=1e-5 * max(1.0, np.abs(left).max()))
 
 
 def test_single_point_is_a_zero_length_trajectory() -> None:
