@@ -66,8 +66,21 @@ def natural_spline(s: FloatArray, y: FloatArray) -> FloatArray:
         return M
     h = np.diff(s)
     d = np.diff(y, axis=0) / h[:, None]
-    M[1:-1] = tridiagonal_solve(h[1:-1], 2.0 * (h[:-1] + h[1:]), 6.0 * (d[1:] - d[:-1]))
+    off, diag, rhs = h[1:-1], 2.0 * (h[:-1] + h[1:]), 6.0 * (d[1:] - d[:-1])
+    if N - 2 <= DENSE_SPLINE:
+        A = np.diag(diag)
+        if N > 3:
+            A += np.diag(off, 1) + np.diag(off, -1)
+        M[1:-1] = np.linalg.solve(A, rhs)
+    else:
+        M[1:-1] = tridiagonal_solve(off, diag, rhs)
     return M
+
+
+#: Spline systems up to this size are solved densely (LAPACK is faster there, 0.05 ms at 50
+#: unknowns); larger ones by :func:`tridiagonal_solve` (0.7 ms at 500, where a dense solve
+#: takes 6 ms on an idle core and several times more beside another process).
+DENSE_SPLINE = 64
 
 
 def tridiagonal_solve(off: FloatArray, diag: FloatArray, rhs: FloatArray) -> FloatArray:
