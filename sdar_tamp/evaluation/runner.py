@@ -75,6 +75,7 @@ from sdar_tamp.evaluation.settings import (
     SETTINGS,
     BenchSettings,
     file_digest,
+    plan_extras,
     read_settings,
     reconcile,
     write_settings,
@@ -312,6 +313,7 @@ def run_bench(
         version=__version__, suite=suite_label(suite), seed=seed, time_limit_s=time_limit,
         workers=recorded_workers, instances={e.name: file_digest(e.path) for e in entries},
         backend=backend, shard=str(shard) if shard is not None else "",
+        extras=plan_extras(),
     )  # fmt: skip
     write_settings(out, reconcile(out, wanted, load_results(out)))
     done = finished_pairs(out)

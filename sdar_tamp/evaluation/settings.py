@@ -9,14 +9,22 @@ own settings are the same, and otherwise stops with one line naming every differ
 than silently mixing outcomes of different settings). Instances added by a later run are
 added to the record; an instance file whose content changed is a difference.
 
+The optional packages that change plans are part of the record too: SDAR-M's first rung
+warm-starts the optimiser from a sampled path where OMPL is installed (``extras``, e.g.
+``{"ompl": "2.0.1"}``; a missing package is ``"none"``), so a rerun on a machine without it
+would otherwise mix two motion ladders in one table.
+
 A folder written before the record existed is checked against the seed and time limit its
 rows hold, then gets a record. A record written before ``backend`` and ``shard`` existed
-reads as the process backend, unsharded.
+reads as the process backend, unsharded; one written before ``extras`` existed does not know
+them, and they are not compared.
 """
 
 from __future__ import annotations
 
 import hashlib
+import importlib.metadata
+import importlib.util
 import json
 import os
 from collections.abc import Iterable, Mapping, Sequence
@@ -28,6 +36,8 @@ from sdar_tamp.errors import SdarError
 
 SETTINGS = "settings.json"
 FORMAT = 1
+#: Optional packages whose presence changes plans (distribution name, import name).
+PLAN_EXTRAS: tuple[tuple[str, str], ...] = (("ompl", "ompl"),)
 
 
 class SettingsMismatch(SdarError):
@@ -41,7 +51,8 @@ class BenchSettings:
     ``suite``: a shipped suite name or the resolved path of a folder; ``time_limit_s`` [s];
     ``workers``: runs at once (0: one per CPU of the Ray cluster); ``backend``: ``process``
     or ``ray``; ``shard``: ``"i/N"`` for one shard of a sweep, ``""`` for all of it;
-    ``instances``: instance name -> SHA-256 of its file."""
+    ``instances``: instance name -> SHA-256 of its file; ``extras``: optional package ->
+    its version or ``"none"`` (:func:`plan_extras`; empty: not recorded)."""
 
     version: str
     suite: str
@@ -51,13 +62,30 @@ class BenchSettings:
     instances: Mapping[str, str] = field(default_factory=dict)
     backend: str = "process"
     shard: str = ""
+    extras: Mapping[str, str] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
         return dict(
             format=FORMAT, version=self.version, suite=self.suite, seed=self.seed,
             time_limit_s=self.time_limit_s, workers=self.workers, backend=self.backend,
-            shard=self.shard, instances=dict(sorted(self.instances.items())),
+            shard=self.shard, extras=dict(sorted(self.extras.items())),
+            instances=dict(sorted(self.instances.items())),
         )  # fmt: skip
+
+
+def plan_extras() -> dict[str, str]:
+    """The installed version of every optional package that changes plans
+    (:data:`PLAN_EXTRAS`), ``"none"`` for one that is not importable."""
+    found = {}
+    for dist, module in PLAN_EXTRAS:
+        version = "none"
+        if importlib.util.find_spec(module) is not None:
+            try:
+                version = importlib.metadata.version(dist)
+            except importlib.metadata.PackageNotFoundError:
+                version = "unknown version"
+        found[dist] = version
+    return found
 
 
 def file_digest(path: Path) -> str:
@@ -80,6 +108,7 @@ def read_settings(out_dir: Path) -> BenchSettings | None:
             time_limit_s=float(data["time_limit_s"]), workers=int(data["workers"]),
             instances={str(k): str(v) for k, v in dict(data["instances"]).items()},
             backend=str(data.get("backend", "process")), shard=str(data.get("shard", "")),
+            extras={str(k): str(v) for k, v in dict(data.get("extras", {})).items()},
         )  # fmt: skip
     except (ValueError, KeyError, TypeError, AttributeError) as error:
         raise SdarError(
@@ -122,6 +151,10 @@ def differences(old: BenchSettings, new: BenchSettings, *, shard: bool = True) -
     ]
     if shard:
         pairs.append(("shard", _shard(old.shard), _shard(new.shard)))
+    if old.extras and new.extras:  # an older record does not know them
+        for name in sorted(set(old.extras) | set(new.extras)):
+            then, now = old.extras.get(name, "none"), new.extras.get(name, "none")
+            pairs.append((name, then, now))
     found = [f"{name} {now} (the rows: {then})" for name, then, now in pairs if then != now]
     found += [
         f"instance {name} (file changed since its rows)"

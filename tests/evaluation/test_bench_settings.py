@@ -12,9 +12,10 @@ import pytest
 from sdar_tamp import __version__
 from sdar_tamp.cli import main
 from sdar_tamp.errors import SdarError
+from sdar_tamp.evaluation import settings
 from sdar_tamp.evaluation.results import COLUMNS, COMBINATIONS, RESULTS, append_rows, load_results
 from sdar_tamp.evaluation.runner import run_bench, suite_entries
-from sdar_tamp.evaluation.settings import SETTINGS
+from sdar_tamp.evaluation.settings import SETTINGS, plan_extras
 
 
 def _row(instance: str, combo: str, seed: int = 0, time_limit: float = 60.0) -> dict[str, Any]:
@@ -128,3 +129,28 @@ def test_run_bench_refuses_bad_numbers_before_writing(
     with pytest.raises(ParameterError, match=option):
         run_bench("paper", out, "sdar", progress=False, **{option: value})
     assert not out.exists()
+
+
+def test_the_optional_packages_that_change_plans_are_recorded_and_enforced(
+    tmp_path: Path,
+) -> None:
+    """A table made with OMPL installed is not extended on a machine without it (the motion
+    ladder differs), nor the other way round; a record from before ``extras`` is not
+    compared on them."""
+    append_rows(tmp_path / RESULTS, COLUMNS, [_row("R4", "sdar")])
+    run_bench("paper", tmp_path, "sdar", instances=["R4"], progress=False)
+    record = json.loads((tmp_path / SETTINGS).read_text())
+    assert record["extras"] == plan_extras() and set(record["extras"]) == {"ompl"}
+    other = "none" if record["extras"]["ompl"] != "none" else "2.0.1"
+    (tmp_path / SETTINGS).write_text(json.dumps(dict(record, extras={"ompl": other})))
+    with pytest.raises(SdarError, match=rf"ompl {record['extras']['ompl']} \(the rows: {other}\)"):
+        run_bench("paper", tmp_path, "sdar", instances=["R4"], progress=False)
+    older = {k: v for k, v in record.items() if k != "extras"}
+    (tmp_path / SETTINGS).write_text(json.dumps(older))
+    run_bench("paper", tmp_path, "sdar", instances=["R4"], progress=False)  # not compared
+    assert json.loads((tmp_path / SETTINGS).read_text())["extras"] == plan_extras()
+
+
+def test_plan_extras_name_a_missing_package_none(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(settings, "PLAN_EXTRAS", (("ompl", "no_such_module_here"),))
+    assert settings.plan_extras() == {"ompl": "none"}
