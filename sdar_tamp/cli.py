@@ -420,7 +420,10 @@ def build_parser() -> argparse.ArgumentParser:
         "bench", help="evaluate planner combinations on a suite", description=cmd_bench.__doc__
     )
     bench.add_argument(
-        "--suite", default="paper", help="paper, stress, dense or a folder of instances"
+        "--suite",
+        default="paper",
+        help="paper, stress, dense or a folder of instances (./NAME for a folder named like "
+        "a shipped suite)",
     )
     bench.add_argument(
         "-o", "--output", "--out", dest="out", type=Path, required=True, help="output folder"

@@ -38,6 +38,7 @@ from __future__ import annotations
 import argparse
 import functools
 import logging
+import os
 import re
 import shlex
 import shutil
@@ -106,18 +107,9 @@ def suite_entries(
 ) -> list[SuiteEntry]:
     """The instances of ``suite`` (a shipped suite name or a folder of instance YAML files),
     keeping the names in ``only`` (instance or file names) and at most ``max_objects``."""
-    from sdar_tamp.resources import domain_file
     from sdar_tamp.world.instance import load_instance
 
-    folder = Path(suite)
-    if not folder.is_dir():
-        shipped = domain_file("dual_arm_rearrangement").parent / "suites"
-        names = sorted(p.name for p in shipped.iterdir() if p.is_dir() and p.name[0] != "_")
-        if str(suite) not in names:
-            raise ParameterError(
-                f"suite must be a folder or one of {', '.join(names)}; got {suite!r}"
-            )
-        folder = shipped / str(suite)
+    folder, _ = suite_folder(suite)
     entries = []
     for path in sorted(folder.glob("*.yaml")):
         inst = load_instance(path)
@@ -139,10 +131,40 @@ def suite_entries(
     return sorted(entries, key=lambda e: (e.objects, instance_sort_key(e.name)))
 
 
+def suite_folder(suite: str | Path) -> tuple[Path, bool]:
+    """The folder of ``suite`` and whether it is a shipped suite.
+
+    A :class:`Path`, or a string with a path separator (``./paper``, ``/data/tables``), is a
+    folder. A bare name is the shipped suite of that name; a folder of that name in the
+    working directory is used only when no suite is shipped under it. A bare name that is
+    both a shipped suite and a folder of instance files here is refused as ambiguous (write
+    ``./name`` for the folder); a folder of that name without instance files (an earlier
+    ``--out``, say) does not hide the shipped suite."""
+    from sdar_tamp.resources import domain_file
+
+    shipped_root = domain_file("dual_arm_rearrangement").parent / "suites"
+    shipped = sorted(p.name for p in shipped_root.iterdir() if p.is_dir() and p.name[0] != "_")
+    text = str(suite)
+    bare = isinstance(suite, str) and "/" not in text and os.sep not in text
+    local = Path(text)
+    if bare and text in shipped:
+        if local.is_dir() and any(local.glob("*.yaml")):
+            raise ParameterError(
+                f"suite {text!r} is both a shipped suite and a folder of instances here; "
+                f"write ./{text} for the folder, or run from another directory for the "
+                "shipped suite"
+            )
+        return shipped_root / text, True
+    if local.is_dir():
+        return local, False
+    raise ParameterError(f"suite must be a folder or one of {', '.join(shipped)}; got {text!r}")
+
+
 def suite_label(suite: str | Path) -> str:
     """How the settings record names ``suite``: a folder by its resolved path, a shipped
     suite by its name."""
-    return str(Path(suite).resolve()) if Path(suite).is_dir() else str(suite)
+    folder, shipped = suite_folder(suite)
+    return str(suite) if shipped else str(folder.resolve())
 
 
 @dataclass(frozen=True)

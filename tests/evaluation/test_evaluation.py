@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,13 @@ from sdar_tamp.evaluation.results import (
     load_steps,
     parse_combos,
 )
-from sdar_tamp.evaluation.runner import finished_pairs, run_bench, suite_entries
+from sdar_tamp.evaluation.runner import (
+    finished_pairs,
+    run_bench,
+    suite_entries,
+    suite_folder,
+    suite_label,
+)
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -94,6 +101,30 @@ def test_suite_selection() -> None:
     with pytest.raises(ParameterError, match="suite must be"):
         suite_entries("no-such-suite")
     assert sorted(["M1", "R10", "S4", "R4"], key=instance_sort_key) == ["R4", "R10", "S4", "M1"]
+
+
+def test_a_folder_named_like_a_shipped_suite(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A bare name is the shipped suite, even beside a folder of that name without instances
+    (an earlier benchmark's output); beside a folder of instances it is ambiguous; written
+    as a path, the folder is used."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "paper").mkdir()
+    (tmp_path / "paper" / "report.md").write_text("an earlier --out\n")
+    shipped = suite_entries("paper", only=["R4"])
+    assert shipped[0].path.parent.name == "paper" and shipped[0].path.parent != tmp_path / "paper"
+    assert suite_folder("paper")[1] and suite_label("paper") == "paper"
+    shutil.copy(shipped[0].path, tmp_path / "paper" / "R4.yaml")
+    with pytest.raises(ParameterError, match=r"both a shipped suite and a folder.*\./paper"):
+        suite_entries("paper")
+    for local in ("./paper", Path("paper")):
+        (entry,) = suite_entries(local)
+        assert entry.path.resolve() == (tmp_path / "paper" / "R4.yaml").resolve()
+        assert suite_label(local) == str((tmp_path / "paper").resolve())
+    (tmp_path / "mine").mkdir()
+    shutil.copy(shipped[0].path, tmp_path / "mine" / "R4.yaml")
+    assert [e.name for e in suite_entries("mine")] == ["R4"]  # not shipped: the folder
 
 
 def test_resume_skips_finished_and_repairs(tmp_path: Path) -> None:
