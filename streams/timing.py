@@ -190,9 +190,18 @@ class _Vertices:
     A vertex is the intersection of two constraint lines. Those that do not involve the
     line ``x + 2 u ds = xn`` (row 2, the only one that changes during the pass) are
     computed once for every step (``x``, ``u`` ``(k, pairs)``, ``keep`` marks those inside
-    the fixed box rows); those on row 2 are computed per step (:meth:`max_x`)."""
+    the fixed box rows); those on row 2 are computed per step (:meth:`max_x`).
+
+    Where the path's tangent vanishes (a path that turns back on itself, such as a retreat
+    followed by the approach to the same grasp) no joint limits the speed and ``xv`` is
+    infinite: vertices on that line come out infinite or NaN (``inf * 0``) and fail the
+    checks, as they should, without a warning."""
 
     def __init__(self, G: FloatArray, h: FloatArray, xv: FloatArray) -> None:
+        with np.errstate(invalid="ignore"):
+            self._build(G, h, xv)
+
+    def _build(self, G: FloatArray, h: FloatArray, xv: FloatArray) -> None:
         self.G, self.h = G, h.copy()
         self.h[:, 0] = xv
         i, j = _pairs(G.shape[1])
@@ -216,6 +225,10 @@ class _Vertices:
     def max_x(self, k: int, xn: float) -> float:
         """Largest ``x`` over the vertices of step ``k``'s polygon with ``x + 2 u ds <= xn``
         that satisfy every constraint (0 when none does)."""
+        with np.errstate(invalid="ignore"):
+            return self._max_x(k, xn)
+
+    def _max_x(self, k: int, xn: float) -> float:
         G, h = self.G[k], self.h[k].copy()
         h[2] = xn
         sel = self.keep[k] & (self.w[k] <= xn + _SLACK)

@@ -1,3 +1,5 @@
+import warnings
+
 import numpy as np
 import pytest
 
@@ -174,3 +176,22 @@ def test_vertex_search_matches_plain_enumeration(seed: int) -> None:
         for xn in (0.0, 0.3, 2.0, 50.0):
             expected = _max_x_every_vertex(rows[step], a2, float(xv[step]), xn, ds)
             assert vertices.max_x(step, xn) == pytest.approx(expected, rel=1e-12, abs=1e-15)
+
+
+@pytest.mark.parametrize("amplitude", [0.1, 0.15, 0.25, 0.5])
+def test_a_path_that_turns_back_is_timed_without_warnings(amplitude: float) -> None:
+    """Out to a via configuration and back (a retreat, then the approach to the same grasp):
+    where the spline's tangent vanishes (on a grid point for 0.1, 0.25 and 0.5 rad) no joint
+    bounds the speed; the profile still starts, turns and ends at rest within the limits, and
+    numpy raises no warning."""
+    a = np.zeros(12)
+    b = a.copy()
+    b[1], b[2] = -amplitude, amplitude / 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        traj = time_parameterize(np.stack([a, b, a]), V, A)
+    vel, acc = _fd(traj.t, traj.q)
+    assert np.abs(vel).max() <= np.pi and np.abs(acc).max() <= 5.0 * 1.01
+    np.testing.assert_allclose(traj.q[[0, -1]], np.stack([a, a]), atol=1e-12)
+    turn = int(np.argmin(traj.q[:, 1]))
+    assert traj.q[turn, 1] == pytest.approx(-amplitude, abs=2e-3)
