@@ -3,7 +3,12 @@ fixtures: the world context and the motion planner."""
 
 from __future__ import annotations
 
+import importlib.util
 import os
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -42,3 +47,22 @@ def ctx() -> WorldContext:
 def planner(ctx: WorldContext) -> DualMotionPlanner:
     """The motion planner of ``ctx``: built once per test process (the optimiser with it)."""
     return DualMotionPlanner(ctx)
+
+
+@pytest.fixture(scope="session")
+def benchmark_script() -> Callable[[str], ModuleType]:
+    """Loads ``benchmarks/<name>.py`` as the module ``name`` (the benchmarks are scripts, not
+    a package), once per session."""
+    folder = Path(__file__).resolve().parents[1] / "benchmarks"
+
+    def load(name: str) -> ModuleType:
+        if name in sys.modules:
+            return sys.modules[name]
+        spec = importlib.util.spec_from_file_location(name, folder / f"{name}.py")
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+        return module
+
+    return load

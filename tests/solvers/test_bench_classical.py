@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import importlib.util
 import stat
-import sys
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 
@@ -15,15 +14,8 @@ DOMAINS = ROOT / "domains"
 
 
 @pytest.fixture(scope="module")
-def bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location(
-        "bench_classical", ROOT / "benchmarks" / "bench_classical.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["bench_classical"] = module
-    spec.loader.exec_module(module)
-    return module
+def bench(benchmark_script: Callable[[str], ModuleType]) -> ModuleType:
+    return benchmark_script("bench_classical")
 
 
 def _touch(folder: Path, *names: str) -> None:
