@@ -44,7 +44,7 @@ from streams.buffers import sample_buffers
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKCandidate, IKRequest, compatible_pairs, solve_ik_candidates
-from streams.motion import DualMotionPlanner, MotionRequest, plan_dual_motion
+from streams.motion import MotionPlanner, MotionRequest, plan_dual_motion
 from streams.validate import HeldObject, configure_world, validate_trajectory
 
 
@@ -69,8 +69,8 @@ def hard_set(instance: str, seed: int, count: int) -> None:
     names = list(objects)
     home = {a: ctx.home(a) for a in ctx.arm_names}
     world = ctx.new_world()
-    ladder = DualMotionPlanner(ctx)
-    alone = DualMotionPlanner(ctx, direct=False)
+    ladder = MotionPlanner(ctx)
+    alone = MotionPlanner(ctx, direct=False)
     planners = {
         "optimiser": (alone, (PlainStrategy(lifted_warm_start=False),)),
         "ompl": (ladder, (SampledStrategy(),)),
@@ -171,7 +171,7 @@ def main() -> None:
 
     ctx = WorldContext.load()
     t_build = time.perf_counter()
-    planner = DualMotionPlanner(ctx)
+    planner = MotionPlanner(ctx)
     build_time = time.perf_counter() - t_build
     inst = load_instance(domain_path(f"suites/paper/{args.instance}.yaml"))
     start = {o.name: _box(o.start.x, o.start.y, o.start.yaw, o.size) for o in inst.objects}

@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 from sdar_tamp.app.cache import PlannerCache
-from sdar_tamp.app.command import solve_instance
+from sdar_tamp.app.pipeline import solve_instance
 from sdar_tamp.app.records import SolveOutcome
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import load_instance
@@ -156,10 +156,10 @@ def compare_adaptive(time_limit: float) -> None:
     from sdar_tamp.world.scene import Workspace
     from solvers.solve import solve
     from streams.context import WorldContext
-    from streams.motion import DualMotionPlanner
+    from streams.motion import MotionPlanner
 
     ctx = WorldContext.load()
-    planner = DualMotionPlanner(ctx)
+    planner = MotionPlanner(ctx)
     size = (0.08, 0.04, 0.05)
     one = Instance(
         "one",

@@ -20,7 +20,7 @@ from sdar_tamp.world.generators import generate_instance
 from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.scene import load_scene
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw, top_down_pose
-from solvers.sdar.feedback import feedback_vertex_set
+from solvers.sdar.buffer_sets import feedback_vertex_set
 
 
 def _best_rate(fn: object, count: int, repeats: int = 5) -> float:

@@ -122,7 +122,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     is written to the working directory)."""
     import tempfile
 
-    from sdar_tamp.app.command import solve_instance
+    from sdar_tamp.app.pipeline import solve_instance
     from sdar_tamp.app.summary import ProgressBar, format_summary
     from sdar_tamp.plan_file import save_plan
     from sdar_tamp.resources import domain_file
@@ -161,8 +161,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
     write it (JSON, see the README). Exit status 0 only when solved and valid."""
     import dataclasses
 
-    from sdar_tamp.app.command import solve_instance
     from sdar_tamp.app.config import PlannerConfig
+    from sdar_tamp.app.pipeline import solve_instance
     from sdar_tamp.app.summary import ProgressBar, format_summary
     from sdar_tamp.plan_file import save_plan
 

@@ -63,9 +63,9 @@ from streams.spheres import object_spheres
 from streams.timing import TimedTrajectory, spline_curve, time_parameterize
 from streams.trajopt import (
     OPTIMISERS,
-    DualArmTrajOpt,
     OptimiserBuild,
     OptimiserCache,
+    TrajectoryOptimiser,
     TrajOptOptions,
     TransferQuery,
     straight_line,
@@ -129,7 +129,7 @@ class TransferStrategy(Protocol):
     def name(self) -> str: ...
 
     def __call__(
-        self, planner: DualMotionPlanner, problem: TransferProblem
+        self, planner: MotionPlanner, problem: TransferProblem
     ) -> list[FloatArray] | None: ...
 
 
@@ -155,13 +155,13 @@ DIRECT_LIFTS = (0.05, 0.12)
 #: Largest joint distance [rad] of a bent path's via configuration from the mid-point of its
 #: ends (farther: another IK branch, not a light bend).
 DIRECT_VIA_SPREAD = 1.0
-#: Whether a bent direct path is refined by the optimiser (see :class:`DualMotionPlanner`):
+#: Whether a bent direct path is refined by the optimiser (see :class:`MotionPlanner`):
 #: on the ``paper`` suite execution 805.0 -> 794.3 s in all (no instance longer), the same
 #: actions; on the hard transfers of ``bench_motion.py --hard`` one arm 1.73 -> 1.40 s.
 REFINE_BENT = True
 
 
-class DualMotionPlanner:
+class MotionPlanner:
     """Owns the optimiser and scratch collision worlds. The optimiser comes from
     ``optimisers`` (default: the process-wide :data:`streams.trajopt.OPTIMISERS`; built once
     per scene and options, in the background, so constructing a planner costs nothing and
@@ -193,7 +193,7 @@ class DualMotionPlanner:
         self.ctx = ctx
         cache = optimisers if optimisers is not None else OptimiserCache()
         self._build = cache.get(ctx, options)
-        self._trajopt: DualArmTrajOpt | None = None
+        self._trajopt: TrajectoryOptimiser | None = None
         self.world = ctx.new_world()
         self.margin_world = ctx.new_world(margin=direct_margin)
         self.near_world = ctx.new_world(arm_margin=ARM_CLEARANCE)
@@ -210,14 +210,14 @@ class DualMotionPlanner:
         self.sampled_paths = 0  # transfers found by sampling, per plan_dual_motion call
 
     @property
-    def trajopt(self) -> DualArmTrajOpt:
+    def trajopt(self) -> TrajectoryOptimiser:
         """The trajectory optimiser; the first access waits for its background build."""
         if self._trajopt is None:
             self._trajopt = self._build.get()
         return self._trajopt
 
     @trajopt.setter
-    def trajopt(self, value: DualArmTrajOpt) -> None:
+    def trajopt(self, value: TrajectoryOptimiser) -> None:
         self._trajopt = value
 
     @property
@@ -597,7 +597,7 @@ def _chain(paths: list[FloatArray]) -> list[FloatArray]:
 
 # -- strategies ---------------------------------------------------------------------------
 #: A further attempt at a transfer: the optimised path, or None.
-Rescue = Callable[["DualMotionPlanner", "TransferProblem"], "FloatArray | None"]
+Rescue = Callable[["MotionPlanner", "TransferProblem"], "FloatArray | None"]
 
 
 @dataclass(frozen=True)
@@ -614,9 +614,7 @@ class PlainStrategy:
     lifted_warm_start: bool = True
     rescue: Rescue | None = None
 
-    def __call__(
-        self, planner: DualMotionPlanner, problem: TransferProblem
-    ) -> list[FloatArray] | None:
+    def __call__(self, planner: MotionPlanner, problem: TransferProblem) -> list[FloatArray] | None:
         path = planner.optimise(problem, problem.q_from, problem.q_to)
         if path is None and self.rescue is not None:
             path = self.rescue(planner, problem)
@@ -633,9 +631,7 @@ class UntangleStrategy:
     name: str = "untangle"
     park_height: float = 0.30  # [m]
 
-    def __call__(
-        self, planner: DualMotionPlanner, problem: TransferProblem
-    ) -> list[FloatArray] | None:
+    def __call__(self, planner: MotionPlanner, problem: TransferProblem) -> list[FloatArray] | None:
         ctx = planner.ctx
         order = np.argsort(-planner.depth(problem.q_from))
         n = len(ctx.layout)
@@ -662,9 +658,7 @@ class SequentialStrategy:
 
     name: str = "sequential"
 
-    def __call__(
-        self, planner: DualMotionPlanner, problem: TransferProblem
-    ) -> list[FloatArray] | None:
+    def __call__(self, planner: MotionPlanner, problem: TransferProblem) -> list[FloatArray] | None:
         ctx = planner.ctx
         layout = ctx.layout
         n = len(layout)
@@ -693,9 +687,7 @@ class OneArmStrategy:
 
     name: str = "one-arm"
 
-    def __call__(
-        self, planner: DualMotionPlanner, problem: TransferProblem
-    ) -> list[FloatArray] | None:
+    def __call__(self, planner: MotionPlanner, problem: TransferProblem) -> list[FloatArray] | None:
         ctx = planner.ctx
         layout = ctx.layout
         n = len(layout)
@@ -736,7 +728,7 @@ def default_strategies(
 
 
 def _clear_phases(
-    planner: DualMotionPlanner, request: MotionRequest, one_at_a_time: bool
+    planner: MotionPlanner, request: MotionRequest, one_at_a_time: bool
 ) -> tuple[list[FloatArray], list[FloatArray]] | str:
     """Retreat and approach that are collision-free on their own (every strategy shares
     them): synchronised, else one arm after the other; or why there are none."""
@@ -760,7 +752,7 @@ def _clear_phases(
 
 
 def plan_dual_motion(
-    planner: DualMotionPlanner,
+    planner: MotionPlanner,
     request: MotionRequest,
     fallbacks: bool = True,
     sequential_only: bool = False,

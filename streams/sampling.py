@@ -2,7 +2,7 @@
 
 An optional extra (``pip install sdar-tamp[ompl]``). The planner samples both arms' joints
 within their limits; a state is valid when the planner's ``margin_world`` (resting and held
-objects grown by the direct-path margin, see :class:`streams.motion.DualMotionPlanner`)
+objects grown by the direct-path margin, see :class:`streams.motion.MotionPlanner`)
 reports no collision, and OMPL checks edges every ``resolution`` [rad] of joint-space
 length. The path found is shortcut by OMPL's simplifier, then the curve that
 :func:`streams.timing.time_parameterize` follows through its waypoints is checked exactly
@@ -36,7 +36,7 @@ import numpy as np
 from sdar_tamp.errors import ParameterError, SdarError
 from sdar_tamp.world.transforms import FloatArray
 from streams.motion import (
-    DualMotionPlanner,
+    MotionPlanner,
     PlainStrategy,
     SequentialStrategy,
     TransferProblem,
@@ -101,7 +101,7 @@ def _ompl() -> tuple[Any, Any, Any]:
 
 
 def sample_path(
-    planner: DualMotionPlanner,
+    planner: MotionPlanner,
     q_a: FloatArray,
     q_b: FloatArray,
     options: SamplingOptions | None = None,
@@ -204,7 +204,7 @@ def _state(space: Any, q: FloatArray, free: Any) -> Any:
     return state
 
 
-def checked_waypoints(planner: DualMotionPlanner, W: FloatArray, samples: int) -> FloatArray | None:
+def checked_waypoints(planner: MotionPlanner, W: FloatArray, samples: int) -> FloatArray | None:
     """``W`` (or ``W`` densified) whose timed curve passes the exact check in
     ``planner.margin_world``; None if neither does."""
     for waypoints in (W, densify(W, 4)):
@@ -223,9 +223,7 @@ class SampledStrategy:
     options: SamplingOptions = SamplingOptions()
     refine: bool = False
 
-    def __call__(
-        self, planner: DualMotionPlanner, problem: TransferProblem
-    ) -> list[FloatArray] | None:
+    def __call__(self, planner: MotionPlanner, problem: TransferProblem) -> list[FloatArray] | None:
         if self.refine and planner.direct:
             direct = planner.direct_path(problem.q_from, problem.q_to)
             if direct is not None:
@@ -242,7 +240,7 @@ class SampledStrategy:
 
 
 def sampled_warm_start(
-    planner: DualMotionPlanner, problem: TransferProblem, options: SamplingOptions | None = None
+    planner: MotionPlanner, problem: TransferProblem, options: SamplingOptions | None = None
 ) -> FloatArray | None:
     """The optimiser's transfer warm-started from a sampled path (:func:`sample_path`, its
     timed curve checked), kept only when the optimiser succeeds and the optimised path's
@@ -254,7 +252,7 @@ def sampled_warm_start(
 
 
 def _checked_sample(
-    planner: DualMotionPlanner, problem: TransferProblem, o: SamplingOptions
+    planner: MotionPlanner, problem: TransferProblem, o: SamplingOptions
 ) -> FloatArray | None:
     """A sampled path for ``problem`` (counted in ``planner.sampled_paths``) whose timed curve
     passes the exact check (:func:`checked_waypoints`), or None."""
@@ -264,7 +262,7 @@ def _checked_sample(
 
 
 def _optimised_along(
-    planner: DualMotionPlanner, problem: TransferProblem, W: FloatArray, o: SamplingOptions
+    planner: MotionPlanner, problem: TransferProblem, W: FloatArray, o: SamplingOptions
 ) -> FloatArray | None:
     """The optimiser's path warm-started along ``W``, if it succeeds and its timed curve
     passes the same check; else None."""
@@ -285,7 +283,7 @@ def warm_started_strategies(
     return (plain,) if not fallbacks else (plain, UntangleStrategy(), SequentialStrategy())
 
 
-def _duration(planner: DualMotionPlanner, path: FloatArray) -> float:
+def _duration(planner: MotionPlanner, path: FloatArray) -> float:
     v, a = planner.limits
     return time_parameterize(path, v, a).duration
 

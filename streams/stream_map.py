@@ -10,7 +10,7 @@ another callable with the same signature to swap a stream.
 
 Values: objects are names (str); poses are :class:`sdar_tamp.world.instance.Pose2D`; grasps
 are :class:`streams.grasps.Grasp`; arm configurations :class:`ArmConf`; dual-arm
-configurations :class:`DualConf`; trajectories :class:`streams.motion.MotionResult`.
+configurations :class:`CellConf`; trajectories :class:`streams.motion.MotionResult`.
 Fluent facts (``atpose ?o ?p``, ``holding ?a ?o ?g``) arrive as tuples in ``fluents=``.
 """
 
@@ -30,13 +30,13 @@ from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
-from streams.blocking import GraspBlocking, gripper_boxes
 from streams.buffers import GRASP_CORRIDOR, BufferPool
 from streams.context import WorldContext
+from streams.finger_blocking import GraspBlocking, gripper_boxes
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, half_turn_twins, sample_grasps
 from streams.ik import GraspIK, SceneCache, collision_free_candidates
 from streams.motion import (
-    DualMotionPlanner,
+    MotionPlanner,
     MotionRequest,
     MotionResult,
     TransferStrategy,
@@ -85,14 +85,14 @@ class ArmConf:
 
 
 @dataclass(frozen=True, init=False)
-class DualConf:
-    """A configuration of every arm, in the scene's arm order: ``DualConf(first, second)``."""
+class CellConf:
+    """A configuration of every arm, in the scene's arm order: ``CellConf(first, second)``."""
 
     arms: tuple[ArmConf, ...]
 
     def __init__(self, *arms: ArmConf) -> None:
         if not arms:
-            raise ParameterError("DualConf: expected one ArmConf per arm, got none")
+            raise ParameterError("CellConf: expected one ArmConf per arm, got none")
         object.__setattr__(self, "arms", tuple(arms))
 
     @property
@@ -127,7 +127,7 @@ BUFFER_MARGIN = 0.01
 MOTION_PLANNERS = ("sdar", "plain", "sequential", "ompl")
 
 
-class DualArmStreams:
+class RearrangementStreams:
     """The streams of one problem: sizes of the objects, a seed, and a shared planner.
 
     ``reserved``: object name -> pose whose footprint buffers must avoid (the goals), unless
@@ -144,7 +144,7 @@ class DualArmStreams:
         ctx: WorldContext,
         sizes: Mapping[str, Size],
         seed: int = 0,
-        planner: DualMotionPlanner | None = None,
+        planner: MotionPlanner | None = None,
         reserved: Mapping[str, Pose2D] | None = None,
         motion: str = "sdar",
         grasps: GraspOptions = DEFAULT_GRASPS,
@@ -169,7 +169,7 @@ class DualArmStreams:
         self._arms_only = ctx.new_world()  # no objects: arm-arm checks of combine-confs
         self.scenes = SceneCache(ctx, IK_MARGIN, WORLD_CACHE)  # IK worlds, one per arrangement
         # the planner's optimiser starts building in the background now, while selection runs
-        self.planner = planner if planner is not None else DualMotionPlanner(ctx)
+        self.planner = planner if planner is not None else MotionPlanner(ctx)
         self.reserved = dict(reserved or {})
         self.motion = motion
         self.grasp_options = grasps
@@ -322,22 +322,22 @@ class DualArmStreams:
 
     def combine_confs(
         self, a1: str, q1: ArmConf, a2: str, q2: ArmConf
-    ) -> Iterator[tuple[DualConf]]:
+    ) -> Iterator[tuple[CellConf]]:
         if a1 == a2:
             return
         by_arm = {a1: q1, a2: q2}
-        conf = DualConf(*(by_arm[a] for a in self.ctx.arm_names))
+        conf = CellConf(*(by_arm[a] for a in self.ctx.arm_names))
         if not self._arms_only.in_collision(conf.q):
             yield (conf,)
 
     def plan_dual_motion(
-        self, q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]] = ()
+        self, q1: CellConf, q2: CellConf, fluents: Sequence[tuple[Any, ...]] = ()
     ) -> Iterator[tuple[MotionResult]]:
         """The motion planner of this map (``motion``): SDAR-M's ladder, plain or one arm."""
         return self._motion(q1, q2, fluents, quick=False)
 
     def plan_dual_motion_quick(
-        self, q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]] = ()
+        self, q1: CellConf, q2: CellConf, fluents: Sequence[tuple[Any, ...]] = ()
     ) -> Iterator[tuple[MotionResult]]:
         """The same motion without the fallbacks of SDAR-M's ladder (trajectory optimisation
         alone): cheap to try and to fail. With ``motion`` plain or sequential it is the same
@@ -345,7 +345,7 @@ class DualArmStreams:
         return self._motion(q1, q2, fluents, quick=True)
 
     def _motion(
-        self, q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]], quick: bool
+        self, q1: CellConf, q2: CellConf, fluents: Sequence[tuple[Any, ...]], quick: bool
     ) -> Iterator[tuple[MotionResult]]:
         objects = self.resting(fluents)
         held: dict[str, HeldObject] = {}
@@ -417,7 +417,7 @@ class DualArmStreams:
         assert t.trajectory is not None
         return t.trajectory.duration
 
-    def distance(self, d1: DualConf, d2: DualConf) -> float:
+    def distance(self, d1: CellConf, d2: CellConf) -> float:
         """Estimated duration [s] of the synchronous motion ``d1 -> d2``: the slowest joint's
         rest-to-rest time at its velocity and acceleration limits (no obstacles)."""
         dq = np.abs(d2.q - d1.q)
@@ -468,9 +468,9 @@ class DualArmStreams:
         return scene.joint_array("velocity_limit"), scene.joint_array("acceleration_limit")
 
 
-def _motion_key(q1: DualConf, q2: DualConf, fluents: Sequence[tuple[Any, ...]]) -> Hashable:
+def _motion_key(q1: CellConf, q2: CellConf, fluents: Sequence[tuple[Any, ...]]) -> Hashable:
     """A motion request as a value: end configurations and fluent facts (grasps compare by
-    identity: one object per grasp of an object, see :meth:`DualArmStreams.grasps`)."""
+    identity: one object per grasp of an object, see :meth:`RearrangementStreams.grasps`)."""
     return (q1, q2, frozenset(tuple(fluents)))
 
 
@@ -484,7 +484,7 @@ def make_stream_map(
     world_context: WorldContext,
     sizes: Mapping[str, Size] | None = None,
     seed: int = 0,
-    planner: DualMotionPlanner | None = None,
+    planner: MotionPlanner | None = None,
     reserved: Mapping[str, Pose2D] | None = None,
     motion: str = "sdar",
     grasps: GraspOptions = DEFAULT_GRASPS,
@@ -501,7 +501,7 @@ def make_stream_map(
     ``sample-grasp``; ``sampling``: with ``sdar``, a sampled path warm-starts the optimiser
     when the straight line does not lead to a transfer (default: where OMPL is installed).
     """
-    s = DualArmStreams(
+    s = RearrangementStreams(
         world_context, sizes or {}, seed, planner, reserved, motion, grasps, sampling=sampling
     )
     return {

@@ -118,7 +118,7 @@ class _Layout:
         p[start : start + rows * cols] = np.asarray(value, dtype=np.float64).reshape(rows * cols)
 
 
-class DualArmTrajOpt:
+class TrajectoryOptimiser:
     """The NLP for one :class:`TrajOptOptions`, built at construction, solved many times.
 
     The collision rows of one knot are one small CasADi function of that knot's joints and
@@ -455,7 +455,7 @@ def _arm_sphere_table(ctx: WorldContext, arm: str) -> _ArmSphereTables:
 
 
 class OptimiserBuild:
-    """A :class:`DualArmTrajOpt` under construction in a background thread (building the NLP
+    """A :class:`TrajectoryOptimiser` under construction in a background thread (building the NLP
     takes a few tenths of a second of CPU; planning that needs no optimisation goes on meanwhile).
 
     :meth:`get` waits for it (``waited`` [s] adds up the waits) and re-raises an error of
@@ -465,7 +465,7 @@ class OptimiserBuild:
         self.options = options
         self.build_time = float("nan")
         self.waited = 0.0
-        self._result: DualArmTrajOpt | None = None
+        self._result: TrajectoryOptimiser | None = None
         self._error: BaseException | None = None
         self._done = threading.Event()
         if background:
@@ -479,7 +479,7 @@ class OptimiserBuild:
     def _run(self, ctx: WorldContext) -> None:
         start = time.thread_time()
         try:
-            self._result = DualArmTrajOpt(ctx, self.options)
+            self._result = TrajectoryOptimiser(ctx, self.options)
         except BaseException as error:  # handed to the caller of get()
             self._error = error
         finally:
@@ -491,7 +491,7 @@ class OptimiserBuild:
             self._request_compiled(self._result)
 
     @staticmethod
-    def _request_compiled(optimiser: DualArmTrajOpt) -> None:
+    def _request_compiled(optimiser: TrajectoryOptimiser) -> None:
         """Compiled derivatives are a speed-up only: whatever stops them, the build stands."""
         try:
             optimiser.request_compiled()
@@ -502,7 +502,7 @@ class OptimiserBuild:
     def ready(self) -> bool:
         return self._done.is_set()
 
-    def get(self) -> DualArmTrajOpt:
+    def get(self) -> TrajectoryOptimiser:
         if not self._done.is_set():
             start = time.perf_counter()
             _log.info("waiting for the trajectory optimiser to be built")

@@ -14,7 +14,7 @@ import pytest
 
 from streams import compiled
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 
 # The suite plans with CasADi's own evaluation of the optimiser's derivatives (the same
 # values as compiled, tests/streams/test_compiled.py): a fresh machine would otherwise spend
@@ -44,9 +44,9 @@ def ctx() -> WorldContext:
 
 
 @pytest.fixture(scope="session")
-def planner(ctx: WorldContext) -> DualMotionPlanner:
+def planner(ctx: WorldContext) -> MotionPlanner:
     """The motion planner of ``ctx``: built once per test process (the optimiser with it)."""
-    return DualMotionPlanner(ctx)
+    return MotionPlanner(ctx)
 
 
 @pytest.fixture(scope="session")

@@ -36,10 +36,8 @@ LAYERS: dict[str, str] = {
     "solvers": "solvers",
     "streams": "streams",
     "domains": "domains",
-    # the application layer (and the former module names it re-exports through)
+    # the application layer
     "sdar_tamp.app": "app",
-    "sdar_tamp.rearrangement": "app",
-    "sdar_tamp.solve_command": "app",
     "sdar_tamp.evaluation": "evaluation",
     "sdar_tamp.compat": "compat",
     "sdar_tamp.viewer": "viewer",

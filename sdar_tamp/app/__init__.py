@@ -12,7 +12,7 @@ One question per module:
 - :mod:`~sdar_tamp.app.records`: what a run reports (:class:`TaskRecord`, :class:`RunFigures`,
   :class:`SolveOutcome`);
 - :mod:`~sdar_tamp.app.cache`: what stays built between solves (:class:`PlannerCache`);
-- :mod:`~sdar_tamp.app.command`: the ``sdar solve`` pipeline (:func:`solve_instance`);
+- :mod:`~sdar_tamp.app.pipeline`: the ``sdar solve`` pipeline (:func:`solve_instance`);
 - :mod:`~sdar_tamp.app.summary`: what people see (summary lines, progress bar);
 - :mod:`~sdar_tamp.app.abstract`: the task planner's geometry-free counts.
 """
@@ -20,8 +20,8 @@ One question per module:
 from __future__ import annotations
 
 from sdar_tamp.app.cache import PlannerCache
-from sdar_tamp.app.command import solve_instance
 from sdar_tamp.app.config import GRIPPER_TIME, MOTION_PLANNERS, TASK_PLANNERS, PlannerConfig
+from sdar_tamp.app.pipeline import solve_instance
 from sdar_tamp.app.plan_export import ActionDecoder, plan_file_from_solution, timeline
 from sdar_tamp.app.problem import DOMAIN, Rearrangement, rearrangement_problem
 from sdar_tamp.app.records import RunFigures, SolveOutcome, StepTime, TaskRecord, task_records

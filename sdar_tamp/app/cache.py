@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 from streams.trajopt import TrajOptOptions
 
 
@@ -17,7 +17,7 @@ class PlanningWorld:
     (0 when they came from the cache)."""
 
     ctx: WorldContext
-    planner: DualMotionPlanner
+    planner: MotionPlanner
     setup_time: float
 
 
@@ -25,11 +25,11 @@ class PlannerCache:
     """Keeps the world and the motion planner of the last scene and optimiser options, so
     that solves of instances on the same scene build them once (the optimiser takes a few
     seconds to build). One cache per thread or process; share it between calls of
-    :func:`sdar_tamp.app.command.solve_instance`."""
+    :func:`sdar_tamp.app.pipeline.solve_instance`."""
 
     def __init__(self) -> None:
         self._key: tuple[Path | None, TrajOptOptions] | None = None
-        self._world: tuple[WorldContext, DualMotionPlanner] | None = None
+        self._world: tuple[WorldContext, MotionPlanner] | None = None
         self.builds = 0  # worlds built so far
 
     def world(self, scene_path: Path | None, trajopt: TrajOptOptions) -> PlanningWorld:
@@ -39,7 +39,7 @@ class PlannerCache:
         key = (scene_path, trajopt)
         if self._world is None or self._key != key:
             ctx = WorldContext.load(scene_path)
-            self._world = (ctx, DualMotionPlanner(ctx, trajopt))
+            self._world = (ctx, MotionPlanner(ctx, trajopt))
             self._key = key
             self.builds += 1
         ctx, planner = self._world

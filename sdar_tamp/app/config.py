@@ -1,7 +1,7 @@
 """Which planner configuration applies: one typed :class:`PlannerConfig` for every option.
 
 The command line, :func:`sdar_tamp.app.solving.solve_rearrangement`,
-:func:`sdar_tamp.app.command.solve_instance` and ``solve(problem, algorithm="sdar",
+:func:`sdar_tamp.app.pipeline.solve_instance` and ``solve(problem, algorithm="sdar",
 sdar_options=config.sdar_options())`` all read it, so every entry point plans alike:
 
 - ``task_planner`` (SDAR-T or the baseline), ``motion_planner`` (the stream behind

@@ -21,8 +21,8 @@ from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
-from streams.motion import DualMotionPlanner
-from streams.stream_map import STREAM_KINDS, ArmConf, DualConf, make_stream_map
+from streams.motion import MotionPlanner
+from streams.stream_map import STREAM_KINDS, ArmConf, CellConf, make_stream_map
 
 DOMAIN = "dual_arm_rearrangement"
 LOG = get_logger(__name__)
@@ -35,7 +35,7 @@ class Rearrangement:
     instance: Instance
     ctx: WorldContext
     problem: PDDLProblem
-    home: DualConf
+    home: CellConf
     config: PlannerConfig = field(default_factory=PlannerConfig)
 
     @property
@@ -59,7 +59,7 @@ def rearrangement_problem(
     config: PlannerConfig | None = None,
     seed: int | None = None,
     motion: str | None = None,
-    planner: DualMotionPlanner | None = None,
+    planner: MotionPlanner | None = None,
     gripper_time: float | None = None,
     overrides: Mapping[str, Callable[..., Any]] | None = None,
 ) -> Rearrangement:
@@ -81,7 +81,7 @@ def rearrangement_problem(
         seed=seed, motion_planner=motion, gripper_time=gripper_time
     )
     ctx = ctx or WorldContext.load()
-    planner = planner if planner is not None else DualMotionPlanner(ctx, config.trajopt)
+    planner = planner if planner is not None else MotionPlanner(ctx, config.trajopt)
     sizes = {o.name: o.size for o in instance.objects}
     goals = {o.name: o.goal for o in instance.objects}
     stream_map = make_stream_map(
@@ -95,7 +95,7 @@ def rearrangement_problem(
     wrapped = {name: _wrap(STREAM_KINDS[name], fn) for name, fn in stream_map.items()}
     arms = ctx.arm_names
     confs = {a: ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in arms}
-    home = DualConf(confs[arms[0]], confs[arms[1]])
+    home = CellConf(confs[arms[0]], confs[arms[1]])
     init: list[tuple[Any, ...]] = [("dualconf", home), ("atdualconf", home)]
     init.append(("=", ("gripper-time",), float(config.gripper_time)))
     for a in arms:

@@ -212,7 +212,7 @@ def _task_row(task: _Task) -> dict[str, Any]:
 
 def _run_task(task: _Task) -> Answer:
     """One solve in a worker: the CSV row, the per-step planning times and the plan."""
-    from sdar_tamp.app.command import solve_instance
+    from sdar_tamp.app.pipeline import solve_instance
 
     e, c = task.entry, task.combo
     path = e.path if task.files is None else unpack(task.files)

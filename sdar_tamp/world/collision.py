@@ -33,11 +33,11 @@ from sdar_tamp.world.transforms import FloatArray, inverse
 
 
 @functools.lru_cache(maxsize=4)
-def _shared_arms(scene: Scene) -> cm.DualArmModel:
+def _shared_arms(scene: Scene) -> cm.CellCollisionModel:
     return cm.build_dual_arm(scene)
 
 
-def _dual_arm(scene: Scene) -> cm.DualArmModel:
+def _dual_arm(scene: Scene) -> cm.CellCollisionModel:
     """The arms' model of ``scene``, built once per scene and shared by its worlds (the model
     and the arm shapes are only read); each world gets its own pinocchio data."""
     shared = _shared_arms(scene)

@@ -36,7 +36,7 @@ class ArmGeometry:
 
 
 @dataclass(frozen=True)
-class DualArmModel:
+class CellCollisionModel:
     """The combined kinematic model and the arms' collision shapes."""
 
     model: Any
@@ -58,7 +58,7 @@ def _prefixed_urdf(text: str, prefix: str) -> str:
     return re.sub(r'(<(?:parent|child)\s+link=")', rf"\g<1>{prefix}", text)
 
 
-def build_dual_arm(scene: Scene) -> DualArmModel:
+def build_dual_arm(scene: Scene) -> CellCollisionModel:
     """Both arms of ``scene`` in one pinocchio model, bases at their world poses."""
     text = read_text(scene.robot_urdf, file_error(SceneError))
     model = pin.Model()
@@ -88,7 +88,7 @@ def build_dual_arm(scene: Scene) -> DualArmModel:
             f"{scene.file}: the robot description has {model.nq // len(layout)} joints per arm; "
             f"the scene's arms have {list(layout.dofs)}"
         )
-    return DualArmModel(
+    return CellCollisionModel(
         model,
         model.createData(),
         geometry,
@@ -100,7 +100,7 @@ def build_dual_arm(scene: Scene) -> DualArmModel:
     )
 
 
-def tool0_pose(arms: DualArmModel, q: FloatArray, arm: str) -> FloatArray:
+def tool0_pose(arms: CellCollisionModel, q: FloatArray, arm: str) -> FloatArray:
     """``T_world_tool0`` of ``arm`` at the configuration ``q`` ``(layout.dof,)``."""
     pin.framesForwardKinematics(arms.model, arms.data, q)
     return se3_to_array(arms.data.oMf[arms.tool0_frame[arm]])
@@ -120,7 +120,7 @@ class SceneGeometry:
 
 
 def build_scene_geometry(
-    arms: DualArmModel,
+    arms: CellCollisionModel,
     table_size: tuple[float, float, float],
     resting: dict[str, tuple[FloatArray, FloatArray]],
     held: dict[str, tuple[str, FloatArray, FloatArray]],
@@ -175,29 +175,31 @@ def build_scene_geometry(
     return SceneGeometry(geometry, data, manager, names)
 
 
-def _arm_index(shape: str, arms: DualArmModel) -> int:
+def _arm_index(shape: str, arms: CellCollisionModel) -> int:
     """The index of the arm a link or gripper shape belongs to (its name's prefix), else -1."""
     return next((k for k, arm in enumerate(arms.wrist_joint) if shape.startswith(f"{arm}_")), -1)
 
 
-def any_collision(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> bool:
+def any_collision(arms: CellCollisionModel, scene: SceneGeometry, q: FloatArray) -> bool:
     """Broad phase then narrow phase; stops at the first colliding pair."""
     return bool(pin.computeCollisions(arms.model, arms.data, scene.manager, q, True))
 
 
-def colliding_pairs(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> list[int]:
+def colliding_pairs(arms: CellCollisionModel, scene: SceneGeometry, q: FloatArray) -> list[int]:
     """Indices (into ``scene.pair_names``) of every colliding pair, narrow phase on all."""
     pin.computeCollisions(arms.model, arms.data, scene.geometry, scene.data, q, False)
     return [i for i, r in enumerate(scene.data.collisionResults) if r.isCollision()]
 
 
-def pair_distances(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> FloatArray:
+def pair_distances(arms: CellCollisionModel, scene: SceneGeometry, q: FloatArray) -> FloatArray:
     """Signed distance of every active pair ``(n_pairs,)`` [m]."""
     pin.computeDistances(arms.model, arms.data, scene.geometry, scene.data, q)
     return np.array([r.min_distance for r in scene.data.distanceResults], dtype=np.float64)
 
 
-def link_poses(arms: DualArmModel, scene: SceneGeometry, q: FloatArray) -> dict[str, FloatArray]:
+def link_poses(
+    arms: CellCollisionModel, scene: SceneGeometry, q: FloatArray
+) -> dict[str, FloatArray]:
     """World pose of every geometry ``name -> (4, 4)`` at ``q`` ``(layout.dof,)``."""
     pin.updateGeometryPlacements(arms.model, arms.data, scene.geometry, scene.data, q)
     return {

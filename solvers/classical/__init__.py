@@ -15,6 +15,7 @@ predicates (stratified axioms), conditional and universal effects, action costs.
 from solvers.classical.errors import GroundingError, PlanValidationError
 from solvers.classical.ground import ground
 from solvers.classical.heuristics import HEURISTICS
+from solvers.classical.plan_check import validated_plan_cost
 from solvers.classical.planner import SEARCHES, plan
 from solvers.classical.problem import (
     GroundAction,
@@ -25,7 +26,6 @@ from solvers.classical.problem import (
     task_from_problem,
 )
 from solvers.classical.task import GroundTask
-from solvers.classical.validate import validated_plan_cost
 
 __all__ = [
     "HEURISTICS",

@@ -31,7 +31,7 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass, field
 
-from solvers.classical.compiled import bits
+from solvers.classical.bitset_task import bits
 from solvers.classical.task import GroundTask
 
 #: The most rules one complement may get (the CNF-to-DNF product can grow exponentially).

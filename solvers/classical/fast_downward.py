@@ -20,6 +20,7 @@ from pathlib import Path
 
 from sdar_tamp.errors import ParameterError
 from solvers.classical.errors import BackendUnavailableError, PlanValidationError
+from solvers.classical.plan_check import validated_plan_cost
 from solvers.classical.planner import ground_or_timeout
 from solvers.classical.problem import (
     GroundAction,
@@ -29,7 +30,6 @@ from solvers.classical.problem import (
     SearchStatistics,
 )
 from solvers.classical.sas import sas_task
-from solvers.classical.validate import validated_plan_cost
 
 _HEURISTICS = {
     "ff": "eval_modify_costs(ff(),cost_type=plusone)",

@@ -38,7 +38,7 @@ import numpy.typing as npt
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
 from solvers.classical import jit
-from solvers.classical.compiled import CompiledTask, bits, mask
+from solvers.classical.bitset_task import CompiledTask, bits, mask
 from solvers.classical.complements import complements, relaxed_operators
 
 logger = get_logger(__name__)

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from collections import deque
 
-from solvers.classical.compiled import CompiledTask, bits, mask
+from solvers.classical.bitset_task import CompiledTask, bits, mask
 from solvers.classical.complements import complements, relaxed_operators
 from solvers.classical.invariants import MutexGroups, mutex_groups
 from solvers.classical.task import GroundTask

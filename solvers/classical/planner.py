@@ -8,11 +8,12 @@ import time
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
-from solvers.classical.compiled import CompiledTask
+from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.errors import PlanValidationError
 from solvers.classical.ground import ground
 from solvers.classical.heuristics import HEURISTICS, RelaxedHeuristic
 from solvers.classical.landmarks import LandmarkCount
+from solvers.classical.plan_check import validated_plan_cost
 from solvers.classical.postprocess import eliminate_redundant_actions
 from solvers.classical.problem import (
     PlanningTask,
@@ -23,7 +24,6 @@ from solvers.classical.problem import (
 from solvers.classical.reachability import GroundingTimeout
 from solvers.classical.search import Evaluator, SearchOutcome, best_first_search
 from solvers.classical.task import GroundTask
-from solvers.classical.validate import validated_plan_cost
 
 SEARCHES = ("gbfs", "astar", "wastar", "lazy-gbfs")
 logger = get_logger(__name__)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 
-from solvers.classical.compiled import CompiledTask
+from solvers.classical.bitset_task import CompiledTask
 
 
 def eliminate_redundant_actions(

@@ -21,7 +21,7 @@ from math import inf
 from random import Random
 from typing import Any
 
-from solvers.classical.compiled import CompiledTask
+from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.landmarks import LandmarkCount
 
 Heuristic = Callable[[int, bool], tuple[float, "set[int] | None"]]

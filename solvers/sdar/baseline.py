@@ -24,7 +24,7 @@ from __future__ import annotations
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
 from solvers.sdar.abstract import view_of
-from solvers.sdar.feedback import feedback_vertex_set, minimum_feedback_vertex_set
+from solvers.sdar.buffer_sets import feedback_vertex_set, minimum_feedback_vertex_set
 from solvers.sdar.tasks import Move, Step, TaskView, step_is_valid
 
 __all__ = [

@@ -34,7 +34,7 @@ them.
 
 Choosing ``x``: the objects that belong to a minimum *buffer set* of the current graph (the
 fewest objects whose removal leaves components of at most two objects, see
-:mod:`solvers.sdar.feedback`) are the optimal ones; goal moves never add to it, so taking the
+:mod:`solvers.sdar.buffer_sets`) are the optimal ones; goal moves never add to it, so taking the
 first candidate always uses ``n + |minimum buffer set|`` actions, never more than a single arm
 optimum (``n + |minimum FVS|``). Among them (or all of them, greedily, when the exact search
 exceeds ``node_budget``, which sets :attr:`SdarTaskPlanner.exact` to ``False``), objects that
@@ -53,7 +53,7 @@ from itertools import combinations
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
-from solvers.sdar.feedback import extending_minimum, optimal_choices
+from solvers.sdar.buffer_sets import extending_minimum, optimal_choices
 from solvers.sdar.tasks import Move, Step, TaskView
 
 _Edges = tuple[tuple[int, int], ...]

@@ -48,7 +48,7 @@ from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.classical.fast_downward import plan_task_with_fast_downward
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
-from solvers.stream_planning.blocking import Blocks, guard_fluent_uses
+from solvers.stream_planning.blocked_calls import Blocks, guard_fluent_uses
 from solvers.stream_planning.calls import CallRunner, CallTimeout
 from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.costs import guard_costs, has_costs

@@ -33,7 +33,7 @@ from solvers.solution import Action, Solution
 from solvers.solve import solve
 from streams.context import WorldContext
 from streams.grasps import GraspOptions
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 from streams.trajopt import TrajOptOptions
 
 #: A solve's time budget: generous, so that a busy machine slows a test down but never turns
@@ -96,7 +96,7 @@ def test_replace_keeps_fields_given_as_none() -> None:
 
 
 def test_both_entry_points_pass_the_same_sdar_options(
-    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+    ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """``solve_rearrangement`` is ``solve(..., algorithm="sdar", sdar_options=...)`` with the
     options of the rearrangement's configuration (here: the sequential motion planner)."""
@@ -121,7 +121,7 @@ def test_both_entry_points_pass_the_same_sdar_options(
 
 
 def test_plain_solve_of_a_rearrangement_plans_as_solve_rearrangement(
-    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+    ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """``solve(r.problem, algorithm="sdar")`` takes the task planner and SDAR-M options the
     rearrangement was configured with (carried by the problem), as ``solve_rearrangement``;
@@ -173,7 +173,7 @@ def test_solve_checks_sdar_options() -> None:
 
 
 def test_a_larger_grasp_set_reaches_the_stream_and_its_cut_is_logged(
-    ctx: WorldContext, planner: DualMotionPlanner, caplog: pytest.LogCaptureFixture
+    ctx: WorldContext, planner: MotionPlanner, caplog: pytest.LogCaptureFixture
 ) -> None:
     grasps = GraspOptions(tilts=(np.pi / 8, np.pi / 4))  # 5 angles x 2 sides x 2 wrists
     config = PlannerConfig(grasps=grasps)
@@ -197,7 +197,7 @@ def _outputs(generator: Any) -> list[Any]:
 
 
 def test_actions_are_read_by_name_through_the_vocabulary(ctx: WorldContext) -> None:
-    r = rearrangement_problem(_one(), ctx, planner=DualMotionPlanner(ctx))
+    r = rearrangement_problem(_one(), ctx, planner=MotionPlanner(ctx))
     decoder = ActionDecoder(r.problem.domain, r.problem.streams)
     g1, g2 = object(), object()
     args = ("d", "left", "o1", "p1", g1, "q1", "right", "o2", "p2", g2, "q2")
@@ -264,7 +264,7 @@ def test_planner_cache_builds_once_per_scene_and_optimiser_options() -> None:
 def test_the_command_line_reaches_the_planner_config(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import sdar_tamp.app.command as command
+    import sdar_tamp.app.pipeline as command
     from sdar_tamp.cli import main
 
     instance = str(domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml"))
@@ -303,7 +303,7 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(
     """``execution="async"``: the solved plan goes through the scheduler before the replay;
     the run reports the scheduling time, and the plan says which execution it holds."""
     from sdar_tamp.app import execution
-    from sdar_tamp.app.command import solve_instance
+    from sdar_tamp.app.pipeline import solve_instance
     from sdar_tamp.app.summary import format_summary
     from sdar_tamp.world.instance import save_instance
 
@@ -319,7 +319,7 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(
         return real(*args, **kwargs)
 
     monkeypatch.setattr("sdar_tamp.app.execution.validate_plan", counting)
-    monkeypatch.setattr("sdar_tamp.app.command.validate_plan", counting)
+    monkeypatch.setattr("sdar_tamp.app.pipeline.validate_plan", counting)
     outcome = solve_instance(
         path, PlannerConfig(execution="async"), time_limit=BUDGET, stage=stages.append
     )

@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from sdar_tamp.app import PlannerCache, PlannerConfig, rearrangement_problem, solve_rearrangement
-from sdar_tamp.app.command import solve_instance
+from sdar_tamp.app.pipeline import solve_instance
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, save_instance
 from sdar_tamp.world.scene import Workspace
 from solvers.solution import Solution, Status

@@ -170,7 +170,7 @@ def test_demo_writes_a_fresh_folder_per_run(
     """Without -o each demo run gets its own new folder under the temporary directory."""
     import tempfile
 
-    import sdar_tamp.app.command as command
+    import sdar_tamp.app.pipeline as command
     from sdar_tamp.app.records import RunFigures, SolveOutcome
     from sdar_tamp.world.instance import load_instance
 

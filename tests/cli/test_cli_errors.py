@@ -173,7 +173,7 @@ def test_show_does_not_overwrite_without_force(
 def test_solve_checks_its_output_before_planning(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import sdar_tamp.app.command as command
+    import sdar_tamp.app.pipeline as command
 
     def no_planning(*args: object, **kwargs: object) -> None:
         raise AssertionError("the output must be checked before planning")

@@ -235,7 +235,7 @@ def test_sweep_plots_stay_small(tmp_path: Path) -> None:
 
 def test_the_asynchronous_combination_reaches_the_solver(monkeypatch: pytest.MonkeyPatch) -> None:
     """``sdar-async`` is SDAR with ``execution="async"``; the paper's six stay synchronous."""
-    import sdar_tamp.app.command as command
+    import sdar_tamp.app.pipeline as command
     from sdar_tamp.evaluation import runner
     from sdar_tamp.evaluation.results import COMBINATIONS, parse_combos
 

@@ -31,7 +31,7 @@ from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, solve_ik_candidates
-from streams.motion import DualMotionPlanner, MotionRequest, MotionResult, plan_dual_motion
+from streams.motion import MotionPlanner, MotionRequest, MotionResult, plan_dual_motion
 from streams.validate import HeldObject
 
 INSTANCE = """name: T2
@@ -62,7 +62,7 @@ def _segment(result: MotionResult, kind: str) -> MotionSegment:
 
 
 @pytest.fixture(scope="module")
-def planned(ctx: WorldContext, planner: DualMotionPlanner) -> Planned:
+def planned(ctx: WorldContext, planner: MotionPlanner) -> Planned:
     instance = parse_instance(INSTANCE, "t2.yaml")
     o1 = instance.objects[0]
     start = {o.name: _box(o, o.start) for o in instance.objects}

@@ -12,14 +12,14 @@ from solvers.sdar.sdar_t import WAIT, SdarTaskPlanner
 from solvers.sdar.solver import SdarOptions, SdarSolver
 from solvers.sdar.tasks import Move, TaskView
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 
 BAR = (0.08, 0.04, 0.05)  # graspable across its 4 cm side only (y)
 CUBE = (0.04, 0.04, 0.05)  # graspable across both sides
 WORKSPACE = Workspace((-0.25, 0.25), (-0.30, 0.30))
 
 
-def _view(ctx: WorldContext, planner: DualMotionPlanner, *objects: ObjectSpec) -> TaskView:
+def _view(ctx: WorldContext, planner: MotionPlanner, *objects: ObjectSpec) -> TaskView:
     """The solver's first view, objects by their instance names."""
     r = rearrangement_problem(Instance("hand", WORKSPACE, objects), ctx, planner=planner)
     solver = SdarSolver(r.problem, make_task_planner("sdar"), SdarOptions(max_time=10.0))
@@ -38,7 +38,7 @@ def _edges(view: TaskView) -> set[tuple[str, str]]:
 
 
 def test_a_goal_beside_a_start_on_its_closing_axis_is_an_edge(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """a's goal lies 5 mm beside b's start across b's graspable side: no footprint overlap,
     but once a is there b cannot be picked, so a waits for b (edge a -> b)."""
@@ -49,7 +49,7 @@ def test_a_goal_beside_a_start_on_its_closing_axis_is_an_edge(
 
 
 def test_far_apart_or_beside_the_long_side_there_is_no_edge(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     b = ObjectSpec("b", BAR, Pose2D(0.1, 0.0, 0.0), Pose2D(-0.15, -0.2, 0.0))
     far = ObjectSpec("a", BAR, Pose2D(-0.15, 0.2, 0.0), Pose2D(0.1, 0.15, 0.0))
@@ -59,7 +59,7 @@ def test_far_apart_or_beside_the_long_side_there_is_no_edge(
 
 
 def test_a_resting_object_that_leaves_a_goal_no_grasp_is_an_edge(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """b rests 5 mm beside a's goal across a's graspable side: a cannot be placed there
     while b stays (edge a -> b)."""
@@ -68,9 +68,7 @@ def test_a_resting_object_that_leaves_a_goal_no_grasp_is_an_edge(
     assert _edges(_view(ctx, planner, a, b)) == {("a", "b")}
 
 
-def test_a_goal_that_blocks_another_goal_waits(
-    ctx: WorldContext, planner: DualMotionPlanner
-) -> None:
+def test_a_goal_that_blocks_another_goal_waits(ctx: WorldContext, planner: MotionPlanner) -> None:
     """The cube's goal lies across the bar's goal: once the cube is there the bar cannot be
     placed, so the cube goes to its goal after the bar (the bar beside the cube leaves the
     cube its grasps across the other side)."""

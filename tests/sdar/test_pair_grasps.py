@@ -22,7 +22,7 @@ from solvers.sdar.solver import SdarOptions, SdarSolver
 from solvers.solution import Status
 from streams.context import WorldContext
 from streams.grasps import GraspOptions
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 
 #: A solve's time budget: generous, so that a busy machine slows a test down but never turns
 #: a solvable case into a timeout (the budget is not what these tests check).
@@ -51,7 +51,7 @@ def _swap(size: tuple[float, float, float], gap: float, yaw: float, turn: float)
 def _solver(
     inst: Instance,
     ctx: WorldContext,
-    planner: DualMotionPlanner,
+    planner: MotionPlanner,
     grasps: GraspOptions | None = None,
     **kw: int,
 ) -> SdarSolver:
@@ -85,7 +85,7 @@ def _row(axis: int) -> Instance:
 
 
 def test_the_pair_search_reaches_grasps_beyond_the_first_ones(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """Two cubes 6 cm apart trading places, turned: no pair among the first six grasps of each
     works (the arms collide); the grasp set holds pairs that do, all tilted."""
@@ -102,7 +102,7 @@ def test_the_pair_search_reaches_grasps_beyond_the_first_ones(
 
 
 def test_pairs_whose_gripper_meets_the_other_object_are_dropped(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     inst = _swap(CUBE, 0.06, 0.0, 0.3)
     solver = _solver(inst, ctx, planner)
@@ -129,7 +129,7 @@ def test_pairs_whose_gripper_meets_the_other_object_are_dropped(
 
 
 def test_close_neighbours_trade_places_in_one_dual_arm_swap(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """Two bars end to end, 2.6 cm apart (the paper suite's clearance), goals turned: one
     synchronous swap, no buffer, and the plan validates."""
@@ -146,7 +146,7 @@ def test_close_neighbours_trade_places_in_one_dual_arm_swap(
 
 
 def test_boxed_in_neighbours_need_the_moderate_pair_tilts(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """The middle two of a row of cubes (along y) trade places: top-down, the two wrists
     collide; at 45 degrees a gripper reaches over an outer cube (so the first six grasps give
@@ -176,7 +176,7 @@ def test_boxed_in_neighbours_need_the_moderate_pair_tilts(
 
 
 def test_a_swap_no_grasp_pair_allows_is_dropped_before_any_ik_among_the_others(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """Two bars side by side, 2.6 cm apart, held across their 4 cm side: both grippers'
     fingers would close in the same gap. No pair works even on an empty table, and the
@@ -204,7 +204,7 @@ def test_a_swap_no_grasp_pair_allows_is_dropped_before_any_ik_among_the_others(
 
 
 def test_neighbours_in_a_row_trade_places_in_one_swap(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     inst = _row(axis=1)
     r = rearrangement_problem(inst, ctx, planner=planner)

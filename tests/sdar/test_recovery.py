@@ -16,7 +16,7 @@ from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
 from solvers.solution import Status
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 from streams.stream_map import make_stream_map
 
 BUDGET = 600.0  # [s] generous: the budget is not what these tests check
@@ -42,7 +42,7 @@ def _nested() -> Instance:
     )
 
 
-def _nested_problem(ctx: WorldContext, planner: DualMotionPlanner) -> Rearrangement:
+def _nested_problem(ctx: WorldContext, planner: MotionPlanner) -> Rearrangement:
     inst = _nested()
     real = make_stream_map(ctx, {o.name: o.size for o in inst.objects})["inverse-kinematics"]
 
@@ -70,7 +70,7 @@ def _recovery(r: Rearrangement, max_depth: int) -> tuple[SdarSolver, Recovery]:
 
 
 def test_a_blocker_that_cannot_be_grasped_is_unblocked_first(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     r = _nested_problem(ctx, planner)
     solver, recovery = _recovery(r, max_depth=3)
@@ -88,7 +88,7 @@ def test_a_blocker_that_cannot_be_grasped_is_unblocked_first(
 
 
 def test_without_depth_an_ungraspable_blocker_is_not_evicted(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     r = _nested_problem(ctx, planner)
     solver, recovery = _recovery(r, max_depth=0)
@@ -96,7 +96,7 @@ def test_without_depth_an_ungraspable_blocker_is_not_evicted(
 
 
 def test_nested_box_in_is_solved_by_recursive_evictions(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     solution = solve_rearrangement(_nested_problem(ctx, planner), "sdar", BUDGET)
     assert solution.status is Status.SOLVED, solution.diagnosis
@@ -124,7 +124,7 @@ def test_a_deferral_at_a_goal_ends_when_the_target_is_back_at_it() -> None:
     assert waiting.update({"b": "gb"}, goal="gb")  # back at its goal
 
 
-def test_recovery_refuses_a_negative_depth(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+def test_recovery_refuses_a_negative_depth(ctx: WorldContext, planner: MotionPlanner) -> None:
     r = _nested_problem(ctx, planner)
     solver = SdarSolver(r.problem, SdarTaskPlanner())
     with pytest.raises(ValueError, match="max_depth must be >= 0, got -1"):

@@ -24,7 +24,7 @@ from sdar_tamp.world.scene import Workspace
 from solvers.solution import Certificate, Solution, Status
 from solvers.solve import solve
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 from streams.stream_map import make_stream_map
 
 #: A solve's time budget: generous, so that a busy machine slows a test down but never turns
@@ -42,7 +42,7 @@ def _swap() -> Instance:
 
 
 @pytest.fixture(scope="module")
-def solved_three(ctx: WorldContext, planner: DualMotionPlanner) -> tuple[Rearrangement, Solution]:
+def solved_three(ctx: WorldContext, planner: MotionPlanner) -> tuple[Rearrangement, Solution]:
     """``_three`` (seed 0) solved once by ``solve_rearrangement`` for the tests that only read
     the solution. With the default motion planner its options are ``SdarOptions(max_time)``
     (the default quick attempts), so it is also the quick run of the motion-stream test."""
@@ -51,7 +51,7 @@ def solved_three(ctx: WorldContext, planner: DualMotionPlanner) -> tuple[Rearran
 
 
 @pytest.fixture(scope="module")
-def solved_swap(ctx: WorldContext, planner: DualMotionPlanner) -> tuple[Rearrangement, Solution]:
+def solved_swap(ctx: WorldContext, planner: MotionPlanner) -> tuple[Rearrangement, Solution]:
     """``_swap`` (seed 0) solved once, through the generic entry point
     ``solve(algorithm="sdar")``; with the default motion planner ``solve_rearrangement`` runs
     the same solver configuration (``test_both_entry_points_configure_sdar_alike``)."""
@@ -111,7 +111,7 @@ def test_plan_is_a_plan_of_the_domain(
     assert order.index("b") <= order.index("c")
 
 
-def test_baseline_task_planner_solves_too(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+def test_baseline_task_planner_solves_too(ctx: WorldContext, planner: MotionPlanner) -> None:
     r = rearrangement_problem(_swap(), ctx, planner=planner)
     solution = solve_rearrangement(r, "baseline", BUDGET)
     assert solution.status is Status.SOLVED
@@ -125,7 +125,7 @@ def test_solve_entry_point_runs_sdar(solved_swap: tuple[Rearrangement, Solution]
 
 
 def test_both_entry_points_configure_sdar_alike(
-    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+    ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """With the default motion planner, ``solve_rearrangement`` and ``solve(algorithm="sdar")``
     build the same solver (problem, task planner, options), so what the tests check of one
@@ -145,9 +145,7 @@ def test_both_entry_points_configure_sdar_alike(
     assert len(built) == 2 and built[0] == built[1]
 
 
-def test_no_ik_gives_infeasible_with_a_diagnosis(
-    ctx: WorldContext, planner: DualMotionPlanner
-) -> None:
+def test_no_ik_gives_infeasible_with_a_diagnosis(ctx: WorldContext, planner: MotionPlanner) -> None:
     def no_ik(*_args: Any, **_kwargs: Any) -> Iterator[Any]:
         return iter(())
 
@@ -160,7 +158,7 @@ def test_no_ik_gives_infeasible_with_a_diagnosis(
     assert any("no grasp with IK" in d for d in solution.diagnosis)
 
 
-def test_time_limit_gives_timeout(ctx: WorldContext, planner: DualMotionPlanner) -> None:
+def test_time_limit_gives_timeout(ctx: WorldContext, planner: MotionPlanner) -> None:
     r = rearrangement_problem(_three(), ctx, planner=planner)
     solution = solve_rearrangement(r, "sdar", 1e-6)
     assert solution.status is Status.TIMEOUT
@@ -168,7 +166,7 @@ def test_time_limit_gives_timeout(ctx: WorldContext, planner: DualMotionPlanner)
 
 
 def test_crowded_goal_is_unblocked_by_an_eviction(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """a cannot be picked while b rests at its start, and a cannot be placed while b rests at
     its goal: b must go to its goal first, then make room for a (an eviction), then return."""
@@ -234,7 +232,7 @@ def test_unknown_task_planner_and_override_are_refused(ctx: WorldContext) -> Non
 
 
 def test_same_seed_gives_the_same_plan(
-    ctx: WorldContext, planner: DualMotionPlanner, solved_three: tuple[Rearrangement, Solution]
+    ctx: WorldContext, planner: MotionPlanner, solved_three: tuple[Rearrangement, Solution]
 ) -> None:
     # a second, independent solve of the shared instance with the same seed (0)
     r = rearrangement_problem(_three(), ctx, planner=planner, seed=0)
@@ -248,7 +246,7 @@ def test_same_seed_gives_the_same_plan(
 
 @pytest.mark.parametrize(("task_planner", "instance"), [("baseline", _three), ("sdar", _swap)])
 def test_baseline_motion_planner_works_one_arm_at_a_time(
-    ctx: WorldContext, planner: DualMotionPlanner, task_planner: str, instance: Any
+    ctx: WorldContext, planner: MotionPlanner, task_planner: str, instance: Any
 ) -> None:
     """The baseline motion planner: one arm moves at a time, and at every gripper action the
     other arm waits at its retract (home) pose; a swap has one arm hold its object at home."""
@@ -276,7 +274,7 @@ def test_baseline_motion_planner_works_one_arm_at_a_time(
 
 
 def test_colliding_first_grasps_widen_the_options(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """D5 is two 2-cycles and a free object. With the first two grasp options per arm, the
     arms collide at every swap and SDAR-M breaks the cycles with buffers; with the widened
@@ -301,7 +299,7 @@ def test_colliding_first_grasps_widen_the_options(
 
 
 def test_motions_come_from_the_quick_stream_first(
-    ctx: WorldContext, planner: DualMotionPlanner, solved_three: tuple[Rearrangement, Solution]
+    ctx: WorldContext, planner: MotionPlanner, solved_three: tuple[Rearrangement, Solution]
 ) -> None:
     """Where optimisation alone finds the motions, the full motion planner (with its
     fallbacks) is never called; without quick attempts only the full planner is."""

@@ -17,7 +17,7 @@ from solvers.sdar.baseline import (
     optimal_single_arm_plan,
     pair_consecutive,
 )
-from solvers.sdar.feedback import (
+from solvers.sdar.buffer_sets import (
     breaks_cycles,
     extending_minimum,
     feedback_vertex_set,

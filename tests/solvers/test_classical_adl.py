@@ -18,7 +18,7 @@ from sdar_tamp.language.model import (
     Parameter,
 )
 from solvers.classical import PlanStatus, ground, plan, validated_plan_cost
-from solvers.classical.compiled import CompiledTask, mask
+from solvers.classical.bitset_task import CompiledTask, mask
 
 
 def test_moving_the_case_moves_its_contents() -> None:

@@ -11,9 +11,9 @@ from classical_helpers import load
 from test_classical_relaxed_engines import _gripper, _states, needs_numba
 
 from sdar_tamp.errors import ParameterError
-from solvers.classical import compiled as compiled_module
+from solvers.classical import bitset_task as compiled_module
 from solvers.classical import ground, heuristics, plan
-from solvers.classical.compiled import CompiledTask
+from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.heuristics import RelaxedHeuristic
 from solvers.classical.search import _TypeBuckets
 

@@ -7,9 +7,9 @@ import random
 import pytest
 
 from sdar_tamp.language import parse_domain, parse_problem
-from solvers.classical import compiled as compiled_module
+from solvers.classical import bitset_task as compiled_module
 from solvers.classical import ground, plan, task_from_problem
-from solvers.classical.compiled import CompiledTask
+from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.complements import complements
 from solvers.classical.heuristics import RelaxedHeuristic
 from solvers.classical.landmarks import LandmarkCount

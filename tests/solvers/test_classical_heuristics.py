@@ -17,7 +17,7 @@ from sdar_tamp.language.model import (
     TypeHierarchy,
 )
 from solvers.classical import PlanningTask, ground
-from solvers.classical.compiled import CompiledTask, mask
+from solvers.classical.bitset_task import CompiledTask, mask
 from solvers.classical.heuristics import RelaxedHeuristic
 
 

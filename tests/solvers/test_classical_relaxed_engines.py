@@ -11,7 +11,7 @@ from classical_helpers import load
 
 from sdar_tamp.errors import ParameterError
 from solvers.classical import ground, jit
-from solvers.classical.compiled import CompiledTask, bits
+from solvers.classical.bitset_task import CompiledTask, bits
 from solvers.classical.complements import complements
 from solvers.classical.heuristics import VECTOR_MIN_SIZE, RelaxedHeuristic
 from solvers.classical.problem import PlanningTask

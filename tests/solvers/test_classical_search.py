@@ -12,7 +12,7 @@ from classical_helpers import load, load_text
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.model import Atom
 from solvers.classical import HEURISTICS, SEARCHES, PlanStatus, ground, plan
-from solvers.classical.compiled import CompiledTask
+from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.postprocess import eliminate_redundant_actions
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))

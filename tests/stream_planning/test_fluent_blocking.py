@@ -25,7 +25,7 @@ from sdar_tamp.language.pddl import parse_domain
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Solution
 from solvers.solve import solve
-from solvers.stream_planning.blocking import Blocks, blocked_predicate, guard_fluent_uses
+from solvers.stream_planning.blocked_calls import Blocks, blocked_predicate, guard_fluent_uses
 
 ALGORITHMS = ("incremental", "focused", "binding", "adaptive")
 

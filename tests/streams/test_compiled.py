@@ -16,7 +16,7 @@ from streams import compiled
 from streams._casadi import ca, to_array
 from streams.context import WorldContext
 from streams.sphere_pairs import HeldSpheres
-from streams.trajopt import DualArmTrajOpt, OptimiserBuild, TrajOptOptions, TransferQuery
+from streams.trajopt import OptimiserBuild, TrajectoryOptimiser, TrajOptOptions, TransferQuery
 
 FAST = ("-O0", "-shared", "-fPIC")  # the tests' flags: the same code, compiled sooner
 needs_cc = pytest.mark.skipif(compiled.compiler() is None, reason="no C compiler (cc)")
@@ -149,8 +149,8 @@ def test_the_optimiser_gives_the_same_paths_compiled(
     options = TrajOptOptions(
         knots=5, arm_arm_slots=4, obstacle_slots=2, table_slots=2, compiled=False
     )
-    plain = DualArmTrajOpt(ctx, options)
-    fast = DualArmTrajOpt(ctx, options)
+    plain = TrajectoryOptimiser(ctx, options)
+    fast = TrajectoryOptimiser(ctx, options)
     fast.request_compiled(FAST)
     assert fast._library is not None
     _wait(fast._library, timeout=300)
@@ -173,7 +173,7 @@ def test_the_optimiser_gives_the_same_paths_compiled(
 def test_a_broken_library_keeps_the_optimiser_uncompiled(
     ctx: WorldContext, tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
-    opt = DualArmTrajOpt(ctx, TrajOptOptions(compiled=False))
+    opt = TrajectoryOptimiser(ctx, TrajOptOptions(compiled=False))
     broken = tmp_path / "casadi-broken.so"
     broken.write_bytes(b"not a shared library")
     opt._library = broken
@@ -209,7 +209,7 @@ def test_a_failure_to_ask_does_not_break_the_build(
     with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.trajopt"):
         build = OptimiserBuild(ctx, TrajOptOptions(knots=6), background=False)
         opt = build.get()
-    assert isinstance(opt, DualArmTrajOpt) and opt._library is None
+    assert isinstance(opt, TrajectoryOptimiser) and opt._library is None
     assert (
         "compiled derivatives unavailable, kept uncompiled: code generation failed" in caplog.text
     )
@@ -221,7 +221,7 @@ def test_a_library_with_other_values_is_not_used_and_removed(
 ) -> None:
     """A library found under the optimiser's recipe that is something else (a stale cache):
     refused, deleted (the next process compiles it again), the optimiser stays uncompiled."""
-    opt = DualArmTrajOpt(ctx, TrajOptOptions(knots=5, compiled=False))
+    opt = TrajectoryOptimiser(ctx, TrajOptOptions(knots=5, compiled=False))
     impostor = compiled.library_path(opt.recipe(), cache)
     code = compiled.source([_function()], "small")
     cc = compiled.compiler()
@@ -240,7 +240,7 @@ def test_a_broken_library_in_a_read_only_cache_is_only_refused(
     monkeypatch: pytest.MonkeyPatch,
     caplog: pytest.LogCaptureFixture,
 ) -> None:
-    opt = DualArmTrajOpt(ctx, TrajOptOptions(knots=5, compiled=False))
+    opt = TrajectoryOptimiser(ctx, TrajOptOptions(knots=5, compiled=False))
     broken = tmp_path / "casadi-broken.so"
     broken.write_bytes(b"not a shared library")
 

@@ -10,7 +10,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.instance import Instance
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_PAIR_TILTS, half_turn_twins, sample_grasps
-from streams.stream_map import ArmConf, DualArmStreams, make_stream_map
+from streams.stream_map import ArmConf, RearrangementStreams, make_stream_map
 
 HALF_TURN = np.diag([-1.0, -1.0, 1.0])  # about the object's vertical axis
 
@@ -37,11 +37,11 @@ def test_ik_yields_the_grasps_own_configurations_then_its_twins(
 ) -> None:
     o = instance.objects[1]
     sizes = {x.name: x.size for x in instance.objects}
-    streams = DualArmStreams(ctx, sizes)
+    streams = RearrangementStreams(ctx, sizes)
     g, twin = streams.grasps(o.name)[0], streams.grasps(o.name)[1]
     fluents = [("atpose", x.name, x.start) for x in instance.objects]
     both = [c for (c,) in streams.inverse_kinematics("left", o.name, o.start, g, fluents)]
-    own = [c for (c,) in DualArmStreams(ctx, sizes, half_turns=False).inverse_kinematics(
+    own = [c for (c,) in RearrangementStreams(ctx, sizes, half_turns=False).inverse_kinematics(
         "left", o.name, o.start, g, fluents)]  # fmt: skip
     kin = ctx.kinematics["left"]
     T_obj = kin.fk_tcp(np.array(own[0].q)) @ np.linalg.inv(g.T_object_tcp)
@@ -57,10 +57,10 @@ def test_ik_yields_the_grasps_own_configurations_then_its_twins(
 def test_tilted_grasps_get_no_twin_configurations(ctx: WorldContext, instance: Instance) -> None:
     o = instance.objects[1]
     sizes = {x.name: x.size for x in instance.objects}
-    tilted = DualArmStreams(ctx, sizes).grasps(o.name)[2]
-    a = list(DualArmStreams(ctx, sizes).inverse_kinematics("left", o.name, o.start, tilted))
+    tilted = RearrangementStreams(ctx, sizes).grasps(o.name)[2]
+    a = list(RearrangementStreams(ctx, sizes).inverse_kinematics("left", o.name, o.start, tilted))
     b = list(
-        DualArmStreams(ctx, sizes, half_turns=False).inverse_kinematics(
+        RearrangementStreams(ctx, sizes, half_turns=False).inverse_kinematics(
             "left", o.name, o.start, tilted
         )
     )
@@ -101,6 +101,8 @@ def test_next_motion_penalises_a_wrist_near_its_limits(ctx: WorldContext) -> Non
     assert at(2.9) == pytest.approx(expected) and at(-2.9) == pytest.approx(expected)
     assert 0.0 < at(2.0) < at(2.9) < at(np.pi)
     assert (
-        DualArmStreams(ctx, {}, half_turns=False).next_motion(ArmConf("left", (*home[:5], 2.9)))
+        RearrangementStreams(ctx, {}, half_turns=False).next_motion(
+            ArmConf("left", (*home[:5], 2.9))
+        )
         == 0.0
     )  # without twins there is no shorter variant to expect

@@ -14,7 +14,7 @@ from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
 from streams.motion import (
-    DualMotionPlanner,
+    MotionPlanner,
     MotionRequest,
     SequentialStrategy,
     TransferProblem,
@@ -68,7 +68,7 @@ def _check(
 
 
 def test_plain_pick_motion_is_valid(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[0], names[5])
@@ -85,12 +85,12 @@ class StraightLine:
 
     name: str = "straight"
 
-    def __call__(self, planner: DualMotionPlanner, problem: TransferProblem) -> list[np.ndarray]:
+    def __call__(self, planner: MotionPlanner, problem: TransferProblem) -> list[np.ndarray]:
         return [straight_line(problem.q_from, problem.q_to, 10)]
 
 
 def test_blocked_straight_line_is_detected_and_a_fallback_takes_over(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     request = MotionRequest(BLOCKED_START, BLOCKED_GOAL, objects, retreat=(True, True),
                             approach=(True, True))  # fmt: skip
@@ -114,7 +114,7 @@ def test_blocked_straight_line_is_detected_and_a_fallback_takes_over(
 
 
 def test_sequential_only_moves_one_arm_at_a_time(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[2], names[7])
@@ -144,7 +144,7 @@ def test_strategy_ladders() -> None:
 
 
 def test_optimiser_is_reused_and_deterministic(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[1], names[4])
@@ -167,7 +167,7 @@ def _home12(ctx: WorldContext) -> np.ndarray:
 
 
 def test_a_colliding_retreat_fails_at_once_without_optimising(
-    ctx: WorldContext, planner: DualMotionPlanner
+    ctx: WorldContext, planner: MotionPlanner
 ) -> None:
     """Every strategy shares the straight retreat and approach: when they collide (here a
     box right above the left tool) the motion fails before any optimisation."""
@@ -186,7 +186,7 @@ def test_a_colliding_retreat_fails_at_once_without_optimising(
 
 
 def test_a_clear_straight_transfer_is_taken_without_optimising(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[0], names[5])
@@ -196,7 +196,7 @@ def test_a_clear_straight_transfer_is_taken_without_optimising(
     assert result.optimisation_time == 0.0 and result.trajectory is not None
     _check(ctx, result.trajectory.t, result.trajectory.q, request)
     # the same transfer through the optimiser (direct paths off) is no faster to execute
-    optimised = DualMotionPlanner(ctx, direct=False)
+    optimised = MotionPlanner(ctx, direct=False)
     assert optimised.trajopt is planner.trajopt  # one optimiser per scene and options
     again = plan_dual_motion(optimised, request)
     assert again.success and again.direct_paths == 0 and again.trajectory is not None
@@ -204,7 +204,7 @@ def test_a_clear_straight_transfer_is_taken_without_optimising(
 
 
 def test_direct_paths_need_the_margin_and_keep_waiting_arms_still(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     request = MotionRequest(BLOCKED_START, BLOCKED_GOAL, objects, retreat=(True, True),
                             approach=(True, True))  # fmt: skip
@@ -230,7 +230,7 @@ def test_direct_paths_need_the_margin_and_keep_waiting_arms_still(
 
 def test_direct_margin_must_not_be_negative(ctx: WorldContext) -> None:
     with pytest.raises(ParameterError, match="direct_margin must be >= 0"):
-        DualMotionPlanner(ctx, direct_margin=-0.001)
+        MotionPlanner(ctx, direct_margin=-0.001)
 
 
 def test_optimisers_are_built_once_per_scene_and_options(
@@ -244,7 +244,7 @@ def test_optimisers_are_built_once_per_scene_and_options(
             if options.knots == 3:
                 raise ParameterError("no NLP with 3 knots")
 
-    monkeypatch.setattr(trajopt, "DualArmTrajOpt", Fake)
+    monkeypatch.setattr(trajopt, "TrajectoryOptimiser", Fake)
     cache = OptimiserCache()
     six = TrajOptOptions(knots=6, compiled=False)
     a = cache.get(ctx, six)
@@ -253,7 +253,7 @@ def test_optimisers_are_built_once_per_scene_and_options(
     assert a is b and c is not a and len(cache) == 2
     assert a.get() is b.get() and a.ready and a.build_time >= 0.0
     assert [o.knots for o in sorted(built, key=lambda o: o.knots)] == [6, 7]
-    planner = DualMotionPlanner(ctx, six, optimisers=cache)
+    planner = MotionPlanner(ctx, six, optimisers=cache)
     assert planner.trajopt is a.get() and len(built) == 2  # no second build
     broken = cache.get(ctx, TrajOptOptions(knots=3, compiled=False))
     with pytest.raises(ParameterError, match="no NLP with 3 knots"):
@@ -261,7 +261,7 @@ def test_optimisers_are_built_once_per_scene_and_options(
 
 
 def test_blended_pick_motion_is_valid_and_ends_straight(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[0], names[5])
@@ -270,7 +270,7 @@ def test_blended_pick_motion_is_valid_and_ends_straight(
     assert result.success and result.blended and result.trajectory is not None
     traj = result.trajectory
     _check(ctx, traj.t, traj.q, request)
-    unblended = DualMotionPlanner(ctx, shape=ShapeOptions(blend=False))
+    unblended = MotionPlanner(ctx, shape=ShapeOptions(blend=False))
     slow = plan_dual_motion(unblended, request)
     assert slow.success and not slow.blended and slow.trajectory is not None
     assert traj.duration < slow.trajectory.duration  # no stop at the pre-grasp points
@@ -299,7 +299,7 @@ def test_blended_pick_motion_is_valid_and_ends_straight(
 
 
 def test_lift_follows_clearance(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[0], names[5])
@@ -329,7 +329,7 @@ BENT_TO = np.array([-0.011385690495040901, -1.480127490251257, 2.094725272785439
 
 
 def _bent_transfer(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> tuple[TransferProblem, np.ndarray]:
     """The transfer between BENT_FROM and BENT_TO, and its bent direct path (3 waypoints)."""
     for world in (planner.world, planner.margin_world):
@@ -340,7 +340,7 @@ def _bent_transfer(
     return planner.transfer_problem(request, BENT_FROM, BENT_TO), bent
 
 
-def _duration(planner: DualMotionPlanner, path: np.ndarray) -> float:
+def _duration(planner: MotionPlanner, path: np.ndarray) -> float:
     v, a = planner.limits
     from streams.timing import time_parameterize
 
@@ -350,7 +350,7 @@ def _duration(planner: DualMotionPlanner, path: np.ndarray) -> float:
 def test_a_bent_direct_path_is_refined_when_the_optimiser_makes_it_faster(
     ctx: WorldContext, objects: dict[str, ObjectBox]
 ) -> None:
-    planner = DualMotionPlanner(ctx)
+    planner = MotionPlanner(ctx)
     assert planner.refine_bent
     problem, bent = _bent_transfer(ctx, planner, objects)
     refined = planner.refine_direct(problem, bent)
@@ -360,7 +360,7 @@ def test_a_bent_direct_path_is_refined_when_the_optimiser_makes_it_faster(
     curve = spline_curve(refined, 128)
     assert validate_trajectory(ctx, planner.margin_world, curve).ok
     # off: the bent path as it is; a straight path is never handed to the optimiser
-    plain = DualMotionPlanner(ctx, refine_bent=False)
+    plain = MotionPlanner(ctx, refine_bent=False)
     assert plain.refine_direct(problem, bent) is bent
     straight = np.stack([bent[0], bent[-1]])
     assert planner.refine_direct(problem, straight) is straight
@@ -369,7 +369,7 @@ def test_a_bent_direct_path_is_refined_when_the_optimiser_makes_it_faster(
 def test_a_refinement_that_collides_or_is_slower_keeps_the_bent_path(
     ctx: WorldContext, objects: dict[str, ObjectBox], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    planner = DualMotionPlanner(ctx)
+    planner = MotionPlanner(ctx)
     problem, bent = _bent_transfer(ctx, planner, objects)
     solve = planner.trajopt.solve
 

@@ -7,7 +7,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from streams import sampling
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner, MotionRequest, plan_dual_motion
+from streams.motion import MotionPlanner, MotionRequest, plan_dual_motion
 from streams.sampling import (
     OmplUnavailableError,
     SampledStrategy,
@@ -37,7 +37,7 @@ def _blocked(objects: dict[str, ObjectBox]) -> MotionRequest:
 
 
 def _blocked_transfer(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> tuple[MotionRequest, np.ndarray, np.ndarray]:
     """The blocked request with both worlds configured, and its transfer's ends (after the
     retreat, before the approach)."""
@@ -51,7 +51,7 @@ def _blocked_transfer(
 
 @needs_ompl
 def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     _, q_a, q_b = _blocked_transfer(ctx, planner, objects)
     straight = np.linspace(0.0, 1.0, 30)[:, None] * (q_b - q_a)[None] + q_a[None]
@@ -74,7 +74,7 @@ def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
 
 @needs_ompl
 def test_a_query_gives_the_same_path_whatever_ran_before_it(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     configure_world(ctx, planner.margin_world, objects, {}, BLOCKED_START)
     retreat, approach = planner.phases(_blocked(objects)) or (None, None)
@@ -94,7 +94,7 @@ def test_a_query_gives_the_same_path_whatever_ran_before_it(
 
 @needs_ompl
 def test_sampled_strategy_plans_a_validated_motion(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     request = _blocked(objects)
     result = plan_dual_motion(planner, request, strategies=[SampledStrategy()])
@@ -123,7 +123,7 @@ def test_sampling_options_are_checked() -> None:
 
 
 def test_missing_ompl_is_a_clear_error(
-    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+    ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(sampling, "ompl_available", lambda: False)
     q = np.concatenate([ctx.home(a) for a in ctx.arm_names])
@@ -133,7 +133,7 @@ def test_missing_ompl_is_a_clear_error(
 
 @needs_ompl
 def test_a_sampled_path_warm_starts_the_optimiser(
-    ctx: WorldContext, planner: DualMotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
 ) -> None:
     request, q_a, q_b = _blocked_transfer(ctx, planner, objects)
     problem = planner.transfer_problem(request, q_a, q_b)
@@ -200,7 +200,7 @@ def test_the_plain_rung_tries_its_rescue_between_straight_and_lifted(
 
 
 def test_sdar_m_warm_starts_from_a_sampled_path_where_ompl_is_installed(
-    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch
+    ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     from streams import stream_map
     from streams.motion import PlainStrategy
@@ -211,10 +211,10 @@ def test_sdar_m_warm_starts_from_a_sampled_path_where_ompl_is_installed(
     assert isinstance(first, PlainStrategy) and first.rescue is not None
     assert first.rescue.keywords == {"options": SamplingOptions(seed=3)}  # type: ignore[attr-defined]
     assert len(sampling.warm_started_strategies(fallbacks=False)) == 1
-    streams = stream_map.DualArmStreams(ctx, {}, planner=planner)
+    streams = stream_map.RearrangementStreams(ctx, {}, planner=planner)
     assert streams.sampling == sampling.ompl_available()
-    assert not stream_map.DualArmStreams(ctx, {}, planner=planner, sampling=False).sampling
+    assert not stream_map.RearrangementStreams(ctx, {}, planner=planner, sampling=False).sampling
     monkeypatch.setattr(stream_map, "ompl_available", lambda: False)
-    assert not stream_map.DualArmStreams(ctx, {}, planner=planner).sampling
+    assert not stream_map.RearrangementStreams(ctx, {}, planner=planner).sampling
     with pytest.raises(OmplUnavailableError, match=r"sampling=True: .*pip install"):
-        stream_map.DualArmStreams(ctx, {}, planner=planner, sampling=True)
+        stream_map.RearrangementStreams(ctx, {}, planner=planner, sampling=True)

@@ -11,8 +11,14 @@ from sdar_tamp.language.streams import parse_stream_file
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance, Pose2D
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner, MotionResult
-from streams.stream_map import STREAM_KINDS, ArmConf, DualArmStreams, DualConf, make_stream_map
+from streams.motion import MotionPlanner, MotionResult
+from streams.stream_map import (
+    STREAM_KINDS,
+    ArmConf,
+    CellConf,
+    RearrangementStreams,
+    make_stream_map,
+)
 
 DOMAIN = Path(__file__).resolve().parents[2] / "domains" / "dual_arm_rearrangement"
 
@@ -52,7 +58,7 @@ def test_overlap_grasp_and_ik_streams(ctx: WorldContext, instance: Instance) -> 
 
 
 def test_motion_stream_plans_a_validated_place(
-    ctx: WorldContext, instance: Instance, planner: DualMotionPlanner
+    ctx: WorldContext, instance: Instance, planner: MotionPlanner
 ) -> None:
     sizes = {x.name: x.size for x in instance.objects}
     sm = make_stream_map(ctx, sizes, planner=planner)
@@ -86,10 +92,10 @@ def test_cfree_is_the_complement_of_overlap(ctx: WorldContext, instance: Instanc
 def test_distance_estimates_a_rest_to_rest_time(ctx: WorldContext) -> None:
     sm = make_stream_map(ctx)
     home = {a: ArmConf(a, tuple(ctx.home(a))) for a in ctx.arm_names}
-    d0 = DualConf(home["left"], home["right"])
+    d0 = CellConf(home["left"], home["right"])
     moved = list(home["left"].q)
     moved[0] += 1.0
-    d1 = DualConf(ArmConf("left", tuple(moved)), home["right"])
+    d1 = CellConf(ArmConf("left", tuple(moved)), home["right"])
     assert sm["Distance"](d0, d0) == 0.0
     t = sm["Distance"](d0, d1)
     v = ctx.scene.arm("left").velocity_limit[0]
@@ -103,7 +109,7 @@ def test_combine_confs_rejects_arms_in_collision(ctx: WorldContext) -> None:
     assert not list(sm["combine-confs"]("left", home["left"], "left", home["left"]))
     # a left configuration whose gripper touches the right arm's gripper at home
     crossing = ArmConf("left", (-2.781, -3.068, 0.89, 2.288, -0.423, 0.863))
-    pairs = ctx.new_world().report(DualConf(crossing, home["right"]).q)
+    pairs = ctx.new_world().report(CellConf(crossing, home["right"]).q)
     assert any(p.first.startswith("left") and p.second.startswith("right") for p in pairs)
     assert not list(sm["combine-confs"]("left", crossing, "right", home["right"]))
 
@@ -129,7 +135,7 @@ def test_unknown_motion_planner_is_refused(ctx: WorldContext) -> None:
 def test_ik_queries_of_one_arrangement_share_one_collision_world(
     ctx: WorldContext, instance: Instance
 ) -> None:
-    sm_obj = DualArmStreams(ctx, {x.name: x.size for x in instance.objects})
+    sm_obj = RearrangementStreams(ctx, {x.name: x.size for x in instance.objects})
     fluents = [("atpose", x.name, x.start) for x in instance.objects]
     grasps = [g for (g,) in sm_obj.sample_grasp(instance.objects[0].name)]
     for o in instance.objects[:4]:  # picks of four objects where they rest, two grasps, both arms
@@ -147,14 +153,14 @@ def test_ik_queries_of_one_arrangement_share_one_collision_world(
 
 def test_dual_conf_holds_every_arm_in_layout_order(ctx: WorldContext) -> None:
     home = {a: ArmConf(a, tuple(ctx.home(a))) for a in ctx.arm_names}
-    d = DualConf(*(home[a] for a in ctx.arm_names))
+    d = CellConf(*(home[a] for a in ctx.arm_names))
     assert d.arms == (home["left"], home["right"]) and d.arm("right") is home["right"]
     np.testing.assert_array_equal(d.q, ctx.scene.home)
     combine = make_stream_map(ctx)["combine-confs"]
     ((combined,),) = list(combine("right", home["right"], "left", home["left"]))
     assert combined == d  # arms in layout order whatever order the stream got them in
-    with pytest.raises(ParameterError, match="DualConf: expected one ArmConf per arm, got none"):
-        DualConf()
+    with pytest.raises(ParameterError, match="CellConf: expected one ArmConf per arm, got none"):
+        CellConf()
     with pytest.raises(ParameterError, match=r"arm must be one of \['left', 'right'\]; got 'up'"):
         d.arm("up")
 
@@ -172,7 +178,7 @@ def test_other_arm_needs_two_arms(ctx: WorldContext) -> None:
 
 @pytest.mark.parametrize("sampling", [False, True])
 def test_the_full_motion_skips_the_rung_the_quick_stream_failed(
-    ctx: WorldContext, planner: DualMotionPlanner, monkeypatch: pytest.MonkeyPatch, sampling: bool
+    ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch, sampling: bool
 ) -> None:
     """The quick stream is the ladder's first rung alone (deterministic): after it failed on
     a motion, the full stream starts that same motion at the second rung."""
@@ -191,8 +197,8 @@ def test_the_full_motion_skips_the_rung_the_quick_stream_failed(
     monkeypatch.setattr(stream_map, "plan_dual_motion", failing)
     sm = make_stream_map(ctx, planner=planner, sampling=sampling)
     home = [ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in ctx.arm_names]
-    d1 = DualConf(*home)
-    d2 = DualConf(ArmConf(home[0].arm, tuple(x + 0.1 for x in home[0].q)), home[1])
+    d1 = CellConf(*home)
+    d2 = CellConf(ArmConf(home[0].arm, tuple(x + 0.1 for x in home[0].q)), home[1])
     here = [("atpose", "o", Pose2D(0.1, 0.0, 0.0))]
     there = [("atpose", "o", Pose2D(0.2, 0.0, 0.0))]
     assert not list(sm["plan-dual-motion-quick"](d1, d2, here))

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from streams._casadi import ca, to_array
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 
 
-def _point(planner: DualMotionPlanner, seed: int) -> tuple[np.ndarray, np.ndarray]:
+def _point(planner: MotionPlanner, seed: int) -> tuple[np.ndarray, np.ndarray]:
     opt = planner.trajopt
     rng = np.random.default_rng(seed)
     n_x = int(opt._nlp["x"].shape[0])
@@ -19,7 +19,7 @@ def _point(planner: DualMotionPlanner, seed: int) -> tuple[np.ndarray, np.ndarra
     return x, p
 
 
-def test_jacobian_matches_finite_differences(planner: DualMotionPlanner) -> None:
+def test_jacobian_matches_finite_differences(planner: MotionPlanner) -> None:
     opt = planner.trajopt
     x, p = _point(planner, 0)
     g, J = (to_array(v) for v in opt._jac_g(x, p))
@@ -33,7 +33,7 @@ def test_jacobian_matches_finite_differences(planner: DualMotionPlanner) -> None
         assert np.allclose(J[:, j], fd, rtol=1e-5, atol=1e-6), f"column {j}"
 
 
-def test_hessian_matches_the_whole_horizon(planner: DualMotionPlanner) -> None:
+def test_hessian_matches_the_whole_horizon(planner: MotionPlanner) -> None:
     opt = planner.trajopt
     nlp = opt._nlp
     x, p = _point(planner, 2)

@@ -9,18 +9,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from sdar_tamp.app.plan_export import plan_file_from_solution
+from sdar_tamp.app.problem import rearrangement_problem
+from sdar_tamp.app.solving import solve_rearrangement
 from sdar_tamp.plan_file import save_plan
-from sdar_tamp.rearrangement import (
-    plan_file_from_solution,
-    rearrangement_problem,
-    solve_rearrangement,
-)
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.suites import shipped_suite_dir
 from solvers.solution import Status
 from streams.context import WorldContext
-from streams.motion import DualMotionPlanner
+from streams.motion import MotionPlanner
 
 #: The instances, by the role they play in the tests.
 INSTANCES = ("R5", "D5", "M2")
@@ -29,7 +27,7 @@ HERE = Path(__file__).resolve().parent
 
 def main() -> None:
     ctx = WorldContext.load()
-    planner = DualMotionPlanner(ctx)
+    planner = MotionPlanner(ctx)
     for name in INSTANCES:
         instance = load_instance(shipped_suite_dir("paper") / f"{name}.yaml")
         problem = rearrangement_problem(instance, ctx, planner=planner)

@@ -9,9 +9,9 @@ import pytest
 
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import pose_xyz_yaw
-from streams.blocking import GraspBlocking, GripperBox, boxes_overlap, gripper_boxes
 from streams.context import WorldContext
-from streams.stream_map import DualArmStreams
+from streams.finger_blocking import GraspBlocking, GripperBox, boxes_overlap, gripper_boxes
+from streams.stream_map import RearrangementStreams
 
 BAR = (0.08, 0.04, 0.05)  # graspable across y only
 CUBE = (0.04, 0.04, 0.05)  # graspable across both sides
@@ -72,12 +72,12 @@ def test_grasp_blocking_checks_its_values() -> None:
 
 
 @pytest.fixture(scope="module")
-def streams(ctx: WorldContext) -> DualArmStreams:
+def streams(ctx: WorldContext) -> RearrangementStreams:
     sizes = {"a": BAR, "b": BAR, "c": CUBE, "d": CUBE}
-    return DualArmStreams(ctx, sizes)
+    return RearrangementStreams(ctx, sizes)
 
 
-def test_neighbour_on_the_closing_axis_blocks_every_grasp(streams: DualArmStreams) -> None:
+def test_neighbour_on_the_closing_axis_blocks_every_grasp(streams: RearrangementStreams) -> None:
     here = Pose2D(0.0, 0.1, 0.0)
     beside = Pose2D(0.0, 0.1 + 0.045, 0.0)  # 5 mm gap across the bar's 4 cm side
     assert streams.test_blocks_grasps("b", beside, "a", here)
@@ -86,7 +86,7 @@ def test_neighbour_on_the_closing_axis_blocks_every_grasp(streams: DualArmStream
     assert streams.test_blocks_grasps("b", turned_beside, "a", turned)
 
 
-def test_far_or_off_axis_neighbours_leave_a_grasp(streams: DualArmStreams) -> None:
+def test_far_or_off_axis_neighbours_leave_a_grasp(streams: RearrangementStreams) -> None:
     here = Pose2D(0.0, 0.1, 0.0)
     assert not streams.test_blocks_grasps("b", Pose2D(0.0, 0.3, 0.0), "a", here)
     assert not streams.test_blocks_grasps("b", Pose2D(0.0, 0.1 + 0.07, 0.0), "a", here)
@@ -97,7 +97,7 @@ def test_far_or_off_axis_neighbours_leave_a_grasp(streams: DualArmStreams) -> No
     assert not streams.test_blocks_grasps("a", here, "a", here)
 
 
-def test_grasp_cfree_tells_grasps_apart(streams: DualArmStreams) -> None:
+def test_grasp_cfree_tells_grasps_apart(streams: RearrangementStreams) -> None:
     here = Pose2D(0.0, 0.1, 0.0)
     grasps = streams.grasps("c")
     across_x = [g for g in grasps if g.closing_axis == 0 and g.is_top_down]
