@@ -28,7 +28,7 @@ from hypothesis.configuration import set_hypothesis_home_dir
 
 from sdar_tamp.errors import SdarError
 from sdar_tamp.language import parse_domain, parse_problem, parse_stream_file
-from sdar_tamp.language.model import Domain
+from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.plan_file import (
     GripperEvent,
     MotionSegment,

@@ -1,5 +1,6 @@
 """The declarative language: PDDL domains and problems, stream files, and ``PDDLProblem``."""
 
+from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.errors import (
     ArityError,
     DuplicateError,
@@ -14,7 +15,7 @@ from sdar_tamp.language.errors import (
     UnsupportedFeatureError,
 )
 from sdar_tamp.language.leniency import Leniency, StrictModeError
-from sdar_tamp.language.pddl import parse_domain, parse_problem
+from sdar_tamp.language.problem_reader import parse_problem
 from sdar_tamp.language.streams import parse_stream_file
 
 __all__ = [

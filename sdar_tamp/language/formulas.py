@@ -10,7 +10,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from sdar_tamp.language.model import TOTAL_COST as TOTAL_COST
+from sdar_tamp.language.formula_model import TOTAL_COST as TOTAL_COST
 from sdar_tamp.textfile import read_text
 
 INF = math.inf

@@ -21,20 +21,20 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.domain_model import Domain, TypeHierarchy
+from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.errors import (
     ArityError,
     ProblemDefinitionError,
     StreamMapError,
     UndeclaredError,
 )
-from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, Leniency, LeniencyLog
-from sdar_tamp.language.model import (
+from sdar_tamp.language.formula_model import (
     EQUALITY,
     OBJECT_TYPE,
     TOTAL_COST,
     And,
     Atom,
-    Domain,
     Exists,
     ForAll,
     Formula,
@@ -42,11 +42,10 @@ from sdar_tamp.language.model import (
     Not,
     Or,
     Parameter,
-    StreamFile,
-    TypeHierarchy,
 )
+from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, Leniency, LeniencyLog
 from sdar_tamp.language.objects import ObjectTable
-from sdar_tamp.language.pddl import parse_domain
+from sdar_tamp.language.stream_model import StreamFile
 from sdar_tamp.language.streams import parse_stream_file
 
 DEBUG = "debug"

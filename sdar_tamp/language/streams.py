@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.errors import (
     ArityError,
     DuplicateError,
@@ -24,9 +25,9 @@ from sdar_tamp.language.errors import (
     UnknownKeywordError,
     UnsupportedFeatureError,
 )
+from sdar_tamp.language.formula_model import Atom, FunctionTerm
+from sdar_tamp.language.formula_reader import FormulaReader, Vocabulary
 from sdar_tamp.language.grammar import (
-    FormulaReader,
-    Vocabulary,
     expect_head,
     expect_list,
     expect_symbol,
@@ -34,10 +35,10 @@ from sdar_tamp.language.grammar import (
     parse_options,
 )
 from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, LeniencyLog, note_glued_variables
-from sdar_tamp.language.model import Atom, Domain, FunctionTerm, Rule, Stream, StreamFile
-from sdar_tamp.language.model import StreamFunction as StreamFunctionDecl
-from sdar_tamp.language.model import StreamPredicate as StreamPredicateDecl
 from sdar_tamp.language.sexpr import SExpr, SList, Symbol, read_sexpr
+from sdar_tamp.language.stream_model import Rule, Stream, StreamFile
+from sdar_tamp.language.stream_model import StreamFunction as StreamFunctionDecl
+from sdar_tamp.language.stream_model import StreamPredicate as StreamPredicateDecl
 
 STREAM_SECTIONS = (":stream", ":function", ":predicate", ":rule", ":optimizer")
 STREAM_OPTIONS = (":inputs", ":domain", ":fluents", ":outputs", ":certified")

@@ -12,7 +12,7 @@ import time
 from collections.abc import Callable, Mapping
 from operator import itemgetter
 
-from sdar_tamp.language.model import EQUALITY, Atom, FunctionTerm, NumericExpr
+from sdar_tamp.language.formula_model import EQUALITY, Atom, FunctionTerm, NumericExpr
 from solvers.classical.errors import GroundingError
 from solvers.classical.join import (
     DEADLINE_STRIDE,

@@ -12,7 +12,7 @@ import time
 from collections.abc import Collection, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 
-from sdar_tamp.language.model import EQUALITY
+from sdar_tamp.language.formula_model import EQUALITY
 from solvers.classical.normalize import Lit
 
 Fact = tuple[str, ...]

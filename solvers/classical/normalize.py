@@ -25,10 +25,10 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from sdar_tamp.language.model import (
+from sdar_tamp.language.domain_model import ActionSchema
+from sdar_tamp.language.formula_model import (
     EQUALITY,
     OBJECT_TYPE,
-    ActionSchema,
     AndEffect,
     Atom,
     Effect,
@@ -43,10 +43,10 @@ from sdar_tamp.language.model import (
     NumericExpr,
     Parameter,
     When,
-    iter_effect_literals,
 )
-from sdar_tamp.language.model import And as AndF
-from sdar_tamp.language.model import Or as OrF
+from sdar_tamp.language.formula_model import And as AndF
+from sdar_tamp.language.formula_model import Or as OrF
+from sdar_tamp.language.traversal import iter_effect_literals
 from solvers.classical.errors import GroundingError
 from solvers.classical.problem import PlanningTask
 

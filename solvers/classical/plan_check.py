@@ -1,6 +1,6 @@
 """Plan validation by independent simulation.
 
-Actions are executed from the *lifted* schemas with :func:`sdar_tamp.language.semantics.run_plan`:
+Actions are executed from the *lifted* schemas with :func:`sdar_tamp.language.plan_run.run_plan`:
 each step's precondition formula is evaluated on a set of atoms (quantifiers range over the
 typed objects, derived predicates are evaluated from the domain's axioms), effects (conditional
 and universal) are evaluated in the state before the step, deletes are applied before adds, and
@@ -12,8 +12,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from sdar_tamp.language.model import FunctionTerm
-from sdar_tamp.language.semantics import TypedObjects, run_plan
+from sdar_tamp.language.formula_model import FunctionTerm
+from sdar_tamp.language.plan_run import run_plan
+from sdar_tamp.language.state_index import TypedObjects
 from solvers.classical.errors import PlanValidationError
 from solvers.classical.problem import GroundAction, PlanningTask
 

@@ -6,7 +6,8 @@ import enum
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from sdar_tamp.language.model import Atom, Domain, Formula, Problem
+from sdar_tamp.language.domain_model import Domain, Problem
+from sdar_tamp.language.formula_model import Atom, Formula
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from sdar_tamp.language.model import EQUALITY
+from sdar_tamp.language.formula_model import EQUALITY
 from solvers.classical.join import (
     Fact,
     FactBase,

@@ -11,7 +11,7 @@ from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.classical.problem import GroundAction, PlanningTask
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.model import Atom, FunctionTerm
+from sdar_tamp.language.formula_model import Atom, FunctionTerm
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, type_facts
 from solvers.sdar.state import LiftedState

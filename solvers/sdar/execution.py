@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.sdar.attempts import MotionMode
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.grounding import Grounding

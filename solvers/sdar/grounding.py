@@ -16,7 +16,7 @@ from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache

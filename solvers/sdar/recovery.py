@@ -20,7 +20,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.logs import get_logger
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
-from sdar_tamp.language.model import And, Atom
+from sdar_tamp.language.formula_model import And, Atom
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.sdar.attempts import MotionMode, QuickLadder, TabuLists

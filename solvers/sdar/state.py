@@ -2,8 +2,8 @@
 
 Facts are atoms over object names: ``static`` ones (initial facts and stream certificates) and
 ``fluents`` (the predicates some action changes). Conditions and effects mean what
-:mod:`sdar_tamp.language.semantics` says; this class keeps the facts, indexed by predicate, and
-changes them in place.
+:mod:`sdar_tamp.language.evaluator` and :mod:`sdar_tamp.language.state_changes` say; this class
+keeps the facts, indexed by predicate, and changes them in place.
 """
 
 from __future__ import annotations
@@ -12,15 +12,12 @@ from collections import defaultdict
 from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
 
 from sdar_tamp.errors import ActionError
-from sdar_tamp.language.model import (
-    OBJECT_TYPE,
-    Atom,
-    Domain,
-    Formula,
-    FunctionTerm,
-    iter_effect_literals,
-)
-from sdar_tamp.language.semantics import Evaluator, bind, effect_changes
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.evaluator import Evaluator
+from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Formula, FunctionTerm
+from sdar_tamp.language.state_changes import effect_changes
+from sdar_tamp.language.substitution import bind
+from sdar_tamp.language.traversal import iter_effect_literals
 
 Binding = Mapping[str, str]
 
@@ -60,7 +57,7 @@ class LiftedState:
         self._cost = cost
         self._evaluator: Evaluator | None = None
 
-    # -- facts (the semantics' Facts and Objects) ----------------------------------------------
+    # -- facts (the Facts and Objects of language.state_index) ---------------------------------
     def __contains__(self, atom: object) -> bool:
         return isinstance(atom, Atom) and atom.args in self._by_predicate.get(atom.predicate, ())
 

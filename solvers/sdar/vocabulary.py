@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.model import Domain
+from sdar_tamp.language.domain_model import Domain
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
 
 

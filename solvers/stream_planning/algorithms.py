@@ -32,17 +32,12 @@ from dataclasses import dataclass, field
 from itertools import chain
 from typing import Any
 
-from sdar_tamp.language.model import (
-    And,
-    Atom,
-    Domain,
-    Formula,
-    FunctionTerm,
-)
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import And, Atom, Formula, FunctionTerm
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
-from sdar_tamp.language.semantics import ground_atom
+from sdar_tamp.language.substitution import ground_atom
 from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan

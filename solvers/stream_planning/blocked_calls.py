@@ -21,20 +21,10 @@ from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.model import (
-    And,
-    Atom,
-    Axiom,
-    Domain,
-    Formula,
-    Not,
-    Parameter,
-    Predicate,
-    Stream,
-    is_variable,
-    map_atoms,
-    map_conditions,
-)
+from sdar_tamp.language.domain_model import Axiom, Domain, Predicate
+from sdar_tamp.language.formula_model import And, Atom, Formula, Not, Parameter, is_variable
+from sdar_tamp.language.stream_model import Stream
+from sdar_tamp.language.traversal import map_atoms, map_conditions
 
 BLOCKED = "@blocked:"
 FAILED = "@failed:"

@@ -24,16 +24,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.model import (
-    ActionSchema,
-    And,
-    AndEffect,
-    Atom,
-    Literal,
-    Or,
-    Parameter,
-    Predicate,
-)
+from sdar_tamp.language.domain_model import ActionSchema, Predicate
+from sdar_tamp.language.formula_model import And, AndEffect, Atom, Literal, Or, Parameter
 from sdar_tamp.language.options import WILD, PlanConstraints
 from sdar_tamp.language.problem import PDDLProblem
 

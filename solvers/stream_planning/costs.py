@@ -10,18 +10,17 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from sdar_tamp.language.model import (
+from sdar_tamp.language.domain_model import Domain, Predicate
+from sdar_tamp.language.formula_model import (
     And,
     AndEffect,
     Atom,
-    Domain,
     Effect,
     FunctionTerm,
     IncreaseCost,
     Parameter,
-    Predicate,
-    iter_effects,
 )
+from sdar_tamp.language.traversal import iter_effects
 from solvers.stream_planning.engine import function_guard
 
 

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from sdar_tamp.language.model import Domain, Formula, iter_atoms, iter_effect_literals
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import Formula
+from sdar_tamp.language.traversal import iter_atoms, iter_effect_literals
 from solvers.solution import Status
 from solvers.stream_planning.calls import Overrun
 from solvers.stream_planning.engine import Engine

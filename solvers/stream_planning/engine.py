@@ -24,19 +24,13 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from sdar_tamp.language.model import (
-    Atom,
-    Domain,
-    FunctionTerm,
-    IncreaseCost,
-    Rule,
-    StreamFunction,
-    StreamPredicate,
-    iter_effects,
-)
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import Atom, FunctionTerm, IncreaseCost
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo, unsupported_options
 from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.language.stream_model import Rule, StreamFunction, StreamPredicate
+from sdar_tamp.language.traversal import iter_effects
 from sdar_tamp.logs import get_logger
 from solvers.stream_planning.calls import CallRunner
 from solvers.stream_planning.externals import (

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sdar_tamp.errors import SdarError
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import (
     SINGLE_CALL,
     ListGenFn,
@@ -24,10 +25,10 @@ from sdar_tamp.language.generators import (
     WildOutput,
     truth_value,
 )
-from sdar_tamp.language.model import Atom, Stream, StreamFunction, StreamPredicate
 from sdar_tamp.language.objects import ObjectTable, keyed_by_identity
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
-from sdar_tamp.language.semantics import ground_atom
+from sdar_tamp.language.stream_model import Stream, StreamFunction, StreamPredicate
+from sdar_tamp.language.substitution import ground_atom
 from sdar_tamp.logs import get_logger
 from solvers.stream_planning.calls import CallRunner, CallTimeout
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
-from sdar_tamp.language.model import Atom, is_variable
+from sdar_tamp.language.formula_model import Atom, is_variable
 
 
 class FactStore:

@@ -20,8 +20,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
-from sdar_tamp.language.model import Atom
-from sdar_tamp.language.semantics import ground_atom
+from sdar_tamp.language.formula_model import Atom
+from sdar_tamp.language.substitution import ground_atom
 from solvers.stream_planning.optimistic import OptResult, is_placeholder
 from solvers.stream_planning.preimage import PlanCheck
 

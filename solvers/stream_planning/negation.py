@@ -12,9 +12,10 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import ListGenFn, WildOutput
-from sdar_tamp.language.model import Atom, Stream, StreamPredicate
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
+from sdar_tamp.language.stream_model import Stream, StreamPredicate
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
 
 

@@ -29,11 +29,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from sdar_tamp.language.generators import SINGLE_CALL, WildOutput
-from sdar_tamp.language.model import (
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import (
     AndEffect,
     Atom,
-    Domain,
     Effect,
     ForAllEffect,
     Formula,
@@ -41,6 +40,7 @@ from sdar_tamp.language.model import (
     Not,
     When,
 )
+from sdar_tamp.language.generators import SINGLE_CALL, WildOutput
 from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import (
     FunctionExternal,

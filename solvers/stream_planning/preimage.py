@@ -1,7 +1,7 @@
 """Lifted plan simulation that also says which initial facts a plan relies on (its preimage).
 
 This is independent of the classical planner's grounding: it executes the plan with
-:func:`sdar_tamp.language.semantics.run_plan` on explicit states, with an explaining evaluator
+:func:`sdar_tamp.language.plan_run.run_plan` on explicit states, with an explaining evaluator
 that picks one witness for each disjunction and existential. It serves two purposes: the stream
 plan of an optimistic plan is the set of stream results behind the initial facts the plan
 needs, and a finished plan is validated against the real facts (and its cost computed).
@@ -12,8 +12,11 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from sdar_tamp.language.model import Atom, Domain, Formula
-from sdar_tamp.language.semantics import CostOf, TypedObjects, run_plan
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import Atom, Formula
+from sdar_tamp.language.plan_run import run_plan
+from sdar_tamp.language.state_changes import CostOf
+from sdar_tamp.language.state_index import TypedObjects
 
 
 @dataclass(frozen=True)

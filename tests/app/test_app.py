@@ -23,7 +23,7 @@ from sdar_tamp.app import (
 from sdar_tamp.app.plan_export import GripperAction
 from sdar_tamp.app.problem import grasp_set_sizes
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.pddl import parse_domain
+from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D

@@ -19,9 +19,10 @@ from sdar_tamp.language import (
     parse_domain,
     parse_problem,
 )
-from sdar_tamp.language.grammar import MAX_FORMULA_DEPTH, FormulaReader, Vocabulary
+from sdar_tamp.language.domain_model import Problem
+from sdar_tamp.language.formula_model import And, Atom, Exists, Not, Parameter
+from sdar_tamp.language.formula_reader import MAX_FORMULA_DEPTH, FormulaReader, Vocabulary
 from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, INIT_TYPE
-from sdar_tamp.language.model import And, Atom, Exists, Not, Parameter, Problem
 from sdar_tamp.language.sexpr import read_sexpr
 
 DOMAIN = parse_domain(

@@ -1,7 +1,7 @@
 """Domain and problem parsing: what comes out of a well-formed file."""
 
 from sdar_tamp.language import parse_domain, parse_problem
-from sdar_tamp.language.model import (
+from sdar_tamp.language.formula_model import (
     And,
     Atom,
     Exists,
@@ -12,8 +12,8 @@ from sdar_tamp.language.model import (
     Not,
     Or,
     When,
-    iter_effect_literals,
 )
+from sdar_tamp.language.traversal import iter_effect_literals
 
 DOMAIN = """
 ; a typed domain exercising every supported requirement

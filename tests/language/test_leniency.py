@@ -18,6 +18,7 @@ from sdar_tamp.language import (
     parse_stream_file,
 )
 from sdar_tamp.language.errors import UnboundVariableError
+from sdar_tamp.language.formula_model import And, Atom, Exists, IncreaseCost
 from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
     DUPLICATE_TYPE,
@@ -28,9 +29,9 @@ from sdar_tamp.language.leniency import (
     REPEATED_VARIABLE,
     UNDECLARED_PARENT_TYPE,
 )
-from sdar_tamp.language.model import And, Atom, Exists, IncreaseCost, iter_effects
 from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.language.sexpr import Symbol, read_sexpr
+from sdar_tamp.language.traversal import iter_effects
 
 TYPED = """(define (domain t) (:requirements :strips :typing :action-costs)
  (:types block table)

@@ -9,11 +9,11 @@ from sdar_tamp.language import (
     StreamMapError,
     UndeclaredError,
 )
+from sdar_tamp.language.formula_model import And as AndF
+from sdar_tamp.language.formula_model import Atom
+from sdar_tamp.language.formula_model import Exists as ExistsF
 from sdar_tamp.language.formulas import And, Equal, Exists, Not
 from sdar_tamp.language.generators import from_gen_fn, from_test
-from sdar_tamp.language.model import And as AndF
-from sdar_tamp.language.model import Atom
-from sdar_tamp.language.model import Exists as ExistsF
 from sdar_tamp.language.problem import PDDLProblem
 
 DOMAIN = """(define (domain pick) (:requirements :strips :typing :equality)

@@ -7,12 +7,14 @@ from collections.abc import Iterable
 import pytest
 
 from sdar_tamp.errors import ActionError, EvaluationError, SdarError
-from sdar_tamp.language.model import (
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.domain_reader import parse_domain
+from sdar_tamp.language.evaluator import Evaluator
+from sdar_tamp.language.formula_model import (
     TRUE,
     And,
     AndEffect,
     Atom,
-    Domain,
     Exists,
     ForAll,
     ForAllEffect,
@@ -25,20 +27,10 @@ from sdar_tamp.language.model import (
     Parameter,
     When,
 )
-from sdar_tamp.language.pddl import parse_domain
-from sdar_tamp.language.semantics import (
-    Changes,
-    Evaluator,
-    FactIndex,
-    TypedObjects,
-    bind,
-    check_arguments,
-    effect_changes,
-    free_parameters,
-    ground_args,
-    ground_atom,
-    run_plan,
-)
+from sdar_tamp.language.plan_run import check_arguments, run_plan
+from sdar_tamp.language.state_changes import Changes, effect_changes
+from sdar_tamp.language.state_index import FactIndex, TypedObjects
+from sdar_tamp.language.substitution import bind, free_parameters, ground_args, ground_atom
 
 DOMAIN = """
 (define (domain lab)

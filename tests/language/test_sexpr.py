@@ -9,7 +9,7 @@ import pytest
 
 from sdar_tamp.language import parse_domain, parse_problem, parse_stream_file
 from sdar_tamp.language.errors import PddlSyntaxError
-from sdar_tamp.language.grammar import MAX_FORMULA_DEPTH
+from sdar_tamp.language.formula_reader import MAX_FORMULA_DEPTH
 from sdar_tamp.language.sexpr import SExpr, SList, Symbol, read_sexpr
 from sdar_tamp.resources import domain_file
 

@@ -1,7 +1,7 @@
 """Stream files: streams, tests, functions, predicates and rules."""
 
 from sdar_tamp.language import parse_domain, parse_stream_file
-from sdar_tamp.language.model import Atom, FunctionTerm
+from sdar_tamp.language.formula_model import Atom, FunctionTerm
 
 DOMAIN = parse_domain(
     """(define (domain pick) (:requirements :strips :typing) (:types block region)

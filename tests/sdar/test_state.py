@@ -2,8 +2,8 @@
 
 import pytest
 
-from sdar_tamp.language.model import Atom, FunctionTerm
-from sdar_tamp.language.pddl import parse_domain
+from sdar_tamp.language.domain_reader import parse_domain
+from sdar_tamp.language.formula_model import Atom, FunctionTerm
 from solvers.sdar.state import ActionError, LiftedState, fluent_predicates
 
 DOMAIN = """

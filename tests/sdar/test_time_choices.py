@@ -8,7 +8,7 @@ import math
 from collections.abc import Hashable, Sequence
 
 from sdar_tamp.graph import DependencyGraph
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.sdar.abstract import view_of
 from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline

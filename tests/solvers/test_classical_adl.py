@@ -6,17 +6,8 @@ import dataclasses
 
 from classical_helpers import load, load_text
 
-from sdar_tamp.language.model import (
-    And,
-    Atom,
-    Axiom,
-    Exists,
-    ForAll,
-    Imply,
-    Not,
-    Or,
-    Parameter,
-)
+from sdar_tamp.language.domain_model import Axiom
+from sdar_tamp.language.formula_model import And, Atom, Exists, ForAll, Imply, Not, Or, Parameter
 from solvers.classical import PlanStatus, ground, plan, validated_plan_cost
 from solvers.classical.bitset_task import CompiledTask, mask
 

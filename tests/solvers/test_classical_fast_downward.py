@@ -12,7 +12,7 @@ from classical_helpers import load, load_text
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language import parse_domain, parse_problem
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.classical import (
     PlanningTask,
     fast_downward,

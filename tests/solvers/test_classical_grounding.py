@@ -7,17 +7,8 @@ import dataclasses
 import pytest
 from classical_helpers import load, load_text
 
-from sdar_tamp.language.model import (
-    ActionSchema,
-    And,
-    Atom,
-    Axiom,
-    Domain,
-    Literal,
-    Not,
-    Parameter,
-    TypeHierarchy,
-)
+from sdar_tamp.language.domain_model import ActionSchema, Axiom, Domain, TypeHierarchy
+from sdar_tamp.language.formula_model import And, Atom, Literal, Not, Parameter
 from solvers.classical import GroundingError, PlanStatus, ground, plan
 
 

@@ -6,16 +6,8 @@ import math
 
 import pytest
 
-from sdar_tamp.language.model import (
-    ActionSchema,
-    And,
-    AndEffect,
-    Atom,
-    Domain,
-    IncreaseCost,
-    Literal,
-    TypeHierarchy,
-)
+from sdar_tamp.language.domain_model import ActionSchema, Domain, TypeHierarchy
+from sdar_tamp.language.formula_model import And, AndEffect, Atom, IncreaseCost, Literal
 from solvers.classical import PlanningTask, ground
 from solvers.classical.bitset_task import CompiledTask, mask
 from solvers.classical.heuristics import RelaxedHeuristic

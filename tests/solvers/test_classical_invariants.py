@@ -7,7 +7,7 @@ import random
 from classical_helpers import load, load_text
 
 from sdar_tamp.language import parse_domain, parse_problem
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.classical import ground, plan, task_from_problem
 from solvers.classical.bitset_task import CompiledTask, bits
 from solvers.classical.invariants import MutexGroups, mutex_groups

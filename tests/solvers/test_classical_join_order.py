@@ -11,7 +11,7 @@ from __future__ import annotations
 from itertools import pairwise
 
 from sdar_tamp.language import parse_domain, parse_problem
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.classical import PlanningTask, PlanStatus, ground, plan, task_from_problem
 from solvers.classical.join import FactBase, compile_join, run_join
 from solvers.classical.normalize import Lit

@@ -6,7 +6,7 @@ import pytest
 from classical_helpers import load
 
 from sdar_tamp.language import parse_domain, parse_problem
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.classical import PlanStatus, ground, plan, task_from_problem
 from solvers.classical.bitset_task import CompiledTask, bits, mask
 from solvers.classical.landmarks import LandmarkCount

@@ -14,13 +14,13 @@ import pytest
 
 from sdar_tamp.cli import main
 from sdar_tamp.language import parse_domain, parse_problem
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
     GLUED_VARIABLE,
     IMPLICIT_PREDICATE,
     REPEATED_VARIABLE,
 )
-from sdar_tamp.language.model import Atom
 from solvers.classical import (
     GroundAction,
     GroundingError,

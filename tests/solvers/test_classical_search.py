@@ -10,7 +10,7 @@ import pytest
 from classical_helpers import load, load_text
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.model import Atom
+from sdar_tamp.language.formula_model import Atom
 from solvers.classical import HEURISTICS, SEARCHES, PlanStatus, ground, plan
 from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.postprocess import eliminate_redundant_actions

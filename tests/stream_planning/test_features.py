@@ -13,6 +13,8 @@ from typing import Any
 import pytest
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.domain_reader import parse_domain
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.formulas import TOTAL_COST, Equal
 from sdar_tamp.language.generators import (
     WildOutput,
@@ -22,9 +24,7 @@ from sdar_tamp.language.generators import (
     from_sampler,
     from_test,
 )
-from sdar_tamp.language.model import Atom
 from sdar_tamp.language.options import StreamInfo
-from sdar_tamp.language.pddl import parse_domain
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.classical import GroundingError
 from solvers.solution import Status

@@ -19,10 +19,11 @@ from typing import Any
 import pytest
 
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.domain_reader import parse_domain
+from sdar_tamp.language.formula_model import Atom, Not
 from sdar_tamp.language.generators import from_fn
-from sdar_tamp.language.model import Atom, Not, Stream
-from sdar_tamp.language.pddl import parse_domain
 from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.language.stream_model import Stream
 from solvers.solution import Solution
 from solvers.solve import solve
 from solvers.stream_planning.blocked_calls import Blocks, blocked_predicate, guard_fluent_uses

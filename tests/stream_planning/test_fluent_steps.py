@@ -16,8 +16,8 @@ from typing import Any
 
 import pytest
 
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import from_fn, from_gen_fn
-from sdar_tamp.language.model import Atom
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Solution
 from solvers.solve import solve

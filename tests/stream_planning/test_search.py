@@ -8,9 +8,9 @@ from collections.abc import Iterator
 
 import pytest
 
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.formulas import Equal
 from sdar_tamp.language.generators import from_gen_fn, from_test
-from sdar_tamp.language.model import Atom
 from sdar_tamp.language.options import PlanConstraints
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solve import solve

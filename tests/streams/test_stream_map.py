@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.pddl import parse_domain
+from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.streams import parse_stream_file
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance, Pose2D

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from sdar_tamp.language.model import OBJECT_TYPE, AndEffect, Atom, Domain, Effect, IncreaseCost
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import OBJECT_TYPE, AndEffect, Atom, Effect, IncreaseCost
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.classical import (
     GroundAction,

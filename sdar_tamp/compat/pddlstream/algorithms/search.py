@@ -6,7 +6,8 @@ import logging
 import math
 from typing import Any
 
-from sdar_tamp.language.pddl import parse_domain, parse_problem
+from sdar_tamp.language.domain_reader import parse_domain
+from sdar_tamp.language.problem_reader import parse_problem
 from solvers.classical import PlanStatus, task_from_problem
 from solvers.classical import plan as plan  # replaced by the runner's --report
 from solvers.solution import Action

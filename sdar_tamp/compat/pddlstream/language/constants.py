@@ -10,7 +10,7 @@ from typing import Any, NamedTuple
 
 from sdar_tamp.compat.pddlstream.language.problem import PDDLProblem as PDDLProblem
 from sdar_tamp.compat.pddlstream.utils import INF, read, str_from_object
-from sdar_tamp.language.model import TOTAL_COST as TOTAL_COST
+from sdar_tamp.language.formula_model import TOTAL_COST as TOTAL_COST
 from solvers.solution import Action as Action
 from solvers.solution import Certificate as Certificate
 from solvers.solution import Solution as Solution

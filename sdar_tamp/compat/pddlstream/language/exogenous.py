@@ -20,23 +20,10 @@ import logging
 from collections.abc import Mapping
 from dataclasses import replace
 
-from sdar_tamp.language.model import (
-    And,
-    Atom,
-    Axiom,
-    Domain,
-    Effect,
-    Exists,
-    Formula,
-    Parameter,
-    Predicate,
-    Rule,
-    Stream,
-    StreamFile,
-    iter_effect_literals,
-    map_atoms,
-    map_conditions,
-)
+from sdar_tamp.language.domain_model import Axiom, Domain, Predicate
+from sdar_tamp.language.formula_model import And, Atom, Effect, Exists, Formula, Parameter
+from sdar_tamp.language.stream_model import Rule, Stream, StreamFile
+from sdar_tamp.language.traversal import iter_effect_literals, map_atoms, map_conditions
 
 LOG = logging.getLogger(__name__)
 EXOGENOUS_AXIOMS = True

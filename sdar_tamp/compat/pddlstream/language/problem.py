@@ -25,10 +25,12 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from sdar_tamp.compat.pddlstream.language.object import DebugValue, SharedDebugValue
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.errors import StreamMapError
-from sdar_tamp.language.model import TOTAL_COST, Domain, StreamFile
-from sdar_tamp.language.pddl import parse_domain
+from sdar_tamp.language.formula_model import TOTAL_COST
 from sdar_tamp.language.problem import PDDLProblem as _CorePDDLProblem
+from sdar_tamp.language.stream_model import StreamFile
 from sdar_tamp.language.streams import parse_stream_file
 
 LOG = logging.getLogger(__name__)

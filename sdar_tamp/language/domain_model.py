@@ -1,0 +1,112 @@
+"""The typed model of a PDDL domain and problem: declarations, schemas and their containers.
+
+Immutable values built by :mod:`sdar_tamp.language.domain_reader` and
+:mod:`sdar_tamp.language.problem_reader` from the pieces of
+:mod:`sdar_tamp.language.formula_model` (names stored lower-case).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Effect, Formula, Parameter
+from sdar_tamp.language.leniency import Leniency
+
+
+@dataclass(frozen=True)
+class Predicate:
+    name: str
+    parameters: tuple[Parameter, ...] = ()
+
+    @property
+    def arity(self) -> int:
+        return len(self.parameters)
+
+
+@dataclass(frozen=True)
+class Function:
+    name: str
+    parameters: tuple[Parameter, ...] = ()
+
+
+@dataclass(frozen=True)
+class ActionSchema:
+    """A domain's ``(:action ...)``: the lifted schema (a plan step is
+    :class:`solvers.solution.Action`)."""
+
+    name: str
+    parameters: tuple[Parameter, ...]
+    precondition: Formula
+    effect: Effect
+    location: SourceLocation | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Axiom:
+    """A derived predicate: ``(:derived (predicate ?params) body)``."""
+
+    predicate: str
+    parameters: tuple[Parameter, ...]
+    body: Formula
+    location: SourceLocation | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class TypeHierarchy:
+    """Types and their parents; ``object`` is the root and has no parent."""
+
+    parents: Mapping[str, str] = field(default_factory=dict)
+
+    def ancestors(self, type_name: str) -> tuple[str, ...]:
+        """``type_name`` followed by its ancestors up to ``object`` (inclusive)."""
+        chain = [type_name]
+        while chain[-1] != OBJECT_TYPE:
+            chain.append(self.parents.get(chain[-1], OBJECT_TYPE))
+        return tuple(chain)
+
+    def is_subtype(self, child: str, parent: str) -> bool:
+        return parent in self.ancestors(child)
+
+    def types(self) -> tuple[str, ...]:
+        return (OBJECT_TYPE, *sorted(self.parents))
+
+
+@dataclass(frozen=True)
+class Domain:
+    name: str
+    requirements: frozenset[str]
+    types: TypeHierarchy
+    constants: Mapping[str, str]  # name -> type
+    predicates: Mapping[str, Predicate]
+    functions: Mapping[str, Function]
+    actions: tuple[ActionSchema, ...]
+    axioms: tuple[Axiom, ...]
+    source: str | None = field(default=None, compare=False)
+    leniencies: tuple[Leniency, ...] = field(default=(), compare=False)
+    """What was accepted although strict PDDL rejects it (see ``language.leniency``)."""
+
+    @property
+    def derived_predicates(self) -> frozenset[str]:
+        return frozenset(axiom.predicate for axiom in self.axioms)
+
+    def action(self, name: str) -> ActionSchema:
+        for action in self.actions:
+            if action.name == name.lower():
+                return action
+        raise KeyError(name)
+
+
+@dataclass(frozen=True)
+class Problem:
+    name: str
+    domain_name: str
+    objects: Mapping[str, str]  # name -> type
+    init: tuple[Atom, ...]
+    numeric_init: Mapping[tuple[str, tuple[str, ...]], float]
+    goal: Formula
+    minimize_cost: bool = False
+    source: str | None = field(default=None, compare=False)
+    leniencies: tuple[Leniency, ...] = field(default=(), compare=False)
+    """What was accepted although strict PDDL rejects it (see ``language.leniency``)."""
