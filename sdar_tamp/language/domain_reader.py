@@ -20,12 +20,7 @@ from sdar_tamp.language.domain_model import (
     Predicate,
     TypeHierarchy,
 )
-from sdar_tamp.language.errors import (
-    ArityError,
-    DuplicateError,
-    PddlSyntaxError,
-    UndeclaredError,
-)
+from sdar_tamp.language.errors import ArityError, DuplicateError, PddlSyntaxError, UndeclaredError
 from sdar_tamp.language.formula_model import (
     OBJECT_TYPE,
     TRUE,
