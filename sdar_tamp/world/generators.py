@@ -9,11 +9,13 @@
   neighbours of one size trading places, the others turned on their spot
   (:mod:`sdar_tamp.world.dense`).
 
-Structured families are built from a *successor map*: object ``i`` with successor ``j`` gets
-its goal on (a perturbation of) ``j``'s start, overlapping no other start and no other goal, so
-the dependency graph has exactly the edges ``i -> j``; objects without successor get a goal
-overlapping no other object's start. Each instance is verified with
-:mod:`sdar_tamp.world.dependency`; failures are retried with the same generator, bounded.
+Starts (and the goals of ``R``) are placed at random (:mod:`sdar_tamp.world.placement`).
+Structured families are built from a *successor map* (:mod:`sdar_tamp.world.structured_goals`):
+object ``i`` with successor ``j`` gets its goal on (a perturbation of) ``j``'s start, overlapping
+no other start and no other goal, so the dependency graph has exactly the edges ``i -> j``;
+objects without successor get a goal overlapping no other object's start. Each instance is
+verified with :mod:`sdar_tamp.world.dependency`; failures are retried with the same generator,
+bounded.
 Every random choice comes from ``numpy.random.default_rng(seed)``: same seed, same instance.
 An optional acceptance test (``accept``: instance -> the reason it is refused, or ``None``)
 rejects further samples, e.g. those the infeasibility proofs of :mod:`streams.feasibility`
@@ -27,11 +29,9 @@ attempts in a row in which the random placement found no room for every object.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 
@@ -46,10 +46,11 @@ from sdar_tamp.world.dense import (
 )
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError
-from sdar_tamp.world.footprint import corners, inflate, inside_rectangle, overlap_matrix
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, validate_instance
+from sdar_tamp.world.placement import random_arrangement
 from sdar_tamp.world.scene import Workspace
-from sdar_tamp.world.transforms import BoolArray, FloatArray
+from sdar_tamp.world.structured_goals import structured_goals, successor_map
+from sdar_tamp.world.transforms import FloatArray
 
 FAMILIES = ("R", "S", "D", "M", "N")
 DEFAULT_SIZE = (0.08, 0.04, 0.05)
@@ -194,42 +195,6 @@ def _verified(family: str, inst: Instance) -> bool:
     return True
 
 
-def _successors(family: str, n: int, rng: np.random.Generator) -> dict[int, int]:
-    """Random successor map with the family's cycles and chains (indices into a permutation)."""
-    order = [int(v) for v in rng.permutation(n)]
-    succ: dict[int, int] = {}
-    if family == "S":
-        cycles = [int(rng.integers(max(2, (n + 1) // 2), n + 1))]
-    elif family == "D":
-        total = int(rng.integers(max(4, (n + 1) // 2), n + 1))
-        first = int(rng.integers(2, total - 1))
-        cycles = [first, total - first]
-    else:  # M: 1-2 cycles, 1-2 chains, >= 1 independent
-        cycles = [int(rng.integers(2, 5)) for _ in range(int(rng.integers(1, 3)))]
-        while sum(cycles) > n - 3:
-            cycles.pop()
-        cycles = cycles or [2]
-    pos = 0
-    for length in cycles:
-        members = order[pos : pos + length]
-        pos += length
-        for k, i in enumerate(members):
-            succ[i] = members[(k + 1) % length]
-    rest = order[pos:]
-    n_chains = 1 if family == "M" else int(rng.integers(0, len(rest) // 2 + 1))
-    if family == "M" and len(rest) >= 6:
-        n_chains = int(rng.integers(1, 3))
-    for _ in range(n_chains):
-        free = len(rest) - (1 if family == "M" else 0)
-        if free < 2:
-            break
-        length = int(rng.integers(2, min(4, free) + 1))
-        chain, rest = rest[:length], rest[length:]
-        for a, b in itertools.pairwise(chain):
-            succ[a] = b
-    return succ
-
-
 def _attempt(
     family: str, n: int, rng: np.random.Generator, opts: GeneratorOptions, name: str, seed: int
 ) -> Instance | int | None:
@@ -238,15 +203,18 @@ def _attempt(
     if family == "N":
         return _dense_attempt(n, rng, opts, name, seed)
     sizes = np.tile(np.array(opts.size[:2]), (n, 1))
-    starts = _arrangement(n, sizes, rng, opts)
+    starts = random_arrangement(n, sizes, rng, opts.workspace, opts.samples, opts.gap)
     if len(starts) < n:
         return len(starts)
     if family == "R":
-        goals: FloatArray | None = _arrangement(n, sizes, rng, opts)
+        goals: FloatArray | None = random_arrangement(
+            n, sizes, rng, opts.workspace, opts.samples, opts.gap
+        )
         if goals is not None and len(goals) < n:
             return len(goals)
     else:
-        goals = _structured_goals(_successors(family, n, rng), starts, sizes, rng, opts)
+        succ = successor_map(family, n, rng)
+        goals = structured_goals(succ, starts, sizes, rng, opts.workspace, opts.samples, opts.gap)
     if goals is None:
         return None
     objects = tuple(
@@ -280,127 +248,3 @@ def _dense_attempt(
         for i in range(n)
     )
     return Instance(name, ws, objects, family="N", seed=seed)
-
-
-def _candidates(
-    k: int, size: FloatArray, rng: np.random.Generator, opts: GeneratorOptions
-) -> FloatArray:
-    """``k`` random poses ``(k, 3)`` whose footprint lies in the workspace."""
-    ws = opts.workspace
-    poses = np.column_stack(
-        [rng.uniform(*ws.x, k), rng.uniform(*ws.y, k), rng.uniform(-np.pi / 2, np.pi / 2, k)]
-    )
-    ok = inside_rectangle(corners(poses, np.tile(size, (k, 1))), ws.x, ws.y)
-    return poses[ok]
-
-
-def _arrangement(
-    n: int, sizes: FloatArray, rng: np.random.Generator, opts: GeneratorOptions
-) -> FloatArray:
-    """Random sequential placement of ``n`` footprints, pairwise at least ``gap`` apart; the
-    poses ``(k, 3)`` placed, ``k < n`` when no candidate had room for the next one."""
-    placed = np.zeros((0, 3))
-    for i in range(n):
-        cand = _candidates(opts.samples, sizes[i], rng, opts)
-        clear = partial(
-            _clear, size=sizes[i], poses=placed, sizes=sizes[: len(placed)], gap=opts.gap
-        )
-        first = _first(cand, clear)
-        if first is None:
-            return placed
-        placed = np.vstack([placed, cand[first]])
-    return placed
-
-
-def _first(
-    cand: FloatArray, test: Callable[[FloatArray], BoolArray], chunk: int = 256
-) -> int | None:
-    """The index of the first candidate pose that passes ``test`` (a mask of poses), testing
-    chunk by chunk: the same answer as ``argmax`` over the whole mask, for less work."""
-    for lo in range(0, len(cand), chunk):
-        ok = test(cand[lo : lo + chunk])
-        if ok.any():
-            return lo + int(np.argmax(ok))
-    return None
-
-
-def _clear(
-    cand: FloatArray, *, size: FloatArray, poses: FloatArray, sizes: FloatArray, gap: float
-) -> BoolArray:
-    """Mask of candidates at least ``gap`` away from every footprint at ``poses``."""
-    if len(poses) == 0:
-        return np.ones(len(cand), dtype=bool)
-    grown = corners(cand, np.tile(inflate(size, gap / 2), (len(cand), 1)))
-    hit = overlap_matrix(grown, corners(poses, inflate(sizes, gap / 2))).any(axis=1)
-    return np.asarray(~hit, dtype=np.bool_)
-
-
-def _structured_goals(
-    succ: dict[int, int],
-    starts: FloatArray,
-    sizes: FloatArray,
-    rng: np.random.Generator,
-    opts: GeneratorOptions,
-) -> FloatArray | None:
-    n = len(starts)
-    start_rect = corners(starts, sizes)
-    goals = np.full((n, 3), np.nan)
-    # objects with a successor first (their goals are pinned near a start), then free goals
-    for i in [*sorted(succ), *(i for i in range(n) if i not in succ)]:
-        if i in succ:
-            j = succ[i]
-            jitter = np.column_stack(
-                [
-                    rng.uniform(-0.01, 0.01, 64),
-                    rng.uniform(-0.01, 0.01, 64),
-                    rng.uniform(-0.3, 0.3, 64),
-                ]
-            )
-            cand = np.vstack([starts[j] + jitter, starts[j]])
-            ws = opts.workspace
-            cand = cand[
-                inside_rectangle(corners(cand, np.tile(sizes[i], (len(cand), 1))), ws.x, ws.y)
-            ]
-            allowed = np.zeros(n, dtype=bool)
-            allowed[[i, j]] = True
-        else:
-            cand = _candidates(opts.samples, sizes[i], rng, opts)
-            allowed = np.zeros(n, dtype=bool)
-            allowed[i] = True
-        test = partial(
-            _goal_ok,
-            i=i,
-            successor=succ.get(i),
-            allowed=allowed,
-            start_rect=start_rect,
-            goals=goals,
-            sizes=sizes,
-            opts=opts,
-        )
-        first = _first(cand, test)
-        if first is None:
-            return None
-        goals[i] = cand[first]
-    return goals
-
-
-def _goal_ok(
-    cand: FloatArray,
-    *,
-    i: int,
-    successor: int | None,
-    allowed: BoolArray,
-    start_rect: FloatArray,
-    goals: FloatArray,
-    sizes: FloatArray,
-    opts: GeneratorOptions,
-) -> BoolArray:
-    """Mask of goal candidates for object ``i``: overlapping no start but the ``allowed``
-    ones, the successor's start if any, and clear of the goals placed so far."""
-    hits = overlap_matrix(corners(cand, np.tile(sizes[i], (len(cand), 1))), start_rect)
-    ok = ~hits[:, ~allowed].any(axis=1)
-    if successor is not None:
-        ok &= hits[:, successor]
-    placed = ~np.isnan(goals[:, 0])
-    ok &= _clear(cand, size=sizes[i], poses=goals[placed], sizes=sizes[placed], gap=opts.gap)
-    return np.asarray(ok, dtype=np.bool_)
