@@ -20,7 +20,6 @@ from sdar_tamp.language.model import (
     IncreaseCost,
     Parameter,
     Predicate,
-    iter_effects,
 )
 from solvers.stream_planning.engine import function_guard
 
@@ -31,15 +30,6 @@ def _cost_terms(effect: Effect) -> list[FunctionTerm]:
     if isinstance(effect, AndEffect):
         return [term for part in effect.parts for term in _cost_terms(part)]
     return []
-
-
-def has_costs(domain: Domain) -> bool:
-    """True when some action increases ``total-cost``."""
-    return any(
-        isinstance(effect, IncreaseCost)
-        for action in domain.actions
-        for effect in iter_effects(action.effect)
-    )
 
 
 def guard_costs(domain: Domain) -> Domain:
