@@ -22,6 +22,7 @@ The policy is chosen once, from ``StreamOptions.algorithm`` (:func:`policy_for`)
 from __future__ import annotations
 
 import heapq
+from collections.abc import Callable
 from typing import Protocol
 
 from solvers.stream_planning.context import SolveContext
@@ -195,7 +196,7 @@ class AdaptivePolicy:
 
 
 #: The algorithms by name, each the policy class that runs it.
-POLICIES: dict[str, type[FocusedPolicy | BindingPolicy | IncrementalPolicy | AdaptivePolicy]] = {
+POLICIES: dict[str, Callable[[SolveContext], AlgorithmPolicy]] = {
     "incremental": IncrementalPolicy,
     "focused": FocusedPolicy,
     "binding": BindingPolicy,

@@ -25,7 +25,7 @@ from sdar_tamp.logs import get_logger
 from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
 from solvers.stream_planning.calls import CallTimeout
 from solvers.stream_planning.constraints import original_name
-from solvers.stream_planning.context import SolveContext, SolveTimeout
+from solvers.stream_planning.context import PlanSteps, SolveContext, SolveTimeout
 from solvers.stream_planning.diagnosis import diagnose
 from solvers.stream_planning.fluents import FluentPlan, fluent_plan
 from solvers.stream_planning.optimistic import OptimisticWorld, OptResult, is_placeholder
@@ -106,36 +106,9 @@ class StreamSolver:
             stats.iterations += 1
             stats.complexity = level
             policy.prepare(level)
-            world = self._world(level)
-            context.unreachable = False
-            found = None
-            if stats.skeletons < options.max_skeletons:
-                found = context.plan(world.facts, world.numeric, world)
-                if found is None and world.more_calls and not context.unreachable:
-                    # no plan with one new output per instance: offer later calls' outputs
-                    world = context.builder.build(
-                        level, policy.lazy, further=True, check_time=context.check_time
-                    )
-                    found = context.plan(world.facts, world.numeric, world)
-            stream_plan: list[OptResult] = []
-            check = None
-            if found is not None and world.provenance:  # (else all facts are real)
-                check = simulate(
-                    context.problem.domain, context.objects(world.facts), world.facts, found[0],
-                    context.goal,
-                )  # fmt: skip
-                stream_plan = extract_stream_plan(check.needed, world)
-            if found is not None:
-                # The same actions on the same optimistic results: nothing learnt since this
-                # plan was met, as if none. (The same actions on real facts are new.)
-                key = (
-                    tuple(found[0]),
-                    tuple((r.external, r.inputs) for r in stream_plan if r.kind == "stream"),
-                )
-                if key in tried:
-                    found = None
-                tried.add(key)
-            if found is None:
+            world, found = self._plan_at(level)
+            ordered = None if found is None else self._new_plan(world, found[0], tried)
+            if found is None or ordered is None:
                 # no new plan: work on the queued skeletons, and raise the level (what they
                 # wait for may lie above it)
                 if policy.no_new_plan(len(world.facts)):
@@ -149,15 +122,9 @@ class StreamSolver:
                 tried.clear()
                 continue
             actions, cost = found
-            ordered = (
-                fluent_plan(stream_plan, check, context.fluent_streams, actions)
-                if check is not None
-                else FluentPlan([], {}, list(actions))
-            )
-            stream_plan = ordered.stream_plan
-            if context.builder.refine(stream_plan):
+            if context.builder.refine(ordered.stream_plan):
                 continue  # it uses shared placeholders: plan again with the instances' own
-            if not any(r.kind == "stream" for r in stream_plan) and not any(
+            if not any(r.kind == "stream" for r in ordered.stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
             ):
                 valid, check = context.real_check(actions)
@@ -175,19 +142,69 @@ class StreamSolver:
                     tried.clear()
                 continue
             stats.skeletons += 1
-            priority = cost
-            if options.effort_weight is not None:
-                efforts = {n: e.info for n, e in context.engine.streams.items()}
-                effort = stream_plan_effort(stream_plan, efforts, options.unit_efforts)
-                priority += options.effort_weight * effort
-            skeleton = Skeleton(
-                (0, priority, context.next_order()),
-                ordered.actions,
-                stream_plan,
-                fluents=ordered.fluents,
-            )
-            if policy.take(skeleton):
+            if policy.take(self._skeleton(ordered, cost)):
                 return Status.SOLVED
+
+    def _plan_at(self, level: int) -> tuple[OptimisticWorld, tuple[PlanSteps, float] | None]:
+        """The world at ``level`` and a plan over it with its cost (None: no plan, or no
+        search once ``max_skeletons`` skeletons were made)."""
+        context = self.context
+        world = self._world(level)
+        context.unreachable = False
+        found = None
+        if context.stats.skeletons < context.options.max_skeletons:
+            found = context.plan(world.facts, world.numeric, world)
+            if found is None and world.more_calls and not context.unreachable:
+                # no plan with one new output per instance: offer later calls' outputs
+                world = context.builder.build(
+                    level, self.policy.lazy, further=True, check_time=context.check_time
+                )
+                found = context.plan(world.facts, world.numeric, world)
+        return world, found
+
+    def _new_plan(
+        self, world: OptimisticWorld, actions: PlanSteps, tried: set[tuple[object, ...]]
+    ) -> FluentPlan | None:
+        """The plan's actions and stream plan, ordered so that fluent streams see the state of
+        the step that uses them; None when the plan was met before at this level."""
+        context = self.context
+        stream_plan: list[OptResult] = []
+        check = None
+        if world.provenance:  # (else all facts are real)
+            check = simulate(
+                context.problem.domain, context.objects(world.facts), world.facts, actions,
+                context.goal,
+            )  # fmt: skip
+            stream_plan = extract_stream_plan(check.needed, world)
+        # The same actions on the same optimistic results: nothing learnt since this plan was
+        # met, as if none. (The same actions on real facts are new.)
+        key = (
+            tuple(actions),
+            tuple((r.external, r.inputs) for r in stream_plan if r.kind == "stream"),
+        )
+        if key in tried:
+            return None
+        tried.add(key)
+        if check is None:
+            return FluentPlan([], {}, list(actions))
+        return fluent_plan(stream_plan, check, context.fluent_streams, actions)
+
+    def _skeleton(self, ordered: FluentPlan, cost: float) -> Skeleton:
+        """The skeleton of a new optimistic plan: first in the queue by cost (plus the effort
+        of its stream plan with ``effort_weight``), ties to the older."""
+        context = self.context
+        options = context.options
+        priority = cost
+        if options.effort_weight is not None:
+            efforts = {n: e.info for n, e in context.engine.streams.items()}
+            effort = stream_plan_effort(ordered.stream_plan, efforts, options.unit_efforts)
+            priority += options.effort_weight * effort
+        return Skeleton(
+            (0, priority, context.next_order()),
+            ordered.actions,
+            ordered.stream_plan,
+            fluents=ordered.fluents,
+        )
 
     def _solution(self, status: Status) -> Solution:
         context = self.context
