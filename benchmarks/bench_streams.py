@@ -28,8 +28,8 @@ from typing import Any
 from sdar_tamp.language.generators import from_sampler, from_test
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solve import solve
-from solvers.stream_planning.algorithms import ALGORITHMS
 from solvers.stream_planning.calls import CallRunner
+from solvers.stream_planning.policies import ALGORITHMS
 
 DOMAINS = ("pick_place_2d", "kitchen", "dual_arm_swap", "infeasible")
 EXPECTED = {"infeasible": "infeasible"}  # every other domain: solved

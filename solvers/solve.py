@@ -27,8 +27,10 @@ from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.logs import get_logger
 from solvers.classical import HEURISTICS, SEARCHES
 from solvers.solution import Solution, print_solution
-from solvers.stream_planning.algorithms import ALGORITHMS, StreamOptions, StreamSolver
 from solvers.stream_planning.constraints import compile_constraints
+from solvers.stream_planning.options import StreamOptions
+from solvers.stream_planning.policies import ALGORITHMS
+from solvers.stream_planning.solver import StreamSolver
 
 if TYPE_CHECKING:
     from solvers.sdar.options import SdarOptions

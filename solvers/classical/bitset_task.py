@@ -13,6 +13,7 @@ from collections.abc import Iterable
 
 from sdar_tamp.logs import get_logger
 from solvers.classical import jit
+from solvers.classical.jit_successors import JitSuccessors
 from solvers.classical.task import GroundAxiom, GroundTask
 
 logger = get_logger(__name__)
@@ -144,7 +145,7 @@ class CompiledTask:
         self._root = self._build_trie()
         self.init = self.close(mask(task.init))
         self._calls = 0
-        self._jit: jit.JitSuccessors | None = None
+        self._jit: JitSuccessors | None = None
         self._jit_pending = len(task.operators) >= JIT_MIN_OPERATORS and jit.available()
 
     def _build_trie(self) -> Trie:
@@ -191,7 +192,7 @@ class CompiledTask:
     def use_compiled_successors(self) -> None:
         """Walk the trie in compiled code from now on (numba must be installed)."""
         negative = [tuple(op.negative_precondition) for op in self.task.operators]
-        self._jit = jit.JitSuccessors(self._root, negative, len(self.task.facts))
+        self._jit = JitSuccessors(self._root, negative, len(self.task.facts))
         self._jit_pending = False
 
     def successor(self, state: int, index: int) -> int:

@@ -16,14 +16,15 @@ operators are the *preferred* operators. A fact's best supporter is the first re
 found reaching it at its cost (the exploration order's choice), or in *canonical* mode the one
 of lowest id among them, so that the relaxed plan does not depend on the order of exploration.
 
-On larger tasks the same algorithm runs compiled by numba (:mod:`solvers.classical.jit`; the
-same values, supporters and relaxed plans in either mode, 5-15x faster per state), switched to
-once the queue has spent :data:`JIT_AFTER_SECONDS` on the task. Without numba, h_add (and so
-h_FF) on larger tasks can instead run vectorised (:class:`VectorHAdd`): NumPy Bellman-Ford
-sweeps over all relaxed operators until no fact cost drops, canonical only; the heuristic then
-times both engines on the initial state and keeps the faster (few sweeps over many operators
-favour NumPy, long chains of cheap steps the queue). On 65 IPC problems the exploration order's
-supporters expanded 21% fewer states than the canonical ones (``benchmarks/bench_classical.py``).
+On larger tasks the same algorithm runs compiled by numba (:mod:`solvers.classical.jit_relaxed`;
+the same values, supporters and relaxed plans in either mode, 5-15x faster per state), switched
+to once the queue has spent :data:`JIT_AFTER_SECONDS` on the task. Without numba, h_add (and so
+h_FF) on larger tasks can instead run vectorised (:class:`~.vector_hadd.VectorHAdd`): NumPy
+Bellman-Ford sweeps over all relaxed operators until no fact cost drops, canonical only; the
+heuristic then times both engines on the initial state and keeps the faster (few sweeps over
+many operators favour NumPy, long chains of cheap steps the queue). On 65 IPC problems the
+exploration order's supporters expanded 21% fewer states than the canonical ones
+(``benchmarks/bench_classical.py``).
 """
 
 from __future__ import annotations
@@ -32,14 +33,13 @@ import time
 from heapq import heappop, heappush
 from math import inf
 
-import numpy as np
-import numpy.typing as npt
-
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
 from solvers.classical import jit
 from solvers.classical.bitset_task import CompiledTask, bits, mask
 from solvers.classical.complements import complements, relaxed_operators
+from solvers.classical.jit_relaxed import JitRelaxed
+from solvers.classical.vector_hadd import VectorHAdd
 
 logger = get_logger(__name__)
 
@@ -99,7 +99,7 @@ class RelaxedHeuristic:
         self.integral = all(c == int(c) and c < 2**20 for c in costs)
         self.int_cost = [int(c) for c in ucost] if self.integral else []
         self.vector: VectorHAdd | None = None
-        self.jit: jit.JitRelaxed | None = None
+        self.jit: JitRelaxed | None = None
         size = sum(map(len, upre)) + sum(map(len, ueff))
         large = engine == "auto" and size >= VECTOR_MIN_SIZE
         self.spent = 0.0  # CPU time of the queue-based engine while the compiled one is pending
@@ -132,7 +132,7 @@ class RelaxedHeuristic:
         """Evaluate with the compiled engine from now on (numba must be installed). It settles
         facts from a heap: first-found supporters then follow the heap's order."""
         self.heap_order = True
-        self.jit = jit.JitRelaxed(
+        self.jit = JitRelaxed(
             self.count,
             self.upre,
             self.ueff,
@@ -352,79 +352,3 @@ class RelaxedHeuristic:
                     seen.add(p)
                     stack.append(p)
         return h, operators
-
-
-class VectorHAdd:
-    """h_add by NumPy Bellman-Ford sweeps, with the same costs and best supporters.
-
-    A sweep computes every relaxed operator's cost (its cost plus the sum of its precondition
-    costs, one precondition column at a time over the operators that have one) and lowers
-    every fact's cost to its cheapest achiever's; sweeps repeat until nothing drops. Achiever
-    lists are sorted by (fact, operator id), so the first achiever at the fact's cost is the one
-    of lowest id.
-    """
-
-    def __init__(
-        self,
-        count: int,
-        upre: list[tuple[int, ...]],
-        ueff: list[tuple[int, ...]],
-        ucost: list[float],
-    ) -> None:
-        self.count = count
-        # operators are stored widest precondition first, so that precondition column j only
-        # covers the leading operators with more than j preconditions (no padding)
-        order = sorted(range(len(upre)), key=lambda u: -len(upre[u]))
-        position = np.empty(len(upre), dtype=np.intp)
-        position[order] = np.arange(len(upre))
-        width = max((len(pre) for pre in upre), default=0)
-        self.columns = [
-            np.asarray([upre[u][j] for u in order if len(upre[u]) > j], dtype=np.intp)
-            for j in range(width)
-        ]
-        self.ucost = np.asarray([ucost[u] for u in order], dtype=np.float64)
-        pairs = sorted({(g, u) for u, eff in enumerate(ueff) for g in eff})
-        self.eff_fact = np.asarray([g for g, _u in pairs], dtype=np.intp)
-        self.eff_id = np.asarray([u for _g, u in pairs], dtype=np.intp)  # relaxed operator id
-        self.eff_op = position[self.eff_id]  # its position in the stored order
-        achieved, starts, counts = np.unique(self.eff_fact, return_index=True, return_counts=True)
-        self.achieved = achieved  # facts with at least one achiever
-        self.starts = starts  # where each achieved fact's achievers start in eff_op
-        self.segment = np.repeat(np.arange(len(achieved)), counts)  # eff entry -> achieved fact
-        self.nbytes = count // 8 + 1
-        self.extra = 1 << count
-
-    def initial_costs(self, state: int) -> npt.NDArray[np.float64]:
-        """0 for the facts of ``state`` and the extra fact, inf for the others."""
-        raw = np.frombuffer((state | self.extra).to_bytes(self.nbytes, "little"), dtype=np.uint8)
-        true = np.unpackbits(raw, bitorder="little")[: self.count + 1]
-        return np.where(true, 0.0, inf)
-
-    def propagate(self, state: int, supporters: bool = True) -> tuple[list[float], list[int]]:
-        """Fact costs (as a list) and, if asked, best supporters (-1 where none is needed)."""
-        cost = self.initial_costs(state)
-        if not len(self.achieved):
-            return cost.tolist(), [-1] * (self.count + 1)
-        achieved, starts, eff_op, columns = self.achieved, self.starts, self.eff_op, self.columns
-        ucost = self.ucost
-        current = cost[achieved]
-        while True:
-            op_cost = ucost.copy()
-            for column in columns:
-                op_cost[: len(column)] += cost[column]
-            reached = op_cost[eff_op]
-            best = np.minimum.reduceat(reached, starts)
-            if not np.count_nonzero(best < current):
-                break
-            np.minimum(current, best, out=current)
-            cost[achieved] = current
-        if not supporters:
-            return cost.tolist(), []
-        match = np.flatnonzero(reached == current[self.segment])
-        segment = self.segment[match]
-        leading = np.ones(len(match), dtype=bool)
-        leading[1:] = segment[1:] != segment[:-1]
-        chosen = match[leading]
-        supporter = np.full(self.count + 1, -1, dtype=np.intp)
-        supporter[self.eff_fact[chosen]] = self.eff_id[chosen]
-        return cost.tolist(), supporter.tolist()

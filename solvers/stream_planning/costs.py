@@ -20,7 +20,6 @@ from sdar_tamp.language.formula_model import (
     IncreaseCost,
     Parameter,
 )
-from sdar_tamp.language.traversal import iter_effects
 from solvers.stream_planning.engine import function_guard
 
 
@@ -30,15 +29,6 @@ def _cost_terms(effect: Effect) -> list[FunctionTerm]:
     if isinstance(effect, AndEffect):
         return [term for part in effect.parts for term in _cost_terms(part)]
     return []
-
-
-def has_costs(domain: Domain) -> bool:
-    """True when some action increases ``total-cost``."""
-    return any(
-        isinstance(effect, IncreaseCost)
-        for action in domain.actions
-        for effect in iter_effects(action.effect)
-    )
 
 
 def guard_costs(domain: Domain) -> Domain:

@@ -4,6 +4,10 @@ Such a test becomes a ``:predicate`` external over its certified fact: it is eva
 its domain holds, the fact is known when the test passes, and ``(not (fact ...))`` holds exactly
 when it fails. Without ``negate`` a negated use of a test's certified fact would hold merely
 because the test had not been called yet, so it is refused with an error naming the stream.
+
+:func:`negated_predicates` says which predicates the domain uses negated (through derived
+predicates too): those the refusal above is about, and those whose predicates on placeholders
+the optimistic world leaves false.
 """
 
 from __future__ import annotations
@@ -12,7 +16,17 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.language.formula_model import Atom
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import (
+    AndEffect,
+    Atom,
+    Effect,
+    ForAllEffect,
+    Formula,
+    Imply,
+    Not,
+    When,
+)
 from sdar_tamp.language.generators import ListGenFn, WildOutput
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.stream_model import Stream, StreamPredicate
@@ -103,3 +117,52 @@ def _as_predicate(gen_fn: ListGenFn, order: list[int]) -> Callable[..., bool]:
         return bool(produced)
 
     return test
+
+
+def negated_predicates(domain: Domain, goal: Formula) -> frozenset[str]:
+    """Predicates that some action precondition, effect condition or the goal uses negated.
+
+    Polarity flows through derived predicates: an atom in the body of an axiom whose head is used
+    negated counts as used negated too (``(not (unsafe ?t))`` with ``unsafe`` derived from
+    ``(collides ?t ?o)`` negates ``collides``), and an ``Imply`` negates its antecedent.
+    """
+    axioms: dict[str, list[Formula]] = {}
+    for axiom in domain.axioms:
+        axioms.setdefault(axiom.predicate, []).append(axiom.body)
+    roots: list[Formula] = [goal, *(a.precondition for a in domain.actions)]
+    roots += [w.condition for a in domain.actions for w in _conditions(a.effect)]
+    found: set[str] = set()
+    seen: set[tuple[str, bool]] = set()
+    stack: list[tuple[Formula, bool]] = [(formula, True) for formula in roots]
+    while stack:
+        node, positive = stack.pop()
+        if isinstance(node, Atom):
+            if not positive:
+                found.add(node.predicate)
+            if node.predicate in axioms and (node.predicate, positive) not in seen:
+                seen.add((node.predicate, positive))
+                stack.extend((body, positive) for body in axioms[node.predicate])
+        elif isinstance(node, Not):
+            stack.append((node.formula, not positive))
+        elif isinstance(node, Imply):
+            stack += [(node.antecedent, not positive), (node.consequent, positive)]
+        else:
+            stack.extend((child, positive) for child in _children(node))
+    return frozenset(found)
+
+
+def _conditions(effect: Effect) -> list[When]:
+    if isinstance(effect, When):
+        return [effect, *_conditions(effect.effect)]
+    if isinstance(effect, AndEffect):
+        return [w for part in effect.parts for w in _conditions(part)]
+    if isinstance(effect, ForAllEffect):
+        return _conditions(effect.effect)
+    return []
+
+
+def _children(node: Formula) -> list[Formula]:
+    parts = getattr(node, "parts", None)
+    if parts is not None:
+        return list(parts)
+    return [node.body]  # type: ignore[union-attr]

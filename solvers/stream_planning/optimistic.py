@@ -19,7 +19,7 @@ instance and solve.
 
 Functions on placeholders take their optimistic value (``FunctionInfo.opt_fn``, default 1,
 called with the Python values of real inputs, the optimistic value of placeholders that have
-one and an :class:`OptimisticValue` for the others);
+one and an :class:`~.opt_values.OptimisticValue` for the others);
 predicates on placeholders are optimistically true unless the domain uses them negated.
 """
 
@@ -29,44 +29,18 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from sdar_tamp.language.domain_model import Domain
-from sdar_tamp.language.formula_model import (
-    AndEffect,
-    Atom,
-    Effect,
-    ForAllEffect,
-    Formula,
-    Imply,
-    Not,
-    When,
-)
-from sdar_tamp.language.generators import SINGLE_CALL, WildOutput
+from sdar_tamp.language.formula_model import Atom
+from sdar_tamp.language.generators import SINGLE_CALL
 from solvers.stream_planning.engine import Engine, first_call_level, function_guard
-from solvers.stream_planning.externals import (
-    FunctionExternal,
-    StreamError,
-    StreamExternal,
-    StreamOutputError,
-)
+from solvers.stream_planning.externals import FunctionExternal, StreamExternal
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
+from solvers.stream_planning.opt_values import OptimisticValue, first_batch
 
 PLACEHOLDER = "#o"
 
 
 def is_placeholder(name: str) -> bool:
     return name.startswith(PLACEHOLDER)
-
-
-@dataclass(frozen=True)
-class OptimisticValue:
-    """What ``FunctionInfo.opt_fn`` receives for an input not sampled yet: the placeholder's
-    name and the stream that will produce it."""
-
-    name: str
-    stream: str
-
-    def __repr__(self) -> str:
-        return f"{self.name}({self.stream})"
 
 
 @dataclass(frozen=True)
@@ -92,55 +66,6 @@ class OptimisticWorld:
     # later calls of some instance were left out for the limit (see OptimisticBuilder._further):
     # no plan proves nothing unless the goal is not even relaxed-reachable
     more_calls: bool = False
-
-
-def negated_predicates(domain: Domain, goal: Formula) -> frozenset[str]:
-    """Predicates that some action precondition, effect condition or the goal uses negated.
-
-    Polarity flows through derived predicates: an atom in the body of an axiom whose head is used
-    negated counts as used negated too (``(not (unsafe ?t))`` with ``unsafe`` derived from
-    ``(collides ?t ?o)`` negates ``collides``), and an ``Imply`` negates its antecedent.
-    """
-    axioms: dict[str, list[Formula]] = {}
-    for axiom in domain.axioms:
-        axioms.setdefault(axiom.predicate, []).append(axiom.body)
-    roots: list[Formula] = [goal, *(a.precondition for a in domain.actions)]
-    roots += [w.condition for a in domain.actions for w in _conditions(a.effect)]
-    found: set[str] = set()
-    seen: set[tuple[str, bool]] = set()
-    stack: list[tuple[Formula, bool]] = [(formula, True) for formula in roots]
-    while stack:
-        node, positive = stack.pop()
-        if isinstance(node, Atom):
-            if not positive:
-                found.add(node.predicate)
-            if node.predicate in axioms and (node.predicate, positive) not in seen:
-                seen.add((node.predicate, positive))
-                stack.extend((body, positive) for body in axioms[node.predicate])
-        elif isinstance(node, Not):
-            stack.append((node.formula, not positive))
-        elif isinstance(node, Imply):
-            stack += [(node.antecedent, not positive), (node.consequent, positive)]
-        else:
-            stack.extend((child, positive) for child in _children(node))
-    return frozenset(found)
-
-
-def _conditions(effect: Effect) -> list[When]:
-    if isinstance(effect, When):
-        return [effect, *_conditions(effect.effect)]
-    if isinstance(effect, AndEffect):
-        return [w for part in effect.parts for w in _conditions(part)]
-    if isinstance(effect, ForAllEffect):
-        return _conditions(effect.effect)
-    return []
-
-
-def _children(node: Formula) -> list[Formula]:
-    parts = getattr(node, "parts", None)
-    if parts is not None:
-        return list(parts)
-    return [node.body]  # type: ignore[union-attr]
 
 
 class OptimisticBuilder:
@@ -397,7 +322,7 @@ class OptimisticBuilder:
         key = (name, inputs)
         batch = self._generated.get(key)
         if batch is None:
-            batch = self._generated[key] = self._call_generator(external, inputs, generator)
+            batch = self._generated[key] = first_batch(external, self._values(inputs), generator)
         result = []
         for index, values in enumerate(batch):
             outputs = tuple(
@@ -407,28 +332,6 @@ class OptimisticBuilder:
                 self.values[placeholder] = value
             result.append(outputs)
         return result
-
-    def _call_generator(
-        self, external: StreamExternal, inputs: tuple[str, ...], generator: Callable[..., Any]
-    ) -> list[tuple[object, ...]]:
-        values = self._values(inputs)
-        what = f"the opt_gen_fn of stream {external.name!r} on inputs {values!r}"
-        try:
-            produced: Any = next(iter(generator(*values)), [])
-        except Exception as error:
-            raise StreamError(f"{what} raised {type(error).__name__}: {error}") from error
-        if isinstance(produced, WildOutput):
-            produced = list(produced.values)
-        if produced is None:
-            return []
-        arity = len(external.declaration.outputs)
-        if not isinstance(produced, list | tuple) or not all(
-            isinstance(output, list | tuple) and len(output) == arity for output in produced
-        ):
-            raise StreamOutputError(
-                f"{what} must produce a list of tuples of {arity} value(s), got {produced!r}"
-            )
-        return [tuple(output) for output in produced]
 
     def _function(
         self,

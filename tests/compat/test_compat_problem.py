@@ -93,7 +93,7 @@ def test_function_info_opt_fn_sees_pddlstream_optimistic_values() -> None:
         return 1.0
 
     assert FunctionInfo().eager and not FunctionInfo(eager=False).eager
-    from solvers.stream_planning.optimistic import OptimisticValue
+    from solvers.stream_planning.opt_values import OptimisticValue
 
     info = FunctionInfo(opt_fn=opt_lift)
     assert info.opt_fn is not None
@@ -102,7 +102,7 @@ def test_function_info_opt_fn_sees_pddlstream_optimistic_values() -> None:
 
 
 def test_stream_info_opt_gen_fn_sees_values_and_pddlstream_optimistic_values() -> None:
-    from solvers.stream_planning.optimistic import OptimisticValue
+    from solvers.stream_planning.opt_values import OptimisticValue
 
     seen: list[object] = []
 

@@ -15,7 +15,7 @@ from solvers.classical import bitset_task as compiled_module
 from solvers.classical import ground, heuristics, plan
 from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.heuristics import RelaxedHeuristic
-from solvers.classical.search import _TypeBuckets
+from solvers.classical.open_lists import TypeBuckets
 
 
 @needs_numba
@@ -75,7 +75,7 @@ def test_large_tasks_switch_to_the_compiled_heuristic_after_its_time(
 
 
 def test_type_buckets_pop_every_successor_once() -> None:
-    buckets = _TypeBuckets(seed=1)
+    buckets = TypeBuckets(seed=1)
     pushed = set()
     rng = random.Random(0)
     for origin in range(30):
@@ -119,7 +119,7 @@ def test_a_broken_numba_leaves_the_search_on_the_python_engines(
     monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     """Compiled code that fails to load mid-search: a warning, then the same search in Python."""
-    from solvers.classical import jit
+    from solvers.classical import jit, jit_relaxed, jit_successors
 
     task = _gripper(100)
     reference = plan(task, search="lazy-gbfs", heuristic="ff-lmcount")
@@ -127,8 +127,8 @@ def test_a_broken_numba_leaves_the_search_on_the_python_engines(
     def broken(*_args: object) -> object:
         raise OSError("llvmlite: cannot load the shared library")
 
-    monkeypatch.setattr(jit, "_kernel", lambda: broken)
-    monkeypatch.setattr(jit, "_applicable_kernel", lambda: broken)
+    monkeypatch.setattr(jit_relaxed, "_kernel", lambda: broken)
+    monkeypatch.setattr(jit_successors, "_applicable_kernel", lambda: broken)
     monkeypatch.setattr(jit, "_broken", [])
     monkeypatch.setattr(heuristics, "JIT_AFTER_SECONDS", 0.0)
     monkeypatch.setattr(compiled_module, "JIT_AFTER_CALLS", 3)
@@ -151,11 +151,11 @@ def test_a_broken_numba_leaves_the_search_on_the_python_engines(
 
 
 def test_numba_that_cannot_be_imported_is_remembered(monkeypatch: pytest.MonkeyPatch) -> None:
-    from solvers.classical import jit
+    from solvers.classical import jit, jit_relaxed
 
     monkeypatch.setattr(jit, "_broken", [])
     monkeypatch.setitem(sys.modules, "numba", None)  # import numba -> ImportError
     with pytest.raises(jit.CompiledCodeUnavailable, match="numba cannot run _evaluate"):
-        jit._compile(jit._evaluate)
+        jit.compile_kernel(jit_relaxed._evaluate)
     assert not jit.available()
     assert "numba failed in this process (_evaluate:" in jit.why_unavailable()

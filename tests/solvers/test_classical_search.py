@@ -182,10 +182,10 @@ def test_cost_bound_keeps_only_cheaper_plans(search: str, lazy: bool) -> None:
 def test_batched_greedy_queues_pop_in_per_successor_order() -> None:
     import random
 
-    from solvers.classical.search import _BatchQueues, _Queues
+    from solvers.classical.open_lists import BatchedOpenLists, OpenLists
 
     rng = random.Random(7)
-    single, batched = _Queues(2, True), _BatchQueues(2, True)
+    single, batched = OpenLists(2, True), BatchedOpenLists(2, True)
     counter, taken_single, taken_batched = 0, [], []
     for expansion in range(60):
         values = (float(rng.randint(0, 5)), float(rng.randint(0, 5)))

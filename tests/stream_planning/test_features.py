@@ -30,7 +30,7 @@ from solvers.classical import GroundingError
 from solvers.solution import Status
 from solvers.solve import solve
 from solvers.stream_planning.externals import StreamError, StreamOutputError
-from solvers.stream_planning.optimistic import negated_predicates
+from solvers.stream_planning.negation import negated_predicates
 
 # A block on a line: sample a pose in a region, then move it there (one move per plan step).
 LINE = """
@@ -387,8 +387,8 @@ TWO_SAMPLERS = (
 
 
 def test_stream_plan_effort_follows_the_cost_model() -> None:
-    from solvers.stream_planning.algorithms import stream_plan_effort
     from solvers.stream_planning.optimistic import OptResult
+    from solvers.stream_planning.stream_plans import stream_plan_effort
 
     def result(name: str, kind: str = "stream") -> OptResult:
         return OptResult(name, (), (), (), (), 0, kind)
@@ -432,8 +432,8 @@ def test_effort_weight_is_validated() -> None:
 def test_action_efforts_count_each_result_once() -> None:
     from solvers.classical import PlanningTask
     from solvers.classical import plan as classical_plan
-    from solvers.stream_planning.algorithms import ActionEfforts, positive_atoms
     from solvers.stream_planning.optimistic import OptimisticWorld, OptResult
+    from solvers.stream_planning.stream_plans import ActionEfforts, positive_atoms
 
     pose = OptResult("sample-pose", ("a", "goal"), ("#o0",), (), (), 1, "stream")
     facts = {
@@ -482,7 +482,7 @@ def test_from_test_adapter_is_usable_as_a_filter() -> None:
 def test_opt_fn_receives_values_and_optimistic_values() -> None:
     from domains.kitchen.samplers import make_problem
     from sdar_tamp.language.options import FunctionInfo
-    from solvers.stream_planning.optimistic import OptimisticValue
+    from solvers.stream_planning.opt_values import OptimisticValue
 
     seen: list[tuple[Any, ...]] = []
 

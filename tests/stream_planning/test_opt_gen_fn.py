@@ -13,7 +13,7 @@ from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Status
 from solvers.solve import solve
 from solvers.stream_planning.externals import StreamError, StreamOutputError
-from solvers.stream_planning.optimistic import OptimisticValue
+from solvers.stream_planning.opt_values import OptimisticValue
 
 DOMAIN = """(define (domain counter) (:requirements :strips :action-costs)
   (:predicates (num ?x) (next ?x ?y) (at ?x) (big ?x))

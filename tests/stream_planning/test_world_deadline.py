@@ -9,7 +9,8 @@ from sdar_tamp.language.generators import from_fn, from_gen_fn, from_test
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Status
 from solvers.solve import solve
-from solvers.stream_planning.algorithms import StreamOptions, StreamSolver
+from solvers.stream_planning.options import StreamOptions
+from solvers.stream_planning.solver import StreamSolver
 
 DOMAIN = """
 (define (domain sums)
@@ -47,7 +48,7 @@ def test_a_large_world_asks_for_the_time_while_it_is_built() -> None:
     # At complexity 4 the sums make a world of thousands of facts: its building must stop when
     # the solve's time is up (before, it ran minutes past max_time). Counted, not timed.
     solver = StreamSolver(_problem(), StreamOptions(algorithm="focused"), None)
-    solver.engine.start()
+    solver.context.engine.start()
     asked = 0
 
     def time_is_up() -> None:
@@ -56,9 +57,9 @@ def test_a_large_world_asks_for_the_time_while_it_is_built() -> None:
         raise _TimeUp
 
     with pytest.raises(_TimeUp):
-        solver.builder.build(4, check_time=time_is_up)
+        solver.context.builder.build(4, check_time=time_is_up)
     assert asked == 1
-    small = solver.builder.build(1, check_time=time_is_up)  # a small world does not ask
+    small = solver.context.builder.build(1, check_time=time_is_up)  # a small world does not ask
     assert small.facts and asked == 1
 
 

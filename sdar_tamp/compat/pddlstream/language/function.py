@@ -10,7 +10,7 @@ from typing import Any
 from sdar_tamp.compat.pddlstream.language.external import never_defer
 from sdar_tamp.compat.pddlstream.language.object import UniqueOptValue
 from sdar_tamp.language.options import FunctionInfo as _CoreFunctionInfo
-from solvers.stream_planning.optimistic import OptimisticValue
+from solvers.stream_planning.opt_values import OptimisticValue
 
 __all__ = ["FunctionInfo", "PredicateInfo", "add_opt_function"]
 

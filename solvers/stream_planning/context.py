@@ -1,0 +1,211 @@
+"""The state of one stream planning solve and the steps every algorithm takes on it: plan
+over a set of facts, call a stream instance, check a plan on the real facts, keep the best
+plan, forget failures when the complexity level rises (nothing here is global)."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Collection, Mapping
+from itertools import chain
+from typing import Any
+
+from sdar_tamp.language.domain_model import Domain
+from sdar_tamp.language.formula_model import Atom, FunctionTerm
+from sdar_tamp.language.problem import PDDLProblem, infer_object_types
+from sdar_tamp.logs import get_logger
+from solvers.classical import PlanningTask, PlanStatus
+from solvers.classical import plan as classical_plan
+from solvers.classical.fast_downward import plan_task_with_fast_downward
+from solvers.stream_planning.blocked_calls import Blocks, guard_fluent_uses
+from solvers.stream_planning.calls import CallRunner
+from solvers.stream_planning.costs import guard_costs
+from solvers.stream_planning.engine import Engine, InstanceState
+from solvers.stream_planning.negation import check_negated_uses, negated_predicates
+from solvers.stream_planning.optimistic import OptimisticBuilder, OptimisticWorld
+from solvers.stream_planning.options import StreamOptions
+from solvers.stream_planning.preimage import PlanCheck, simulate
+from solvers.stream_planning.statistics import SearchStatistics
+from solvers.stream_planning.stream_plans import ActionEfforts
+
+LOG = get_logger(__name__)
+PlanSteps = list[tuple[str, tuple[str, ...]]]
+
+
+class SolveTimeout(Exception):
+    """The solve's ``max_time`` is up."""
+
+
+class SolveContext:
+    """One solve of one problem: its engine, optimistic worlds, blocks, counters and best plan."""
+
+    def __init__(
+        self,
+        problem: PDDLProblem,
+        options: StreamOptions,
+        stream_info: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.problem = problem
+        self.options = options
+        self.start = time.perf_counter()
+        self.domain: Domain = guard_costs(problem.domain)
+        self.goal = problem.facts.goal
+        negated = negated_predicates(problem.domain, self.goal)
+        check_negated_uses(problem.streams.streams, stream_info, negated)
+        self.runner = CallRunner(self.start + options.max_time, options.enforce_max_time)
+        self.engine = Engine(problem, stream_info, self.runner)
+        self.builder = OptimisticBuilder(self.engine, negated)
+        self.fluent_streams = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
+        self.blocks = Blocks(guard_fluent_uses(self.domain, problem.streams.streams))
+        self.stats = SearchStatistics()
+        self.best: tuple[float, PlanSteps, frozenset[Atom]] | None = None
+        self.calls = 0  # stream calls made so far (the queue's work is counted in calls)
+        self.unreachable = False  # the last plan search found the goal relaxed-unreachable
+        self._order = 0
+
+    def next_order(self) -> int:
+        """A number larger than all given before (ties among skeletons go to the older)."""
+        order = self._order
+        self._order += 1
+        return order
+
+    def remaining(self) -> float:
+        return self.options.max_time - (time.perf_counter() - self.start)
+
+    def check_time(self) -> None:
+        """Raise :class:`SolveTimeout` when the solve's time is up."""
+        if self.remaining() <= 0:
+            raise SolveTimeout
+
+    def objects(self, facts: Collection[Atom]) -> dict[str, str]:
+        """The objects of the problem and of ``facts``, with the types the facts imply."""
+        constants = self.problem.domain.constants
+        names = dict.fromkeys(self.problem.facts.objects, "object")
+        names.update(dict.fromkeys(constants, "object"))
+        names.update(dict.fromkeys(chain.from_iterable(atom.args for atom in facts), "object"))
+        declared = {n: constants.get(n, "object") for n in names}
+        types = self.problem.domain.types
+        return infer_object_types(
+            declared, (a for a in facts if len(a.args) == 1 and a.predicate in types.parents), types
+        )
+
+    def plan(
+        self,
+        facts: Mapping[Atom, int],
+        numeric: Mapping[tuple[str, tuple[str, ...]], float],
+        world: OptimisticWorld | None = None,
+    ) -> tuple[PlanSteps, float] | None:
+        """A classical plan over ``facts``; None when there is none. With ``effort_weight``,
+        each action of the optimistic ``world`` also pays for the stream effort behind it."""
+        self.check_time()
+        limit = min(self.remaining(), self.options.max_planner_time)
+        domain = self.blocks.domain()
+        extra = None
+        if self.options.effort_weight is not None and world is not None and world.provenance:
+            info = {n: e.info for n, e in self.engine.streams.items()}
+            extra = ActionEfforts(
+                domain, world, info, self.options.effort_weight, self.options.unit_efforts
+            )
+        task = PlanningTask(
+            domain,
+            self.objects(facts),
+            frozenset(facts) | self.blocks.facts(),
+            self.goal,
+            numeric,
+            use_costs=not self.options.unit_costs,
+            extra_cost=extra,
+        )
+        start = time.perf_counter()
+        planner = plan_task_with_fast_downward if self.options.backend == "fd" else classical_plan
+        result = planner(
+            task,
+            search=self.options.search,
+            heuristic=self.options.heuristic,
+            weight=self.options.weight,
+            time_limit=limit,
+            # with efforts, the bound applies to cost plus effort (as in PDDLStream)
+            cost_bound=self._cost_bound(),
+        )
+        self.stats.search_time += time.perf_counter() - start
+        statistics = result.statistics
+        LOG.debug(
+            "plan search: %s, %d facts, %d ground operators, %d expanded, %.3f s",
+            result.status.value, len(facts), statistics.ground_actions, statistics.expanded,
+            time.perf_counter() - start,
+        )  # fmt: skip
+        # nothing expanded: the goal is not reachable even ignoring deletes
+        self.unreachable = result.status is PlanStatus.UNSOLVABLE and (
+            result.statistics.expanded == 0
+        )
+        if result.status is PlanStatus.TIMEOUT:
+            self.check_time()
+            return None
+        if result.plan is None:
+            return None
+        return [(step.name, step.args) for step in result.plan], result.cost
+
+    def _cost_bound(self) -> float:
+        """The planner keeps only plans cheaper than this: plans above ``max_cost`` are never
+        returned, and once a plan is known (anytime), only cheaper ones are of interest."""
+        bound = math.nextafter(self.options.max_cost, math.inf)
+        return min(bound, self.best[0]) if self.best is not None else bound
+
+    def sample(self, state: InstanceState) -> bool:
+        """Call a real instance once; True when it produced."""
+        start = time.perf_counter()
+        self.calls += 1
+        produced = self.engine.sample(state)
+        self.stats.sample_time += time.perf_counter() - start
+        return produced
+
+    def real_check(
+        self, actions: PlanSteps, trusted: frozenset[Atom] = frozenset()
+    ) -> tuple[bool, PlanCheck]:
+        """Is the plan valid on the real facts, each fact a fluent stream certified used only
+        in the state it was certified in (or ``trusted``: bound by the plan's skeleton)? The
+        check also gives the facts it needs and its cost."""
+        engine = self.engine
+        facts = engine.store.levels
+        numeric = engine.numeric
+
+        def cost_of(term: FunctionTerm) -> float:
+            return numeric.get((term.name, term.args), 0.0)
+
+        check = simulate(
+            self.problem.domain, self.objects(facts), facts, actions, self.goal, cost_of
+        )  # fmt: skip
+        if not check.valid or not engine.hidden:
+            return check.valid, check
+        for state, support in zip(check.states, check.supports, strict=True):
+            hidden = (support & engine.hidden) - trusted
+            if any(not engine.certified_in(a, state) for a in hidden):
+                return False, check
+        return True, check
+
+    def failed(self, state: InstanceState) -> None:
+        """A call produced nothing: a fluent instance blocks its facts in states like its own
+        (for good once exhausted); another instance is disabled until the level rises."""
+        instance = state.instance
+        if instance.external.declaration.fluents:
+            self.blocks.add(
+                instance.external.name, instance.inputs, instance.fluents, instance.exhausted
+            )
+        else:
+            self.engine.disable(state)
+
+    def lift(self) -> None:
+        """The complexity level rose: failures that may not repeat are forgotten."""
+        for state in self.engine.instances.values():
+            state.instance.disabled = False
+        self.blocks.lift()
+
+    def record(self, actions: PlanSteps, check: PlanCheck) -> bool:
+        """Keep a real plan if it is the best so far (its cost: its length with unit costs,
+        else the sum of its steps' costs); True when it is good enough to stop."""
+        cost = float(len(actions)) if self.options.unit_costs else check.cost
+        needed = check.needed
+        if cost > self.options.max_cost:
+            return False
+        if self.best is None or cost < self.best[0]:
+            self.best = (cost, actions, needed)
+        return self.best[0] <= self.options.success_cost

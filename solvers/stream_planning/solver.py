@@ -1,0 +1,255 @@
+"""The search loop of the stream planning algorithms (PDDLStream's incremental, focused,
+binding and adaptive), one loop for all, with what differs in a policy (:mod:`.policies`).
+
+Each pass builds the world at the complexity level (the optimistic one, or for incremental the
+real facts with only fluent streams optimistic), plans over it, and hands the stream plan of a
+new optimistic plan to the policy as a skeleton; a search without a new plan raises the level.
+
+A ``:fluents`` stream is called with the fluent facts of the state of the step that uses its
+certified facts (:mod:`.fluents`); what it certifies holds in that state only, so it never
+becomes a fact an optimistic plan may use freely, and a stream plan with fluent streams is
+bound (as in binding) even by focused. A failed fluent call blocks the stream's facts in states
+like the one it failed in (:mod:`.blocked_calls`), so the next optimistic plan goes another way.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from typing import Any
+
+from sdar_tamp.language.formula_model import Atom
+from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.logs import get_logger
+from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
+from solvers.stream_planning.calls import CallTimeout
+from solvers.stream_planning.constraints import original_name
+from solvers.stream_planning.context import PlanSteps, SolveContext, SolveTimeout
+from solvers.stream_planning.diagnosis import diagnose
+from solvers.stream_planning.fluents import FluentPlan, fluent_plan
+from solvers.stream_planning.optimistic import OptimisticWorld, OptResult, is_placeholder
+from solvers.stream_planning.options import StreamOptions
+from solvers.stream_planning.policies import policy_for
+from solvers.stream_planning.preimage import simulate
+from solvers.stream_planning.skeletons import Skeleton
+from solvers.stream_planning.stream_plans import extract_stream_plan, stream_plan_effort
+
+LOG = get_logger(__name__)
+
+
+class StreamSolver:
+    """One solve of one problem with the algorithm ``options.algorithm`` names (all state
+    lives in its :class:`~.context.SolveContext` and its policy, nothing is global)."""
+
+    def __init__(
+        self,
+        problem: PDDLProblem,
+        options: StreamOptions,
+        stream_info: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.context = SolveContext(problem, options, stream_info)
+        self.policy = policy_for(self.context)
+
+    def solve(self) -> Solution:
+        context = self.context
+        try:
+            context.engine.start()
+            status = self._search()
+        except (SolveTimeout, CallTimeout):
+            status = Status.TIMEOUT
+        finally:
+            context.runner.close()
+        if context.best is not None:
+            status = Status.SOLVED
+        return self._solution(status)
+
+    def _world(self, level: int) -> OptimisticWorld:
+        """The facts to plan over: the optimistic world, or in incremental without fluent
+        streams (nothing optimistic), just the real facts."""
+        context = self.context
+        engine = context.engine
+        lazy = self.policy.lazy
+        if lazy and not any(context.fluent_streams.values()):
+            return OptimisticWorld(dict(engine.planning_facts()), {}, dict(engine.numeric))
+        return context.builder.build(level, lazy, check_time=context.check_time)
+
+    def _complete(self, world: OptimisticWorld) -> bool:
+        """Nothing left out at this level: no plan now means no plan at all."""
+        context = self.context
+        if not world.complete or context.blocks.temporary:
+            return False
+        # later calls (left out above the level) could give the several new values of one
+        # instance a plan needs; mapped onto its one placeholder, a relaxed plan stays one, so
+        # only a goal that is not relaxed-reachable proves that they would not help
+        if world.more_calls and not context.unreachable:
+            return False
+        if any(s.instance.disabled for s in context.engine.instances.values()):
+            return False
+        return not self.policy.lazy or all(
+            s.instance.exhausted or s.instance.external.declaration.fluents
+            for s in context.engine.instances.values()
+        )
+
+    def _search(self) -> Status:
+        """The loop all algorithms share: build the world at the level, plan, hand the new
+        skeleton to the policy, or, with no new plan, raise the level."""
+        context = self.context
+        options = context.options
+        stats = context.stats
+        policy = self.policy
+        level = options.initial_complexity
+        tried: set[tuple[object, ...]] = set()  # (plan, optimistic results) met at this level
+        while True:
+            if stats.iterations >= options.max_iterations:
+                return Status.TIMEOUT
+            stats.iterations += 1
+            stats.complexity = level
+            policy.prepare(level)
+            world, found = self._plan_at(level)
+            ordered = None if found is None else self._new_plan(world, found[0], tried)
+            if found is None or ordered is None:
+                # no new plan: work on the queued skeletons, and raise the level (what they
+                # wait for may lie above it)
+                if policy.no_new_plan(len(world.facts)):
+                    return Status.SOLVED
+                if not policy.waiting and self._complete(world):
+                    return Status.INFEASIBLE
+                level += options.complexity_step
+                if level > options.max_complexity:
+                    return Status.INFEASIBLE
+                context.lift()
+                tried.clear()
+                continue
+            actions, cost = found
+            if context.builder.refine(ordered.stream_plan):
+                continue  # it uses shared placeholders: plan again with the instances' own
+            if not any(r.kind == "stream" for r in ordered.stream_plan) and not any(
+                is_placeholder(a) for _, args in actions for a in args
+            ):
+                valid, check = context.real_check(actions)
+                if valid and context.record(actions, check):
+                    return Status.SOLVED
+                if not valid:
+                    LOG.debug("plan on real facts failed validation; raising complexity")
+                    level += options.complexity_step
+                elif policy.lazy:
+                    # incremental looks for a cheaper plan on more facts (as PDDLStream's
+                    # does): the next search covers these facts too, bounded by this plan
+                    level += options.complexity_step
+                    if level > options.max_complexity:
+                        return Status.INFEASIBLE
+                    tried.clear()
+                continue
+            stats.skeletons += 1
+            if policy.take(self._skeleton(ordered, cost)):
+                return Status.SOLVED
+
+    def _plan_at(self, level: int) -> tuple[OptimisticWorld, tuple[PlanSteps, float] | None]:
+        """The world at ``level`` and a plan over it with its cost (None: no plan, or no
+        search once ``max_skeletons`` skeletons were made)."""
+        context = self.context
+        world = self._world(level)
+        context.unreachable = False
+        found = None
+        if context.stats.skeletons < context.options.max_skeletons:
+            found = context.plan(world.facts, world.numeric, world)
+            if found is None and world.more_calls and not context.unreachable:
+                # no plan with one new output per instance: offer later calls' outputs
+                world = context.builder.build(
+                    level, self.policy.lazy, further=True, check_time=context.check_time
+                )
+                found = context.plan(world.facts, world.numeric, world)
+        return world, found
+
+    def _new_plan(
+        self, world: OptimisticWorld, actions: PlanSteps, tried: set[tuple[object, ...]]
+    ) -> FluentPlan | None:
+        """The plan's actions and stream plan, ordered so that fluent streams see the state of
+        the step that uses them; None when the plan was met before at this level."""
+        context = self.context
+        stream_plan: list[OptResult] = []
+        check = None
+        if world.provenance:  # (else all facts are real)
+            check = simulate(
+                context.problem.domain, context.objects(world.facts), world.facts, actions,
+                context.goal,
+            )  # fmt: skip
+            stream_plan = extract_stream_plan(check.needed, world)
+        # The same actions on the same optimistic results: nothing learnt since this plan was
+        # met, as if none. (The same actions on real facts are new.)
+        key = (
+            tuple(actions),
+            tuple((r.external, r.inputs) for r in stream_plan if r.kind == "stream"),
+        )
+        if key in tried:
+            return None
+        tried.add(key)
+        if check is None:
+            return FluentPlan([], {}, list(actions))
+        return fluent_plan(stream_plan, check, context.fluent_streams, actions)
+
+    def _skeleton(self, ordered: FluentPlan, cost: float) -> Skeleton:
+        """The skeleton of a new optimistic plan: first in the queue by cost (plus the effort
+        of its stream plan with ``effort_weight``), ties to the older."""
+        context = self.context
+        options = context.options
+        priority = cost
+        if options.effort_weight is not None:
+            efforts = {n: e.info for n, e in context.engine.streams.items()}
+            effort = stream_plan_effort(ordered.stream_plan, efforts, options.unit_efforts)
+            priority += options.effort_weight * effort
+        return Skeleton(
+            (0, priority, context.next_order()),
+            ordered.actions,
+            ordered.stream_plan,
+            fluents=ordered.fluents,
+        )
+
+    def _solution(self, status: Status) -> Solution:
+        context = self.context
+        stats = context.stats
+        engine = context.engine
+        table = engine.table
+        streams = {
+            name: StreamStatistics(c.calls, c.successes, c.outputs, c.time)
+            for name, c in (
+                *((n, e.counters) for n, e in engine.streams.items()),
+                *((e.stream or n, e.counters) for n, e in engine.functions.items()),
+            )
+        }
+        stats.time = time.perf_counter() - context.start
+        stats.facts = len(engine.store)
+
+        def fact(atom: Atom) -> tuple[Any, ...]:
+            return (atom.predicate, *(table.value(a) for a in atom.args))
+
+        real = [a for a in engine.store.levels if not a.predicate.startswith("@")]
+        if context.best is None:
+            return Solution(
+                None,
+                math.inf,
+                Certificate(tuple(fact(a) for a in real), ()),
+                status,
+                stats.as_mapping(),
+                streams,
+                diagnose(
+                    engine,
+                    context.problem.domain,
+                    context.goal,
+                    status,
+                    max_time=context.options.max_time,
+                    overruns=context.runner.overruns,
+                    complexity=stats.complexity,
+                ),
+            )
+        cost, actions, needed = context.best
+        plan = [
+            Action(original_name(name), tuple(table.value(a) for a in args))
+            for name, args in actions
+        ]
+        certificate = Certificate(
+            tuple(fact(a) for a in real),
+            tuple(fact(a) for a in sorted(needed, key=str) if not a.predicate.startswith("@")),
+        )
+        return Solution(plan, cost, certificate, Status.SOLVED, stats.as_mapping(), streams)
