@@ -40,7 +40,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import GRIPPER_DWELL, PlanEvent, PlanFile, load_plan
+from sdar_tamp.plan_file import GRIPPER_DWELL, PlanEvent, PlanFile
+from sdar_tamp.plan_reading import load_plan
 from sdar_tamp.plan_rules import (
     LIMIT_RTOL,
     STILL_TOL,

@@ -30,6 +30,10 @@ LAYERS: dict[str, str] = {
     "sdar_tamp.world": "world",
     # plan files and their independent validator: the world only
     "sdar_tamp.plan_file": "plan",
+    "sdar_tamp.plan_metrics": "plan",
+    "sdar_tamp.plan_reading": "plan",
+    "sdar_tamp.plan_writing": "plan",
+    "sdar_tamp.plan_building": "plan",
     "sdar_tamp.plan_rules": "plan",
     "sdar_tamp.replay": "plan",
     # planners, geometric streams, the declarative domains' samplers

@@ -22,7 +22,8 @@ from sdar_tamp.language.model import (
     iter_atoms,
     iter_effect_literals,
 )
-from sdar_tamp.plan_file import GripperEvent, MotionSegment, PlanFile, build_plan_file
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.world.transforms import inverse
 from solvers.sdar.vocabulary import SdarVocabulary
 from solvers.solution import Action, Solution
