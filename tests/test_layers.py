@@ -36,6 +36,8 @@ LAYERS: dict[str, str] = {
     "sdar_tamp.plan_building": "plan",
     "sdar_tamp.plan_rules": "plan",
     "sdar_tamp.replay": "plan",
+    "sdar_tamp.replay_walk": "plan",
+    "sdar_tamp.replay_sampling": "plan",
     # planners, geometric streams, the declarative domains' samplers
     "solvers": "solvers",
     "streams": "streams",

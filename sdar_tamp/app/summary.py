@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 from typing import Any, TextIO
 
 from sdar_tamp.app.records import SolveOutcome
@@ -33,7 +34,7 @@ def format_summary(outcome: SolveOutcome) -> str:
     return "\n".join(lines)
 
 
-def summary_record(outcome: SolveOutcome, plan_file: Any = None) -> dict[str, Any]:
+def summary_record(outcome: SolveOutcome, plan_file: Path | None = None) -> dict[str, Any]:
     """The run as one JSON-ready object (``sdar solve --json``): status, validity, the plan's
     metrics, the run's figures and, without a plan, the diagnosis."""
     f = outcome.figures

@@ -249,3 +249,14 @@ def test_the_asynchronous_combination_reaches_the_solver(monkeypatch: pytest.Mon
         row = run_task(BenchTask(entry, combo, 60.0, 0)).row
         assert row.status == "error" and row.combination == combo.id
     assert seen == ["sync", "async"]
+
+
+def test_a_bench_row_has_one_field_per_column_in_order() -> None:
+    """The CSV columns come from the row record at the writing boundary, in COLUMNS order."""
+    import dataclasses
+
+    from sdar_tamp.evaluation.records import BenchRow
+
+    assert tuple(f.name for f in dataclasses.fields(BenchRow)) == COLUMNS
+    row = BenchRow("R4", "R", 4, "sdar", "sdar", "sdar", 0, 60.0, False, "error", False)
+    assert list(row.cells()) == list(COLUMNS) and row.cells()["actions"] is None
