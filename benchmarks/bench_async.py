@@ -26,7 +26,9 @@ from pathlib import Path
 
 from sdar_tamp.app import PlannerCache, solve_instance
 from sdar_tamp.app.execution import execution_options
-from sdar_tamp.plan_file import PlanFile, load_plan, save_plan
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.resources import domain_file
 from sdar_tamp.schedule import ScheduleOptions, schedule_async

@@ -81,8 +81,11 @@ def main() -> None:
     args = ap.parse_args()
     if args.runs < 1:
         ap.error(f"--runs: expected a number of runs >= 1, got {args.runs}")
-    if args.against is not None and not (args.against / "sdar_tamp" / "cli.py").is_file():
-        ap.error(f"--against: {args.against} is not a checkout of sdar-tamp (no sdar_tamp/cli.py)")
+    cli = None if args.against is None else args.against / "sdar_tamp" / "cli"
+    if cli is not None and not (
+        cli.with_suffix(".py").is_file() or (cli / "__init__.py").is_file()
+    ):
+        ap.error(f"--against: {args.against} is not a checkout of sdar-tamp (no sdar_tamp/cli)")
     versions: dict[str, Path | None] = {"this": ROOT}
     if args.against is not None:
         versions["against"] = args.against.resolve()

@@ -59,7 +59,7 @@ def _rigid(T: FloatArray) -> bool:
 
 
 def check_format(plan: PlanFile) -> Violation | None:
-    """What :func:`~sdar_tamp.plan_file.load_plan` guarantees, for plans built in memory:
+    """What :func:`~sdar_tamp.plan_reading.load_plan` guarantees, for plans built in memory:
     times from 0, increasing, at most ``MAX_DT`` apart; finite values; events sorted, within
     the trajectory, of a known arm and type, with rigid transforms."""
     t, q = plan.t, plan.q

@@ -25,45 +25,33 @@ earliest of those violations, and returns the FIRST violation. Replay rules:
   1 degree, yaw modulo pi), ``final poses`` (equal to the plan's ``final_poses``, same
   tolerances).
 
-The README section "What `sdar validate` checks" lists every rule with its tolerance.
+The walk itself is :class:`~sdar_tamp.replay_walk.ReplayWalk`; the points it checks between
+samples come from :mod:`sdar_tamp.replay_sampling`. The README section "What `sdar validate`
+checks" lists every rule with its tolerance.
 """
 
 from __future__ import annotations
 
-import json
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
-
-import numpy as np
-from numpy.typing import NDArray
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import GRIPPER_DWELL, PlanEvent, PlanFile, load_plan
+from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile
 from sdar_tamp.plan_rules import (
     LIMIT_RTOL,
-    STILL_TOL,
     Violation,
     check_format,
     check_instance,
     check_scene,
     check_timeline,
 )
-from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
-from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
-from sdar_tamp.world.instance import Instance, load_instance
+from sdar_tamp.replay_walk import ReplayWalk
+from sdar_tamp.world.collision import CollisionWorld
+from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.kinematics import ArmKinematics
-from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene, load_scene
-from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
-__all__ = ["PlanValidator", "ReplayReport", "Violation", "run_validate", "validate_plan"]
-
-POS_TOL = 1e-3  #: [m]
-ANGLE_TOL = math.radians(1.0)  #: [rad]
-#: Rotations mapping a cuboid onto itself (pi about x, y or z).
-_SYMMETRY = [np.diag(d) for d in ((1.0, 1, 1), (1.0, -1, -1), (-1.0, 1, -1), (-1.0, -1, 1))]
+__all__ = ["PlanValidator", "ReplayReport", "Violation", "validate_plan"]
 
 
 @dataclass(frozen=True)
@@ -124,7 +112,7 @@ class PlanValidator:
         for arm in self.scene.arm_names:  # a fresh world: nothing held
             if self.world.held_by(arm) is not None:
                 self.world.detach(arm)
-        replay = _Replay(instance, plan, self.scene, self.step, self.kins, self.world)
+        replay = ReplayWalk(instance, plan, self.scene, self.step, self.kins, self.world)
         found = replay.walk(limit.t if limit is not None else math.inf)
         violation = found if found is not None else limit
         return ReplayReport(violation is None, violation, replay.checks)
@@ -151,294 +139,3 @@ def validate_plan(
         acceleration_tolerance=acceleration_tolerance,
     )
     return validator.validate(instance, plan)
-
-
-def run_validate(instance_path: Path, plan_path: Path, *, as_json: bool = False) -> int:
-    """``sdar validate``: print the verdict (one JSON object with ``as_json``); 0 when valid,
-    1 when not. Bad files raise."""
-    instance = load_instance(instance_path)
-    plan = load_plan(plan_path)
-    scene = load_scene(instance.scene_path(Path(instance_path)))
-    report = validate_plan(instance, plan, scene)
-    v = report.violation
-    if as_json:
-        record = {
-            "valid": v is None,
-            "instance": instance.name,
-            "plan": str(plan_path),
-            "events": len(plan.events),
-            "checks": report.checks,
-            "duration": plan.duration,
-            "violation": None if v is None else {"t": v.t, "kind": v.kind, "message": v.message},
-        }
-        print(json.dumps(record, sort_keys=True))
-    elif v is None:
-        print(
-            f"valid: {len(plan.events)} gripper events, {report.checks} collision checks, "
-            f"duration {plan.duration:.2f} s"
-        )
-    else:
-        print(f"invalid at t={v.t:.3f}s: {v.kind}: {v.message}")
-    return 0 if v is None else 1
-
-
-def _pose_error(T_a: FloatArray, T_b: FloatArray) -> tuple[float, float]:
-    """Distance [m] and rotation angle [rad] between two cuboid poses, modulo symmetry."""
-    R = T_a[:3, :3].T @ T_b[:3, :3]
-    trace = max(float(np.trace(R @ S)) for S in _SYMMETRY)
-    angle = math.acos(min(1.0, max(-1.0, (trace - 1.0) / 2.0)))
-    return float(np.linalg.norm(T_a[:3, 3] - T_b[:3, 3])), angle
-
-
-def _planar_error(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float]:
-    """Distance [m] and yaw difference modulo pi [rad] of two ``(x, y, yaw)`` poses."""
-    d = (a[2] - b[2]) % math.pi
-    return math.hypot(a[0] - b[0], a[1] - b[1]), min(d, math.pi - d)
-
-
-def contact_allowed(pair: CollisionPair, exempt: Mapping[str, tuple[str, FloatArray]]) -> bool:
-    """The contact rule: ``pair`` is the gripper of an arm touching the object of its grasp or
-    release while that arm stands at its event configuration (``exempt``: arm -> (object,
-    configuration))."""
-    for arm, (obj, _) in exempt.items():
-        target = f"object:{obj}"
-        other = pair.second if pair.first == target else pair.first if pair.second == target else ""
-        if other.startswith(f"{arm}_gripper"):
-            return True
-    return False
-
-
-def tcp_positions(
-    q: FloatArray, kins: Mapping[str, ArmKinematics], layout: ArmLayout
-) -> FloatArray:
-    """Every arm's TCP position ``(m, arms, 3)`` [m] for ``q`` ``(m, dof)`` (closed-form FK)."""
-    out = []
-    for arm in layout:
-        kin = kins[arm]
-        out.append((kin.fk_batch(layout.part(q, arm)) @ kin.T_tool0_tcp)[:, :3, 3])
-    return np.stack(out, axis=1)
-
-
-def tcp_subdivisions(
-    q: FloatArray, kins: Mapping[str, ArmKinematics], layout: ArmLayout, step: float
-) -> NDArray[np.int_]:
-    """Per interval of ``q`` ``(K, dof)``: the number of linear steps after which no TCP has
-    moved more than ``step`` [m] (refined until it holds). Each interval's count depends on its
-    two ends only, so a plan and any stretch of it agree on the points the replay checks."""
-    return interval_subdivisions(q[:-1], q[1:], kins, layout, step)
-
-
-def interval_subdivisions(
-    start: FloatArray,
-    end: FloatArray,
-    kins: Mapping[str, ArmKinematics],
-    layout: ArmLayout,
-    step: float,
-) -> NDArray[np.int_]:
-    """:func:`tcp_subdivisions` of the intervals from ``start`` to ``end`` ``(r, dof)``, each
-    on its own (the same count as within any sequence it is part of)."""
-    chord = np.linalg.norm(
-        tcp_positions(end, kins, layout) - tcp_positions(start, kins, layout), axis=2
-    ).max(axis=1)
-    n: NDArray[np.int_] = np.maximum(1, np.ceil(chord / step)).astype(int)
-    for _ in range(30):
-        off = np.cumsum(n + 1) - (n + 1)  # first dense point of every interval
-        idx = np.repeat(np.arange(len(n)), n + 1)
-        frac = (np.arange(len(idx)) - np.repeat(off, n + 1)) / np.repeat(n, n + 1)
-        dense = start[idx] + frac[:, None] * (end[idx] - start[idx])
-        d = np.linalg.norm(np.diff(tcp_positions(dense, kins, layout), axis=0), axis=2)
-        d = d.max(axis=1)
-        d[off[1:] - 1] = 0.0  # steps across intervals
-        worst = np.maximum.reduceat(np.append(d, 0.0), off)
-        bad = worst > step
-        if not bad.any():
-            break
-        n[bad] = np.maximum(n[bad] + 1, np.ceil(1.1 * n[bad] * worst[bad] / step))
-    return n
-
-
-class _Replay:
-    """The state of the world along the timeline: resting and held objects."""
-
-    def __init__(
-        self,
-        instance: Instance,
-        plan: PlanFile,
-        scene: Scene,
-        step: float,
-        kins: dict[str, ArmKinematics],
-        world: CollisionWorld,
-    ) -> None:
-        self.instance, self.plan, self.scene, self.step = instance, plan, scene, step
-        self.kins = kins
-        self.layout = scene.layout
-        self.sizes = {o.name: o.size for o in instance.objects}
-        self.rest = {o.name: o.start.as_tuple() for o in instance.objects}
-        self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
-        self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
-        self.world = world
-        self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
-        self.checks = 0
-        self.free: FloatArray | None = None  # the last configuration found free
-
-    def box(self, name: str, pose: tuple[float, ...]) -> ObjectBox:
-        size = self.sizes[name]
-        return ObjectBox(pose_xyz_yaw(pose[0], pose[1], size[2] / 2.0, pose[2]), size)
-
-    def arm_q(self, arm: str, q: FloatArray) -> FloatArray:
-        return self.layout.part(q, arm)
-
-    def tcp(self, arm: str, q: FloatArray) -> FloatArray:
-        return self.kins[arm].fk_tcp(self.arm_q(arm, q))
-
-    # -- collisions -----------------------------------------------------------------------------
-    def collide(self, q: FloatArray, t: float) -> Violation | None:
-        if self.free is not None and np.array_equal(q, self.free):
-            return None  # standing still in an unchanged world
-        self.checks += 1
-        for arm, (_, q_event) in list(self.exempt.items()):
-            if np.abs(self.arm_q(arm, q) - q_event).max() > STILL_TOL:
-                del self.exempt[arm]  # the arm has moved: contact counts again
-        if not self.world.in_collision(q):
-            self.free = q.copy()
-            return None
-        pairs = [p for p in self.world.report(q) if not self.allowed(p)]
-        if not pairs:
-            return None
-        text = ", ".join(f"{p.first} with {p.second}" for p in pairs[:3])
-        return Violation(t, "collision", text + (" ..." if len(pairs) > 3 else ""))
-
-    def allowed(self, p: CollisionPair) -> bool:
-        return contact_allowed(p, self.exempt)
-
-    def subdivisions(self, q: FloatArray) -> NDArray[np.int_]:
-        """See :func:`tcp_subdivisions`."""
-        return tcp_subdivisions(q, self.kins, self.layout, self.step)
-
-    # -- the walk -------------------------------------------------------------------------------
-    def walk(self, t_stop: float) -> Violation | None:
-        """Replay until ``t_stop`` [s] (exclusive); the first violation, or None."""
-        plan = self.plan
-        knot_t = np.union1d(plan.t, [e.t for e in plan.events])
-        knot_t = knot_t[: int(np.searchsorted(knot_t, t_stop)) + 1]  # the last one: to t_stop
-        columns = range(self.layout.dof)
-        knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in columns], axis=1)
-        counts = self.subdivisions(knot_q) if len(knot_t) > 1 else np.zeros(0, dtype=int)
-        pending = list(plan.events)
-        for k, tk in enumerate(knot_t):
-            if tk >= t_stop:
-                return None
-            group = [e for e in pending if e.t <= tk]
-            pending = pending[len(group) :]
-            for e in group:
-                self.exempt[e.arm] = (e.object, self.arm_q(e.arm, knot_q[k]).copy())
-            found = self.collide(knot_q[k], float(tk))
-            for e in group:
-                found = found or self.apply(e, knot_q[k], float(tk))
-            if group and found is None:
-                found = self.collide(knot_q[k], float(tk))
-            if found is not None:
-                return found
-            if k + 1 < len(knot_t):
-                n = int(counts[k])
-                for s in range(1, n):
-                    t = float(tk + (knot_t[k + 1] - tk) * s / n)
-                    if t >= t_stop:
-                        return None
-                    q = knot_q[k] + (knot_q[k + 1] - knot_q[k]) * (s / n)
-                    found = self.collide(q, t)
-                    if found is not None:
-                        return found
-        return self.final(float(knot_t[-1]))
-
-    def apply(self, e: PlanEvent, q: FloatArray, t: float) -> Violation | None:
-        """Check and perform one gripper event at configuration ``q`` ``(dof,)``."""
-        self.free = None  # the world changes
-        T_world_tcp = self.tcp(e.arm, q)
-        if e.type == "grasp":
-            if e.arm in self.held:
-                return Violation(
-                    t, "grasp", f"{e.arm} grasps {e.object} while holding {self.held[e.arm][0]}"
-                )
-            if e.object not in self.rest:
-                return Violation(t, "grasp", f"{e.arm} grasps {e.object}, which is not resting")
-            T_obj = self.box(e.object, self.rest[e.object]).T_world_obj
-            d, a = _pose_error(T_world_tcp @ e.T_tcp_object, T_obj)
-            if d > POS_TOL or a > ANGLE_TOL:
-                return Violation(
-                    t,
-                    "grasp",
-                    f"{e.arm} grasps {e.object} with the tool "
-                    f"{d * 1e3:.1f} mm / {math.degrees(a):.1f} deg away from it "
-                    "(tolerance 1 mm / 1 deg)",
-                )
-            del self.rest[e.object]
-            self.held[e.arm] = (e.object, inverse(T_world_tcp) @ T_obj)
-            self.world.attach(e.arm, e.object, self.arm_q(e.arm, q))
-            return None
-        holding = self.held.get(e.arm)
-        if holding is None or holding[0] != e.object:
-            what = holding[0] if holding else "nothing"
-            return Violation(t, "release", f"{e.arm} releases {e.object} but holds {what}")
-        d, a = _pose_error(holding[1], e.T_tcp_object)
-        if d > POS_TOL or a > ANGLE_TOL:
-            return Violation(
-                t,
-                "release",
-                f"{e.arm} releases {e.object} with T_tcp_object "
-                f"{d * 1e3:.1f} mm / {math.degrees(a):.1f} deg off the grasp",
-            )
-        T = T_world_tcp @ holding[1]
-        lz = self.sizes[e.object][2]
-        tilt = math.acos(min(1.0, abs(float(T[2, 2]))))
-        if abs(T[2, 3] - lz / 2.0) > POS_TOL or tilt > ANGLE_TOL:
-            return Violation(
-                t,
-                "release",
-                f"{e.object} released at z = {T[2, 3]:.4f} m tilted "
-                f"{math.degrees(tilt):.1f} deg; it must rest flat on the table "
-                f"(z = {lz / 2:.4f} m)",
-            )
-        pose = (float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0]))
-        size = np.array(self.sizes[e.object][:2])
-        ws = self.instance.workspace
-        rect = corners(np.array([pose]), size)
-        if not inside_rectangle(
-            rect, (ws.x[0] - POS_TOL, ws.x[1] + POS_TOL), (ws.y[0] - POS_TOL, ws.y[1] + POS_TOL)
-        )[0]:
-            return Violation(
-                t,
-                "release",
-                f"{e.object} released at ({pose[0]:.3f}, {pose[1]:.3f}) m leaves the workspace",
-            )
-        shrunk = corners(np.array([pose]), size - 2.0 * POS_TOL)
-        for other, p in self.rest.items():
-            rect_o = corners(np.array([p]), np.array(self.sizes[other][:2]))
-            if overlap_matrix(shrunk, rect_o)[0, 0]:
-                return Violation(t, "release", f"{e.object} released onto {other}")
-        del self.held[e.arm]
-        self.world.detach(e.arm, self.arm_q(e.arm, q))
-        self.world.set_object(e.object, self.box(e.object, pose))
-        self.rest[e.object] = pose
-        return None
-
-    def final(self, t: float) -> Violation | None:
-        if self.held:
-            what = ", ".join(f"{a} holds {o}" for a, (o, _) in self.held.items())
-            return Violation(t, "held", f"the plan ends with {what}")
-        for o in self.instance.objects:
-            for kind, ref in (
-                ("goal", o.goal.as_tuple()),
-                ("final poses", self.plan.final_poses[o.name]),
-            ):
-                d, a = _planar_error(self.rest[o.name], ref)
-                if d > POS_TOL or a > ANGLE_TOL:
-                    x, y, yaw = self.rest[o.name]
-                    return Violation(
-                        t,
-                        kind,
-                        f"{o.name} ends at ({x:.4f}, {y:.4f}, {yaw:.4f}), "
-                        f"{d * 1e3:.1f} mm / {math.degrees(a):.1f} deg from "
-                        f"{kind} {tuple(round(v, 4) for v in ref)}",
-                    )
-        return None

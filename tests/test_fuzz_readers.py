@@ -29,14 +29,10 @@ from hypothesis.configuration import set_hypothesis_home_dir
 from sdar_tamp.errors import SdarError
 from sdar_tamp.language import parse_domain, parse_problem, parse_stream_file
 from sdar_tamp.language.domain_model import Domain
-from sdar_tamp.plan_file import (
-    GripperEvent,
-    MotionSegment,
-    PlanFile,
-    build_plan_file,
-    load_plan,
-    save_plan,
-)
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.textfile import decode_text
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.scene import load_scene

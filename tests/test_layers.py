@@ -30,8 +30,14 @@ LAYERS: dict[str, str] = {
     "sdar_tamp.world": "world",
     # plan files and their independent validator: the world only
     "sdar_tamp.plan_file": "plan",
+    "sdar_tamp.plan_metrics": "plan",
+    "sdar_tamp.plan_reading": "plan",
+    "sdar_tamp.plan_writing": "plan",
+    "sdar_tamp.plan_building": "plan",
     "sdar_tamp.plan_rules": "plan",
     "sdar_tamp.replay": "plan",
+    "sdar_tamp.replay_walk": "plan",
+    "sdar_tamp.replay_sampling": "plan",
     # planners, geometric streams, the declarative domains' samplers
     "solvers": "solvers",
     "streams": "streams",

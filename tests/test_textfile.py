@@ -12,7 +12,8 @@ from sdar_tamp.cli import main
 from sdar_tamp.compat.pddlstream import read
 from sdar_tamp.errors import SdarError
 from sdar_tamp.evaluation.results import read_rows
-from sdar_tamp.plan_file import PlanFileError, load_plan
+from sdar_tamp.plan_file import PlanFileError
+from sdar_tamp.plan_reading import load_plan
 from sdar_tamp.resources import domain_file
 from sdar_tamp.textfile import TextFileError, decode_text, read_text
 from sdar_tamp.world._pin import PinRobot

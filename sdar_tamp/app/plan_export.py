@@ -18,7 +18,8 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.domain_model import ActionSchema, Domain
 from sdar_tamp.language.stream_model import StreamFile
 from sdar_tamp.language.traversal import iter_atoms, iter_effect_literals
-from sdar_tamp.plan_file import GripperEvent, MotionSegment, PlanFile, build_plan_file
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.world.transforms import inverse
 from solvers.sdar.vocabulary import SdarVocabulary
 from solvers.solution import Action, Solution

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 from typing import Any, TextIO
 
 from sdar_tamp.app.records import SolveOutcome
+from sdar_tamp.plan_metrics import PlanMetrics
 
 
 def format_summary(outcome: SolveOutcome) -> str:
@@ -17,9 +19,10 @@ def format_summary(outcome: SolveOutcome) -> str:
     m = outcome.plan.metrics
     lines = [
         head + (", plan valid" if outcome.valid else f", plan INVALID ({outcome.violation})"),
-        f"  actions {m['actions']} ({f.buffer_moves} to buffers), synchronous steps "
-        f"{m['steps']} ({m['dual_arm_steps']} with both arms moving at once)",
-        f"  execution time {float(m['execution_time']):.2f} s" + _async_note(m, f.schedule_time),
+        f"  actions {m.actions} ({f.buffer_moves} to buffers), synchronous steps "
+        f"{m.steps} ({m.dual_arm_steps} with both arms moving at once)",
+        f"  execution time {float(_given(m.execution_time)):.2f} s"
+        + _async_note(m, f.schedule_time),
         f"  planning time {f.planning_time:.2f} s: selection/IK {f.selection_time:.2f} s, "
         f"motion {f.motion_time:.2f} s (setup {f.setup_time:.2f} s not counted; "
         f"optimiser built in the background, waited for {f.optimiser_wait:.2f} s)",
@@ -31,7 +34,7 @@ def format_summary(outcome: SolveOutcome) -> str:
     return "\n".join(lines)
 
 
-def summary_record(outcome: SolveOutcome, plan_file: Any = None) -> dict[str, Any]:
+def summary_record(outcome: SolveOutcome, plan_file: Path | None = None) -> dict[str, Any]:
     """The run as one JSON-ready object (``sdar solve --json``): status, validity, the plan's
     metrics, the run's figures and, without a plan, the diagnosis."""
     f = outcome.figures
@@ -58,13 +61,20 @@ def summary_record(outcome: SolveOutcome, plan_file: Any = None) -> dict[str, An
     return record
 
 
-def _async_note(metrics: Any, schedule_time: float) -> str:
+def _given(value: float | None) -> float:
+    """A metric every plan the pipeline builds has."""
+    if value is None:
+        raise KeyError("the plan's metrics lack a figure the summary shows")
+    return value
+
+
+def _async_note(metrics: PlanMetrics, schedule_time: float) -> str:
     """How the asynchronous schedule changed the execution time (empty for a sync run)."""
     if schedule_time <= 0.0:
         return ""
-    if metrics.get("execution") != "async":
+    if metrics.execution != "async":
         return f" (asynchronous schedule not shorter, synchronous kept; {schedule_time:.2f} s)"
-    sync = float(metrics["execution_time_sync"])
+    sync = float(_given(metrics.execution_time_sync))
     return f" asynchronous (synchronous {sync:.2f} s; scheduled in {schedule_time:.2f} s)"
 
 

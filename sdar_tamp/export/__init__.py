@@ -1,7 +1,7 @@
 """Plan export: a plan file as ROS-style joint trajectories, a CSV table or URScript programs.
 
 ``sdar export PLAN.json --format joint-trajectory|csv|urscript [-o OUT]``; in Python,
-:func:`export_plan` (a loaded plan) or :func:`run_export` (a plan file, with the command's
+:func:`export_plan` (a loaded plan) or :func:`export_plan_file` (a plan file, with the command's
 output checks). The formats are described in their modules. Importing the package is light
 (the CLI imports it); the writers and NumPy load on first use.
 """
@@ -11,8 +11,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from sdar_tamp.export.command import default_output, export_plan, run_export
 from sdar_tamp.export.formats import CSV_RATE, FORMATS
+from sdar_tamp.export.plan_files import default_output, export_plan, export_plan_file
 
 if TYPE_CHECKING:
     from sdar_tamp.export.joint_trajectory import (
@@ -49,8 +49,8 @@ __all__ = [
     "csv_header",
     "default_output",
     "export_plan",
+    "export_plan_file",
     "joint_trajectory_document",
-    "run_export",
     "sample_derivatives",
     "urscript_programs",
     "write_csv",

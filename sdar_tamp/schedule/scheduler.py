@@ -381,11 +381,12 @@ class _Placement:
                       e.event.T_tcp_object)
             for e in self.events
         )  # fmt: skip
-        metrics = dict(self.plan.metrics)
-        metrics.update(
-            execution="async",
-            execution_time=float(t[-1]),
-            execution_time_sync=self.plan.duration,
+        metrics = self.plan.metrics.updated(
+            {
+                "execution": "async",
+                "execution_time": float(t[-1]),
+                "execution_time_sync": self.plan.duration,
+            }
         )
         steps = tuple(sorted(self.steps, key=lambda s: (s.t_start, s.t_end)))
         return dataclasses.replace(self.plan, t=t, q=q, events=events, metrics=metrics, steps=steps)

@@ -18,7 +18,8 @@ import numpy as np
 
 from sdar_tamp.plan_file import PlanEvent
 from sdar_tamp.plan_rules import STILL_TOL
-from sdar_tamp.replay import POS_TOL, contact_allowed, interval_subdivisions
+from sdar_tamp.replay_sampling import interval_subdivisions
+from sdar_tamp.replay_walk import POS_TOL, contact_allowed
 from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Instance
@@ -120,7 +121,7 @@ class WorldSweep:
 
     def subdivisions(self, q: FloatArray) -> list[int]:
         """The replay's subdivision of every interval of ``q`` ``(m, dof)``
-        (:func:`~sdar_tamp.replay.tcp_subdivisions`), remembered by interval."""
+        (:func:`~sdar_tamp.replay_sampling.tcp_subdivisions`), remembered by interval."""
         q = np.ascontiguousarray(q, dtype=np.float64)
         width = q.shape[1] * q.itemsize
         raw = q.tobytes()

@@ -7,9 +7,9 @@ optional ``viz`` extra and are imported only when a picture is written.
 """
 
 from sdar_tamp.viewer._plan import ArmLike, EventLike, PlanLike, StepLike
-from sdar_tamp.viewer.commands import show
 from sdar_tamp.viewer.errors import MissingDependencyError
 from sdar_tamp.viewer.html import write_html
+from sdar_tamp.viewer.pictures import show
 from sdar_tamp.viewer.storyboard import write_storyboard
 
 __all__ = [

@@ -122,7 +122,7 @@ def test_generate_output_must_be_yaml_and_writable(
 def test_generate_suite_needs_a_folder_and_force_to_replace(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import sdar_tamp.world.commands as commands
+    import sdar_tamp.world.instance_files as commands
     import sdar_tamp.world.suites as suites
 
     few = suites.suite_members("paper")[:2]
@@ -196,7 +196,7 @@ def test_demo_output_folder_is_checked(capsys: pytest.CaptureFixture[str], tmp_p
 def test_a_failed_write_is_one_line(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import sdar_tamp.viewer.commands as commands
+    import sdar_tamp.viewer.pictures as commands
 
     def denied(*args: object) -> Path:
         raise PermissionError(13, "Permission denied", str(tmp_path / "x.png"))

@@ -14,8 +14,9 @@ from sdar_tamp.cli import main
 from sdar_tamp.errors import SdarError
 from sdar_tamp.evaluation import settings
 from sdar_tamp.evaluation.results import COLUMNS, COMBINATIONS, RESULTS, append_rows, load_results
-from sdar_tamp.evaluation.runner import run_bench, suite_entries
+from sdar_tamp.evaluation.runner import run_bench
 from sdar_tamp.evaluation.settings import SETTINGS, plan_extras
+from sdar_tamp.evaluation.suite import suite_entries
 
 
 def _row(instance: str, combo: str, seed: int = 0, time_limit: float = 60.0) -> dict[str, Any]:

@@ -23,13 +23,9 @@ from sdar_tamp.evaluation.results import (
     load_steps,
     parse_combos,
 )
-from sdar_tamp.evaluation.runner import (
-    finished_pairs,
-    run_bench,
-    suite_entries,
-    suite_folder,
-    suite_label,
-)
+from sdar_tamp.evaluation.resume import finished_pairs
+from sdar_tamp.evaluation.runner import run_bench
+from sdar_tamp.evaluation.suite import suite_entries, suite_folder, suite_label
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -236,7 +232,7 @@ def test_sweep_plots_stay_small(tmp_path: Path) -> None:
 def test_the_asynchronous_combination_reaches_the_solver(monkeypatch: pytest.MonkeyPatch) -> None:
     """``sdar-async`` is SDAR with ``execution="async"``; the paper's six stay synchronous."""
     import sdar_tamp.app.pipeline as command
-    from sdar_tamp.evaluation import runner
+    from sdar_tamp.evaluation.bench_task import BenchTask, run_task
     from sdar_tamp.evaluation.results import COMBINATIONS, parse_combos
 
     assert [c.id for c in parse_combos("sdar-async")] == ["sdar-async"]
@@ -248,8 +244,19 @@ def test_the_asynchronous_combination_reaches_the_solver(monkeypatch: pytest.Mon
         raise RuntimeError("stop")
 
     monkeypatch.setattr(command, "solve_instance", capture)
-    (entry,) = runner.suite_entries("paper", only=["R4"])
+    (entry,) = suite_entries("paper", only=["R4"])
     for combo in parse_combos("sdar,sdar-async"):
-        row, _, _ = runner._run_task(runner._Task(entry, combo, 60.0, 0))
-        assert row["status"] == "error" and row["combination"] == combo.id
+        row = run_task(BenchTask(entry, combo, 60.0, 0)).row
+        assert row.status == "error" and row.combination == combo.id
     assert seen == ["sync", "async"]
+
+
+def test_a_bench_row_has_one_field_per_column_in_order() -> None:
+    """The CSV columns come from the row record at the writing boundary, in COLUMNS order."""
+    import dataclasses
+
+    from sdar_tamp.evaluation.records import BenchRow
+
+    assert tuple(f.name for f in dataclasses.fields(BenchRow)) == COLUMNS
+    row = BenchRow("R4", "R", 4, "sdar", "sdar", "sdar", 0, 60.0, False, "error", False)
+    assert list(row.cells()) == list(COLUMNS) and row.cells()["actions"] is None

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from sdar_tamp.evaluation.payload import InstanceFiles, PayloadError, pack, unpack
-from sdar_tamp.evaluation.runner import suite_entries
+from sdar_tamp.evaluation.suite import suite_entries
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.scene import load_scene

@@ -20,13 +20,15 @@ import pytest
 from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.evaluation.backends import BackendError
+from sdar_tamp.evaluation.bench_task import BenchTask, run_task
 from sdar_tamp.evaluation.payload import pack
 from sdar_tamp.evaluation.ray_backend import RayBackend, probe
 from sdar_tamp.evaluation.results import COMBINATIONS, RESULTS, load_results, plan_path
-from sdar_tamp.evaluation.runner import SuiteEntry, _run_task, _Task, run_bench, suite_entries
+from sdar_tamp.evaluation.runner import run_bench
 from sdar_tamp.evaluation.settings import SETTINGS
+from sdar_tamp.evaluation.suite import SuiteEntry, suite_entries
 from sdar_tamp.evaluation.workers import WorkerFailure
-from sdar_tamp.plan_file import load_plan
+from sdar_tamp.plan_reading import load_plan
 
 ray: Any = pytest.importorskip("ray")
 
@@ -106,13 +108,13 @@ def test_tasks_carry_the_instance_text(local_ray: None) -> None:
     """The task names a file that does not exist: the worker solves from the carried text."""
     real = suite_entries("paper", only=["R4"])[0].path
     entry = SuiteEntry(Path("/nonexistent/R4.yaml"), "R4", "R", 4)
-    task = _Task(entry, SDAR, time_limit=30.0, seed=0, files=pack(real))
-    with RayBackend(_run_task, workers=1, hard_limit=300.0) as backend:
+    task = BenchTask(entry, SDAR, time_limit=30.0, seed=0, files=pack(real))
+    with RayBackend(run_task, workers=1, hard_limit=300.0) as backend:
         ((done, answer),) = list(backend.run([task]))
     assert done is task and not isinstance(answer, WorkerFailure), answer
-    row, steps, plan = answer
-    assert row["status"] == "solved" and row["abstract_actions"] == 4
-    assert plan is not None and plan.instance == "R4" and len(steps) == row["steps"]
+    row, steps, plan = answer.row, answer.step_times, answer.plan
+    assert row.status == "solved" and row.abstract_actions == 4
+    assert plan is not None and plan.instance == "R4" and len(steps) == row.steps
 
 
 def _stuck(pid_file: str) -> None:

@@ -12,10 +12,12 @@ import pytest
 
 from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.evaluation.rerun import bench_commands
 from sdar_tamp.evaluation.results import COMBINATIONS, RESULTS, load_results
-from sdar_tamp.evaluation.runner import bench_commands, run_bench, suite_entries
+from sdar_tamp.evaluation.runner import run_bench
 from sdar_tamp.evaluation.settings import SETTINGS, SettingsMismatch, read_settings
 from sdar_tamp.evaluation.shards import Shard, parse_shard, shard_of
+from sdar_tamp.evaluation.suite import suite_entries
 
 FinishedFolder = Callable[..., Path]
 

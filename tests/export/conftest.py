@@ -9,14 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sdar_tamp.plan_file import (
-    GripperEvent,
-    MotionSegment,
-    PlanFile,
-    build_plan_file,
-    load_plan,
-    save_plan,
-)
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.world.scene import load_scene
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
 

@@ -11,7 +11,7 @@ import pytest
 
 from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.export import default_output, export_plan, run_export
+from sdar_tamp.export import default_output, export_plan, export_plan_file
 from sdar_tamp.plan_file import PlanFile, PlanFileError
 
 
@@ -89,7 +89,7 @@ def test_unknown_format(copy: Path, plan: PlanFile, capsys: pytest.CaptureFixtur
     with pytest.raises(ParameterError, match="format must be one of joint-trajectory, csv"):
         export_plan(plan, "rosbag", copy.parent / "x")
     with pytest.raises(ParameterError, match="format must be one of"):
-        run_export(copy, "mcap")
+        export_plan_file(copy, "mcap")
     assert sorted(p.name for p in copy.parent.iterdir()) == ["run.json"]
 
 
@@ -102,7 +102,7 @@ def test_missing_and_broken_plans(tmp_path: Path, capsys: pytest.CaptureFixture[
     err = refused(["export", str(broken), "--format", "csv"], capsys)
     assert f"{broken}:1:" in err and "invalid JSON" in err
     with pytest.raises(PlanFileError):
-        run_export(missing, "csv")
+        export_plan_file(missing, "csv")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.json"]
 
 

@@ -13,19 +13,11 @@ import numpy as np
 import pytest
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import (
-    GripperEvent,
-    MotionSegment,
-    PlanFile,
-    PlanFileError,
-    build_plan_file,
-    load_plan,
-    plan_from_dict,
-    plan_to_dict,
-    resample,
-    save_plan,
-)
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file, resample
+from sdar_tamp.plan_file import PlanFile, PlanFileError
+from sdar_tamp.plan_reading import load_plan, plan_from_dict
 from sdar_tamp.plan_rules import check_timeline
+from sdar_tamp.plan_writing import plan_to_dict, save_plan
 from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import pose_xyz_yaw

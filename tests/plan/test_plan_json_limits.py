@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from sdar_tamp.plan_file import MAX_DEPTH, PlanFileError, load_plan
+from sdar_tamp.plan_file import MAX_DEPTH, PlanFileError
+from sdar_tamp.plan_reading import load_plan
 
 
 def _write(tmp_path: Path, text: str) -> Path:

@@ -15,14 +15,9 @@ import numpy as np
 import pytest
 
 from sdar_tamp.cli import main
-from sdar_tamp.plan_file import (
-    GripperEvent,
-    MotionSegment,
-    PlanEvent,
-    PlanFile,
-    build_plan_file,
-    save_plan,
-)
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import PlanEvent, PlanFile
+from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, parse_instance

@@ -15,9 +15,12 @@ import pytest
 from sdar_tamp.app import execution
 from sdar_tamp.app.execution import execution_options, schedule_and_validate, schedule_plan
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile, load_plan, save_plan
+from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile
+from sdar_tamp.plan_reading import load_plan
 from sdar_tamp.plan_rules import STILL_TOL, check_timeline
-from sdar_tamp.replay import ReplayReport, tcp_subdivisions, validate_plan
+from sdar_tamp.plan_writing import save_plan
+from sdar_tamp.replay import ReplayReport, validate_plan
+from sdar_tamp.replay_sampling import tcp_subdivisions
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule import sweep as sweep_module
 from sdar_tamp.schedule.pieces import arm_blocks, arm_columns, on_ticks

@@ -25,18 +25,10 @@ import pytest
 
 from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import (
-    GRIPPER_DWELL,
-    GripperEvent,
-    MotionSegment,
-    PlanEvent,
-    PlanFile,
-    PlanFileError,
-    build_plan_file,
-    load_plan,
-    plan_to_dict,
-    save_plan,
-)
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import GRIPPER_DWELL, PlanEvent, PlanFile, PlanFileError
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_writing import plan_to_dict, save_plan
 from sdar_tamp.replay import PlanValidator, ReplayReport, validate_plan
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, parse_instance

@@ -14,13 +14,9 @@ import pytest
 import yaml
 
 from sdar_tamp.errors import ParameterError, SdarError
-from sdar_tamp.plan_file import (
-    GripperEvent,
-    MotionSegment,
-    build_plan_file,
-    plan_from_dict,
-    save_plan,
-)
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_reading import plan_from_dict
+from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.resources import domains_root
 from sdar_tamp.schemas import SCHEMAS, schema, schema_path
 from sdar_tamp.world.instance import parse_instance

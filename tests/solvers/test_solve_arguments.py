@@ -98,7 +98,7 @@ def test_solve_rearrangement_uses_the_checks_of_solve() -> None:
 
 
 def test_show_checks_fps_and_the_suffix_before_reading(tmp_path: Path) -> None:
-    from sdar_tamp.viewer.commands import show
+    from sdar_tamp.viewer.pictures import show
 
     missing = tmp_path / "none.yaml"
     with pytest.raises(ParameterError, match=r"fps must be a finite number > 0 \[1/s\], got 0"):

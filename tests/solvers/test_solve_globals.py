@@ -99,8 +99,8 @@ _ALLOWED = {
     ("solvers/solve.py", "seed"),  # _seeded_globals: seeds, then restores the states
     ("solvers/solve.py", "basicConfig"),  # solve_from_command_line: a program's main
     ("sdar_tamp/compat/pddlstream/__main__.py", "basicConfig"),  # python -m ...: a program
-    ("sdar_tamp/cli.py", "basicConfig"),  # the sdar program: -v / --log-level
-    ("sdar_tamp/cli.py", "setLevel"),
+    ("sdar_tamp/cli/log_options.py", "basicConfig"),  # the sdar program: -v / --log-level
+    ("sdar_tamp/cli/log_options.py", "setLevel"),
     ("sdar_tamp/logs.py", "getLogger"),  # the one place that names loggers
 }
 

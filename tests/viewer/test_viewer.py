@@ -22,14 +22,10 @@ from PIL import Image
 
 from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import (
-    GripperEvent,
-    MotionSegment,
-    PlanFile,
-    build_plan_file,
-    load_plan,
-    save_plan,
-)
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.viewer import MissingDependencyError, write_html, write_storyboard
 from sdar_tamp.viewer._story import grips, joint_curves, link_poses, pose7
 from sdar_tamp.viewer._timeline import Timeline

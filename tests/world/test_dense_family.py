@@ -103,6 +103,6 @@ def test_the_dense_suite_is_shipped() -> None:
 
 
 def test_the_command_line_names_every_family_and_suite() -> None:
-    from sdar_tamp.cli import CLI_FAMILIES, CLI_SUITES
+    from sdar_tamp.cli.generate import CLI_FAMILIES, CLI_SUITES
 
     assert CLI_FAMILIES == FAMILIES and CLI_SUITES == SUITES

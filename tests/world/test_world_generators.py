@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.world.commands import generate, generate_suite, show_instance
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError, SuiteError
 from sdar_tamp.world.footprint import corners, inflate, overlap_matrix
 from sdar_tamp.world.generators import GeneratorOptions, generate_instance, max_objects
 from sdar_tamp.world.instance import Instance, load_instance, validate_instance
+from sdar_tamp.world.instance_files import generate, generate_suite, show_instance
 from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.suites import build_suite, load_suite, suite_members
 

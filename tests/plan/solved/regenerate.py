@@ -12,7 +12,7 @@ from pathlib import Path
 from sdar_tamp.app.plan_export import plan_file_from_solution
 from sdar_tamp.app.problem import rearrangement_problem
 from sdar_tamp.app.solving import solve_rearrangement
-from sdar_tamp.plan_file import save_plan
+from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.suites import shipped_suite_dir

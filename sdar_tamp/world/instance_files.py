@@ -1,4 +1,5 @@
-"""Plain functions behind the ``sdar`` command line for the dual-arm world.
+"""Instance files: generate one instance or a named suite into files, and draw an instance
+file (``sdar generate`` and ``sdar show`` call these).
 
 Each writes files only where it is told to and returns what it wrote.
 """

@@ -1,4 +1,5 @@
-"""The function behind ``sdar show``: draw an instance, or a plan on it, to a file."""
+"""Picture files: draw an instance, or a plan on it, to a file whose suffix picks the
+picture (``sdar show`` calls :func:`show`)."""
 
 from __future__ import annotations
 
@@ -61,7 +62,7 @@ def show(instance_path: Path, plan_path: Path | None, out: Path, fps: float | No
 
     if plan_path is None:
         return write_html(instance, None, out, scene)
-    from sdar_tamp.plan_file import load_plan
+    from sdar_tamp.plan_reading import load_plan
 
     plan = load_plan(Path(plan_path))
     if suffix == ".html":

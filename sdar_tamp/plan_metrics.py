@@ -1,0 +1,95 @@
+"""The ``metrics`` of a plan file: what the planner and the timeline say about the plan.
+
+:class:`PlanMetrics` names the metrics the program writes; the plan file keeps them under
+the same JSON keys (the format allows any further string or number metrics, which are kept in
+``extra``). It is also a read-only mapping of the keys present (``metrics["actions"]``), in the
+order the plan file lists them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field, fields
+
+MetricValue = float | int | str
+
+_INT, _FLOAT, _STR = "int", "float", "str"
+
+
+@dataclass(frozen=True)
+class PlanMetrics(Mapping[str, MetricValue]):
+    """A plan's metrics; ``None``: not in the plan (a plan file need not have them all).
+
+    Planning figures [s] (``planning_time`` and its ``_selection`` and ``_motion`` parts,
+    ``step_time_median``), the run that made it (``task_planner``, ``motion_planner``,
+    ``seed``, ``buffer_moves``), the counts and duration [s] of the timeline
+    (``actions``, ``steps``, ``dual_arm_steps``, ``execution_time``; see
+    :data:`~sdar_tamp.plan_building.COMPUTED_METRICS`), and for an asynchronous schedule
+    ``execution`` (``"async"``) and the synchronous duration ``execution_time_sync`` [s].
+    ``extra``: any other metrics, by name."""
+
+    planning_time: float | None = None
+    planning_time_selection: float | None = None
+    planning_time_motion: float | None = None
+    task_planner: str | None = None
+    motion_planner: str | None = None
+    seed: int | None = None
+    step_time_median: float | None = None
+    buffer_moves: int | None = None
+    actions: int | None = None
+    steps: int | None = None
+    dual_arm_steps: int | None = None
+    execution_time: float | None = None
+    execution: str | None = None
+    execution_time_sync: float | None = None
+    extra: Mapping[str, MetricValue] = field(default_factory=dict)
+
+    @classmethod
+    def from_mapping(cls, values: Mapping[str, MetricValue]) -> PlanMetrics:
+        """The metrics of ``values`` (JSON key -> value): a known key whose value has its
+        field's type goes to that field, anything else to ``extra``."""
+        known: dict[str, MetricValue] = {}
+        extra: dict[str, MetricValue] = {}
+        for key, value in values.items():
+            kind = _KINDS.get(key)
+            (known if kind is not None and _fits(value, kind) else extra)[key] = value
+        return cls(**known, extra=extra)  # type: ignore[arg-type]  # checked by _fits
+
+    def updated(self, values: Mapping[str, MetricValue]) -> PlanMetrics:
+        """These metrics with ``values`` added or replacing those of the same keys."""
+        return PlanMetrics.from_mapping({**self, **values})
+
+    def __getitem__(self, key: str) -> MetricValue:
+        value: MetricValue | None = getattr(self, key) if key in _KINDS else None
+        if value is not None:
+            return value
+        if key in self.extra:
+            return self.extra[key]
+        raise KeyError(key)
+
+    def __iter__(self) -> Iterator[str]:
+        named = [name for name in _KINDS if getattr(self, name) is not None]
+        yield from named
+        yield from (k for k in self.extra if k not in named)
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
+def _fits(value: MetricValue, kind: str) -> bool:
+    if isinstance(value, bool):
+        return False
+    if kind == _STR:
+        return isinstance(value, str)
+    if kind == _INT:
+        return isinstance(value, int)
+    return isinstance(value, int | float)
+
+
+def _kind(annotation: object) -> str:
+    text = str(annotation)
+    return _INT if text.startswith("int") else _STR if text.startswith("str") else _FLOAT
+
+
+#: The named fields (every field but ``extra``) and the type of their values.
+_KINDS: dict[str, str] = {f.name: _kind(f.type) for f in fields(PlanMetrics) if f.name != "extra"}
