@@ -96,10 +96,10 @@ def main() -> None:
         if outcome.plan is not None:
             m = outcome.plan.metrics
             row.update(
-                actions=m["actions"],
-                steps=m["steps"],
-                dual_arm_steps=m["dual_arm_steps"],
-                execution_time=m["execution_time"],
+                actions=m.actions,
+                steps=m.steps,
+                dual_arm_steps=m.dual_arm_steps,
+                execution_time=m.execution_time,
                 step_time_median=f.step_time_median,
                 levels=dict(f.levels),
                 buffer_moves=f.buffer_moves,

@@ -2,13 +2,12 @@
 
 :class:`PlanMetrics` names the metrics the program writes; the plan file keeps them under
 the same JSON keys (the format allows any further string or number metrics, which are kept in
-``extra``). It is also a read-only mapping of the keys present (``metrics["actions"]``), in the
-order the plan file lists them.
+``extra``). :meth:`PlanMetrics.as_json` is the plan file's ``metrics`` object.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
 MetricValue = float | int | str
@@ -17,7 +16,7 @@ _INT, _FLOAT, _STR = "int", "float", "str"
 
 
 @dataclass(frozen=True)
-class PlanMetrics(Mapping[str, MetricValue]):
+class PlanMetrics:
     """A plan's metrics; ``None``: not in the plan (a plan file need not have them all).
 
     Planning figures [s] (``planning_time`` and its ``_selection`` and ``_motion`` parts,
@@ -57,23 +56,19 @@ class PlanMetrics(Mapping[str, MetricValue]):
 
     def updated(self, values: Mapping[str, MetricValue]) -> PlanMetrics:
         """These metrics with ``values`` added or replacing those of the same keys."""
-        return PlanMetrics.from_mapping({**self, **values})
+        return PlanMetrics.from_mapping({**self.as_json(), **values})
 
-    def __getitem__(self, key: str) -> MetricValue:
-        value: MetricValue | None = getattr(self, key) if key in _KINDS else None
-        if value is not None:
-            return value
-        if key in self.extra:
-            return self.extra[key]
-        raise KeyError(key)
-
-    def __iter__(self) -> Iterator[str]:
-        named = [name for name in _KINDS if getattr(self, name) is not None]
-        yield from named
-        yield from (k for k in self.extra if k not in named)
-
-    def __len__(self) -> int:
-        return sum(1 for _ in self)
+    def as_json(self) -> dict[str, MetricValue]:
+        """JSON key -> value of the metrics present: the named ones in field order, then
+        ``extra``."""
+        out: dict[str, MetricValue] = {}
+        for name in _KINDS:
+            value = getattr(self, name)
+            if value is not None:
+                out[name] = value
+        for key, value in self.extra.items():
+            out.setdefault(key, value)
+        return out
 
 
 def _fits(value: MetricValue, kind: str) -> bool:

@@ -23,7 +23,7 @@ def plan_to_dict(plan: PlanFile) -> dict[str, Any]:
         "trajectory": {"t": plan.t.tolist(), "q": plan.q.tolist()},
         "events": _json(plan.events),
         "final_poses": _json(plan.final_poses),
-        "metrics": dict(plan.metrics),
+        "metrics": plan.metrics.as_json(),
         "steps": _json(plan.steps),
     }
 

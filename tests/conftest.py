@@ -33,6 +33,7 @@ def usable_cpus() -> int:
     return os.cpu_count() or 1
 
 
+@pytest.hookimpl(optionalhook=True)
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     return max(1, min(MAX_WORKERS, usable_cpus()))
 

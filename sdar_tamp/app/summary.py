@@ -44,7 +44,7 @@ def summary_record(outcome: SolveOutcome, plan_file: Path | None = None) -> dict
         "valid": outcome.valid,
         "violation": outcome.violation or None,
         "plan_file": None if plan_file is None else str(plan_file),
-        "metrics": {} if outcome.plan is None else dict(outcome.plan.metrics),
+        "metrics": {} if outcome.plan is None else outcome.plan.metrics.as_json(),
         "figures": {
             "planning_time": f.planning_time,
             "selection_time": f.selection_time,

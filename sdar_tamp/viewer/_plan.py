@@ -6,10 +6,12 @@ same attributes, which keeps the viewer usable on plans built in memory.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from typing import Any, Protocol
+from collections.abc import Sequence
+from typing import Protocol
 
 from numpy.typing import ArrayLike
+
+from sdar_tamp.plan_metrics import PlanMetrics
 
 
 class ArmLike(Protocol):
@@ -68,6 +70,6 @@ class PlanLike(Protocol):
     @property
     def events(self) -> Sequence[EventLike]: ...
     @property
-    def metrics(self) -> Mapping[str, Any]: ...
+    def metrics(self) -> PlanMetrics: ...
     @property
     def steps(self) -> Sequence[StepLike]: ...

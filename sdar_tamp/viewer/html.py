@@ -345,11 +345,11 @@ def _title(timeline: Timeline) -> str:
     if plan is None:
         return f"{name}: start (arms at home)"
     parts = [f"{name}: {timeline.t_end - timeline.t_start:.1f} s"]
-    if len(plan.steps) > 0 and "steps" not in plan.metrics:
+    if len(plan.steps) > 0 and plan.metrics.steps is None:
         parts.append(f"{len(plan.steps)} steps")
     numbers = {
         key: value
-        for key, value in plan.metrics.items()
+        for key, value in plan.metrics.as_json().items()
         if isinstance(value, (int, float)) and not isinstance(value, bool)
     }
     keys = [k for k in _TITLE_METRICS if k in numbers] or list(numbers)[:4]

@@ -328,8 +328,8 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(
     assert replays == [outcome.plan]  # the plan kept is replayed once
     assert outcome.figures.schedule_time > 0.0
     metrics = outcome.plan.metrics
-    if metrics.get("execution") == "async":
-        assert float(metrics["execution_time"]) < float(metrics["execution_time_sync"])
+    if metrics.execution == "async":
+        assert float(metrics.execution_time) < float(metrics.execution_time_sync)
         assert "asynchronous (synchronous" in format_summary(outcome)
     else:
         assert "synchronous kept" in format_summary(outcome)

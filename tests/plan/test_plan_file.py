@@ -212,10 +212,10 @@ def test_a_second_event_of_one_arm_waits_for_the_dwell_of_its_first(scene: Scene
 
 def test_metrics_and_final_poses(plan: PlanFile, scene: Scene) -> None:
     m = plan.metrics
-    assert m["actions"] == 1  # o1 placed; o2 still held; the passed 99 is replaced
-    assert m["steps"] == 2 and m["dual_arm_steps"] == 1
-    assert m["execution_time"] == pytest.approx(plan.duration)
-    assert m["planning_time"] == 1.5
+    assert m.actions == 1  # o1 placed; o2 still held; the passed 99 is replaced
+    assert m.steps == 2 and m.dual_arm_steps == 1
+    assert m.execution_time == pytest.approx(plan.duration)
+    assert m.planning_time == 1.5
     assert plan.final_poses["o2"] == STARTS["o2"]
     q_left = plan.q[np.searchsorted(plan.t, plan.events[2].t), :6]
     T = ArmKinematics.from_scene(scene, "left").fk_tcp(q_left) @ T_TCP_OBJ

@@ -123,7 +123,7 @@ def test_the_planned_plan_is_valid(planned: Planned) -> None:
     report = validate_plan(planned.instance, planned.plan, planned.ctx.scene)
     assert report.ok and report.violation is None
     assert report.checks > len(planned.plan.t) // 2
-    assert planned.plan.metrics["actions"] == 1
+    assert planned.plan.metrics.actions == 1
 
 
 def test_a_finer_tcp_step_makes_more_checks(planned: Planned) -> None:

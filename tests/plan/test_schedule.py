@@ -83,8 +83,8 @@ def test_an_async_plan_validates_and_is_shorter(uneven: Solved, tmp_path: Path) 
     assert s.asynchronous, s.reason
     assert s.async_duration is not None and s.async_duration < s.sync_duration
     assert s.plan.duration == pytest.approx(s.async_duration)
-    assert s.plan.metrics["execution"] == "async"
-    assert s.plan.metrics["execution_time"] == pytest.approx(s.plan.duration)
+    assert s.plan.metrics.execution == "async"
+    assert s.plan.metrics.execution_time == pytest.approx(s.plan.duration)
     assert _dwell_overlaps(s.plan) >= 1  # one arm moves while the other's gripper acts
     assert _dwell_overlaps(uneven.plan) == 0
     # the same events per object, in the same order per object

@@ -814,7 +814,7 @@ def test_the_base_plan_is_valid(base: Base) -> None:
         ("left", "release"),
         ("right", "release"),
     ]
-    assert base.plan.metrics["dual_arm_steps"] == 3
+    assert base.plan.metrics.dual_arm_steps == 3
     assert len(_rest_junctions(base.plan)) >= 1
 
 

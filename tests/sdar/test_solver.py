@@ -81,7 +81,7 @@ def test_swap_is_one_synchronous_dual_arm_step(
     assert names == ["move", "pick-both", "move", "place-both"]
     assert [t["kind"] for t in solution.trace] == ["swap"]
     plan = plan_file_from_solution(r, solution)
-    assert plan.metrics["actions"] == 2 and plan.metrics["dual_arm_steps"] == 2
+    assert plan.metrics.actions == 2 and plan.metrics.dual_arm_steps == 2
     report = validate_plan(r.instance, plan, ctx.scene)
     assert report.ok, report.violation
 
@@ -259,7 +259,7 @@ def test_baseline_motion_planner_works_one_arm_at_a_time(
     assert validate_plan(r.instance, plan, ctx.scene).ok
     moving = np.abs(np.diff(plan.q, axis=0)) > 1e-9
     assert not np.any(moving[:, :6].any(axis=1) & moving[:, 6:].any(axis=1))
-    assert plan.metrics["dual_arm_steps"] == 0
+    assert plan.metrics.dual_arm_steps == 0
     home = [arm.home for arm in plan.arms]
     for event in plan.events:
         k = int(np.searchsorted(plan.t, event.t))
