@@ -149,7 +149,8 @@ class QuickRuns:
         check = CHECKS.get(run)
         if check is not None:
             check(out)
-        assert list(tmp_path.iterdir()) in ([], [tmp_path / "numba-cache"]), "wrote files"
+        written = sorted(p.name for p in tmp_path.iterdir() if p.name != "numba-cache")
+        assert not written, f"{self.script.name} wrote into its working folder: {written}"
 
 
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
