@@ -14,7 +14,7 @@ schedule was found, so the ratio is at most 1).
 Prints one row per instance (``bound``: the busier arm's motions and dwells, a lower bound
 for any schedule of these motions), the median ratio, then one JSON object on the last line.
 
-``--quick`` changes only the defaults: the 4-object ``R4`` of the suite alone (``--only R4``),
+``--quick`` changes only the defaults: ``--only R4`` (4 objects, in the ``paper`` suite),
 solved with a 30 s time limit; the JSON keys are the same, plus ``"quick": true``.
 """
 

@@ -13,7 +13,7 @@ planner's one-off set-up (building the optimiser) is excluded and printed separa
 
 Prints one row per instance, a summary, then one JSON object on the last line.
 
-``--quick`` changes only the defaults: the 4-object ``R4`` of the suite alone (``--only R4``)
+``--quick`` changes only the defaults: ``--only R4`` (4 objects, in the ``paper`` suite)
 with a 30 s time limit; the JSON keys are the same, plus ``"quick": true``.
 """
 
