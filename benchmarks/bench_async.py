@@ -9,9 +9,13 @@ schedule was found, so the ratio is at most 1).
 
     python benchmarks/bench_async.py [--suite paper] [--only R4,R6,D5] [--plans DIR] [--save]
                                      [--time-limit 60] [--sync-pace]
+    python benchmarks/bench_async.py --quick    # R4 alone: seconds
 
 Prints one row per instance (``bound``: the busier arm's motions and dwells, a lower bound
 for any schedule of these motions), the median ratio, then one JSON object on the last line.
+
+``--quick`` changes only the defaults: ``--only R4`` (4 objects, in the ``paper`` suite),
+solved with a 30 s time limit; the JSON keys are the same, plus ``"quick": true``.
 """
 
 from __future__ import annotations
@@ -61,7 +65,11 @@ def _plan(path: Path, args: argparse.Namespace, cache: PlannerCache) -> PlanFile
     return outcome.plan
 
 
-def main() -> None:
+#: ``--quick``'s defaults
+QUICK = {"only": "R4", "time_limit": 30.0}
+
+
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--suite", default="paper", choices=SUITES)
     ap.add_argument("--only", default="", help="comma-separated instance names")
@@ -74,7 +82,11 @@ def main() -> None:
         action="store_true",
         help="re-time each arm's motions uniformly faster (no time-optimal path timing)",
     )
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
+    args = ap.parse_args(argv)
+    if args.quick:  # explicit options still win
+        ap.set_defaults(**QUICK)
+        args = ap.parse_args(argv)
     only = {s for s in args.only.split(",") if s}
     files = [p for p in _suite_files(args.suite) if not only or p.stem in only]
     cache = PlannerCache()
@@ -134,6 +146,7 @@ def main() -> None:
         "mean_ratio": round(statistics.fmean(ratios), 4) if ratios else None,
         "all_valid": all(r["valid"] for r in rows),
         "rows": rows,
+        "quick": args.quick,
     }
     if ratios:
         print(f"median async/sync execution time: {summary['median_ratio']:.3f}")

@@ -19,6 +19,14 @@ validator (reported as such). Prints a
 coverage table per domain, geometric-mean time ratios, then one JSON line.
 
     python benchmarks/bench_classical.py --suite /path/to/ipc [--time-limit 60] [--planners ...]
+    python benchmarks/bench_classical.py               # the shipped and generated problems
+    python benchmarks/bench_classical.py --quick       # seconds
+
+``--quick`` changes only the defaults: the first problem of each domain (``--per-domain 1``:
+without ``--suite``, ``bw-8`` and logistics ``three-cities``) under a 10 s CPU limit; with a
+``--suite`` that is not a folder it prints ``{"skipped": "<why>", ...}`` and exits 0. The JSON
+keys are the same, plus ``"quick": true`` (its list ``skipped`` names the planners that are
+not installed).
 """
 
 from __future__ import annotations
@@ -71,6 +79,10 @@ IPC13: dict[str, tuple[str, ...]] = {
     "transport-sat08-strips": ("p05", "p09", "p13", "p17", "p21"),
     "visitall-sat11-strips": ("problem14", "problem20", "problem26", "problem32", "problem38"),
 }
+
+
+#: ``--quick``'s defaults
+QUICK: dict[str, Any] = {"per_domain": 1, "time_limit": 10.0}
 
 
 # ---------------------------------------------------------------- one run, in a child process
@@ -306,14 +318,27 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     parser.add_argument(
         "--planners", nargs="*", default=["ours", "fd", "pyperplan"], choices=PLANNERS
     )
+    parser.add_argument("--quick", action="store_true", help="one problem per domain, 10 s")
     parser.add_argument("--worker", nargs=4, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.quick:  # explicit options still win
+        parser.set_defaults(**QUICK)
+        args = parser.parse_args(argv)
     if args.per_domain is not None and args.per_domain < 1:
         parser.error(f"--per-domain: expected an integer >= 1, got {args.per_domain}")
     if args.worker:
         planner, domain, problem, plan_file = args.worker
         _worker(planner, Path(domain), Path(problem), Path(plan_file))
         return {}
+
+    if args.suite is not None and not args.suite.is_dir():
+        if not args.quick:
+            parser.error(f"--suite: {args.suite} is not a folder")
+        why = f"no IPC problem collection at {args.suite} (--suite: not a folder)"
+        print(f"skipped: {why}")
+        skip: dict[str, Any] = {"benchmark": "classical_ipc", "skipped": why, "quick": True}
+        print(json.dumps(skip))
+        return skip
 
     available = {
         "fd": importlib.util.find_spec("up_fast_downward") is not None,
@@ -417,6 +442,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "invalid": {p: sum(r[p]["status"] == "invalid" for r in rows) for p in planners},
         "ratios_vs_fd": ratios,
         "skipped": skipped,
+        "quick": args.quick,
         "rows": [
             {
                 "problem": f"{r['domain']}/{r['problem']}",

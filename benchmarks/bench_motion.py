@@ -12,8 +12,14 @@ spent in the trajectory optimiser for the segment (all attempts of the ladder).
 
     python benchmarks/bench_motion.py [--segments 200] [--instance M1] [--seed 0]
     python benchmarks/bench_motion.py --hard 12     # needs OMPL (pip install sdar-tamp[ompl])
+    python benchmarks/bench_motion.py --quick            # 3 segments: seconds
+    python benchmarks/bench_motion.py --quick --hard 1   # 1 hard transfer of each kind
 
 Prints a line per 20 segments, then one JSON object on the last line.
+
+``--quick`` changes only the default of ``--segments`` (3); without OMPL, ``--quick --hard N``
+prints ``{"skipped": "<why>", ...}`` as its last line and exits 0. The JSON keys are the same,
+plus ``"quick": true``.
 
 ``--hard N``: instead, N transfers whose straight joint-space line collides, for one arm
 (the other waits at home) and for both arms (N each): each arm goes from a grasp of one
@@ -30,6 +36,7 @@ both solved.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import time
 
@@ -58,7 +65,7 @@ def _footprint(box: ObjectBox) -> np.ndarray:
     return corners(pose, np.array([box.size[:2]]))
 
 
-def hard_set(instance: str, seed: int, count: int) -> None:
+def hard_set(instance: str, seed: int, count: int, quick: bool = False) -> None:
     """See the module docstring (``--hard``)."""
     from streams.motion import PlainStrategy
     from streams.sampling import SampledStrategy, sampled_strategies, warm_started_strategies
@@ -154,19 +161,33 @@ def hard_set(instance: str, seed: int, count: int) -> None:
                   f"{summary[name]['time_median_s']:.3f} s, execution (common) "  # type: ignore[str-format]
                   f"{summary[name]['execution_median_common_s']}", flush=True)  # fmt: skip
         out[kind] = summary
+    out["quick"] = quick
     print(json.dumps(out))
 
 
-def main() -> None:
+#: ``--quick``'s defaults
+QUICK = {"segments": 3}
+
+
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--segments", type=int, default=200)
     ap.add_argument("--instance", default="M1")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--verbose", action="store_true", help="print every non-plain segment")
     ap.add_argument("--hard", type=int, default=0, help="the hard set instead (see above)")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="3 segments: seconds")
+    args = ap.parse_args(argv)
+    if args.quick:  # explicit options still win
+        ap.set_defaults(**QUICK)
+        args = ap.parse_args(argv)
     if args.hard:
-        hard_set(args.instance, args.seed, args.hard)
+        if args.quick and importlib.util.find_spec("ompl") is None:
+            why = "OMPL is not installed (pip install sdar-tamp[ompl])"
+            print(f"skipped: {why}")
+            print(json.dumps({"benchmark": "bench_motion_hard", "skipped": why, "quick": True}))
+            return
+        hard_set(args.instance, args.seed, args.hard, args.quick)
         return
 
     ctx = WorldContext.load()
@@ -315,6 +336,7 @@ def main() -> None:
         "skipped_unsampleable": skipped,
         "nlp_build_time_s": build_time,
         "wall_time_s": time.perf_counter() - t_all,
+        "quick": args.quick,
     }
     print(json.dumps(out))
 

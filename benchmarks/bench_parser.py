@@ -4,7 +4,12 @@ Generates a logistics problem of about ``--megabytes`` MB (many objects, init fa
 then times ``read_sexpr`` and ``parse_problem`` on it (best of ``--repeats`` runs, in process
 CPU time, so that other processes on a shared machine distort the figures less). Prints a small
 table, then as its last line one JSON object with the figures.
-Run: ``python benchmarks/bench_parser.py``.
+
+    python benchmarks/bench_parser.py [--megabytes 1.25] [--repeats 3]    # the full run
+    python benchmarks/bench_parser.py --quick    # a 0.05 MB problem, one repeat: under a second
+
+``--quick`` only changes the defaults of ``--megabytes`` and ``--repeats``; the JSON keys are
+the same, plus ``"quick": true``.
 """
 
 from __future__ import annotations
@@ -71,11 +76,19 @@ def best_time(fn: Callable[[], object], repeats: int) -> float:
     return best
 
 
-def main() -> None:
+#: ``--quick``'s defaults
+QUICK = {"megabytes": 0.05, "repeats": 1}
+
+
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--megabytes", type=float, default=1.25)
     parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="a tiny problem, one repeat")
+    args = parser.parse_args(argv)
+    if args.quick:  # explicit options still win
+        parser.set_defaults(**QUICK)
+        args = parser.parse_args(argv)
     domain = parse_domain(DOMAIN.read_text(encoding="utf-8"), str(DOMAIN))
     text = logistics_problem(args.megabytes)
     megabytes = len(text.encode("utf-8")) / 1e6
@@ -90,6 +103,7 @@ def main() -> None:
         "reader_mb_per_s": round(megabytes / reader_s, 2),
         "problem_s": round(problem_s, 4),
         "problem_mb_per_s": round(megabytes / problem_s, 2),
+        "quick": args.quick,
     }
     print(f"problem text: {megabytes:.2f} MB, {figures['init_facts']} init facts")
     print(f"s-expression reader: {reader_s:.3f} s  ({figures['reader_mb_per_s']} MB/s)")

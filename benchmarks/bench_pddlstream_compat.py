@@ -34,7 +34,14 @@ written): ``continuous_tamp_unfactored`` (not within its own 30 s), ``continuous
 (unsolvable as written) and ``discrete_belief`` (its own ``opt_gen_fn`` raises); the table
 says so under their rows, and the summary lists them as ``fail_in_pddlstream_too``.
 
-Prints a table example -> result -> time [s]; the last line is one JSON object.
+Prints a table example -> result -> time [s]; the last line is one JSON object. Without a
+checkout it prints ``{"skipped": "<why>", ...}`` as its last line and exits 0.
+
+``--quick`` changes only the defaults: the ``blocksworld`` example alone, within 60 s (seconds
+with a checkout; without one, the skip line). The JSON keys are the same, plus
+``"quick": true``::
+
+    python benchmarks/bench_pddlstream_compat.py PATH_TO_PDDLSTREAM_CHECKOUT --quick
 """
 
 from __future__ import annotations
@@ -104,6 +111,9 @@ EXAMPLES = (
     Example("rovers", "examples.ipc.rovers.run"),
     Example("satellites", "examples.ipc.satellites.run"),
 )
+
+#: ``--quick``'s defaults
+QUICK: dict[str, object] = {"only": ["blocksworld"], "timeout": 60.0}
 
 #: PDDLStream's examples predate NumPy 2 and use names it removed; the runner puts those
 #: aliases back in the example's process (an environment fix, the examples stay unmodified)
@@ -230,15 +240,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--repeat", type=int, default=1, help="runs per example (unseeded ones vary: pass rates)"
     )
+    parser.add_argument("--quick", action="store_true", help="one example (blocksworld)")
     args = parser.parse_args(argv)
+    if args.quick:  # explicit options still win
+        parser.set_defaults(**QUICK)
+        args = parser.parse_args(argv)
     if args.repeat < 1:
         parser.error(f"--repeat must be >= 1; got {args.repeat}")
     if not args.checkout or not (Path(args.checkout) / "examples").is_dir():
-        print(
-            "skipped: no PDDLStream checkout (pass its path or set PDDLSTREAM_PATH); "
-            f"got {args.checkout!r}"
+        why = (
+            f"no PDDLStream checkout (pass its path or set PDDLSTREAM_PATH); got {args.checkout!r}"
         )
-        print(json.dumps({"skipped": True, "reason": "no PDDLStream checkout"}))
+        print(f"skipped: {why}")
+        print(json.dumps({"skipped": why, "quick": args.quick}))
         return 0
     checkout = Path(args.checkout).resolve()
     chosen = [e for e in EXAMPLES if args.only is None or e.name in args.only]
@@ -263,6 +277,7 @@ def main(argv: list[str] | None = None) -> int:
         "failed": sorted({str(r["example"]) for r in rows if not r["passed"]}),
         "fail_in_pddlstream_too": [e.name for e in chosen if e.upstream],
         "seconds": {str(r["example"]): r["seconds"] for r in rows},
+        "quick": args.quick,
     }
     if args.repeat > 1:
         summary["pass_rates"] = rates

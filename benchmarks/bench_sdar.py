@@ -9,8 +9,12 @@ planner's one-off set-up (building the optimiser) is excluded and printed separa
 
     python benchmarks/bench_sdar.py [--suite paper] [--max-objects 12] [--time-limit 60]
                                     [--task-planner sdar] [--motion-planner sdar] [--only M1,R4]
+    python benchmarks/bench_sdar.py --quick    # R4 alone: seconds
 
 Prints one row per instance, a summary, then one JSON object on the last line.
+
+``--quick`` changes only the defaults: ``--only R4`` (4 objects, in the ``paper`` suite)
+with a 30 s time limit; the JSON keys are the same, plus ``"quick": true``.
 """
 
 from __future__ import annotations
@@ -40,7 +44,11 @@ def _suite_files(suite: str) -> list[Path]:
     return sorted(folder.glob("*.yaml"), key=key)
 
 
-def main() -> None:
+#: ``--quick``'s defaults
+QUICK = {"only": "R4", "time_limit": 30.0}
+
+
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--suite", default="paper", choices=SUITES)
     ap.add_argument("--max-objects", type=int, default=None)
@@ -54,9 +62,13 @@ def main() -> None:
         action="store_true",
         help="instead: the generic adaptive algorithm against sdar on a one-object instance",
     )
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
+    args = ap.parse_args(argv)
+    if args.quick:  # explicit options still win
+        ap.set_defaults(**QUICK)
+        args = ap.parse_args(argv)
     if args.compare_adaptive:
-        compare_adaptive(args.time_limit)
+        compare_adaptive(args.time_limit, args.quick)
         return
 
     cache = PlannerCache()
@@ -138,6 +150,7 @@ def main() -> None:
         "planning_time_total": sum(r["planning_time"] for r in rows),
         "wall_time": time.perf_counter() - start,
         "failures": [r["instance"] for r in rows if not r["success"]],
+        "quick": args.quick,
     }
     print(
         f"success {summary['success']}/{summary['instances']}; step planning time median "
@@ -149,7 +162,7 @@ def main() -> None:
     print(json.dumps(summary))
 
 
-def compare_adaptive(time_limit: float) -> None:
+def compare_adaptive(time_limit: float, quick: bool = False) -> None:
     """The same PDDL domain solved by the generic ``adaptive`` algorithm and by ``sdar``."""
     from sdar_tamp.app.problem import rearrangement_problem
     from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
@@ -175,7 +188,7 @@ def compare_adaptive(time_limit: float) -> None:
         actions = [a.name for a in solution.plan or []]
         results[algorithm] = {"status": solution.status.value, "time": elapsed, "plan": actions}
         print(f"{algorithm:>9}: {solution.status.value} in {elapsed:.2f} s, plan {actions}")
-    print(json.dumps({"benchmark": "sdar-vs-adaptive", "objects": 1, **results}))
+    print(json.dumps({"benchmark": "sdar-vs-adaptive", "objects": 1, **results, "quick": quick}))
 
 
 def _steps(outcome: SolveOutcome) -> list[tuple[float, float]]:

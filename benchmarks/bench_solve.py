@@ -9,8 +9,12 @@ other), the only fair comparison of two versions on a noisy machine.
 
     python benchmarks/bench_solve.py [--instance suites/paper/M1.yaml] [--runs 5]
                                      [--against /path/to/other/checkout]
+    python benchmarks/bench_solve.py --quick    # one run on R4: seconds
 
 Prints one row per run, the medians, then one JSON object on the last line.
+
+``--quick`` changes only the defaults: one run (``--runs 1``) on the 4-object
+``suites/paper/R4.yaml``; the JSON keys are the same, plus ``"quick": true``.
 """
 
 from __future__ import annotations
@@ -72,13 +76,18 @@ def medians(runs: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     default = domain_file("dual_arm_rearrangement", "suites/paper/M1.yaml")
     ap.add_argument("--instance", type=Path, default=default)
     ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--against", type=Path, default=None, help="another checkout to compare")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="one run on a small instance (R4)")
+    args = ap.parse_args(argv)
+    if args.quick:  # explicit options still win
+        small = domain_file("dual_arm_rearrangement", "suites/paper/R4.yaml")
+        ap.set_defaults(runs=1, instance=small)
+        args = ap.parse_args(argv)
     if args.runs < 1:
         ap.error(f"--runs: expected a number of runs >= 1, got {args.runs}")
     cli = None if args.against is None else args.against / "sdar_tamp" / "cli"
@@ -106,6 +115,7 @@ def main() -> None:
         print(f"{name:>7}: median wall {m['wall_s']:.2f} s (range {m['wall_range_s'][0]:.2f}-"
               f"{m['wall_range_s'][1]:.2f}), cpu {m['cpu_s']:.2f} s, planning "
               f"{m['planning_s']:.2f} s, schedule {m['schedule_s']:.2f} s")  # fmt: skip
+    result["quick"] = args.quick
     print(json.dumps(result))
 
 

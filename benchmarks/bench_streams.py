@@ -11,7 +11,12 @@ With ``--call-modes threaded inline`` every run is made once per way of calling 
 cost in each mode; ``cpu`` is the process time [s] of a run (all threads).
 
     python benchmarks/bench_streams.py [--max-time 30] [--seed 0] [--domains kitchen ...]
-        [--limit-probe 1.5]
+        [--limit-probe 1.5]                       # the full run
+    python benchmarks/bench_streams.py --quick    # seconds
+
+``--quick`` changes only the defaults: every algorithm on kitchen, dual_arm_swap and infeasible
+(pick_place_2d, the slow one, left out), a 0.2 s overrun probe and 2,000 calls for the call
+overhead; the JSON keys are the same, plus ``"quick": true``.
 """
 
 from __future__ import annotations
@@ -36,6 +41,12 @@ EXPECTED = {"infeasible": "infeasible"}  # every other domain: solved
 
 
 MODES = {"threaded": True, "inline": False}
+#: ``--quick``'s defaults
+QUICK = {
+    "domains": ["kitchen", "dual_arm_swap", "infeasible"],
+    "limit_probe": 0.2,
+    "overhead_calls": 2_000,
+}
 
 
 def run(
@@ -149,7 +160,14 @@ def main(argv: list[str] | None = None) -> int:
         default=["threaded"],
         help="ways of calling user code to run side by side (default: %(default)s)",
     )
+    parser.add_argument(
+        "--overhead-calls", type=int, default=20_000, help="calls timed for the call overhead"
+    )
+    parser.add_argument("--quick", action="store_true", help="the fast domains, short probes")
     args = parser.parse_args(argv)
+    if args.quick:  # explicit options still win
+        parser.set_defaults(**QUICK)
+        args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     rows = [
         run(domain, algorithm, args.max_time, args.seed, mode)
@@ -168,7 +186,9 @@ def main(argv: list[str] | None = None) -> int:
             f"max_time {probe['max_time']:.2f} s, {probe['algorithm']:<12} {probe['status']:<9} "
             f"ran {probe['time']:.3f} s (overrun {probe['overrun']:+.1%})"
         )
-    overhead = {mode: round(call_overhead(mode), 2) for mode in args.call_modes}
+    overhead = {
+        mode: round(call_overhead(mode, args.overhead_calls), 2) for mode in args.call_modes
+    }
     if len(args.call_modes) > 1:
         print("one trivial user call [us]: " + ", ".join(f"{m} {v}" for m, v in overhead.items()))
         for mode in args.call_modes:
@@ -186,6 +206,7 @@ def main(argv: list[str] | None = None) -> int:
         "runs": rows,
         "max_time_probes": probes,
         "max_time_overrun_max": max((p["overrun"] for p in probes), default=None),
+        "quick": args.quick,
     }
     print(json.dumps(summary, separators=(",", ":")))
     return 0 if summary["all_expected"] else 1

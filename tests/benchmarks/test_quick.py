@@ -1,0 +1,166 @@
+"""Every benchmark's ``--quick`` run, so that no benchmark stops working unseen.
+
+Each ``benchmarks/bench_*.py`` (found by glob: a new benchmark without ``--quick`` fails here)
+runs as ``python SCRIPT --quick`` in a fresh process from an empty folder, with this checkout
+first on its path and its byte code and numba's cache kept out of the checkout. It must exit 0
+and end its output with one JSON object holding ``"quick": true`` and the figures checked
+below. A benchmark that needs what the repository does not hold (a PDDLStream checkout, OMPL)
+may end with ``{"skipped": "<why>", ...}`` instead; the test then skips with that reason.
+
+One test class per benchmark: ``pytest --dist loadscope`` keeps a module's test functions (their
+parametrisations included) in one process but gives each class its own share, so the classes
+spread the benchmarks over the processes.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import os
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPTS = sorted((ROOT / "benchmarks").glob("bench_*.py"))
+#: guards against a hung benchmark only (a quick run takes seconds)
+HANG_GUARD = 900.0  # [s]
+
+#: Runs besides ``--quick`` alone (their arguments after ``--quick``): other modes kept alive
+EXTRA_RUNS: dict[str, tuple[tuple[str, ...], ...]] = {"bench_motion": (("--hard", "1"),)}
+#: The runs that may skip: what they need is not in the repository
+MAY_SKIP = {("bench_pddlstream_compat", ()), ("bench_motion", ("--hard", "1"))}
+
+Summary = dict[str, Any]
+
+
+def _async(out: Summary) -> None:
+    assert out["instances"] == 1 and out["all_valid"] is True
+    assert out["median_ratio"] <= 1.0  # the scheduler never returns a longer plan
+
+
+def _classical(out: Summary) -> None:
+    assert out["problems"] >= 1 and out["solved"]["ours"] == out["problems"]
+    assert not any(out["invalid"].values())
+
+
+def _feasibility(out: Summary) -> None:
+    for label in ("paper", "stress", "stress_before"):
+        assert out[label]["seconds"], label
+
+
+def _motion(out: Summary) -> None:
+    assert out["segments"] == 3 and 0.0 <= out["success_rate_with_fallbacks"] <= 1.0
+    assert out["validation_failures_returned_as_success"] == 0
+
+
+def _motion_hard(out: Summary) -> None:
+    for kind in ("one_arm", "both_arms"):
+        assert {"optimiser", "ompl", "ladder", "sdar-m"} <= out[kind].keys()
+
+
+def _parser(out: Summary) -> None:
+    assert out["init_facts"] > 0 and out["problem_mb_per_s"] > 0
+
+
+def _pddlstream(out: Summary) -> None:
+    assert out["total"] == 1 and "passed" in out
+
+
+def _sdar(out: Summary) -> None:
+    assert out["instances"] == 1 and out["success"] == 1 and out["steps"] > 0
+
+
+def _solve(out: Summary) -> None:
+    assert out["runs"] == 1 and out["this"]["all_valid"] is True
+
+
+def _streams(out: Summary) -> None:
+    assert out["runs"] and out["all_expected"] is True and out["max_time_probes"]
+
+
+def _world(out: Summary) -> None:
+    keys = ("ik_poses_per_s_per_core", "collision_checks_per_s_12_objects",
+            "dependency_graph_24_objects_ms", "exact_fvs_24_object_component_ms")  # fmt: skip
+    assert all(out[key] > 0 for key in keys)
+
+
+#: What a run's summary must show (runs not named here: only the common checks)
+CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
+    ("bench_async", ()): _async,
+    ("bench_classical", ()): _classical,
+    ("bench_feasibility", ()): _feasibility,
+    ("bench_motion", ()): _motion,
+    ("bench_motion", ("--hard", "1")): _motion_hard,
+    ("bench_parser", ()): _parser,
+    ("bench_pddlstream_compat", ()): _pddlstream,
+    ("bench_sdar", ()): _sdar,
+    ("bench_solve", ()): _solve,
+    ("bench_streams", ()): _streams,
+    ("bench_world", ()): _world,
+}
+
+
+def run_quick(script: Path, extra: tuple[str, ...], folder: Path) -> Summary:
+    """Run ``script --quick *extra`` from ``folder``; its last output line, read as JSON."""
+    env = dict(os.environ)  # tests/conftest.py switched the compiled derivatives off
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH")) if p)
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    env["NUMBA_CACHE_DIR"] = str(folder / "numba-cache")
+    done = subprocess.run(
+        [sys.executable, str(script), "--quick", *extra],
+        cwd=folder,
+        env=env,
+        stdin=subprocess.DEVNULL,
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=HANG_GUARD,
+    )
+    said = f"stdout ends:\n{done.stdout[-2000:]}\nstderr ends:\n{done.stderr[-2000:]}"
+    assert done.returncode == 0, f"{script.name} exited {done.returncode}\n{said}"
+    lines = done.stdout.strip().splitlines()
+    assert lines, f"{script.name} printed nothing\n{said}"
+    out = json.loads(lines[-1])
+    assert isinstance(out, dict), f"{script.name}: the last line is not one JSON object\n{said}"
+    return out
+
+
+class QuickRuns:
+    """The ``--quick`` runs of one benchmark (one subclass per script, below)."""
+
+    script: Path
+
+    def test_docstring_states_the_quick_mode(self) -> None:
+        doc = ast.get_docstring(ast.parse(self.script.read_text(encoding="utf-8"))) or ""
+        assert "--quick" in doc, f"{self.script.name}: the docstring does not state --quick"
+
+    def test_quick_run(self, extra: tuple[str, ...], tmp_path: Path) -> None:
+        out = run_quick(self.script, extra, tmp_path)
+        assert out.get("quick") is True, f'{self.script.name}: no "quick": true in {out}'
+        run = (self.script.stem, extra)
+        if isinstance(out.get("skipped"), str):
+            assert run in MAY_SKIP, f"{self.script.name} skipped: {out['skipped']}"
+            pytest.skip(f"{self.script.name}: {out['skipped']}")
+        check = CHECKS.get(run)
+        if check is not None:
+            check(out)
+        written = sorted(p.name for p in tmp_path.iterdir() if p.name != "numba-cache")
+        assert not written, f"{self.script.name} wrote into its working folder: {written}"
+
+
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    if "extra" in metafunc.fixturenames and metafunc.cls is not None:
+        runs = [(), *EXTRA_RUNS.get(metafunc.cls.script.stem, ())]
+        ids = ["_".join(a.lstrip("-") for a in ("--quick", *r)) for r in runs]
+        metafunc.parametrize("extra", runs, ids=ids)
+
+
+for _script in SCRIPTS:
+    globals()[f"Test_{_script.stem}"] = type(
+        f"Test_{_script.stem}", (QuickRuns,), {"script": _script}
+    )
