@@ -35,21 +35,17 @@ from streams.context import WorldContext
 from streams.finger_blocking import GraspBlocking, gripper_boxes
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, half_turn_twins, sample_grasps
 from streams.ik import GraspIK, SceneCache, collision_free_candidates
-from streams.motion import (
-    MotionPlanner,
-    MotionRequest,
-    MotionResult,
-    TransferStrategy,
-    default_strategies,
-    plan_dual_motion,
-)
-from streams.sampling import (
+from streams.motion.exact_check import HeldObject
+from streams.motion.ladder import default_strategies, plan_dual_motion
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionRequest, MotionResult
+from streams.motion.sampling import (
     OmplUnavailableError,
     SamplingOptions,
     ompl_available,
     warm_started_strategies,
 )
-from streams.validate import HeldObject
+from streams.motion.strategies import TransferStrategy
 
 LOG = get_logger(__name__)
 Size = tuple[float, float, float]
@@ -123,7 +119,7 @@ BUFFERS_PER_ARM = 4
 BUFFER_MARGIN = 0.01
 
 #: Motion planners of ``plan-dual-motion``: SDAR-M's ladder, plain optimisation, one arm at a
-#: time, and OMPL's RRTConnect (optional extra ``sdar-tamp[ompl]``, :mod:`streams.sampling`).
+#: time, and OMPL's RRTConnect (optional extra ``sdar-tamp[ompl]``, :mod:`streams.motion.sampling`).
 MOTION_PLANNERS = ("sdar", "plain", "sequential", "ompl")
 
 
@@ -160,7 +156,7 @@ class RearrangementStreams:
                 "sampling=True: the sampled warm start needs OMPL: pip install 'sdar-tamp[ompl]'"
             )
         #: SDAR-M's first rung also warm-starts the optimiser from a sampled path (default:
-        #: where OMPL is installed; :func:`streams.sampling.warm_started_strategies`)
+        #: where OMPL is installed; :func:`streams.motion.sampling.warm_started_strategies`)
         self.sampling = ompl_available() if sampling is None else sampling
         self.ctx = ctx
         self.sizes = dict(sizes)
@@ -361,7 +357,7 @@ class RearrangementStreams:
         strategies: tuple[TransferStrategy, ...] | None = None
         ladder = self.motion == "sdar" and not quick
         if self.motion == "ompl":
-            from streams.sampling import SampledStrategy
+            from streams.motion.sampling import SampledStrategy
 
             strategies = (SampledStrategy(options=SamplingOptions(seed=self.seed)),)
         elif self.motion == "sdar" and self.sampling:

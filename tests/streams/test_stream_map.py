@@ -11,7 +11,8 @@ from sdar_tamp.language.streams import parse_stream_file
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance, Pose2D
 from streams.context import WorldContext
-from streams.motion import MotionPlanner, MotionResult
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionResult
 from streams.stream_map import (
     STREAM_KINDS,
     ArmConf,
