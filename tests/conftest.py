@@ -18,8 +18,8 @@ from streams.motion.optimiser_cache import OptimiserCache
 from streams.motion.planner import MotionPlanner
 
 # The suite plans with CasADi's own evaluation of the optimiser's derivatives (the same
-# values as compiled, tests/streams/test_compiled.py): a fresh machine would otherwise spend
-# about 20 s of CPU compiling them beside the tests. Subprocesses inherit the switch.
+# values as compiled, tests/streams/motion/test_codegen.py): a fresh machine would otherwise
+# spend about 20 s of CPU compiling them beside the tests. Subprocesses inherit the switch.
 os.environ[codegen.ENV_SWITCH] = "0"
 
 #: Most of the suite's time is spent in a few long planning tests; beyond four processes the

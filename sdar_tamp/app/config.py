@@ -15,7 +15,7 @@ sdar_options=config.sdar_options())`` all read it, so every entry point plans al
   (``one_arm_at_a_time``, and ``quick_attempts`` which only the ``sdar`` motion planner uses)
   and the run's ``max_time`` and ``progress`` are set by :meth:`PlannerConfig.sdar_options`;
 - ``trajopt``: the trajectory optimiser's shape and solver settings
-  (:class:`streams.motion.optimiser.TrajOptOptions`).
+  (:class:`streams.motion.optimiser_records.TrajOptOptions`).
 """
 
 from __future__ import annotations

@@ -59,14 +59,19 @@ class SphereTable:
 
 @dataclass(frozen=True)
 class ArmSphereTables:
+    """One arm's fine spheres (arm-obstacle and arm-table slots) and coarse spheres
+    (arm-arm slots)."""
+
     fine: SphereTable
     coarse: SphereTable
 
     def with_held(self, held: HeldSpheres) -> tuple[SphereTable, SphereTable]:
+        """Fine and coarse tables with the held object's spheres appended."""
         return self.fine.plus(held), self.coarse.plus(held)
 
 
 def arm_sphere_tables(ctx: WorldContext, arm: str) -> ArmSphereTables:
+    """The sphere tables of ``arm`` from its symbolic FK's sphere models."""
     fk = ctx.fk[arm]
 
     def table(spheres: Any) -> SphereTable:
@@ -77,6 +82,7 @@ def arm_sphere_tables(ctx: WorldContext, arm: str) -> ArmSphereTables:
 
 
 def slot_lower_bounds(lb: FloatArray, slots: int) -> FloatArray:
+    """``lb`` padded to ``slots`` entries with ``-inf`` (unused slots constrain nothing)."""
     out = np.full(slots, -np.inf)
     out[: len(lb)] = lb
     return out
@@ -97,6 +103,9 @@ class Selection:
 
 @dataclass(frozen=True)
 class Violators:
+    """Pairs without a slot that a solution brings too close, per kind (arm-arm; per arm
+    arm-obstacle and arm-table)."""
+
     aa: set[tuple[int, int]]
     ao: tuple[set[tuple[int, int]], ...]  # per arm
     table: tuple[set[int], ...]  # per arm
@@ -144,6 +153,9 @@ def select_pairs(
     o: TrajOptOptions,
     forced: Selection | None,
 ) -> Selection:
+    """The pairs that get slots: per kind the closest along ``dense`` (the warm start's
+    spheres) below ``select_distance``, ``forced`` ones first, each with its lower bound from
+    the end points ``ends``."""
     aa_c = arm_arm_clearance(dense).min(axis=0)
     aa = _pick(aa_c, o.arm_arm_slots, o.select_distance, forced.aa if forced else None)
     aa_end = arm_arm_clearance(ends)[:, aa[:, 0], aa[:, 1]]

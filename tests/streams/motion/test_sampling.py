@@ -19,7 +19,7 @@ from streams.motion.sampling import (
 )
 
 # Two grasp configurations in M1 whose straight synchronous transfer is blocked (as in
-# test_motion.py).
+# test_motion_planner.py).
 BLOCKED_START = np.array([-0.9597713794940521, -1.487539072672206, 2.2951842532166142,
     -2.3784415073393053, -1.5707963267948966, 0.6482225313692203, -0.5339339743344569,
     -0.675777200007472, 1.1304521182278542, -1.6688772479994611, -0.8550081079150917,
@@ -205,7 +205,7 @@ def test_the_plain_rung_tries_its_rescue_between_straight_and_lifted(
 def test_sdar_m_warm_starts_from_a_sampled_path_where_ompl_is_installed(
     ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from streams import stream_map
+    from streams import motion_streams, stream_map
     from streams.motion.strategies import PlainStrategy
 
     ladder = sampling.warm_started_strategies(options=SamplingOptions(seed=3))
@@ -217,7 +217,7 @@ def test_sdar_m_warm_starts_from_a_sampled_path_where_ompl_is_installed(
     streams = stream_map.RearrangementStreams(ctx, {}, planner=planner)
     assert streams.sampling == sampling.ompl_available()
     assert not stream_map.RearrangementStreams(ctx, {}, planner=planner, sampling=False).sampling
-    monkeypatch.setattr(stream_map, "ompl_available", lambda: False)
+    monkeypatch.setattr(motion_streams, "ompl_available", lambda: False)
     assert not stream_map.RearrangementStreams(ctx, {}, planner=planner).sampling
     with pytest.raises(OmplUnavailableError, match=r"sampling=True: .*pip install"):
         stream_map.RearrangementStreams(ctx, {}, planner=planner, sampling=True)
