@@ -11,12 +11,11 @@ from sdar_tamp.world.collision import ObjectBox
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
-from streams.motion import optimiser_build
 from streams.motion.cartesian import tool_pose_ik
 from streams.motion.exact_check import configure_world, validate_trajectory
 from streams.motion.ladder import default_strategies, plan_dual_motion
 from streams.motion.optimiser_cache import OptimiserCache
-from streams.motion.optimiser_records import TrajOptOptions, TransferQuery
+from streams.motion.optimiser_records import TransferQuery
 from streams.motion.planner import MotionPlanner
 from streams.motion.records import MotionRequest, TransferProblem
 from streams.motion.shape import ShapeOptions, straight_end_deviation
@@ -231,33 +230,6 @@ def test_direct_paths_need_the_margin_and_keep_waiting_arms_still(
 def test_direct_margin_must_not_be_negative(ctx: WorldContext) -> None:
     with pytest.raises(ParameterError, match="direct_margin must be >= 0"):
         MotionPlanner(ctx, direct_margin=-0.001)
-
-
-def test_optimisers_are_built_once_per_scene_and_options(
-    ctx: WorldContext, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    built: list[TrajOptOptions] = []
-
-    class Fake:
-        def __init__(self, ctx: WorldContext, options: TrajOptOptions) -> None:
-            built.append(options)
-            if options.knots == 3:
-                raise ParameterError("no NLP with 3 knots")
-
-    monkeypatch.setattr(optimiser_build, "TrajectoryOptimiser", Fake)
-    cache = OptimiserCache()
-    six = TrajOptOptions(knots=6, compiled=False)
-    a = cache.get(ctx, six)
-    b = cache.get(ctx, six)
-    c = cache.get(ctx, TrajOptOptions(knots=7, compiled=False), background=False)
-    assert a is b and c is not a and len(cache) == 2
-    assert a.get() is b.get() and a.ready and a.build_time >= 0.0
-    assert [o.knots for o in sorted(built, key=lambda o: o.knots)] == [6, 7]
-    planner = MotionPlanner(ctx, six, optimisers=cache)
-    assert planner.trajopt is a.get() and len(built) == 2  # no second build
-    broken = cache.get(ctx, TrajOptOptions(knots=3, compiled=False))
-    with pytest.raises(ParameterError, match="no NLP with 3 knots"):
-        broken.get()
 
 
 def test_blended_pick_motion_is_valid_and_ends_straight(
