@@ -51,8 +51,11 @@ from streams.buffers import sample_buffers
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKCandidate, IKRequest, compatible_pairs, solve_ik_candidates
-from streams.motion import MotionPlanner, MotionRequest, plan_dual_motion
-from streams.validate import HeldObject, configure_world, validate_trajectory
+from streams.motion.exact_check import HeldObject, configure_world, validate_trajectory
+from streams.motion.ladder import plan_dual_motion
+from streams.motion.optimiser_cache import OptimiserCache
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionRequest
 
 
 def _box(x: float, y: float, yaw: float, size: tuple[float, float, float]) -> ObjectBox:
@@ -67,8 +70,8 @@ def _footprint(box: ObjectBox) -> np.ndarray:
 
 def hard_set(instance: str, seed: int, count: int, quick: bool = False) -> None:
     """See the module docstring (``--hard``)."""
-    from streams.motion import PlainStrategy
-    from streams.sampling import SampledStrategy, sampled_strategies, warm_started_strategies
+    from streams.motion.sampling import SampledStrategy, sampled_strategies, warm_started_strategies
+    from streams.motion.strategies import PlainStrategy
 
     ctx = WorldContext.load()
     inst = load_instance(domain_path(f"suites/paper/{instance}.yaml"))
@@ -76,8 +79,9 @@ def hard_set(instance: str, seed: int, count: int, quick: bool = False) -> None:
     names = list(objects)
     home = {a: ctx.home(a) for a in ctx.arm_names}
     world = ctx.new_world()
-    ladder = MotionPlanner(ctx)
-    alone = MotionPlanner(ctx, direct=False)
+    optimisers = OptimiserCache()  # one optimiser for both planners
+    ladder = MotionPlanner(ctx, optimisers=optimisers)
+    alone = MotionPlanner(ctx, direct=False, optimisers=optimisers)
     planners = {
         "optimiser": (alone, (PlainStrategy(lifted_warm_start=False),)),
         "ompl": (ladder, (SampledStrategy(),)),

@@ -169,7 +169,7 @@ def compare_adaptive(time_limit: float, quick: bool = False) -> None:
     from sdar_tamp.world.scene import Workspace
     from solvers.solve import solve
     from streams.context import WorldContext
-    from streams.motion import MotionPlanner
+    from streams.motion.planner import MotionPlanner
 
     ctx = WorldContext.load()
     planner = MotionPlanner(ctx)

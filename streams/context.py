@@ -14,7 +14,7 @@ from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene, load_scene
 from sdar_tamp.world.transforms import FloatArray
-from streams.fk_casadi import ArmFK
+from streams.motion.fk_casadi import ArmFK
 
 
 @dataclass(frozen=True)

@@ -29,9 +29,9 @@ import numpy as np
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.transforms import FloatArray
-from streams.cartesian import straight_tool_move
 from streams.context import WorldContext
 from streams.grasps import Grasp, pregrasp_offset
+from streams.motion.cartesian import straight_tool_move
 
 
 @dataclass(frozen=True, eq=False)

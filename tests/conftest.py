@@ -1,5 +1,5 @@
 """Suite-wide settings (how many processes `pytest -n auto` starts) and the expensive shared
-fixtures: the world context and the motion planner."""
+fixtures: the world context, the optimisers and the motion planner."""
 
 from __future__ import annotations
 
@@ -12,14 +12,15 @@ from types import ModuleType
 
 import pytest
 
-from streams import compiled
 from streams.context import WorldContext
-from streams.motion import MotionPlanner
+from streams.motion import codegen
+from streams.motion.optimiser_cache import OptimiserCache
+from streams.motion.planner import MotionPlanner
 
 # The suite plans with CasADi's own evaluation of the optimiser's derivatives (the same
-# values as compiled, tests/streams/test_compiled.py): a fresh machine would otherwise spend
-# about 20 s of CPU compiling them beside the tests. Subprocesses inherit the switch.
-os.environ[compiled.ENV_SWITCH] = "0"
+# values as compiled, tests/streams/motion/test_codegen.py): a fresh machine would otherwise
+# spend about 20 s of CPU compiling them beside the tests. Subprocesses inherit the switch.
+os.environ[codegen.ENV_SWITCH] = "0"
 
 #: Most of the suite's time is spent in a few long planning tests; beyond four processes the
 #: start-up of each (pinocchio, CasADi, the optimiser build) outweighs what they share out.
@@ -45,9 +46,16 @@ def ctx() -> WorldContext:
 
 
 @pytest.fixture(scope="session")
-def planner(ctx: WorldContext) -> MotionPlanner:
+def optimisers() -> OptimiserCache:
+    """The trajectory optimisers of the test process: a planner made with this cache shares
+    the optimiser of every other planner of the same scene and options (built once)."""
+    return OptimiserCache()
+
+
+@pytest.fixture(scope="session")
+def planner(ctx: WorldContext, optimisers: OptimiserCache) -> MotionPlanner:
     """The motion planner of ``ctx``: built once per test process (the optimiser with it)."""
-    return MotionPlanner(ctx)
+    return MotionPlanner(ctx, optimisers=optimisers)
 
 
 @pytest.fixture(scope="session")

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from streams.context import WorldContext
-from streams.motion import MotionPlanner
-from streams.trajopt import TrajOptOptions
+from streams.motion.optimiser_records import TrajOptOptions
+from streams.motion.planner import MotionPlanner
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ sdar_options=config.sdar_options())`` all read it, so every entry point plans al
   (``one_arm_at_a_time``, and ``quick_attempts`` which only the ``sdar`` motion planner uses)
   and the run's ``max_time`` and ``progress`` are set by :meth:`PlannerConfig.sdar_options`;
 - ``trajopt``: the trajectory optimiser's shape and solver settings
-  (:class:`streams.trajopt.TrajOptOptions`).
+  (:class:`streams.motion.optimiser_records.TrajOptOptions`).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import GRIPPER_DWELL
 from solvers.sdar.options import SdarOptions
 from streams.grasps import DEFAULT_GRASPS, GraspOptions
-from streams.trajopt import TrajOptOptions
+from streams.motion.optimiser_records import TrajOptOptions
 
 TASK_PLANNERS = ("sdar", "baseline")
 MOTION_PLANNERS = ("sdar", "plain", "sequential")

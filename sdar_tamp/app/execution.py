@@ -1,6 +1,7 @@
 """How a synchronous plan is executed asynchronously: the scheduler's options, with each arm's
 motions re-timed by the same time-optimal path timing the motion planner uses
-(:func:`streams.timing.time_parameterize`) and the same slow tool travel at gripper events."""
+(:func:`streams.motion.timing.time_parameterize`) and the same slow tool travel at gripper
+events."""
 
 from __future__ import annotations
 
@@ -15,8 +16,8 @@ from sdar_tamp.schedule.retiming import PathTimer
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
-from streams.shape import ShapeOptions
-from streams.timing import time_parameterize
+from streams.motion.shape import ShapeOptions
+from streams.motion.timing import time_parameterize
 
 _log = logging.getLogger(__name__)
 

@@ -24,7 +24,7 @@ from sdar_tamp.world.transforms import inverse
 from solvers.sdar.vocabulary import SdarVocabulary
 from solvers.solution import Action, Solution
 from streams.grasps import Grasp
-from streams.motion import MotionResult
+from streams.motion.records import MotionResult
 
 
 @dataclass(frozen=True)

@@ -21,8 +21,9 @@ from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
-from streams.motion import MotionPlanner
-from streams.stream_map import STREAM_KINDS, ArmConf, CellConf, make_stream_map
+from streams.motion.planner import MotionPlanner
+from streams.stream_map import make_stream_map
+from streams.stream_types import STREAM_KINDS, ArmConf, CellConf
 
 DOMAIN = "dual_arm_rearrangement"
 LOG = get_logger(__name__)

@@ -5,7 +5,7 @@ the harder path allows, so the other arm moves slower than its own limits permit
 arm's share of the motion can be timed again along the same geometric path:
 
 * with a :data:`PathTimer` (a time-optimal parameterisation under the arm's velocity and
-  acceleration limits, e.g. :func:`streams.timing.time_parameterize`, passed in by the
+  acceleration limits, e.g. :func:`streams.motion.timing.time_parameterize`, passed in by the
   application), the path through the motion's samples (thinned to at least ``spacing`` [rad]
   apart, so that the slow samples near the ends do not bend the path) is timed from rest to
   rest; within ``straight`` [m] of the tool's travel from a gripper event the tool centre

@@ -33,8 +33,9 @@ from solvers.solution import Action, Solution
 from solvers.solve import solve
 from streams.context import WorldContext
 from streams.grasps import GraspOptions
-from streams.motion import MotionPlanner
-from streams.trajopt import TrajOptOptions
+from streams.motion.optimiser_cache import OptimiserCache
+from streams.motion.optimiser_records import TrajOptOptions
+from streams.motion.planner import MotionPlanner
 
 #: A solve's time budget: generous, so that a busy machine slows a test down but never turns
 #: a solvable case into a timeout (the budget is not what these tests check).
@@ -196,8 +197,10 @@ def _outputs(generator: Any) -> list[Any]:
     return [output for batch in generator for output in batch]
 
 
-def test_actions_are_read_by_name_through_the_vocabulary(ctx: WorldContext) -> None:
-    r = rearrangement_problem(_one(), ctx, planner=MotionPlanner(ctx))
+def test_actions_are_read_by_name_through_the_vocabulary(
+    ctx: WorldContext, optimisers: OptimiserCache
+) -> None:
+    r = rearrangement_problem(_one(), ctx, planner=MotionPlanner(ctx, optimisers=optimisers))
     decoder = ActionDecoder(r.problem.domain, r.problem.streams)
     g1, g2 = object(), object()
     args = ("d", "left", "o1", "p1", g1, "q1", "right", "o2", "p2", g2, "q2")

@@ -26,8 +26,10 @@ from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, solve_ik_candidates
-from streams.motion import MotionPlanner, MotionRequest, MotionResult, plan_dual_motion
-from streams.validate import HeldObject
+from streams.motion.exact_check import HeldObject
+from streams.motion.ladder import plan_dual_motion
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionRequest, MotionResult
 
 INSTANCE = """name: T2
 workspace: {x: [-0.25, 0.25], y: [-0.3, 0.3]}

@@ -37,9 +37,12 @@ from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, solve_ik_candidates
-from streams.motion import MotionPlanner, MotionRequest, MotionResult, plan_dual_motion
-from streams.shape import ShapeOptions
-from streams.validate import HeldObject
+from streams.motion.exact_check import HeldObject
+from streams.motion.ladder import plan_dual_motion
+from streams.motion.optimiser_cache import OptimiserCache
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionRequest, MotionResult
+from streams.motion.shape import ShapeOptions
 
 INSTANCE = """name: D3
 workspace: {x: [-0.25, 0.25], y: [-0.3, 0.3]}
@@ -88,7 +91,7 @@ def _segment(result: MotionResult, kind: str) -> MotionSegment:
 
 
 @pytest.fixture(scope="module")
-def base(ctx: WorldContext, planner: MotionPlanner) -> Base:
+def base(ctx: WorldContext, planner: MotionPlanner, optimisers: OptimiserCache) -> Base:
     instance = parse_instance(INSTANCE, "d3.yaml")
     objects = {o.name: o for o in instance.objects}
     start = {o.name: _box(o, o.start) for o in instance.objects}
@@ -120,7 +123,7 @@ def base(ctx: WorldContext, planner: MotionPlanner) -> Base:
     ]
     # the carrying motion is not blended: it passes through rest at its lifted points, where
     # the "drop" mutants pause; the others are blended (no stop at the pre-grasp points)
-    unblended = MotionPlanner(ctx, shape=ShapeOptions(blend=False))
+    unblended = MotionPlanner(ctx, shape=ShapeOptions(blend=False), optimisers=optimisers)
     a, b, c = (
         plan_dual_motion(p, r) for p, r in zip((planner, unblended, planner), requests, strict=True)
     )

@@ -12,7 +12,7 @@ from solvers.sdar.sdar_t import WAIT, SdarTaskPlanner
 from solvers.sdar.solver import SdarOptions, SdarSolver
 from solvers.sdar.tasks import Move, TaskView
 from streams.context import WorldContext
-from streams.motion import MotionPlanner
+from streams.motion.planner import MotionPlanner
 
 BAR = (0.08, 0.04, 0.05)  # graspable across its 4 cm side only (y)
 CUBE = (0.04, 0.04, 0.05)  # graspable across both sides

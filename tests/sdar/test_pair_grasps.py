@@ -22,7 +22,7 @@ from solvers.sdar.solver import SdarOptions, SdarSolver
 from solvers.solution import Status
 from streams.context import WorldContext
 from streams.grasps import GraspOptions
-from streams.motion import MotionPlanner
+from streams.motion.planner import MotionPlanner
 
 #: A solve's time budget: generous, so that a busy machine slows a test down but never turns
 #: a solvable case into a timeout (the budget is not what these tests check).

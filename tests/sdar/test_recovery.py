@@ -16,7 +16,7 @@ from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
 from solvers.solution import Status
 from streams.context import WorldContext
-from streams.motion import MotionPlanner
+from streams.motion.planner import MotionPlanner
 from streams.stream_map import make_stream_map
 
 BUDGET = 600.0  # [s] generous: the budget is not what these tests check

@@ -24,7 +24,7 @@ from sdar_tamp.world.scene import Workspace
 from solvers.solution import Certificate, Solution, Status
 from solvers.solve import solve
 from streams.context import WorldContext
-from streams.motion import MotionPlanner
+from streams.motion.planner import MotionPlanner
 from streams.stream_map import make_stream_map
 
 #: A solve's time budget: generous, so that a busy machine slows a test down but never turns

@@ -89,7 +89,7 @@ def test_logger_names_sit_under_the_package_prefix() -> None:
     assert logger_name("solvers.classical.search") == "sdar_tamp.solvers.classical.search"
     assert logger_name("sdar_tamp.language") == "sdar_tamp.language"
     assert logger_name("sdar_tamp_other") == "sdar_tamp.sdar_tamp_other"
-    assert get_logger("streams.trajopt").name == "sdar_tamp.streams.trajopt"
+    assert get_logger("streams.motion.optimiser").name == "sdar_tamp.streams.motion.optimiser"
 
 
 #: Calls that change global logging or RNG state, and the only places allowed to make them:

@@ -10,7 +10,8 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.instance import Instance
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_PAIR_TILTS, half_turn_twins, sample_grasps
-from streams.stream_map import ArmConf, RearrangementStreams, make_stream_map
+from streams.stream_map import RearrangementStreams, make_stream_map
+from streams.stream_types import ArmConf
 
 HALF_TURN = np.diag([-1.0, -1.0, 1.0])  # about the object's vertical axis
 
@@ -101,7 +102,7 @@ def test_next_motion_penalises_a_wrist_near_its_limits(ctx: WorldContext) -> Non
     assert at(2.9) == pytest.approx(expected) and at(-2.9) == pytest.approx(expected)
     assert 0.0 < at(2.0) < at(2.9) < at(np.pi)
     assert (
-        RearrangementStreams(ctx, {}, half_turns=False).next_motion(
+        RearrangementStreams(ctx, {}, half_turns=False).motions.next_motion(
             ArmConf("left", (*home[:5], 2.9))
         )
         == 0.0

@@ -1,6 +1,5 @@
 import dataclasses
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -11,14 +10,8 @@ from sdar_tamp.language.streams import parse_stream_file
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance, Pose2D
 from streams.context import WorldContext
-from streams.motion import MotionPlanner, MotionResult
-from streams.stream_map import (
-    STREAM_KINDS,
-    ArmConf,
-    CellConf,
-    RearrangementStreams,
-    make_stream_map,
-)
+from streams.stream_map import RearrangementStreams, make_stream_map
+from streams.stream_types import STREAM_KINDS, ArmConf, CellConf
 
 DOMAIN = Path(__file__).resolve().parents[2] / "domains" / "dual_arm_rearrangement"
 
@@ -57,29 +50,6 @@ def test_overlap_grasp_and_ik_streams(ctx: WorldContext, instance: Instance) -> 
     assert len(buffers) == 3
 
 
-def test_motion_stream_plans_a_validated_place(
-    ctx: WorldContext, instance: Instance, planner: MotionPlanner
-) -> None:
-    sizes = {x.name: x.size for x in instance.objects}
-    sm = make_stream_map(ctx, sizes, planner=planner)
-    o = instance.objects[3]
-    grasp = next(g for (g,) in sm["sample-grasp"](o.name))
-    fluents = [("atpose", x.name, x.start) for x in instance.objects if x.name != o.name]
-    pick = next(c for (c,) in sm["inverse-kinematics"]("left", o.name, o.start, grasp, fluents))
-    place_pose = next(p for (p,) in sm["sample-buffer"](o.name, fluents))
-    place = next(c for (c,) in sm["inverse-kinematics"]("left", o.name, place_pose, grasp, fluents))
-    home_right = ArmConf("right", tuple(ctx.home("right")))
-    (q1,) = next(sm["combine-confs"]("left", pick, "right", home_right))
-    (q2,) = next(sm["combine-confs"]("right", home_right, "left", place))
-    holding = [("holding", "left", o.name, grasp)]
-    (result,) = next(sm["plan-dual-motion"](q1, q2, fluents + holding))
-    assert result.success and result.trajectory is not None
-    q = result.trajectory.q
-    np.testing.assert_allclose(q[0], q1.q, atol=1e-9)
-    np.testing.assert_allclose(q[-1], q2.q, atol=1e-9)
-    assert np.allclose(q[:, 6:], q1.q[6:])  # the right arm waits at home
-
-
 def test_cfree_is_the_complement_of_overlap(ctx: WorldContext, instance: Instance) -> None:
     o = instance.objects[0]
     sm = make_stream_map(ctx, {x.name: x.size for x in instance.objects})
@@ -87,19 +57,6 @@ def test_cfree_is_the_complement_of_overlap(ctx: WorldContext, instance: Instanc
     assert not sm["test-cfree"](o.name, o.start, "x", near)
     assert sm["test-cfree"](o.name, o.start, "x", far)
     assert not sm["test-cfree"](o.name, o.start, o.name, far)  # an object and itself
-
-
-def test_distance_estimates_a_rest_to_rest_time(ctx: WorldContext) -> None:
-    sm = make_stream_map(ctx)
-    home = {a: ArmConf(a, tuple(ctx.home(a))) for a in ctx.arm_names}
-    d0 = CellConf(home["left"], home["right"])
-    moved = list(home["left"].q)
-    moved[0] += 1.0
-    d1 = CellConf(ArmConf("left", tuple(moved)), home["right"])
-    assert sm["Distance"](d0, d0) == 0.0
-    t = sm["Distance"](d0, d1)
-    v = ctx.scene.arm("left").velocity_limit[0]
-    assert 1.0 / v < t < 1.0 / v + 2.0  # slower than the velocity limit allows, not absurd
 
 
 def test_combine_confs_rejects_arms_in_collision(ctx: WorldContext) -> None:
@@ -125,11 +82,6 @@ def test_buffers_keep_clear_of_reserved_goals(ctx: WorldContext, instance: Insta
             if x.name != o.name:
                 assert sm["test-cfree"](o.name, p, x.name, x.goal)
                 assert sm["test-cfree"](o.name, p, x.name, x.start)
-
-
-def test_unknown_motion_planner_is_refused(ctx: WorldContext) -> None:
-    with pytest.raises(ParameterError, match="motion planner must be one of sdar, plain"):
-        make_stream_map(ctx, motion="fast")
 
 
 def test_ik_queries_of_one_arrangement_share_one_collision_world(
@@ -174,38 +126,3 @@ def test_other_arm_needs_two_arms(ctx: WorldContext) -> None:
     with pytest.raises(ParameterError, match="other: defined for two arms, the scene has 3"):
         three.other("left")
     assert three.split(np.arange(18.0))["middle"].tolist() == list(range(12, 18))
-
-
-@pytest.mark.parametrize("sampling", [False, True])
-def test_the_full_motion_skips_the_rung_the_quick_stream_failed(
-    ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch, sampling: bool
-) -> None:
-    """The quick stream is the ladder's first rung alone (deterministic): after it failed on
-    a motion, the full stream starts that same motion at the second rung."""
-    import streams.stream_map as stream_map
-
-    if sampling and not stream_map.ompl_available():
-        pytest.skip("OMPL not installed")
-    calls: list[tuple[bool, tuple[str, ...] | None]] = []
-
-    def failing(planner: Any, request: Any, fallbacks: bool = True, sequential_only: bool = False,
-                strategies: Any = None) -> MotionResult:  # fmt: skip
-        calls.append((fallbacks, None if strategies is None else tuple(s.name for s in strategies)))
-        return MotionResult(False, None, None, 0.0, 0.0, ("plain: optimisation failed",),
-                            reason="plain: optimisation failed")  # fmt: skip
-
-    monkeypatch.setattr(stream_map, "plan_dual_motion", failing)
-    sm = make_stream_map(ctx, planner=planner, sampling=sampling)
-    home = [ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in ctx.arm_names]
-    d1 = CellConf(*home)
-    d2 = CellConf(ArmConf(home[0].arm, tuple(x + 0.1 for x in home[0].q)), home[1])
-    here = [("atpose", "o", Pose2D(0.1, 0.0, 0.0))]
-    there = [("atpose", "o", Pose2D(0.2, 0.0, 0.0))]
-    assert not list(sm["plan-dual-motion-quick"](d1, d2, here))
-    assert not list(sm["plan-dual-motion"](d1, d2, here))
-    assert not list(sm["plan-dual-motion"](d1, d2, there))  # another motion: the whole ladder
-    if sampling:  # the ladder is passed: its first rung has the sampled warm start
-        ladder = ("plain", "untangle", "sequential")
-        assert calls == [(False, ("plain",)), (True, ladder[1:]), (True, ladder)]
-    else:
-        assert calls == [(False, None), (True, ("untangle", "sequential")), (True, None)]

@@ -18,7 +18,7 @@ from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.suites import shipped_suite_dir
 from solvers.solution import Status
 from streams.context import WorldContext
-from streams.motion import MotionPlanner
+from streams.motion.planner import MotionPlanner
 
 #: The instances, by the role they play in the tests.
 INSTANCES = ("R5", "D5", "M2")

@@ -1,4 +1,4 @@
-"""Compiled CasADi derivatives (``streams.compiled``): the cache, the background compile, the
+"""Compiled CasADi derivatives (``streams.motion.codegen``): the cache, the background compile, the
 lock, every way it can fail (the caller then keeps CasADi's own evaluation), and the
 optimiser giving the same paths with its derivatives compiled."""
 
@@ -12,14 +12,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from streams import compiled
-from streams._casadi import ca, to_array
 from streams.context import WorldContext
-from streams.sphere_pairs import HeldSpheres
-from streams.trajopt import OptimiserBuild, TrajectoryOptimiser, TrajOptOptions, TransferQuery
+from streams.motion import codegen
+from streams.motion._casadi import ca, to_array
+from streams.motion.optimiser import TrajectoryOptimiser
+from streams.motion.optimiser_build import OptimiserBuild
+from streams.motion.optimiser_records import TrajOptOptions, TransferQuery
+from streams.motion.sphere_pairs import HeldSpheres
 
 FAST = ("-O0", "-shared", "-fPIC")  # the tests' flags: the same code, compiled sooner
-needs_cc = pytest.mark.skipif(compiled.compiler() is None, reason="no C compiler (cc)")
+needs_cc = pytest.mark.skipif(codegen.compiler() is None, reason="no C compiler (cc)")
 
 
 RECIPE = "sin(x0) x1^2 + exp(x2), and its gradient"
@@ -41,27 +43,27 @@ def _wait(path: Path, timeout: float = 120.0) -> None:
 @pytest.fixture
 def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     folder = tmp_path / "cache"
-    monkeypatch.setenv(compiled.ENV_CACHE, str(folder))
-    monkeypatch.delenv(compiled.ENV_SWITCH, raising=False)
+    monkeypatch.setenv(codegen.ENV_CACHE, str(folder))
+    monkeypatch.delenv(codegen.ENV_SWITCH, raising=False)
     return folder
 
 
 def test_switch_and_cache_folder(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     for off in ("0", "false", "No", " off "):
-        monkeypatch.setenv(compiled.ENV_SWITCH, off)
-        assert not compiled.enabled()
-    monkeypatch.setenv(compiled.ENV_SWITCH, "1")
-    assert compiled.enabled()
-    monkeypatch.setenv(compiled.ENV_CACHE, str(tmp_path / "a"))
-    assert compiled.cache_dir() == tmp_path / "a"
-    monkeypatch.delenv(compiled.ENV_CACHE)
+        monkeypatch.setenv(codegen.ENV_SWITCH, off)
+        assert not codegen.enabled()
+    monkeypatch.setenv(codegen.ENV_SWITCH, "1")
+    assert codegen.enabled()
+    monkeypatch.setenv(codegen.ENV_CACHE, str(tmp_path / "a"))
+    assert codegen.cache_dir() == tmp_path / "a"
+    monkeypatch.delenv(codegen.ENV_CACHE)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
-    assert compiled.cache_dir() == tmp_path / "xdg" / "sdar-tamp"
+    assert codegen.cache_dir() == tmp_path / "xdg" / "sdar-tamp"
 
 
 def test_switched_off_compiles_nothing(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv(compiled.ENV_SWITCH, "0")
-    assert compiled.request([_function()], "small", RECIPE, FAST) is None
+    monkeypatch.setenv(codegen.ENV_SWITCH, "0")
+    assert codegen.request([_function()], "small", RECIPE, FAST) is None
     assert not cache.exists()
 
 
@@ -69,8 +71,8 @@ def test_without_a_compiler_nothing_is_compiled(
     cache: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     monkeypatch.setenv("CC", "no-such-compiler-here")
-    with caplog.at_level(logging.INFO, logger=compiled._log.name):
-        assert compiled.request([_function()], "small", RECIPE, FAST) is None
+    with caplog.at_level(logging.INFO, logger=codegen._log.name):
+        assert codegen.request([_function()], "small", RECIPE, FAST) is None
     assert "no C compiler (no-such-compiler-here)" in caplog.text
     assert not cache.exists()
 
@@ -78,7 +80,7 @@ def test_without_a_compiler_nothing_is_compiled(
 @needs_cc
 def test_compiled_in_the_background_then_taken_from_the_cache(cache: Path) -> None:
     fn = _function()
-    target = compiled.request([fn], "small", RECIPE, FAST)
+    target = codegen.request([fn], "small", RECIPE, FAST)
     assert target is not None and target.parent == cache
     _wait(target)
     lock = target.with_name(target.name + ".lock")
@@ -86,40 +88,40 @@ def test_compiled_in_the_background_then_taken_from_the_cache(cache: Path) -> No
     while lock.exists() and time.monotonic() < deadline:  # the compile's shell cleans up
         time.sleep(0.05)
     assert sorted(p.name for p in cache.iterdir()) == [target.name]  # no lock, no staging
-    (twin,) = compiled.load([fn], target)
+    (twin,) = codegen.load([fn], target)
     assert twin.name_out() == fn.name_out()
     for x in ([0.3, -1.2, 0.5], [2.0, 0.1, -3.0]):
         for a, b in zip(twin(x), fn(x), strict=True):
             assert np.array_equal(to_array(a), to_array(b))
-    assert compiled.request([fn], "small", RECIPE, FAST) == target  # found at once
-    assert compiled.library_path(RECIPE, cache, FAST) == target
-    assert compiled.library_path(RECIPE, cache) != target  # other flags, another library
-    assert compiled.library_path("another recipe", cache, FAST) != target
-    assert compiled.same_values([fn], [twin])
-    assert not compiled.same_values([fn], [_function(scale=2.0)])
+    assert codegen.request([fn], "small", RECIPE, FAST) == target  # found at once
+    assert codegen.library_path(RECIPE, cache, FAST) == target
+    assert codegen.library_path(RECIPE, cache) != target  # other flags, another library
+    assert codegen.library_path("another recipe", cache, FAST) != target
+    assert codegen.same_values([fn], [twin])
+    assert not codegen.same_values([fn], [_function(scale=2.0)])
 
 
 @needs_cc
 def test_a_fresh_lock_is_respected_and_a_stale_one_taken_over(cache: Path) -> None:
-    code = compiled.source([_function()], "small")
-    target = compiled.library_path(RECIPE, cache, FAST)
+    code = codegen.source([_function()], "small")
+    target = codegen.library_path(RECIPE, cache, FAST)
     cache.mkdir(parents=True)
     lock = target.with_name(target.name + ".lock")
     lock.touch()
-    cc = compiled.compiler()
+    cc = codegen.compiler()
     assert cc is not None
-    assert not compiled.start_compile(code, target, cc, FAST)  # another process compiles
-    old = time.time() - compiled.STALE_LOCK - 1
+    assert not codegen.start_compile(code, target, cc, FAST)  # another process compiles
+    old = time.time() - codegen.STALE_LOCK - 1
     os.utime(lock, (old, old))
-    assert compiled.start_compile(code, target, cc, FAST)  # that one died: taken over
+    assert codegen.start_compile(code, target, cc, FAST)  # that one died: taken over
     _wait(target)
 
 
 @needs_cc
 def test_a_failing_compiler_leaves_no_library(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CC", "false")  # exits 1, like a compiler that rejects the code
-    target = compiled.request([_function()], "small", RECIPE, FAST)
-    assert target == compiled.library_path(RECIPE, cache, FAST)
+    target = codegen.request([_function()], "small", RECIPE, FAST)
+    assert target == codegen.library_path(RECIPE, cache, FAST)
     lock = target.with_name(target.name + ".lock")
     deadline = time.monotonic() + 30
     while lock.exists() and time.monotonic() < deadline:
@@ -155,7 +157,7 @@ def test_the_optimiser_gives_the_same_paths_compiled(
     assert fast._library is not None
     _wait(fast._library, timeout=300)
     query = _query(ctx)
-    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.trajopt"):
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.motion.optimiser"):
         b = fast.solve(query)
     assert fast.compiled and "compiled derivatives in use" in caplog.text
     a = plain.solve(query)
@@ -177,7 +179,7 @@ def test_a_broken_library_keeps_the_optimiser_uncompiled(
     broken = tmp_path / "casadi-broken.so"
     broken.write_bytes(b"not a shared library")
     opt._library = broken
-    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.trajopt"):
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.motion.optimiser"):
         result = opt.solve(_query(ctx))
     assert not opt.compiled and opt._library is None and not broken.exists()
     assert "could not be loaded, kept uncompiled" in caplog.text
@@ -205,8 +207,8 @@ def test_a_failure_to_ask_does_not_break_the_build(
     def refuse(*args: object, **kwargs: object) -> None:
         raise RuntimeError("code generation failed")
 
-    monkeypatch.setattr(compiled, "request", refuse)
-    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.trajopt"):
+    monkeypatch.setattr(codegen, "request", refuse)
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.motion.optimiser_build"):
         build = OptimiserBuild(ctx, TrajOptOptions(knots=6), background=False)
         opt = build.get()
     assert isinstance(opt, TrajectoryOptimiser) and opt._library is None
@@ -222,13 +224,13 @@ def test_a_library_with_other_values_is_not_used_and_removed(
     """A library found under the optimiser's recipe that is something else (a stale cache):
     refused, deleted (the next process compiles it again), the optimiser stays uncompiled."""
     opt = TrajectoryOptimiser(ctx, TrajOptOptions(knots=5, compiled=False))
-    impostor = compiled.library_path(opt.recipe(), cache)
-    code = compiled.source([_function()], "small")
-    cc = compiled.compiler()
-    assert cc is not None and compiled.start_compile(code, impostor, cc, FAST)
+    impostor = codegen.library_path(opt.recipe(), cache)
+    code = codegen.source([_function()], "small")
+    cc = codegen.compiler()
+    assert cc is not None and codegen.start_compile(code, impostor, cc, FAST)
     _wait(impostor)
     opt._library = impostor
-    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.trajopt"):
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.motion.optimiser"):
         opt.solve(_query(ctx))
     assert not opt.compiled and opt._library is None and not impostor.exists()
     assert "could not be loaded" in caplog.text or "gives other values" in caplog.text
@@ -249,7 +251,7 @@ def test_a_broken_library_in_a_read_only_cache_is_only_refused(
 
     monkeypatch.setattr(Path, "unlink", refuse)
     opt._library = broken
-    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.trajopt"):
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.streams.motion.optimiser"):
         opt.solve(_query(ctx))
     assert not opt.compiled and opt._library is None and broken.exists()
     assert f"could not remove {broken}" in caplog.text

@@ -9,7 +9,8 @@ PROGRAM = """
 import time
 
 from streams.context import WorldContext
-from streams.trajopt import OptimiserBuild, TrajOptOptions
+from streams.motion.optimiser_build import OptimiserBuild
+from streams.motion.optimiser_records import TrajOptOptions
 
 build = OptimiserBuild(WorldContext.load(), TrajOptOptions())
 time.sleep(0.05)  # in the build (a few tenths of a second of CPU) when the program ends

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from sdar_tamp.logs import get_logger
-from streams._casadi import ca
+from streams.motion._casadi import ca
 
 _log = get_logger(__name__)
 

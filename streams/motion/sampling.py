@@ -2,13 +2,13 @@
 
 An optional extra (``pip install sdar-tamp[ompl]``). The planner samples both arms' joints
 within their limits; a state is valid when the planner's ``margin_world`` (resting and held
-objects grown by the direct-path margin, see :class:`streams.motion.MotionPlanner`)
+objects grown by the direct-path margin, see :class:`streams.motion.planner.MotionPlanner`)
 reports no collision, and OMPL checks edges every ``resolution`` [rad] of joint-space
 length. The path found is shortcut by OMPL's simplifier, then the curve that
-:func:`streams.timing.time_parameterize` follows through its waypoints is checked exactly
+:func:`streams.motion.timing.time_parameterize` follows through its waypoints is checked exactly
 (5 mm of TCP travel) in the same world; if the spline bulges into an obstacle, the path is
 densified once and checked again. The motion is then assembled, timed and validated like
-any other strategy's (:func:`streams.motion.plan_dual_motion`).
+any other strategy's (:func:`streams.motion.ladder.plan_dual_motion`).
 
 Work is bounded by counts, not seconds (``max_checks`` state checks for planning,
 ``simplify_checks`` for shortcutting), and every query restarts OMPL's process-wide seed
@@ -17,7 +17,7 @@ same path whatever the process planned before it (a benchmark worker that solves
 instances in turn, in any order). OMPL's console output is lowered to warnings during each
 query (silenced while the seed is set) and restored.
 
-:class:`SampledStrategy` is a :class:`streams.motion.TransferStrategy`; with
+:class:`SampledStrategy` is a :class:`streams.motion.strategies.TransferStrategy`; with
 ``refine=True`` the trajectory optimiser is warm-started from the sampled path and its
 result kept when it executes faster.
 """
@@ -35,17 +35,17 @@ import numpy as np
 
 from sdar_tamp.errors import ParameterError, SdarError
 from sdar_tamp.world.transforms import FloatArray
-from streams.motion import (
-    MotionPlanner,
+from streams.motion.exact_check import validate_trajectory
+from streams.motion.records import TransferProblem
+from streams.motion.strategies import (
     PlainStrategy,
     SequentialStrategy,
-    TransferProblem,
     TransferStrategy,
     UntangleStrategy,
 )
-from streams.timing import spline_curve, time_parameterize
-from streams.trajopt import densify
-from streams.validate import validate_trajectory
+from streams.motion.timing import spline_curve, time_parameterize
+from streams.motion.transfers import Transfers
+from streams.motion.waypoints import densify
 
 
 class OmplUnavailableError(SdarError):
@@ -101,16 +101,16 @@ def _ompl() -> tuple[Any, Any, Any]:
 
 
 def sample_path(
-    planner: MotionPlanner,
+    transfers: Transfers,
     q_a: FloatArray,
     q_b: FloatArray,
     options: SamplingOptions | None = None,
 ) -> FloatArray | None:
-    """Collision-free waypoints ``(k, dof)`` from ``q_a`` to ``q_b`` (``planner.margin_world``
+    """Collision-free waypoints ``(k, dof)`` from ``q_a`` to ``q_b`` (``transfers.margin_world``
     configured for the segment), shortcut; None when the budget runs out."""
     o = options or SamplingOptions()
     ob, og, ou = _ompl()
-    ctx, world = planner.ctx, planner.margin_world
+    ctx, world = transfers.ctx, transfers.margin_world
     lo, hi = ctx.scene.joint_array("lower"), ctx.scene.joint_array("upper")
     q_a, q_b = np.asarray(q_a, dtype=np.float64), np.asarray(q_b, dtype=np.float64)
     # arms that do not move are pinned: zero-width bounds keep them at their start
@@ -204,12 +204,12 @@ def _state(space: Any, q: FloatArray, free: Any) -> Any:
     return state
 
 
-def checked_waypoints(planner: MotionPlanner, W: FloatArray, samples: int) -> FloatArray | None:
+def checked_waypoints(transfers: Transfers, W: FloatArray, samples: int) -> FloatArray | None:
     """``W`` (or ``W`` densified) whose timed curve passes the exact check in
-    ``planner.margin_world``; None if neither does."""
+    ``transfers.margin_world``; None if neither does."""
     for waypoints in (W, densify(W, 4)):
         curve = spline_curve(waypoints, max(samples, 2 * len(waypoints)))
-        if validate_trajectory(planner.ctx, planner.margin_world, curve).ok:
+        if validate_trajectory(transfers.ctx, transfers.margin_world, curve).ok:
             return waypoints
     return None
 
@@ -223,51 +223,51 @@ class SampledStrategy:
     options: SamplingOptions = SamplingOptions()
     refine: bool = False
 
-    def __call__(self, planner: MotionPlanner, problem: TransferProblem) -> list[FloatArray] | None:
-        if self.refine and planner.direct:
-            direct = planner.direct_path(problem.q_from, problem.q_to)
+    def __call__(self, transfers: Transfers, problem: TransferProblem) -> list[FloatArray] | None:
+        if self.refine and transfers.direct:
+            direct = transfers.direct_path(problem.q_from, problem.q_to)
             if direct is not None:
-                planner.direct_paths += 1
-                return [planner.refine_direct(problem, direct)]
-        W = _checked_sample(planner, problem, self.options)
+                transfers.tally.direct_paths += 1
+                return [transfers.refine_direct(problem, direct)]
+        W = _checked_sample(transfers, problem, self.options)
         if W is None:
             return None
         if self.refine:
-            refined = _optimised_along(planner, problem, W, self.options)
-            if refined is not None and _duration(planner, refined) < _duration(planner, W):
+            refined = _optimised_along(transfers, problem, W, self.options)
+            if refined is not None and _duration(transfers, refined) < _duration(transfers, W):
                 return [refined]
         return [W]
 
 
 def sampled_warm_start(
-    planner: MotionPlanner, problem: TransferProblem, options: SamplingOptions | None = None
+    transfers: Transfers, problem: TransferProblem, options: SamplingOptions | None = None
 ) -> FloatArray | None:
     """The optimiser's transfer warm-started from a sampled path (:func:`sample_path`, its
     timed curve checked), kept only when the optimiser succeeds and the optimised path's
     timed curve passes the same check; None otherwise. The first rung of SDAR-M's ladder
-    (:class:`streams.motion.PlainStrategy`) tries it after the straight line."""
+    (:class:`streams.motion.strategies.PlainStrategy`) tries it after the straight line."""
     o = options or SamplingOptions()
-    W = _checked_sample(planner, problem, o)
-    return None if W is None else _optimised_along(planner, problem, W, o)
+    W = _checked_sample(transfers, problem, o)
+    return None if W is None else _optimised_along(transfers, problem, W, o)
 
 
 def _checked_sample(
-    planner: MotionPlanner, problem: TransferProblem, o: SamplingOptions
+    transfers: Transfers, problem: TransferProblem, o: SamplingOptions
 ) -> FloatArray | None:
-    """A sampled path for ``problem`` (counted in ``planner.sampled_paths``) whose timed curve
-    passes the exact check (:func:`checked_waypoints`), or None."""
-    W = sample_path(planner, problem.q_from, problem.q_to, o)
-    planner.sampled_paths += int(W is not None)
-    return None if W is None else checked_waypoints(planner, W, o.curve_samples)
+    """A sampled path for ``problem`` (counted in ``transfers.tally.sampled_paths``) whose
+    timed curve passes the exact check (:func:`checked_waypoints`), or None."""
+    W = sample_path(transfers, problem.q_from, problem.q_to, o)
+    transfers.tally.sampled_paths += int(W is not None)
+    return None if W is None else checked_waypoints(transfers, W, o.curve_samples)
 
 
 def _optimised_along(
-    planner: MotionPlanner, problem: TransferProblem, W: FloatArray, o: SamplingOptions
+    transfers: Transfers, problem: TransferProblem, W: FloatArray, o: SamplingOptions
 ) -> FloatArray | None:
     """The optimiser's path warm-started along ``W``, if it succeeds and its timed curve
     passes the same check; else None."""
-    path = planner.optimise(problem, problem.q_from, problem.q_to, planner.warm_start_along(W))
-    if path is None or checked_waypoints(planner, path, o.curve_samples) is None:
+    path = transfers.optimise(problem, problem.q_from, problem.q_to, transfers.warm_start_along(W))
+    if path is None or checked_waypoints(transfers, path, o.curve_samples) is None:
         return None
     return path
 
@@ -275,7 +275,7 @@ def _optimised_along(
 def warm_started_strategies(
     fallbacks: bool = True, options: SamplingOptions | None = None
 ) -> tuple[TransferStrategy, ...]:
-    """SDAR-M's ladder (:func:`streams.motion.default_strategies`) whose first rung tries a
+    """SDAR-M's ladder (:func:`streams.motion.ladder.default_strategies`) whose first rung tries a
     sampled path's warm start (:func:`sampled_warm_start` with ``options``) after the
     straight line's and before the lifted via-point's; the first rung alone unless
     ``fallbacks``."""
@@ -283,8 +283,8 @@ def warm_started_strategies(
     return (plain,) if not fallbacks else (plain, UntangleStrategy(), SequentialStrategy())
 
 
-def _duration(planner: MotionPlanner, path: FloatArray) -> float:
-    v, a = planner.limits
+def _duration(transfers: Transfers, path: FloatArray) -> float:
+    v, a = transfers.limits
     return time_parameterize(path, v, a).duration
 
 

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from sdar_tamp.errors import ParameterError
-from streams import timing
-from streams.timing import (
+from streams.motion import timing
+from streams.motion.timing import (
     natural_spline,
     sample_limit_ratio,
     spline_curve,

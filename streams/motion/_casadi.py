@@ -13,8 +13,8 @@ import numpy as np
 
 from sdar_tamp.world.transforms import FloatArray
 
-#: The casadi module, typed as ``Any`` for the symbolic code in :mod:`streams.fk_casadi` and
-#: :mod:`streams.trajopt`.
+#: The casadi module, typed as ``Any`` for the symbolic code in :mod:`streams.motion.fk_casadi` and
+#: :mod:`streams.motion.optimiser`.
 ca: Any = _ca
 
 

@@ -18,8 +18,8 @@ from sdar_tamp.world.kinematics import T_BASE_DH
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
 from sdar_tamp.world.ur_ik import UR5E, URParameters
-from streams._casadi import ca, function, sx_sym, to_array
-from streams.spheres import ArmSpheres, arm_spheres
+from streams.motion._casadi import ca, function, sx_sym, to_array
+from streams.motion.spheres import ArmSpheres, arm_spheres
 
 
 def _rz_tz(q: Any, d: float) -> Any:

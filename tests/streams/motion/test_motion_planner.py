@@ -8,24 +8,20 @@ import pytest
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
-from streams import trajopt
-from streams.cartesian import tool_pose_ik
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.ik import IKRequest, compatible_pairs, solve_ik_candidates
-from streams.motion import (
-    MotionPlanner,
-    MotionRequest,
-    SequentialStrategy,
-    TransferProblem,
-    UntangleStrategy,
-    default_strategies,
-    plan_dual_motion,
-)
-from streams.shape import ShapeOptions, straight_end_deviation
-from streams.timing import spline_curve
-from streams.trajopt import OptimiserCache, TrajOptOptions, TransferQuery, straight_line
-from streams.validate import configure_world, validate_trajectory
+from streams.motion.cartesian import tool_pose_ik
+from streams.motion.exact_check import configure_world, validate_trajectory
+from streams.motion.ladder import default_strategies, plan_dual_motion
+from streams.motion.optimiser_cache import OptimiserCache
+from streams.motion.optimiser_records import TransferQuery
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionRequest, TransferProblem
+from streams.motion.shape import ShapeOptions, straight_end_deviation
+from streams.motion.strategies import SequentialStrategy, UntangleStrategy
+from streams.motion.timing import spline_curve
+from streams.motion.waypoints import straight_line
 
 # Two grasp configurations in M1 whose straight synchronous transfer is blocked (found by search).
 BLOCKED_START = np.array([-0.9597713794940521, -1.487539072672206, 2.2951842532166142,
@@ -186,7 +182,10 @@ def test_a_colliding_retreat_fails_at_once_without_optimising(
 
 
 def test_a_clear_straight_transfer_is_taken_without_optimising(
-    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext,
+    planner: MotionPlanner,
+    objects: dict[str, ObjectBox],
+    optimisers: OptimiserCache,
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[0], names[5])
@@ -196,7 +195,7 @@ def test_a_clear_straight_transfer_is_taken_without_optimising(
     assert result.optimisation_time == 0.0 and result.trajectory is not None
     _check(ctx, result.trajectory.t, result.trajectory.q, request)
     # the same transfer through the optimiser (direct paths off) is no faster to execute
-    optimised = MotionPlanner(ctx, direct=False)
+    optimised = MotionPlanner(ctx, direct=False, optimisers=optimisers)
     assert optimised.trajopt is planner.trajopt  # one optimiser per scene and options
     again = plan_dual_motion(optimised, request)
     assert again.success and again.direct_paths == 0 and again.trajectory is not None
@@ -213,17 +212,17 @@ def test_direct_paths_need_the_margin_and_keep_waiting_arms_still(
     retreat, approach = planner.phases(request) or (None, None)
     assert retreat is not None and approach is not None
     q_a, q_b = retreat[-1][-1], approach[0][0]
-    path = planner.direct_path(q_a, q_b)
+    path = planner.transfers().direct_path(q_a, q_b)
     if path is not None:  # a bent path: it passes the check with the margin
         assert len(path) == 3
         curve = spline_curve(path, 64)
         assert validate_trajectory(ctx, planner.margin_world, curve).ok
     # an arm told to wait cannot reach a different goal directly
-    assert planner.direct_path(q_a, q_b, fixed=(True, False)) is None
+    assert planner.transfers().direct_path(q_a, q_b, fixed=(True, False)) is None
     # a waiting arm stays put on the bent paths too
     q_b2 = q_b.copy()
     q_b2[:6] = q_a[:6]
-    moved = planner.direct_path(q_a, q_b2, fixed=(True, False))
+    moved = planner.transfers().direct_path(q_a, q_b2, fixed=(True, False))
     if moved is not None:
         assert np.allclose(moved[:, :6], q_a[:6])
 
@@ -233,35 +232,11 @@ def test_direct_margin_must_not_be_negative(ctx: WorldContext) -> None:
         MotionPlanner(ctx, direct_margin=-0.001)
 
 
-def test_optimisers_are_built_once_per_scene_and_options(
-    ctx: WorldContext, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    built: list[TrajOptOptions] = []
-
-    class Fake:
-        def __init__(self, ctx: WorldContext, options: TrajOptOptions) -> None:
-            built.append(options)
-            if options.knots == 3:
-                raise ParameterError("no NLP with 3 knots")
-
-    monkeypatch.setattr(trajopt, "TrajectoryOptimiser", Fake)
-    cache = OptimiserCache()
-    six = TrajOptOptions(knots=6, compiled=False)
-    a = cache.get(ctx, six)
-    b = cache.get(ctx, six)
-    c = cache.get(ctx, TrajOptOptions(knots=7, compiled=False), background=False)
-    assert a is b and c is not a and len(cache) == 2
-    assert a.get() is b.get() and a.ready and a.build_time >= 0.0
-    assert [o.knots for o in sorted(built, key=lambda o: o.knots)] == [6, 7]
-    planner = MotionPlanner(ctx, six, optimisers=cache)
-    assert planner.trajopt is a.get() and len(built) == 2  # no second build
-    broken = cache.get(ctx, TrajOptOptions(knots=3, compiled=False))
-    with pytest.raises(ParameterError, match="no NLP with 3 knots"):
-        broken.get()
-
-
 def test_blended_pick_motion_is_valid_and_ends_straight(
-    ctx: WorldContext, planner: MotionPlanner, objects: dict[str, ObjectBox]
+    ctx: WorldContext,
+    planner: MotionPlanner,
+    objects: dict[str, ObjectBox],
+    optimisers: OptimiserCache,
 ) -> None:
     names = list(objects)
     q_goal = _pick_goal(ctx, objects, names[0], names[5])
@@ -270,7 +245,7 @@ def test_blended_pick_motion_is_valid_and_ends_straight(
     assert result.success and result.blended and result.trajectory is not None
     traj = result.trajectory
     _check(ctx, traj.t, traj.q, request)
-    unblended = MotionPlanner(ctx, shape=ShapeOptions(blend=False))
+    unblended = MotionPlanner(ctx, shape=ShapeOptions(blend=False), optimisers=optimisers)
     slow = plan_dual_motion(unblended, request)
     assert slow.success and not slow.blended and slow.trajectory is not None
     assert traj.duration < slow.trajectory.duration  # no stop at the pre-grasp points
@@ -334,7 +309,7 @@ def _bent_transfer(
     """The transfer between BENT_FROM and BENT_TO, and its bent direct path (3 waypoints)."""
     for world in (planner.world, planner.margin_world):
         configure_world(ctx, world, objects, {}, BENT_FROM)
-    bent = planner.direct_path(BENT_FROM, BENT_TO)
+    bent = planner.transfers().direct_path(BENT_FROM, BENT_TO)
     assert bent is not None and len(bent) == 3, "the case needs a bent direct path"
     request = MotionRequest(BENT_FROM, BENT_TO, objects)
     return planner.transfer_problem(request, BENT_FROM, BENT_TO), bent
@@ -342,34 +317,37 @@ def _bent_transfer(
 
 def _duration(planner: MotionPlanner, path: np.ndarray) -> float:
     v, a = planner.limits
-    from streams.timing import time_parameterize
+    from streams.motion.timing import time_parameterize
 
     return time_parameterize(path, v, a).duration
 
 
 def test_a_bent_direct_path_is_refined_when_the_optimiser_makes_it_faster(
-    ctx: WorldContext, objects: dict[str, ObjectBox]
+    ctx: WorldContext, objects: dict[str, ObjectBox], optimisers: OptimiserCache
 ) -> None:
-    planner = MotionPlanner(ctx)
+    planner = MotionPlanner(ctx, optimisers=optimisers)
     assert planner.refine_bent
     problem, bent = _bent_transfer(ctx, planner, objects)
-    refined = planner.refine_direct(problem, bent)
+    refined = planner.transfers().refine_direct(problem, bent)
     assert refined is not bent and len(refined) > 3
     assert _duration(planner, refined) < _duration(planner, bent)
     assert np.allclose(refined[0], bent[0]) and np.allclose(refined[-1], bent[-1])
     curve = spline_curve(refined, 128)
     assert validate_trajectory(ctx, planner.margin_world, curve).ok
     # off: the bent path as it is; a straight path is never handed to the optimiser
-    plain = MotionPlanner(ctx, refine_bent=False)
-    assert plain.refine_direct(problem, bent) is bent
+    plain = MotionPlanner(ctx, refine_bent=False, optimisers=optimisers)
+    assert plain.transfers().refine_direct(problem, bent) is bent
     straight = np.stack([bent[0], bent[-1]])
-    assert planner.refine_direct(problem, straight) is straight
+    assert planner.transfers().refine_direct(problem, straight) is straight
 
 
 def test_a_refinement_that_collides_or_is_slower_keeps_the_bent_path(
-    ctx: WorldContext, objects: dict[str, ObjectBox], monkeypatch: pytest.MonkeyPatch
+    ctx: WorldContext,
+    objects: dict[str, ObjectBox],
+    monkeypatch: pytest.MonkeyPatch,
+    optimisers: OptimiserCache,
 ) -> None:
-    planner = MotionPlanner(ctx)
+    planner = MotionPlanner(ctx, optimisers=optimisers)
     problem, bent = _bent_transfer(ctx, planner, objects)
     solve = planner.trajopt.solve
 
@@ -382,7 +360,7 @@ def test_a_refinement_that_collides_or_is_slower_keeps_the_bent_path(
     assert _duration(planner, straight) < _duration(planner, bent)
     assert not validate_trajectory(ctx, planner.margin_world, spline_curve(straight, 128)).ok
     monkeypatch.setattr(planner.trajopt, "solve", through_the_table)
-    assert planner.refine_direct(problem, bent) is bent
+    assert planner.transfers().refine_direct(problem, bent) is bent
 
     def slower(query: TransferQuery, warm: np.ndarray | None = None) -> object:
         result = solve(query, warm)
@@ -393,4 +371,4 @@ def test_a_refinement_that_collides_or_is_slower_keeps_the_bent_path(
         return np.concatenate([path[:2], path[:1], path])
 
     monkeypatch.setattr(planner.trajopt, "solve", slower)
-    assert planner.refine_direct(problem, bent) is bent
+    assert planner.transfers().refine_direct(problem, bent) is bent

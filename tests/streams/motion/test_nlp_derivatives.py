@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from streams._casadi import ca, to_array
-from streams.motion import MotionPlanner
+from streams.motion._casadi import ca, to_array
+from streams.motion.planner import MotionPlanner
 
 
 def _point(planner: MotionPlanner, seed: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1,6 +1,6 @@
 """Numeric sphere clearances along a dual-arm path, for choosing the optimiser's pair slots.
 
-Arm spheres are those of :class:`streams.spheres.ArmSpheres` followed by the held-object
+Arm spheres are those of :class:`streams.motion.spheres.ArmSpheres` followed by the held-object
 spheres of that arm (given in the tool0 frame). Clearance of a sphere pair is
 ``|c_i - c_j| - r_i - r_j`` [m]; of a sphere and the table, ``z - r``.
 """

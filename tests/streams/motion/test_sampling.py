@@ -5,19 +5,21 @@ import pytest
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
-from streams import sampling
 from streams.context import WorldContext
-from streams.motion import MotionPlanner, MotionRequest, plan_dual_motion
-from streams.sampling import (
+from streams.motion import sampling
+from streams.motion.exact_check import configure_world, validate_trajectory
+from streams.motion.ladder import plan_dual_motion
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionRequest, MotionTally
+from streams.motion.sampling import (
     OmplUnavailableError,
     SampledStrategy,
     SamplingOptions,
     sample_path,
 )
-from streams.validate import configure_world, validate_trajectory
 
 # Two grasp configurations in M1 whose straight synchronous transfer is blocked (as in
-# test_motion.py).
+# test_motion_planner.py).
 BLOCKED_START = np.array([-0.9597713794940521, -1.487539072672206, 2.2951842532166142,
     -2.3784415073393053, -1.5707963267948966, 0.6482225313692203, -0.5339339743344569,
     -0.675777200007472, 1.1304521182278542, -1.6688772479994611, -0.8550081079150917,
@@ -56,7 +58,7 @@ def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
     _, q_a, q_b = _blocked_transfer(ctx, planner, objects)
     straight = np.linspace(0.0, 1.0, 30)[:, None] * (q_b - q_a)[None] + q_a[None]
     assert not validate_trajectory(ctx, planner.world, straight).ok
-    W = sample_path(planner, q_a, q_b)
+    W = sample_path(planner.transfers(), q_a, q_b)
     assert W is not None and len(W) >= 3
     np.testing.assert_allclose(W[[0, -1]], np.stack([q_a, q_b]))
     for k in range(len(W)):  # every waypoint is clear, with the margin
@@ -64,12 +66,12 @@ def test_sampled_path_is_collision_free_where_the_straight_line_is_not(
     # a waiting arm stays where it is
     layout = ctx.layout
     q_b2 = layout.replace(q_b, "left", layout.part(q_a, "left"))
-    W2 = sample_path(planner, q_a, q_b2)
+    W2 = sample_path(planner.transfers(), q_a, q_b2)
     assert W2 is not None and np.allclose(layout.part(W2, "left"), layout.part(q_a, "left"))
     # a goal in collision ends at once (RRTConnect alone would wait for a valid goal)
     q_bad = layout.replace(q_b, "right", layout.part(q_a, "right"))
     assert planner.margin_world.in_collision(q_bad)
-    assert sample_path(planner, q_a, q_bad) is None
+    assert sample_path(planner.transfers(), q_a, q_bad) is None
 
 
 @needs_ompl
@@ -80,12 +82,12 @@ def test_a_query_gives_the_same_path_whatever_ran_before_it(
     retreat, approach = planner.phases(_blocked(objects)) or (None, None)
     assert retreat is not None and approach is not None
     q_a, q_b = retreat[-1][-1], approach[0][0]
-    first = sample_path(planner, q_a, q_b)
-    other = sample_path(planner, q_b, q_a)  # advances OMPL's process-wide sequence
-    again = sample_path(planner, q_a, q_b)
+    first = sample_path(planner.transfers(), q_a, q_b)
+    other = sample_path(planner.transfers(), q_b, q_a)  # advances OMPL's process-wide sequence
+    again = sample_path(planner.transfers(), q_a, q_b)
     assert first is not None and other is not None and again is not None
     np.testing.assert_array_equal(first, again)
-    reseeded = sample_path(planner, q_a, q_b, SamplingOptions(seed=1))
+    reseeded = sample_path(planner.transfers(), q_a, q_b, SamplingOptions(seed=1))
     assert reseeded is not None and not np.array_equal(reseeded, first)
     assert sampling.query_seed(0, q_a, q_b) == sampling.query_seed(0, q_a.copy(), q_b.copy())
     assert sampling.query_seed(0, q_a, q_b) != sampling.query_seed(0, q_b, q_a)
@@ -128,7 +130,7 @@ def test_missing_ompl_is_a_clear_error(
     monkeypatch.setattr(sampling, "ompl_available", lambda: False)
     q = np.concatenate([ctx.home(a) for a in ctx.arm_names])
     with pytest.raises(OmplUnavailableError, match=r"pip install 'sdar-tamp\[ompl\]'"):
-        sample_path(planner, q, q + 0.1)
+        sample_path(planner.transfers(), q, q + 0.1)
 
 
 @needs_ompl
@@ -137,18 +139,19 @@ def test_a_sampled_path_warm_starts_the_optimiser(
 ) -> None:
     request, q_a, q_b = _blocked_transfer(ctx, planner, objects)
     problem = planner.transfer_problem(request, q_a, q_b)
-    planner.sampled_paths = planner.ipopt_solves = 0
-    path = sampling.sampled_warm_start(planner, problem)
-    assert path is not None and planner.sampled_paths == 1 and planner.ipopt_solves == 1
+    tally = MotionTally()
+    path = sampling.sampled_warm_start(planner.transfers(tally), problem)
+    assert path is not None and tally.sampled_paths == 1 and tally.ipopt_solves == 1
     assert path.shape == (planner.build.options.knots, len(BLOCKED_START))
     np.testing.assert_allclose(path[[0, -1]], np.stack([problem.q_from, problem.q_to]))
     # the optimised knots, not the sampled waypoints, and their timed curve is clear
-    assert sampling.checked_waypoints(planner, path, SamplingOptions().curve_samples) is not None
+    samples = SamplingOptions().curve_samples
+    assert sampling.checked_waypoints(planner.transfers(), path, samples) is not None
     # no sampled path within the budget: nothing, and no optimisation
     tiny = SamplingOptions(max_checks=1)
-    planner.sampled_paths = planner.ipopt_solves = 0
-    assert sampling.sampled_warm_start(planner, problem, tiny) is None
-    assert planner.sampled_paths == 0 and planner.ipopt_solves == 0
+    tally = MotionTally()
+    assert sampling.sampled_warm_start(planner.transfers(tally), problem, tiny) is None
+    assert tally.sampled_paths == 0 and tally.ipopt_solves == 0
 
 
 class _StubPlanner:
@@ -186,7 +189,7 @@ class _StubProblem:
 def test_the_plain_rung_tries_its_rescue_between_straight_and_lifted(
     rescue: bool, succeed_with: str, calls: list[str]
 ) -> None:
-    from streams.motion import PlainStrategy
+    from streams.motion.strategies import PlainStrategy
 
     stub = _StubPlanner(succeed_with)
 
@@ -202,8 +205,8 @@ def test_the_plain_rung_tries_its_rescue_between_straight_and_lifted(
 def test_sdar_m_warm_starts_from_a_sampled_path_where_ompl_is_installed(
     ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from streams import stream_map
-    from streams.motion import PlainStrategy
+    from streams import motion_streams, stream_map
+    from streams.motion.strategies import PlainStrategy
 
     ladder = sampling.warm_started_strategies(options=SamplingOptions(seed=3))
     assert [s.name for s in ladder] == ["plain", "untangle", "sequential"]
@@ -214,7 +217,7 @@ def test_sdar_m_warm_starts_from_a_sampled_path_where_ompl_is_installed(
     streams = stream_map.RearrangementStreams(ctx, {}, planner=planner)
     assert streams.sampling == sampling.ompl_available()
     assert not stream_map.RearrangementStreams(ctx, {}, planner=planner, sampling=False).sampling
-    monkeypatch.setattr(stream_map, "ompl_available", lambda: False)
+    monkeypatch.setattr(motion_streams, "ompl_available", lambda: False)
     assert not stream_map.RearrangementStreams(ctx, {}, planner=planner).sampling
     with pytest.raises(OmplUnavailableError, match=r"sampling=True: .*pip install"):
         stream_map.RearrangementStreams(ctx, {}, planner=planner, sampling=True)

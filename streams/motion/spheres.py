@@ -3,7 +3,7 @@
 Every sphere set *covers* its primitive: a cylinder of radius ``r`` and length ``L`` becomes
 ``n`` spheres on its axis, spacing ``s = L / n``, radius ``sqrt(r^2 + (s/2)^2)``; a box becomes a
 grid of cells, one sphere per cell circumscribing it. The optimiser keeps these spheres apart;
-the exact coal check (:mod:`streams.validate`) decides in the end.
+the exact coal check (:mod:`streams.motion.exact_check`) decides in the end.
 """
 
 from __future__ import annotations

@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 
 from sdar_tamp.world.kinematics import ArmKinematics
-from streams._casadi import ca, function, sx_sym, to_array
 from streams.context import WorldContext
-from streams.fk_casadi import joint_frames
-from streams.spheres import arm_spheres, box_spheres, cylinder_spheres
+from streams.motion._casadi import ca, function, sx_sym, to_array
+from streams.motion.fk_casadi import joint_frames
+from streams.motion.spheres import arm_spheres, box_spheres, cylinder_spheres
 
 LINKS = ("shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link",
          "wrist_3_link")  # fmt: skip

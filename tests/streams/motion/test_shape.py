@@ -10,9 +10,9 @@ import pytest
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.transforms import pose_xyz_yaw
-from streams.cartesian import straight_tool_move
 from streams.context import WorldContext
-from streams.shape import (
+from streams.motion.cartesian import straight_tool_move
+from streams.motion.shape import (
     FINGER_ENVELOPE,
     ShapeOptions,
     clearance_lift,

@@ -3,7 +3,12 @@ import numpy as np
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.transforms import pose_xyz_yaw
 from streams.context import WorldContext
-from streams.validate import HeldObject, configure_world, interpolate_by_tcp, validate_trajectory
+from streams.motion.exact_check import (
+    HeldObject,
+    configure_world,
+    interpolate_by_tcp,
+    validate_trajectory,
+)
 
 
 def test_interpolation_keeps_tcp_steps_below_a_centimetre(ctx: WorldContext) -> None:

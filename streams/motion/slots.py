@@ -1,0 +1,221 @@
+"""Which sphere pairs get the optimiser's slots: the sphere tables the slots are filled from,
+the choice of the closest pairs along a warm start, and the pairs without a slot that a
+solution brings too close (the next active-set round's forced pairs).
+
+Each slot constraint is ``|c_i - c_j|^2 - (r_i + r_j + margin)^2 >= lb`` (table:
+``z - r - margin >= lb``) with ``lb = 0`` unless an end point itself is closer (the fixed
+end points may touch, e.g. a held object on the table at a place), then ``lb`` is that value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sdar_tamp.world.transforms import FloatArray
+from streams.context import WorldContext
+from streams.motion.nlp import FRAMES
+from streams.motion.optimiser_records import TrajOptOptions, TransferQuery
+from streams.motion.sphere_pairs import (
+    HeldSpheres,
+    PathSpheres,
+    arm_arm_clearance,
+    obstacle_clearance,
+    table_clearance,
+)
+
+
+@dataclass(frozen=True)
+class SphereTable:
+    """Spheres of one arm as the optimiser's slots see them: frame index ``(n,)`` (0-based),
+    centre in that frame ``(n, 3)`` [m], radius ``(n,)`` [m]."""
+
+    frame: Any
+    centre: FloatArray
+    radius: FloatArray
+
+    def plus(self, held: HeldSpheres) -> SphereTable:
+        """With the held spheres appended (on tool0), as :func:`path_spheres` orders them."""
+        n = len(held.radius)
+        return SphereTable(
+            np.concatenate([self.frame, np.full(n, FRAMES - 1, dtype=np.int64)]),
+            np.concatenate([self.centre, np.asarray(held.centre).reshape(n, 3)]),
+            np.concatenate([self.radius, held.radius]),
+        )
+
+    def slots(self, idx: Any, slots: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Slot rows for spheres ``idx``: one-hot frames ``(slots, FRAMES)``, centres
+        ``(slots, 3)``, radii ``(slots, 1)``; unused slots are zero."""
+        idx = np.asarray(idx, dtype=np.int64)
+        frame = np.zeros((slots, FRAMES))
+        centre, radius = np.zeros((slots, 3)), np.zeros((slots, 1))
+        frame[np.arange(len(idx)), self.frame[idx]] = 1.0
+        centre[: len(idx)] = self.centre[idx]
+        radius[: len(idx), 0] = self.radius[idx]
+        return frame, centre, radius
+
+
+@dataclass(frozen=True)
+class ArmSphereTables:
+    """One arm's fine spheres (arm-obstacle and arm-table slots) and coarse spheres
+    (arm-arm slots)."""
+
+    fine: SphereTable
+    coarse: SphereTable
+
+    def with_held(self, held: HeldSpheres) -> tuple[SphereTable, SphereTable]:
+        """Fine and coarse tables with the held object's spheres appended."""
+        return self.fine.plus(held), self.coarse.plus(held)
+
+
+def arm_sphere_tables(ctx: WorldContext, arm: str) -> ArmSphereTables:
+    """The sphere tables of ``arm`` from its symbolic FK's sphere models."""
+    fk = ctx.fk[arm]
+
+    def table(spheres: Any) -> SphereTable:
+        frame = np.asarray(spheres.joint, dtype=np.int64) - 1
+        return SphereTable(frame, np.asarray(spheres.centre), np.asarray(spheres.radius))
+
+    return ArmSphereTables(table(fk.spheres), table(fk.coarse))
+
+
+def slot_lower_bounds(lb: FloatArray, slots: int) -> FloatArray:
+    """``lb`` padded to ``slots`` entries with ``-inf`` (unused slots constrain nothing)."""
+    out = np.full(slots, -np.inf)
+    out[: len(lb)] = lb
+    return out
+
+
+@dataclass(frozen=True)
+class Selection:
+    """Chosen pairs: ``aa`` ``(n, 2)`` sphere indices; ``ao[i]`` ``(n, 2)`` (arm sphere,
+    obstacle sphere); ``table[i]`` ``(n,)``; and each slot's constraint lower bound."""
+
+    aa: Any
+    ao: tuple[Any, ...]  # per arm
+    table: tuple[Any, ...]  # per arm
+    aa_lb: FloatArray
+    ao_lb: tuple[FloatArray, ...]  # per arm
+    table_lb: tuple[FloatArray, ...]  # per arm
+
+
+@dataclass(frozen=True)
+class Violators:
+    """Pairs without a slot that a solution brings too close, per kind (arm-arm; per arm
+    arm-obstacle and arm-table)."""
+
+    aa: set[tuple[int, int]]
+    ao: tuple[set[tuple[int, int]], ...]  # per arm
+    table: tuple[set[int], ...]  # per arm
+
+    def any_left(self) -> bool:
+        return bool(self.aa or any(self.ao) or any(self.table))
+
+    def merged(self, other: Selection | None) -> Selection:
+        def pairs(base: Any, extra: set[tuple[int, int]]) -> Any:
+            have = {tuple(int(v) for v in r) for r in np.asarray(base).reshape(-1, 2)}
+            return np.array(sorted(have | extra), dtype=np.int64).reshape(-1, 2)
+
+        def singles(base: Any, extra: set[int]) -> Any:
+            return np.array(sorted({int(v) for v in np.asarray(base)} | extra), dtype=np.int64)
+
+        empty2 = np.zeros((0, 2), dtype=np.int64)
+        empty1 = np.zeros(0, dtype=np.int64)
+        nolb = np.zeros(0)
+        aa = pairs(other.aa if other else empty2, self.aa)
+        arms = range(len(self.ao))
+        ao = tuple(pairs(other.ao[i] if other else empty2, self.ao[i]) for i in arms)
+        tb = tuple(singles(other.table[i] if other else empty1, self.table[i]) for i in arms)
+        nolbs = tuple(nolb for _ in arms)
+        return Selection(aa, ao, tb, nolb, nolbs, nolbs)
+
+
+def _pick(clear: FloatArray, slots: int, limit: float, forced: Any) -> Any:
+    """Indices (rows of ``np.argwhere``) of the ``slots`` smallest entries below ``limit``,
+    forced ones first."""
+    flat = clear.reshape(-1)
+    forced_flat = (
+        np.ravel_multi_index(tuple(np.asarray(forced, dtype=np.int64).T), clear.shape)
+        if forced is not None and np.asarray(forced).size
+        else np.zeros(0, dtype=np.int64)
+    )
+    order = [int(i) for i in np.argsort(flat) if flat[i] < limit and i not in set(forced_flat)]
+    chosen = (list(dict.fromkeys(int(i) for i in forced_flat)) + order)[:slots]
+    return np.stack(np.unravel_index(np.array(chosen, dtype=np.int64), clear.shape), axis=1)
+
+
+def select_pairs(
+    dense: PathSpheres,
+    ends: PathSpheres,
+    query: TransferQuery,
+    o: TrajOptOptions,
+    forced: Selection | None,
+) -> Selection:
+    """The pairs that get slots: per kind the closest along ``dense`` (the warm start's
+    spheres) below ``select_distance``, ``forced`` ones first, each with its lower bound from
+    the end points ``ends``."""
+    aa_c = arm_arm_clearance(dense).min(axis=0)
+    aa = _pick(aa_c, o.arm_arm_slots, o.select_distance, forced.aa if forced else None)
+    aa_end = arm_arm_clearance(ends)[:, aa[:, 0], aa[:, 1]]
+    rl, rr = ends.coarse_radii[0][aa[:, 0]], ends.coarse_radii[1][aa[:, 1]]
+    aa_lb = _lb_sq(aa_end, rl + rr, o.margin)
+    ao, ao_lb, tb, tb_lb = [], [], [], []
+    oc, orad = query.obstacles
+    for i in range(len(query.held)):
+        if len(orad):
+            c = obstacle_clearance(dense, i, oc, orad).min(axis=0)
+            sel = _pick(c, o.obstacle_slots, o.select_distance, forced.ao[i] if forced else None)
+            end = obstacle_clearance(ends, i, oc, orad)[:, sel[:, 0], sel[:, 1]]
+            ao_lb.append(_lb_sq(end, ends.radii[i][sel[:, 0]] + orad[sel[:, 1]], o.margin))
+        else:
+            sel, _ = np.zeros((0, 2), dtype=np.int64), None
+            ao_lb.append(np.zeros(0))
+        ao.append(sel)
+        t = table_clearance(dense, i).min(axis=0)
+        tsel = _pick(
+            t, o.table_slots, o.select_distance, forced.table[i][:, None] if forced else None
+        )[:, 0]
+        tend = table_clearance(ends, i)[:, tsel].min(axis=0)
+        tb.append(tsel)
+        tb_lb.append(np.minimum(0.0, tend - o.margin) - 1e-6)
+    return Selection(aa, tuple(ao), tuple(tb), aa_lb, tuple(ao_lb), tuple(tb_lb))
+
+
+def _lb_sq(end_clearance: FloatArray, rsum: FloatArray, margin: float) -> FloatArray:
+    """Lower bound of ``d^2 - (rsum + margin)^2`` from the end points' clearances ``(2, n)``."""
+    d = np.maximum(end_clearance.min(axis=0) + rsum, 0.0)
+    out: FloatArray = np.minimum(0.0, d**2 - (rsum + margin) ** 2) - 1e-6
+    return out
+
+
+def violations(
+    dense: PathSpheres, ends: PathSpheres, query: TransferQuery, selection: Selection
+) -> tuple[float, Violators]:
+    """Pairs without a slot that come closer than zero clearance on the dense path (and
+    closer than at both end points). Pairs with a slot are the NLP's business."""
+    tol = -1e-3
+    aa = arm_arm_clearance(dense).min(axis=0)
+    aa_end = arm_arm_clearance(ends).min(axis=0)
+    bad_aa = {(int(a), int(b)) for a, b in np.argwhere(aa < np.minimum(0.0, aa_end) + tol)}
+    bad_aa -= {(int(a), int(b)) for a, b in selection.aa}
+    worst = float(aa.min())
+    ao: list[set[tuple[int, int]]] = []
+    tb: list[set[int]] = []
+    oc, orad = query.obstacles
+    for i in range(len(query.held)):
+        if len(orad):
+            c = obstacle_clearance(dense, i, oc, orad).min(axis=0)
+            ce = obstacle_clearance(ends, i, oc, orad).min(axis=0)
+            bad = {(int(a), int(b)) for a, b in np.argwhere(c < np.minimum(0.0, ce) + tol)}
+            ao.append(bad - {(int(a), int(b)) for a, b in selection.ao[i]})
+            worst = min(worst, float(c.min()))
+        else:
+            ao.append(set())
+        t = table_clearance(dense, i).min(axis=0)
+        te = table_clearance(ends, i).min(axis=0)
+        bad_t = {int(a) for a in np.flatnonzero(t < np.minimum(0.0, te) + tol)}
+        tb.append(bad_t - {int(a) for a in selection.table[i]})
+        worst = min(worst, float(t.min()))
+    return worst, Violators(bad_aa, tuple(ao), tuple(tb))
