@@ -97,8 +97,10 @@ def _references(page: Path) -> list[tuple[int, str]]:
             continue
         if "/" in token and token.split("/")[0] in TOP_FOLDERS:
             refs.append((line, token.split(":")[0].split("#")[0]))
-        elif re.fullmatch(r"[A-Za-z_][\w]*(\.[A-Za-z_]\w*)+", token) and (
-            token.split(".")[0] in PACKAGES
+        elif (
+            re.fullmatch(r"[A-Za-z_][\w]*(\.[A-Za-z_]\w*)+", token)
+            and token.split(".")[0] in PACKAGES
+            and not token.endswith(".py")  # a file name (`streams.py`), not a dotted name
         ):
             refs.append((line, token))
     return refs
