@@ -57,28 +57,6 @@ class AlgorithmPolicy(Protocol):
         ...
 
 
-class FocusedPolicy:
-    """Call the first layer of each stream plan (bind it when it has fluent streams)."""
-
-    lazy = False
-    waiting = False
-
-    def __init__(self, context: SolveContext) -> None:
-        self.binder = SkeletonBinder(context, disable_failures=True)
-
-    def prepare(self, level: int) -> None:
-        pass
-
-    def take(self, skeleton: Skeleton) -> bool:
-        if not skeleton.fluents:
-            self.binder.sample_first_layer(skeleton)
-            return False
-        return self.binder.bind(skeleton) is True
-
-    def no_new_plan(self, searched: int) -> bool:
-        return False
-
-
 class BindingPolicy:
     """Bind each stream plan once, placeholders to the outputs of earlier calls."""
 
@@ -96,6 +74,16 @@ class BindingPolicy:
 
     def no_new_plan(self, searched: int) -> bool:
         return False
+
+
+class FocusedPolicy(BindingPolicy):
+    """Call the first layer of each stream plan (bind it when it has fluent streams)."""
+
+    def take(self, skeleton: Skeleton) -> bool:
+        if not skeleton.fluents:
+            self.binder.sample_first_layer(skeleton)
+            return False
+        return self.binder.bind(skeleton) is True
 
 
 class IncrementalPolicy(BindingPolicy):
