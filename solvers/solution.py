@@ -23,6 +23,25 @@ class Certificate(NamedTuple):
     preimage_facts: tuple[tuple[Any, ...], ...]
 
 
+@dataclass(frozen=True)
+class TaskTrace:
+    """One decision of a solver that executes step by step (``algorithm="sdar"``): the task's
+    kind (``single``, ``pair``, ``swap``, ...), its objects and arms (the problem's Python
+    values), which of its moves went to a buffer, the time [s] spent selecting its grounding
+    and planning its motions, the motions it executed (and their times [s]) and the
+    groundings it tried."""
+
+    kind: str
+    objects: tuple[Any, ...]
+    arms: tuple[Any, ...]
+    to_buffer: tuple[bool, ...]
+    selection_time: float
+    motion_time: float
+    motions: int
+    tried: int
+    motion_times: tuple[float, ...]
+
+
 class Status(enum.Enum):
     SOLVED = "solved"
     INFEASIBLE = "infeasible"
@@ -63,7 +82,7 @@ class Solution:
     statistics: Mapping[str, float] = field(default_factory=dict)
     streams: Mapping[str, StreamStatistics] = field(default_factory=dict)
     diagnosis: Sequence[str] = ()
-    trace: Sequence[Mapping[str, Any]] = ()
+    trace: Sequence[TaskTrace] = ()
     partial_plan: Sequence[Action] = ()
 
     def __iter__(self) -> Iterator[Any]:

@@ -14,11 +14,11 @@ from __future__ import annotations
 import statistics
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.world.instance import Instance
-from solvers.solution import Solution
+from solvers.solution import Solution, TaskTrace
 
 
 @dataclass(frozen=True)
@@ -39,18 +39,18 @@ class TaskRecord:
     motion_times: tuple[float, ...]
 
     @classmethod
-    def from_trace(cls, record: Mapping[str, Any]) -> TaskRecord:
+    def from_trace(cls, record: TaskTrace) -> TaskRecord:
         """The record of one entry of ``Solution.trace`` (``algorithm="sdar"``)."""
         return cls(
-            kind=str(record["kind"]),
-            objects=tuple(str(o) for o in record["objects"]),
-            arms=tuple(str(a) for a in record["arms"]),
-            to_buffer=tuple(bool(b) for b in record["to_buffer"]),
-            selection_time=float(record["selection_time"]),
-            motion_time=float(record["motion_time"]),
-            motions=int(record["motions"]),
-            tried=int(record["tried"]),
-            motion_times=tuple(float(t) for t in record["motion_times"]),
+            kind=record.kind,
+            objects=tuple(str(o) for o in record.objects),
+            arms=tuple(str(a) for a in record.arms),
+            to_buffer=record.to_buffer,
+            selection_time=record.selection_time,
+            motion_time=record.motion_time,
+            motions=record.motions,
+            tried=record.tried,
+            motion_times=record.motion_times,
         )
 
     @property

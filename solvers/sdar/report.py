@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from sdar_tamp.logs import get_logger
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.tasks import Step
-from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
+from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics, TaskTrace
 
 LOG = get_logger(__name__)
 
@@ -90,17 +90,17 @@ def build_solution(
         )
     }
     trace = tuple(
-        {
-            "kind": r.kind,
-            "objects": tuple(value(o) for o in r.objects),
-            "arms": tuple(value(a) for a in r.arms),
-            "to_buffer": r.to_buffer,
-            "selection_time": r.selection_time,
-            "motion_time": r.motion_time,
-            "motions": r.motions,
-            "tried": r.tried,
-            "motion_times": tuple(r.motion_times),
-        }
+        TaskTrace(
+            kind=r.kind,
+            objects=tuple(value(o) for o in r.objects),
+            arms=tuple(value(a) for a in r.arms),
+            to_buffer=tuple(r.to_buffer),
+            selection_time=r.selection_time,
+            motion_time=r.motion_time,
+            motions=r.motions,
+            tried=r.tried,
+            motion_times=tuple(r.motion_times),
+        )
         for r in records
     )
     solved = summary.status is Status.SOLVED

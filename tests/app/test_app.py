@@ -29,7 +29,7 @@ from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.scene import Workspace
 from solvers.sdar.solver import SdarOptions
-from solvers.solution import Action, Solution
+from solvers.solution import Action, Solution, TaskTrace
 from solvers.solve import solve
 from streams.context import WorldContext
 from streams.grasps import GraspOptions
@@ -236,11 +236,11 @@ def rearrangement_streams() -> Any:
 
 def test_task_records_are_typed_and_share_wasted_time() -> None:
     record = TaskRecord.from_trace(
-        {
-            "kind": "swap", "objects": ("a", "b"), "arms": ("left", "right"),
-            "to_buffer": (False, True), "selection_time": 0.4, "motion_time": 1.0,
-            "motions": 2, "tried": 3, "motion_times": (0.3, 0.5),
-        }
+        TaskTrace(
+            kind="swap", objects=("a", "b"), arms=("left", "right"),
+            to_buffer=(False, True), selection_time=0.4, motion_time=1.0,
+            motions=2, tried=3, motion_times=(0.3, 0.5),
+        )
     )  # fmt: skip
     assert record.buffer_moves == 1 and record.objects == ("a", "b")
     steps = record.step_times()

@@ -137,8 +137,8 @@ def test_close_neighbours_trade_places_in_one_dual_arm_swap(
     r = rearrangement_problem(inst, ctx, planner=planner)
     solution = solve_rearrangement(r, "sdar", BUDGET)
     assert solution.status is Status.SOLVED, solution.diagnosis
-    assert [t["kind"] for t in solution.trace] == ["swap"]
-    assert not any(any(t["to_buffer"]) for t in solution.trace)
+    assert [t.kind for t in solution.trace] == ["swap"]
+    assert not any(any(t.to_buffer) for t in solution.trace)
     plan = plan_file_from_solution(r, solution)
     assert plan.metrics.actions == 2
     report = validate_plan(r.instance, plan, ctx.scene)
@@ -210,7 +210,7 @@ def test_neighbours_in_a_row_trade_places_in_one_swap(
     r = rearrangement_problem(inst, ctx, planner=planner)
     solution = solve_rearrangement(r, "sdar", BUDGET)
     assert solution.status is Status.SOLVED, solution.diagnosis
-    assert [t["kind"] for t in solution.trace] == ["swap"]
+    assert [t.kind for t in solution.trace] == ["swap"]
     plan = plan_file_from_solution(r, solution)
     assert plan.metrics.actions == 2
     report = validate_plan(r.instance, plan, ctx.scene)

@@ -100,14 +100,12 @@ def test_nested_box_in_is_solved_by_recursive_evictions(
 ) -> None:
     solution = solve_rearrangement(_nested_problem(ctx, planner), "sdar", BUDGET)
     assert solution.status is Status.SOLVED, solution.diagnosis
-    moves = [
-        (o, b) for t in solution.trace for o, b in zip(t["objects"], t["to_buffer"], strict=True)
-    ]
+    moves = [(o, b) for t in solution.trace for o, b in zip(t.objects, t.to_buffer, strict=True)]
     # c makes room for b, b for a; then b returns before c (c at its goal would box b in)
     assert moves.index(("c", True)) < moves.index(("b", True)) < moves.index(("a", False))
     assert moves.index(("b", False)) < moves.index(("c", False))
     assert len(moves) == 5  # a once, b and c out and back
-    assert [t["kind"] for t in solution.trace].count("evict") == 2
+    assert [t.kind for t in solution.trace].count("evict") == 2
 
 
 def test_a_deferral_ends_when_the_target_has_left_its_pose() -> None:

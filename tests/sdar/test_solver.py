@@ -79,7 +79,7 @@ def test_swap_is_one_synchronous_dual_arm_step(
     assert solution.status is Status.SOLVED
     names = [a.name for a in solution.plan or []]
     assert names == ["move", "pick-both", "move", "place-both"]
-    assert [t["kind"] for t in solution.trace] == ["swap"]
+    assert [t.kind for t in solution.trace] == ["swap"]
     plan = plan_file_from_solution(r, solution)
     assert plan.metrics.actions == 2 and plan.metrics.dual_arm_steps == 2
     report = validate_plan(r.instance, plan, ctx.scene)
@@ -116,7 +116,7 @@ def test_baseline_task_planner_solves_too(ctx: WorldContext, planner: MotionPlan
     solution = solve_rearrangement(r, "baseline", BUDGET)
     assert solution.status is Status.SOLVED
     # the baseline has no dual-arm swap: one object goes through a buffer
-    assert sum(sum(t["to_buffer"]) for t in solution.trace) == 1
+    assert sum(sum(t.to_buffer) for t in solution.trace) == 1
 
 
 def test_solve_entry_point_runs_sdar(solved_swap: tuple[Rearrangement, Solution]) -> None:
@@ -195,7 +195,7 @@ def test_crowded_goal_is_unblocked_by_an_eviction(
     )
     solution = solve_rearrangement(r, "sdar", BUDGET)
     assert solution.status is Status.SOLVED, solution.diagnosis
-    kinds = [t["kind"] for t in solution.trace]
+    kinds = [t.kind for t in solution.trace]
     assert "evict" in kinds
 
 
@@ -292,8 +292,8 @@ def test_colliding_first_grasps_widen_the_options(
         options = SdarOptions(max_time=BUDGET, more_options=more, pair_grasps=0)
         solution = SdarSolver(r.problem, make_task_planner("sdar"), options).solve()
         assert solution.status is Status.SOLVED
-        kinds[more] = [t["kind"] for t in solution.trace]
-        buffered[more] = sum(sum(t["to_buffer"]) for t in solution.trace)
+        kinds[more] = [t.kind for t in solution.trace]
+        buffered[more] = sum(sum(t.to_buffer) for t in solution.trace)
     assert "swap" not in kinds[2] and buffered[2] > 0  # the 2-cycles broken with buffers
     assert kinds[6].count("swap") == 2 and buffered[6] == 0
 
