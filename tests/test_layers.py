@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import ast
 from collections.abc import Iterator
+from functools import cache
 from pathlib import Path
 
 import pytest
@@ -84,6 +85,7 @@ def layer_of(module: str) -> str | None:
     return None
 
 
+@cache
 def module_files() -> dict[str, Path]:
     """Module name -> file, for every module of :data:`PACKAGES`."""
     out: dict[str, Path] = {}
@@ -115,6 +117,7 @@ def imports(module: str, path: Path, known: set[str]) -> Iterator[tuple[str, int
                 yield (full if full in known else base), node.lineno
 
 
+@cache
 def dependency_graph() -> dict[str, dict[str, int]]:
     """Module -> {imported module of ours: line}."""
     files = module_files()
