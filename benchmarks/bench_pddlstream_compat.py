@@ -47,6 +47,7 @@ with a checkout; without one, the skip line). The JSON keys are the same, plus
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import subprocess
@@ -67,6 +68,8 @@ class Example:
     #: set when PDDLStream itself finds no plan for the example as written (run locally with
     #: Fast Downward): what happens there
     upstream: str = ""
+    #: a module the example needs that is not a dependency of this project (an optional extra)
+    needs: str = ""
 
 
 EXAMPLES = (
@@ -110,6 +113,16 @@ EXAMPLES = (
     Example("satisfy", "examples.advanced.satisfy.run"),
     Example("rovers", "examples.ipc.rovers.run"),
     Example("satellites", "examples.ipc.satellites.run"),
+    # the robot programs: PyBullet (``pip install sdar-tamp[pybullet]``) in DIRECT mode (no
+    # $DISPLAY, so their ``connect`` opens no window)
+    Example("kuka", "examples.pybullet.kuka.run", needs="pybullet"),
+    Example("pr2", "examples.pybullet.pr2.run", needs="pybullet"),
+    Example("namo", "examples.pybullet.namo.run", needs="pybullet"),
+    Example("pr2_rovers", "examples.pybullet.pr2_rovers.run", needs="pybullet"),
+    Example("pr2_belief", "examples.pybullet.pr2_belief.run", needs="pybullet"),
+    Example("tamp", "examples.pybullet.tamp.run", needs="pybullet"),
+    Example("turtlebot_rovers", "examples.pybullet.turtlebot_rovers.run", needs="pybullet"),
+    Example("turtlebots", "examples.pybullet.turtlebots.run", needs="pybullet"),
 )
 
 #: ``--quick``'s defaults
@@ -163,6 +176,16 @@ _GUARD = (
 
 def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, object]:
     """Run one example; returns its name, result, time [s] and details."""
+    if example.needs and importlib.util.find_spec(example.needs) is None:
+        return {
+            "example": example.name,
+            "result": f"skipped: needs {example.needs!r} (pip install sdar-tamp[pybullet])",
+            "passed": False,
+            "skipped": True,
+            "seconds": 0.0,
+            "solve_calls": 0,
+            "plans": 0,
+        }
     with tempfile.TemporaryDirectory() as scratch:
         report = Path(scratch) / "report.json"
         guard = _GUARD.format(
