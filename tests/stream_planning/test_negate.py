@@ -1,12 +1,15 @@
 """``StreamInfo(negate=True)``: a test stream whose certified fact is used negated.
 
 ``(not (blocked ?x))`` holds for an instance exactly when the test ``test-blocked`` says False;
-without ``negate`` such a use is refused with an error naming the stream and the option.
+without ``negate`` such a use holds until the test certifies the fact (as in PDDLStream), noted in
+the log with the option; PDDLStream's automatic negation of tests under negated derived
+predicates is applied too.
 """
 
 from __future__ import annotations
 
 import itertools
+import logging
 from collections.abc import Iterator
 from typing import Any
 
@@ -95,12 +98,72 @@ def test_negated_test_on_sampled_values(algorithm: str) -> None:
     assert (7.0, "a") in seen and all(isinstance(p, float) for p, _ in seen)
 
 
-def test_negated_use_without_negate_is_an_error_naming_stream_and_option() -> None:
-    with pytest.raises(ParameterError) as info:
-        solve(shelf(from_test(lambda x: False)), verbose=False)
-    message = str(info.value)
-    assert "'test-blocked'" in message and "'blocked'" in message
-    assert "StreamInfo(negate=True)" in message
+def test_negated_use_without_negate_is_noted_and_solved_closed_world(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    # as PDDLStream: no error; the negation is read against the facts known: the optimistic
+    # algorithms assume the test passes (no plan), the incremental one holds it until certified
+    for algorithm, solved in (("adaptive", False), ("focused", False), ("incremental", True)):
+        caplog.clear()
+        with caplog.at_level(logging.WARNING):
+            solution = solve(shelf(from_test(lambda x: False)), algorithm=algorithm,
+                             max_time=10, verbose=False)  # fmt: skip
+        notes = [r.getMessage() for r in caplog.records if "uses negated" in r.getMessage()]
+        assert len(notes) == 1
+        assert "'test-blocked'" in notes[0] and "'blocked'" in notes[0]
+        assert "StreamInfo(negate=True)" in notes[0]
+        assert solution.solved is solved, algorithm
+
+
+# PDDLStream's automatic negation: a test certifying a fact that a derived predicate negates,
+# the derived predicate used negated by an action, the fact needed by no stream's domain.
+UNSAFE_DOMAIN = """
+(define (domain shelf)
+  (:requirements :strips :negative-preconditions :derived-predicates)
+  (:predicates (item ?x) (free ?x) (unsafe ?x) (taken ?x) (done))
+  (:derived (unsafe ?x) (and (item ?x) (not (free ?x))))
+  (:action take :parameters (?x)
+    :precondition (and (item ?x) (not (unsafe ?x)))
+    :effect (and (taken ?x) (done))))
+"""
+FREE_STREAM = """
+(define (stream shelf)
+  (:stream test-free :inputs (?x) :domain (item ?x) :certified (free ?x))
+  {extra})
+"""
+
+
+@pytest.mark.parametrize(
+    ("extra", "automatic"),
+    [
+        ("", True),
+        # another stream needs (free ?x) in its domain: the test is a producer, not negated
+        ("(:stream mark :inputs (?x) :domain (free ?x) :certified (taken ?x))", False),
+    ],
+)
+def test_tests_negated_automatically_as_pddlstream_does(
+    extra: str, automatic: bool, caplog: pytest.LogCaptureFixture
+) -> None:
+    asked: list[str] = []
+
+    def free(x: str) -> bool:
+        asked.append(x)
+        return x == "x3"
+
+    stream_map = {"test-free": from_test(free)}
+    if extra:
+        stream_map["mark"] = from_test(lambda x: True)
+    init = [("item", x) for x in ITEMS]
+    problem = PDDLProblem(
+        UNSAFE_DOMAIN, {}, FREE_STREAM.format(extra=extra), stream_map, init, ("done",)
+    )
+    with caplog.at_level(logging.INFO):
+        solution = solve(problem, max_time=10, verbose=False)
+    messages = " ".join(r.getMessage() for r in caplog.records)
+    assert ("negate=True set automatically" in messages) is automatic
+    assert solution.solved
+    assert [(a.name, a.args) for a in solution.plan or []] == [("take", ("x3",))]
+    assert "x3" in asked
 
 
 @pytest.mark.parametrize(
