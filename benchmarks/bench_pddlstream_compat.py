@@ -17,8 +17,10 @@ and every plan it found is valid; an error raised after a valid plan was found i
 does not fail the example.
 
 The runner fixes the environment, never the examples: without a display (no ``$DISPLAY``) the
-examples' tkinter viewers get a do-nothing stand-in; NumPy names removed in NumPy 2 that the
-examples use (``np.product``, ``np.mat``) are put back; ``discrete_belief`` and
+examples' tkinter viewers get a do-nothing stand-in and the pybullet ones connect in DIRECT mode
+(their ``connect`` falls back to it by itself); every prompt is answered with Enter; NumPy
+names removed in NumPy 2 that the examples use (``np.product``, ``np.mat``, ``np.math``) are
+put back; ``discrete_belief`` and
 ``table_belief`` need SciPy (their own dependency: ``pip install scipy``, or a folder on
 ``PYTHONPATH``, which is passed on).
 
@@ -129,7 +131,8 @@ EXAMPLES = (
 QUICK: dict[str, object] = {"only": ["blocksworld"], "timeout": 60.0}
 
 #: PDDLStream's examples predate NumPy 2 and use names it removed; the runner puts those
-#: aliases back in the example's process (an environment fix, the examples stay unmodified)
+#: aliases back in the example's process (an environment fix, the examples stay unmodified),
+#: and ``numpy.math`` (the standard ``math`` module, used by pr2_rovers' streams)
 NUMPY_ALIASES = (
     ("product", "prod"),
     ("cumproduct", "cumprod"),
@@ -137,6 +140,10 @@ NUMPY_ALIASES = (
     ("sometrue", "any"),
     ("mat", "asmatrix"),
 )
+
+#: the examples' standard input: Enter pressed at every prompt (pr2_belief waits for the user
+#: before each of its planning rounds; ``wait_for_user`` reads a line)
+PRESSES = "\n" * 10_000
 
 #: loaded modules whose file lies in the checkout's own package mean the alias was bypassed
 _GUARD = (
@@ -151,6 +158,9 @@ _GUARD = (
     "for _old, _new in {numpy_aliases!r}:\n"
     "    if _old not in dir(numpy):\n"
     "        setattr(numpy, _old, getattr(numpy, _new) if isinstance(_new, str) else _new)\n"
+    "if 'math' not in dir(numpy):\n"
+    "    import math as _math\n"
+    "    numpy.math = _math\n"
     "if not os.environ.get('DISPLAY'):\n"
     "    import types\n"
     "    class _Null:\n"
@@ -212,7 +222,7 @@ def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, o
                 command,
                 cwd=checkout,
                 env=env,
-                stdin=subprocess.DEVNULL,
+                input=PRESSES,
                 capture_output=True,
                 text=True,
                 timeout=timeout,
