@@ -211,3 +211,53 @@ def test_negated_test_in_debug_mode_fails_like_a_debug_predicate() -> None:
     problem = PDDLProblem(DOMAIN, {}, TEST_STREAM, "debug", [("item", x) for x in ITEMS], ("done",))
     solution = solve(problem, stream_info=NEGATE, verbose=False)
     assert solution.solved
+
+
+# The rovers' ray rule: a generator's outputs (?q ?y) certify (Ray ?y), and a test over
+# (Ray ?y) (Conf ?v ?q) certifies the fact a derived predicate negates; the test is negated
+# automatically and instantiated on the generator's rays.
+RAY_DOMAIN = """
+(define (domain rays)
+  (:requirements :strips :derived-predicates :negative-preconditions)
+  (:predicates (rover ?v) (objective ?o) (conf ?v ?q) (ray ?y) (atconf ?v ?q)
+    (visible ?v ?q ?y ?o) (cfreerayconf ?y ?v ?q) (blocked ?y) (haveimage ?v ?o))
+  (:action move :parameters (?v ?q1 ?q2)
+    :precondition (and (atconf ?v ?q1) (conf ?v ?q2))
+    :effect (and (atconf ?v ?q2) (not (atconf ?v ?q1))))
+  (:action take :parameters (?v ?q ?y ?o)
+    :precondition (and (visible ?v ?q ?y ?o) (atconf ?v ?q) (not (blocked ?y)))
+    :effect (haveimage ?v ?o))
+  (:derived (blocked ?y) (exists (?v ?q) (and (ray ?y) (conf ?v ?q)
+    (not (cfreerayconf ?y ?v ?q)) (atconf ?v ?q)))))
+"""
+RAY_STREAMS = """
+(define (stream rays)
+  (:stream test-cfree-ray-conf :inputs (?y ?v ?q) :domain (and (ray ?y) (conf ?v ?q))
+    :certified (cfreerayconf ?y ?v ?q))
+  (:stream inv-visible :inputs (?v ?o) :domain (and (rover ?v) (objective ?o))
+    :outputs (?q ?y) :certified (and (visible ?v ?q ?y ?o) (conf ?v ?q) (ray ?y))))
+"""
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
+def test_rays_from_a_generator_reach_the_negated_test(algorithm: str) -> None:
+    def visible(v: str, o: str) -> Iterator[tuple[str, str]]:
+        for k in itertools.count():
+            yield ("view0", f"ray{k}")  # one view, a new ray each time
+
+    checked: list[tuple[str, str, str]] = []
+
+    def cfree(y: str, v: str, q: str) -> bool:
+        checked.append((y, v, q))
+        return not (y == "ray0" and v == "v2")  # the other rover blocks the first ray
+
+    init = [("rover", "v1"), ("rover", "v2"), ("objective", "o1")]
+    init += [("conf", "v1", "view0"), ("atconf", "v1", "view0")]
+    init += [("conf", "v2", "home"), ("atconf", "v2", "home")]
+    stream_map = {"test-cfree-ray-conf": from_test(cfree), "inv-visible": from_gen_fn(visible)}
+    problem = PDDLProblem(RAY_DOMAIN, {}, RAY_STREAMS, stream_map, init, ("haveimage", "v1", "o1"))
+    solution = solve(problem, algorithm=algorithm, max_time=20, verbose=False)
+    assert solution.solved, solution.diagnosis
+    take = (solution.plan or [])[-1]
+    assert take.name == "take" and take.args[2] != "ray0"  # ray0 is blocked by v2 at home
+    assert any(y == "ray0" and v == "v2" for y, v, _ in checked)
