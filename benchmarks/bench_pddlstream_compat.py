@@ -17,8 +17,10 @@ and every plan it found is valid; an error raised after a valid plan was found i
 does not fail the example.
 
 The runner fixes the environment, never the examples: without a display (no ``$DISPLAY``) the
-examples' tkinter viewers get a do-nothing stand-in; NumPy names removed in NumPy 2 that the
-examples use (``np.product``, ``np.mat``) are put back; ``discrete_belief`` and
+examples' tkinter viewers get a do-nothing stand-in and the pybullet ones connect in DIRECT mode
+(their ``connect`` falls back to it by itself); every prompt is answered with Enter; NumPy
+names removed in NumPy 2 that the examples use (``np.product``, ``np.mat``, ``np.math``) are
+put back; ``discrete_belief`` and
 ``table_belief`` need SciPy (their own dependency: ``pip install scipy``, or a folder on
 ``PYTHONPATH``, which is passed on).
 
@@ -47,6 +49,7 @@ with a checkout; without one, the skip line). The JSON keys are the same, plus
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import subprocess
@@ -67,6 +70,8 @@ class Example:
     #: set when PDDLStream itself finds no plan for the example as written (run locally with
     #: Fast Downward): what happens there
     upstream: str = ""
+    #: a module the example needs that is not a dependency of this project (an optional extra)
+    needs: str = ""
 
 
 EXAMPLES = (
@@ -110,13 +115,24 @@ EXAMPLES = (
     Example("satisfy", "examples.advanced.satisfy.run"),
     Example("rovers", "examples.ipc.rovers.run"),
     Example("satellites", "examples.ipc.satellites.run"),
+    # the robot programs: PyBullet (``pip install sdar-tamp[pybullet]``) in DIRECT mode (no
+    # $DISPLAY, so their ``connect`` opens no window)
+    Example("kuka", "examples.pybullet.kuka.run", needs="pybullet"),
+    Example("pr2", "examples.pybullet.pr2.run", needs="pybullet"),
+    Example("namo", "examples.pybullet.namo.run", needs="pybullet"),
+    Example("pr2_rovers", "examples.pybullet.pr2_rovers.run", needs="pybullet"),
+    Example("pr2_belief", "examples.pybullet.pr2_belief.run", needs="pybullet"),
+    Example("tamp", "examples.pybullet.tamp.run", needs="pybullet"),
+    Example("turtlebot_rovers", "examples.pybullet.turtlebot_rovers.run", needs="pybullet"),
+    Example("turtlebots", "examples.pybullet.turtlebots.run", needs="pybullet"),
 )
 
 #: ``--quick``'s defaults
 QUICK: dict[str, object] = {"only": ["blocksworld"], "timeout": 60.0}
 
 #: PDDLStream's examples predate NumPy 2 and use names it removed; the runner puts those
-#: aliases back in the example's process (an environment fix, the examples stay unmodified)
+#: aliases back in the example's process (an environment fix, the examples stay unmodified),
+#: and ``numpy.math`` (the standard ``math`` module, used by pr2_rovers' streams)
 NUMPY_ALIASES = (
     ("product", "prod"),
     ("cumproduct", "cumprod"),
@@ -124,6 +140,10 @@ NUMPY_ALIASES = (
     ("sometrue", "any"),
     ("mat", "asmatrix"),
 )
+
+#: the examples' standard input: Enter pressed at every prompt (pr2_belief waits for the user
+#: before each of its planning rounds; ``wait_for_user`` reads a line)
+PRESSES = "\n" * 10_000
 
 #: loaded modules whose file lies in the checkout's own package mean the alias was bypassed
 _GUARD = (
@@ -138,6 +158,9 @@ _GUARD = (
     "for _old, _new in {numpy_aliases!r}:\n"
     "    if _old not in dir(numpy):\n"
     "        setattr(numpy, _old, getattr(numpy, _new) if isinstance(_new, str) else _new)\n"
+    "if 'math' not in dir(numpy):\n"
+    "    import math as _math\n"
+    "    numpy.math = _math\n"
     "if not os.environ.get('DISPLAY'):\n"
     "    import types\n"
     "    class _Null:\n"
@@ -163,6 +186,16 @@ _GUARD = (
 
 def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, object]:
     """Run one example; returns its name, result, time [s] and details."""
+    if example.needs and importlib.util.find_spec(example.needs) is None:
+        return {
+            "example": example.name,
+            "result": f"skipped: needs {example.needs!r} (pip install sdar-tamp[pybullet])",
+            "passed": False,
+            "skipped": True,
+            "seconds": 0.0,
+            "solve_calls": 0,
+            "plans": 0,
+        }
     with tempfile.TemporaryDirectory() as scratch:
         report = Path(scratch) / "report.json"
         guard = _GUARD.format(
@@ -189,7 +222,7 @@ def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, o
                 command,
                 cwd=checkout,
                 env=env,
-                stdin=subprocess.DEVNULL,
+                input=PRESSES,
                 capture_output=True,
                 text=True,
                 timeout=timeout,

@@ -23,6 +23,7 @@ from sdar_tamp.language.domain_model import (
 from sdar_tamp.language.errors import ArityError, DuplicateError, PddlSyntaxError, UndeclaredError
 from sdar_tamp.language.formula_model import (
     OBJECT_TYPE,
+    TOTAL_COST,
     TRUE,
     AndEffect,
     Exists,
@@ -40,6 +41,7 @@ from sdar_tamp.language.grammar import (
 from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
     FREE_VARIABLE,
+    FUNCTION_ARITY,
     LeniencyLog,
     note_glued_variables,
 )
@@ -113,6 +115,9 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
                 vocabulary.predicates[predicate.name] = predicate.arity
         elif keyword == ":functions":
             declare_functions(body, reader, functions, parents)
+            vocabulary.open_arity_functions = {
+                f.name for f in functions.values() if not f.parameters and f.name != TOTAL_COST
+            }
         else:
             pending.append((keyword, section))
     vocabulary.derived = frozenset(
@@ -128,6 +133,14 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
             actions.append(action)
         else:
             axioms.append(_axiom(section, reader, predicates, log))
+    for fname, (arity, location) in vocabulary.function_arity_uses.items():
+        log.add(
+            FUNCTION_ARITY,
+            f"function {fname!r} is declared with no arguments and used with {arity}; read "
+            f"with {arity} (as PDDLStream does; a stream file's :function gives the arity)",
+            location,
+        )
+        functions[fname] = Function(fname, tuple(Parameter(f"?x{i}") for i in range(arity)))
     for fname, arity in vocabulary.functions.items():
         if fname not in functions:
             params = tuple(Parameter(f"?x{i}") for i in range(arity))

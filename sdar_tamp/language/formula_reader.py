@@ -63,6 +63,11 @@ class Vocabulary:
     filename: str | None = None
     implicit_predicates: dict[str, SourceLocation] | None = None
     """When not None, an undeclared predicate is declared at its first use (noted here)."""
+    open_arity_functions: set[str] = field(default_factory=set)
+    """Functions declared with no arguments whose first use sets their arity (PDDLStream
+    programs declare ``(:functions (Cost))`` and use ``(Cost ?a ?b)``)."""
+    function_arity_uses: dict[str, tuple[int, SourceLocation]] = field(default_factory=dict)
+    """The open-arity functions first used with arguments: their arity and that use."""
 
 
 class FormulaReader:
@@ -318,6 +323,11 @@ class FormulaReader:
             if not self.vocabulary.allow_new_functions:
                 raise UndeclaredError(f"undeclared function {head.text!r}", head.location)
             functions[head.text] = arity
+        if head.text in self.vocabulary.open_arity_functions:
+            self.vocabulary.open_arity_functions.discard(head.text)
+            if arity != functions[head.text]:
+                functions[head.text] = arity
+                self.vocabulary.function_arity_uses[head.text] = (arity, location)
         if functions[head.text] != arity:
             raise ArityError(
                 f"function {head.text!r} takes {functions[head.text]} argument(s), got {arity}",

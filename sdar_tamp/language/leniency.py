@@ -25,9 +25,13 @@ logged), and reject it only with ``strict=True`` (:class:`StrictModeError`). The
     Downward's translator does.
 ``init-type``
     an initial fact whose argument's type is not the declared parameter type.
+``function-arity``
+    a function declared with no arguments (``(:functions (Cost))``) and used with some
+    (``(Cost ?a ?b)``), as PDDLStream programs do: the first use gives its arity, which a
+    stream file's ``(:function (Cost ?a ?b) ...)`` must then match.
 
-The last two are more likely mistakes than dialect, so they are logged as warnings; the others
-at info level.
+``undeclared-parent-type``, ``init-type`` and ``function-arity`` are more likely mistakes than
+dialect, so they are logged as warnings; the others at info level.
 """
 
 from __future__ import annotations
@@ -50,6 +54,7 @@ DUPLICATE_TYPE = "duplicate-type"
 UNDECLARED_PARENT_TYPE = "undeclared-parent-type"
 INIT_TYPE = "init-type"
 FREE_VARIABLE = "free-variable"
+FUNCTION_ARITY = "function-arity"
 
 KINDS = (
     GLUED_VARIABLE,
@@ -60,8 +65,9 @@ KINDS = (
     UNDECLARED_PARENT_TYPE,
     INIT_TYPE,
     FREE_VARIABLE,
+    FUNCTION_ARITY,
 )
-_WARNING_KINDS = frozenset({UNDECLARED_PARENT_TYPE, INIT_TYPE})
+_WARNING_KINDS = frozenset({UNDECLARED_PARENT_TYPE, INIT_TYPE, FUNCTION_ARITY})
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from solvers.stream_planning.blocked_calls import Blocks, guard_fluent_uses
 from solvers.stream_planning.calls import CallRunner
 from solvers.stream_planning.costs import guard_costs
 from solvers.stream_planning.engine import Engine, InstanceState
-from solvers.stream_planning.negation import check_negated_uses, negated_predicates
+from solvers.stream_planning.negation import negated_predicates, resolve_negated_uses
 from solvers.stream_planning.optimistic import OptimisticBuilder, OptimisticWorld
 from solvers.stream_planning.options import StreamOptions
 from solvers.stream_planning.preimage import PlanCheck, simulate
@@ -51,7 +51,7 @@ class SolveContext:
         self.domain: Domain = guard_costs(problem.domain)
         self.goal = problem.facts.goal
         negated = negated_predicates(problem.domain, self.goal)
-        check_negated_uses(problem.streams.streams, stream_info, negated)
+        stream_info = resolve_negated_uses(problem.streams, stream_info, problem.domain, negated)
         self.runner = CallRunner(self.start + options.max_time, options.enforce_max_time)
         self.engine = Engine(problem, stream_info, self.runner)
         self.builder = OptimisticBuilder(self.engine, negated)

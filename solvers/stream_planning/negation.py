@@ -2,8 +2,9 @@
 
 Such a test becomes a ``:predicate`` external over its certified fact: it is evaluated as soon as
 its domain holds, the fact is known when the test passes, and ``(not (fact ...))`` holds exactly
-when it fails. Without ``negate`` a negated use of a test's certified fact would hold merely
-because the test had not been called yet, so it is refused with an error naming the stream.
+when it fails. :func:`resolve_negated_uses` sets ``negate`` where PDDLStream sets it itself and
+notes in the log every other negated use of a test's certified fact (read, as there, against the
+facts known).
 
 :func:`negated_predicates` says which predicates the domain uses negated (through derived
 predicates too): those the refusal above is about, and those whose predicates on placeholders
@@ -13,14 +14,17 @@ the optimistic world leaves false.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
+from dataclasses import replace
 from typing import Any
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import (
+    And,
     AndEffect,
     Atom,
     Effect,
+    Exists,
     ForAllEffect,
     Formula,
     Imply,
@@ -29,33 +33,104 @@ from sdar_tamp.language.formula_model import (
 )
 from sdar_tamp.language.generators import ListGenFn, WildOutput
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
-from sdar_tamp.language.stream_model import Stream, StreamPredicate
+from sdar_tamp.language.stream_model import Stream, StreamFile, StreamPredicate
+from sdar_tamp.logs import get_logger
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
 
+LOG = get_logger(__name__)
 
-def check_negated_uses(
-    streams: Iterable[Stream],
+
+def resolve_negated_uses(
+    stream_file: StreamFile,
     stream_info: Mapping[str, StreamInfo | FunctionInfo] | None,
+    domain: Domain,
     negated: frozenset[str],
-) -> None:
-    """Raise when the domain uses negated a fact certified by a test stream without ``negate``.
+) -> dict[str, StreamInfo | FunctionInfo]:
+    """``stream_info`` with ``negate=True`` set where PDDLStream sets it itself.
 
-    (A generator's facts are about its outputs; a derived predicate used negated puts them under
-    a negation too, as in ``(not (unsafe ?b ?p))`` over ``(pose ?b ?p)``, and that is fine: a
-    placeholder's facts are only assumed where the plan needs them.)
+    PDDLStream's focused algorithms negate a test stream automatically when it is a plain test
+    (no outputs, no fluents) that certifies nothing any stream, function or predicate needs in
+    its domain, is the only source of its certified predicates, and each of them appears
+    negated directly in the body of a derived predicate that an action precondition uses
+    negated (``(not (unsafe ?q))`` with ``unsafe`` derived from ``(not (cfree ?q ?p))``).
+    The same rule applies here (logged at info level).
+
+    Any other negated use of a test's certified fact (in ``negated``) is read as in PDDLStream,
+    against the facts known: the optimistic algorithms assume the test passes, so the negation
+    fails until a real plan is found without it; the incremental algorithm lets it hold until
+    the test certifies the fact. The meaning depends on the algorithm, so each such stream is
+    noted in the log with the remedy, ``StreamInfo(negate=True)``.
     """
-    info = {k.lower(): v for k, v in (stream_info or {}).items()}
-    for stream in streams:
-        options = info.get(stream.name)
+    info: dict[str, StreamInfo | FunctionInfo] = dict(stream_info or {})
+    by_name = {k.lower(): k for k in info}
+    needed = {atom.predicate for stream in stream_file.streams for atom in stream.domain}
+    needed |= {a.predicate for f in stream_file.functions for a in f.domain}
+    needed |= {a.predicate for f in stream_file.predicates for a in f.domain}
+    sources: dict[str, int] = {}
+    for stream in stream_file.streams:
+        for predicate in {atom.predicate for atom in stream.certified}:
+            sources[predicate] = sources.get(predicate, 0) + 1
+    under_axioms = _negated_in_negated_axioms(domain)
+    for stream in stream_file.streams:
+        key = by_name.get(stream.name, stream.name)
+        options = info.get(key)
         if not stream.is_test or (isinstance(options, StreamInfo) and options.negate):
             continue
-        for atom in stream.certified:
-            if atom.predicate in negated:
-                raise ParameterError(
-                    f"stream {stream.name!r} certifies {atom.predicate!r}, which the domain "
-                    f"uses negated; only a :predicate or a test stream with "
-                    f"stream_info[{stream.name!r}] = StreamInfo(negate=True) may be used negated"
-                )
+        certified = {atom.predicate for atom in stream.certified}
+        if (
+            not stream.fluents
+            and certified
+            and not certified & needed
+            and all(p in under_axioms and sources[p] == 1 for p in certified)
+        ):
+            base = options if isinstance(options, StreamInfo) else StreamInfo()
+            info[key] = replace(base, negate=True)
+            LOG.info(
+                "stream %r: negate=True set automatically (its certified fact is used negated "
+                "in a derived predicate, as PDDLStream does)",
+                stream.name,
+            )
+            continue
+        used = sorted(certified & negated)
+        if used:
+            LOG.warning(
+                "stream %r certifies %s, which the domain uses negated: as in PDDLStream, the "
+                "negation is read against the facts known, so the optimistic algorithms assume "
+                "the test passes (the negation fails) and the incremental one lets it hold "
+                "until the test certifies the fact; give stream_info[%r] = "
+                "StreamInfo(negate=True) to evaluate the negation by calling the test",
+                stream.name,
+                ", ".join(repr(p) for p in used),
+                stream.name,
+            )
+    return info
+
+
+def _negated_in_negated_axioms(domain: Domain) -> frozenset[str]:
+    """PDDLStream's rule: predicates negated among the conjuncts of a derived predicate's
+    body (below its existential quantifiers), for derived predicates that some action's
+    precondition uses negated among its conjuncts."""
+    negated_heads = {
+        part.formula.predicate
+        for action in domain.actions
+        for part in _conjuncts(action.precondition)
+        if isinstance(part, Not) and isinstance(part.formula, Atom)
+    }
+    return frozenset(
+        part.formula.predicate
+        for axiom in domain.axioms
+        if axiom.predicate in negated_heads
+        for part in _conjuncts(axiom.body)
+        if isinstance(part, Not) and isinstance(part.formula, Atom)
+    )
+
+
+def _conjuncts(formula: Formula) -> list[Formula]:
+    if isinstance(formula, And):
+        return [c for part in formula.parts for c in _conjuncts(part)]
+    if isinstance(formula, Exists):
+        return _conjuncts(formula.body)
+    return [formula]
 
 
 def split_negated(

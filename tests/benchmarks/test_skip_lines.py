@@ -36,6 +36,26 @@ def test_pddlstream_examples_without_a_checkout(
         assert isinstance(out["skipped"], str) and "no PDDLStream checkout" in out["skipped"]
 
 
+def test_pddlstream_robot_example_without_its_simulator(
+    benchmark_script: Loader, tmp_path: Path
+) -> None:
+    bench = benchmark_script("bench_pddlstream_compat")
+    example = bench.Example("kuka", "examples.pybullet.kuka.run", needs="no_such_module_xyz")
+    row = bench.run_example(tmp_path, example, 1.0)
+    assert row["skipped"] is True and row["passed"] is False and row["seconds"] == 0.0
+    assert "needs 'no_such_module_xyz'" in str(row["result"])
+    assert {e.name for e in bench.EXAMPLES if e.needs == "pybullet"} == {
+        "kuka",
+        "pr2",
+        "namo",
+        "pr2_rovers",
+        "pr2_belief",
+        "tamp",
+        "turtlebot_rovers",
+        "turtlebots",
+    }
+
+
 def test_classical_without_its_problem_folder(
     benchmark_script: Loader, capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:

@@ -126,8 +126,13 @@ def test_max_cost_and_pddlstream_wildcard_skeletons() -> None:
     constraints = PlanConstraints(skeletons=[skeleton], exact=True, groups={}, hint=False)
     solution = solve(problem, constraints=constraints, max_time=30, verbose=False)
     assert [a.name for a in solution.plan or []] == ["pick", "place"]
+    from sdar_tamp.compat.pddlstream.algorithms.common import SOLUTIONS
+
+    assert [(s.plan, s.cost) for s in SOLUTIONS] == [(solution.plan, solution.cost)]
+    assert SOLUTIONS[0].time >= 0
     bounded = solve(problem, max_cost=1.0, max_time=1, verbose=False)  # lifting costs 2
     assert bounded.plan is None and math.isinf(bounded.cost)
+    assert SOLUTIONS == []  # the last call's plans: none
 
 
 def test_solve_from_pddl_returns_plan_and_cost() -> None:

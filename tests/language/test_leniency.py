@@ -23,6 +23,7 @@ from sdar_tamp.language.leniency import (
     DUPLICATE_PREDICATE,
     DUPLICATE_TYPE,
     FREE_VARIABLE,
+    FUNCTION_ARITY,
     GLUED_VARIABLE,
     IMPLICIT_PREDICATE,
     INIT_TYPE,
@@ -345,3 +346,54 @@ def test_free_variable_in_an_effect_is_still_an_error() -> None:
     text = FREE.replace(":effect (not (clear ?x))", ":effect (not (clear ?w))")
     with pytest.raises(UnboundVariableError, match=r"f\.pddl:5:23: variable \?w is not bound"):
         parse_domain(text, "f.pddl")
+
+
+# --- the PDDLStream projects' (:functions (Cost)) used as (Cost ?a ?b) --------------------------
+
+COST_DOMAIN = """(define (domain nav) (:requirements :strips :action-costs)
+ (:predicates (at ?x) (road ?x ?y))
+ (:functions (Cost) (total-cost))
+ (:action move :parameters (?a ?b) :precondition (and (at ?a) (road ?a ?b))
+  :effect (and (at ?b) (not (at ?a)) (increase (total-cost) (Cost ?a ?b)))))
+"""
+COST_STREAMS = """(define (stream nav)
+ (:function (Cost ?a ?b) (road ?a ?b)))
+"""
+
+
+def test_zero_arity_function_used_with_arguments_is_a_located_warning(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    with caplog.at_level(logging.WARNING, logger="sdar_tamp.language"):
+        domain = parse_domain(COST_DOMAIN, "nav.pddl")
+    assert len(domain.functions["cost"].parameters) == 2
+    (item,) = domain.leniencies
+    assert item.kind == FUNCTION_ARITY and item.level == logging.WARNING
+    assert str(item).startswith("nav.pddl:5:")
+    assert "'cost' is declared with no arguments and used with 2" in caplog.text
+    with pytest.raises(StrictModeError, match=r"nav\.pddl:5:\d+: function 'cost'.*function-arity"):
+        parse_domain(COST_DOMAIN, "nav.pddl", strict=True)
+
+
+def test_the_stream_file_function_gives_the_cost_and_must_match() -> None:
+    init = [("at", "a"), ("road", "a", "b")]
+    problem = PDDLProblem(COST_DOMAIN, {}, COST_STREAMS, {"cost": lambda a, b: 3.0}, init,
+                          ("at", "b"))  # fmt: skip
+    from solvers.solve import solve
+
+    solution = solve(problem, max_time=10, verbose=False)
+    assert solution.solved and solution.cost == pytest.approx(3.0)
+    wrong = COST_STREAMS.replace("(Cost ?a ?b)", "(Cost ?a)")
+    with pytest.raises(ArityError, match=r"function 'cost' takes 2 argument\(s\), got 1"):
+        parse_stream_file(wrong, parse_domain(COST_DOMAIN, "nav.pddl"), "s.pddl")
+
+
+def test_function_arity_set_by_its_first_use_binds_later_uses() -> None:
+    two_uses = COST_DOMAIN.replace(
+        "(increase (total-cost) (Cost ?a ?b))",
+        "(increase (total-cost) (Cost ?a ?b)) (increase (total-cost) (Cost ?a))",
+    )
+    with pytest.raises(ArityError, match=r"function 'cost' takes 2 argument\(s\), got 1"):
+        parse_domain(two_uses, "nav.pddl")
+    declared = COST_DOMAIN.replace("(Cost) (total-cost)", "(Cost ?x ?y) (total-cost)")
+    assert parse_domain(declared, "nav.pddl", strict=True).leniencies == ()

@@ -1,12 +1,15 @@
 """``StreamInfo(negate=True)``: a test stream whose certified fact is used negated.
 
 ``(not (blocked ?x))`` holds for an instance exactly when the test ``test-blocked`` says False;
-without ``negate`` such a use is refused with an error naming the stream and the option.
+without ``negate`` such a use holds until the test certifies the fact (as in PDDLStream), noted in
+the log with the option; PDDLStream's automatic negation of tests under negated derived
+predicates is applied too.
 """
 
 from __future__ import annotations
 
 import itertools
+import logging
 from collections.abc import Iterator
 from typing import Any
 
@@ -95,12 +98,72 @@ def test_negated_test_on_sampled_values(algorithm: str) -> None:
     assert (7.0, "a") in seen and all(isinstance(p, float) for p, _ in seen)
 
 
-def test_negated_use_without_negate_is_an_error_naming_stream_and_option() -> None:
-    with pytest.raises(ParameterError) as info:
-        solve(shelf(from_test(lambda x: False)), verbose=False)
-    message = str(info.value)
-    assert "'test-blocked'" in message and "'blocked'" in message
-    assert "StreamInfo(negate=True)" in message
+def test_negated_use_without_negate_is_noted_and_solved_closed_world(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    # as PDDLStream: no error; the negation is read against the facts known: the optimistic
+    # algorithms assume the test passes (no plan), the incremental one holds it until certified
+    for algorithm, solved in (("adaptive", False), ("focused", False), ("incremental", True)):
+        caplog.clear()
+        with caplog.at_level(logging.WARNING):
+            solution = solve(shelf(from_test(lambda x: False)), algorithm=algorithm,
+                             max_time=10, verbose=False)  # fmt: skip
+        notes = [r.getMessage() for r in caplog.records if "uses negated" in r.getMessage()]
+        assert len(notes) == 1
+        assert "'test-blocked'" in notes[0] and "'blocked'" in notes[0]
+        assert "StreamInfo(negate=True)" in notes[0]
+        assert solution.solved is solved, algorithm
+
+
+# PDDLStream's automatic negation: a test certifying a fact that a derived predicate negates,
+# the derived predicate used negated by an action, the fact needed by no stream's domain.
+UNSAFE_DOMAIN = """
+(define (domain shelf)
+  (:requirements :strips :negative-preconditions :derived-predicates)
+  (:predicates (item ?x) (free ?x) (unsafe ?x) (taken ?x) (done))
+  (:derived (unsafe ?x) (and (item ?x) (not (free ?x))))
+  (:action take :parameters (?x)
+    :precondition (and (item ?x) (not (unsafe ?x)))
+    :effect (and (taken ?x) (done))))
+"""
+FREE_STREAM = """
+(define (stream shelf)
+  (:stream test-free :inputs (?x) :domain (item ?x) :certified (free ?x))
+  {extra})
+"""
+
+
+@pytest.mark.parametrize(
+    ("extra", "automatic"),
+    [
+        ("", True),
+        # another stream needs (free ?x) in its domain: the test is a producer, not negated
+        ("(:stream mark :inputs (?x) :domain (free ?x) :certified (taken ?x))", False),
+    ],
+)
+def test_tests_negated_automatically_as_pddlstream_does(
+    extra: str, automatic: bool, caplog: pytest.LogCaptureFixture
+) -> None:
+    asked: list[str] = []
+
+    def free(x: str) -> bool:
+        asked.append(x)
+        return x == "x3"
+
+    stream_map = {"test-free": from_test(free)}
+    if extra:
+        stream_map["mark"] = from_test(lambda x: True)
+    init = [("item", x) for x in ITEMS]
+    problem = PDDLProblem(
+        UNSAFE_DOMAIN, {}, FREE_STREAM.format(extra=extra), stream_map, init, ("done",)
+    )
+    with caplog.at_level(logging.INFO):
+        solution = solve(problem, max_time=10, verbose=False)
+    messages = " ".join(r.getMessage() for r in caplog.records)
+    assert ("negate=True set automatically" in messages) is automatic
+    assert solution.solved
+    assert [(a.name, a.args) for a in solution.plan or []] == [("take", ("x3",))]
+    assert "x3" in asked
 
 
 @pytest.mark.parametrize(
@@ -148,3 +211,53 @@ def test_negated_test_in_debug_mode_fails_like_a_debug_predicate() -> None:
     problem = PDDLProblem(DOMAIN, {}, TEST_STREAM, "debug", [("item", x) for x in ITEMS], ("done",))
     solution = solve(problem, stream_info=NEGATE, verbose=False)
     assert solution.solved
+
+
+# The rovers' ray rule: a generator's outputs (?q ?y) certify (Ray ?y), and a test over
+# (Ray ?y) (Conf ?v ?q) certifies the fact a derived predicate negates; the test is negated
+# automatically and instantiated on the generator's rays.
+RAY_DOMAIN = """
+(define (domain rays)
+  (:requirements :strips :derived-predicates :negative-preconditions)
+  (:predicates (rover ?v) (objective ?o) (conf ?v ?q) (ray ?y) (atconf ?v ?q)
+    (visible ?v ?q ?y ?o) (cfreerayconf ?y ?v ?q) (blocked ?y) (haveimage ?v ?o))
+  (:action move :parameters (?v ?q1 ?q2)
+    :precondition (and (atconf ?v ?q1) (conf ?v ?q2))
+    :effect (and (atconf ?v ?q2) (not (atconf ?v ?q1))))
+  (:action take :parameters (?v ?q ?y ?o)
+    :precondition (and (visible ?v ?q ?y ?o) (atconf ?v ?q) (not (blocked ?y)))
+    :effect (haveimage ?v ?o))
+  (:derived (blocked ?y) (exists (?v ?q) (and (ray ?y) (conf ?v ?q)
+    (not (cfreerayconf ?y ?v ?q)) (atconf ?v ?q)))))
+"""
+RAY_STREAMS = """
+(define (stream rays)
+  (:stream test-cfree-ray-conf :inputs (?y ?v ?q) :domain (and (ray ?y) (conf ?v ?q))
+    :certified (cfreerayconf ?y ?v ?q))
+  (:stream inv-visible :inputs (?v ?o) :domain (and (rover ?v) (objective ?o))
+    :outputs (?q ?y) :certified (and (visible ?v ?q ?y ?o) (conf ?v ?q) (ray ?y))))
+"""
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
+def test_rays_from_a_generator_reach_the_negated_test(algorithm: str) -> None:
+    def visible(v: str, o: str) -> Iterator[tuple[str, str]]:
+        for k in itertools.count():
+            yield ("view0", f"ray{k}")  # one view, a new ray each time
+
+    checked: list[tuple[str, str, str]] = []
+
+    def cfree(y: str, v: str, q: str) -> bool:
+        checked.append((y, v, q))
+        return not (y == "ray0" and v == "v2")  # the other rover blocks the first ray
+
+    init = [("rover", "v1"), ("rover", "v2"), ("objective", "o1")]
+    init += [("conf", "v1", "view0"), ("atconf", "v1", "view0")]
+    init += [("conf", "v2", "home"), ("atconf", "v2", "home")]
+    stream_map = {"test-cfree-ray-conf": from_test(cfree), "inv-visible": from_gen_fn(visible)}
+    problem = PDDLProblem(RAY_DOMAIN, {}, RAY_STREAMS, stream_map, init, ("haveimage", "v1", "o1"))
+    solution = solve(problem, algorithm=algorithm, max_time=20, verbose=False)
+    assert solution.solved, solution.diagnosis
+    take = (solution.plan or [])[-1]
+    assert take.name == "take" and take.args[2] != "ray0"  # ray0 is blocked by v2 at home
+    assert any(y == "ray0" and v == "v2" for y, v, _ in checked)

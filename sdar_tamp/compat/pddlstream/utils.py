@@ -21,8 +21,46 @@ from collections.abc import Callable, Hashable, Iterable, Iterator, Sequence
 from types import TracebackType
 from typing import Any
 
+from sdar_tamp.compat.pddlstream.unsupported import not_provided
 from sdar_tamp.errors import ParameterError
+from sdar_tamp.language.generators import negate_test as negate_test
 from sdar_tamp.textfile import decode_text
+
+__all__ = [
+    "INF",
+    "SEPARATOR",
+    "Profiler",
+    "Verbose",
+    "apply_mapping",
+    "clear_dir",
+    "elapsed_time",
+    "ensure_dir",
+    "find",
+    "find_unique",
+    "flatten",
+    "get_file_path",
+    "get_mapping",
+    "implies",
+    "inclusive_range",
+    "inf_generator",
+    "int_ceil",
+    "irange",
+    "is_hashable",
+    "negate_test",
+    "neighbors_from_orders",
+    "randomize",
+    "read",
+    "read_pddl",
+    "safe_apply_mapping",
+    "safe_rm_dir",
+    "safe_zip",
+    "sorted_str_from_list",
+    "str_eq",
+    "str_from_object",
+    "user_input",
+    "value_or_id",
+    "write",
+]
 
 INF = math.inf
 SEPARATOR = "\n" + 80 * "-" + "\n"
@@ -269,3 +307,12 @@ def neighbors_from_orders(orders: Iterable[tuple[Any, Any]]) -> tuple[dict[Any, 
         incoming[after].add(before)
         outgoing[before].add(after)
     return incoming, outgoing
+
+
+__getattr__ = not_provided(
+    __name__,
+    (
+        "PDDLStream's helpers for its own internals (memory checks, timers over Fast "
+        "Downward, graph helpers) are not provided"
+    ),
+)

@@ -13,9 +13,12 @@ import argparse
 import dataclasses
 import logging
 import math
+import time
 from collections.abc import Iterable, Mapping
 from typing import Any
 
+from sdar_tamp.compat.pddlstream.algorithms.common import Solution as SolutionRecord
+from sdar_tamp.compat.pddlstream.algorithms.common import record_solutions
 from sdar_tamp.compat.pddlstream.algorithms.constraints import PlanConstraints
 from sdar_tamp.compat.pddlstream.language.stream import StreamInfo as PddlstreamStreamInfo
 from sdar_tamp.errors import ParameterError
@@ -24,6 +27,16 @@ from sdar_tamp.language.options import PlanConstraints as _CorePlanConstraints
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Solution
 from solvers.solve import solve as core_solve  # replaced by the runner's --report
+
+__all__ = [
+    "ALGORITHMS",
+    "DEFAULT_ALGORITHM",
+    "FOCUSED_ALGORITHMS",
+    "analyze_goal",
+    "create_parser",
+    "solve",
+    "solve_restart",
+]
 
 LOG = logging.getLogger(__name__)
 INF = math.inf
@@ -142,7 +155,8 @@ def solve(
         max_skeletons = INF
     if search_sample_ratio is None or search_sample_ratio <= 0:
         search_sample_ratio = 1.0
-    return core_solve(
+    start = time.perf_counter()
+    solution = core_solve(
         problem,
         algorithm=algorithm,
         stream_info=_with_default_info(problem, stream_info),
@@ -163,6 +177,12 @@ def solve(
         seed=seed,
         planner=planner,
     )
+    plan = getattr(solution, "plan", None)  # a stand-in solver may return anything
+    found = (
+        [] if plan is None else [SolutionRecord(plan, solution.cost, time.perf_counter() - start)]
+    )
+    record_solutions(found)
+    return solution
 
 
 def solve_restart(
@@ -174,8 +194,6 @@ def solve_restart(
     **kwargs: Any,
 ) -> Solution:
     """``solve`` with a fresh start up to ``max_restarts`` times within ``max_time`` [s]."""
-    import time
-
     start = time.time()
     solution = Solution(None)
     for _ in range(1 + max_restarts):

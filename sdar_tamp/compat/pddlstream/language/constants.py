@@ -9,11 +9,86 @@ from collections.abc import Iterable, Sequence
 from typing import Any, NamedTuple
 
 from sdar_tamp.compat.pddlstream.language.problem import PDDLProblem as PDDLProblem
+from sdar_tamp.compat.pddlstream.unsupported import not_provided
 from sdar_tamp.compat.pddlstream.utils import INF, read, str_from_object
 from sdar_tamp.language.formula_model import TOTAL_COST as TOTAL_COST
 from solvers.solution import Action as Action
 from solvers.solution import Certificate as Certificate
 from solvers.solution import Solution as Solution
+
+__all__ = [
+    "AND",
+    "CONNECTIVES",
+    "DOMAIN_FILE",
+    "EQ",
+    "EXISTS",
+    "FAILED",
+    "FORALL",
+    "IMPLY",
+    "INCREASE",
+    "INFEASIBLE",
+    "MAXIMIZE",
+    "MINIMIZE",
+    "NOT",
+    "NOT_PLAN",
+    "OBJECT",
+    "OBJECTIVES",
+    "OPERATORS",
+    "OR",
+    "PARAMETER",
+    "PDDLSTREAM_FILES",
+    "PDDL_FILES",
+    "PROBLEM_FILE",
+    "QUANTIFIERS",
+    "STREAM_FILE",
+    "SUCCEEDED",
+    "TOTAL_COST",
+    "TOTAL_TIME",
+    "TYPE",
+    "WHEN",
+    "Action",
+    "And",
+    "Assignment",
+    "Certificate",
+    "DurativeAction",
+    "Equal",
+    "Evaluation",
+    "Exists",
+    "Fact",
+    "ForAll",
+    "FunctionAction",
+    "Head",
+    "Imply",
+    "Minimize",
+    "Not",
+    "OptPlan",
+    "Or",
+    "Output",
+    "PDDLProblem",
+    "Solution",
+    "StreamAction",
+    "Type",
+    "concatenate",
+    "get_args",
+    "get_constraints",
+    "get_costs",
+    "get_length",
+    "get_parameter_name",
+    "get_prefix",
+    "is_cost",
+    "is_head",
+    "is_parameter",
+    "is_plan",
+    "partition_facts",
+    "print_plan",
+    "print_solution",
+    "read_pddl_pair",
+    "read_pddlstream_pair",
+    "read_relative",
+    "read_relative_dir",
+    "str_from_action",
+    "str_from_plan",
+]
 
 EQ = "="
 AND = "and"
@@ -255,3 +330,8 @@ def read_pddl_pair(file: str, **kwargs: Any) -> list[str]:
 def read_pddlstream_pair(file: str, **kwargs: Any) -> list[str]:
     """``[domain.pddl, stream.pddl]`` texts from the folder of ``file``."""
     return read_relative_dir(file, filenames=PDDLSTREAM_FILES, **kwargs)
+
+
+__getattr__ = not_provided(
+    __name__, "PDDLStream's internal expression helpers over its own objects"
+)

@@ -25,6 +25,9 @@ from sdar_tamp.language.formula_model import And, Atom, Effect, Exists, Formula,
 from sdar_tamp.language.stream_model import Rule, Stream, StreamFile
 from sdar_tamp.language.traversal import iter_effect_literals, map_atoms, map_conditions
 
+#: PDDLStream's public names here (the functions below are this tree's compilation)
+__all__ = ["EXOGENOUS_AXIOMS", "REPLACE_STREAM"]
+
 LOG = logging.getLogger(__name__)
 EXOGENOUS_AXIOMS = True
 REPLACE_STREAM = True

@@ -6,6 +6,15 @@ from __future__ import annotations
 import itertools
 from typing import Any, NamedTuple
 
+from sdar_tamp.compat.pddlstream.unsupported import not_provided
+
+__all__ = [
+    "DebugValue",
+    "SharedDebugValue",
+    "SharedOptValue",
+    "UniqueOptValue",
+]
+
 
 class UniqueOptValue(NamedTuple):
     """An optimistic output of one stream instance (``opt_fn`` receives these)."""
@@ -55,3 +64,9 @@ class SharedDebugValue(NamedTuple):
 
     def __repr__(self) -> str:
         return f"&{self.output_parameter.lstrip('?')}"
+
+
+__getattr__ = not_provided(
+    __name__,
+    "PDDLStream's Object/OptimisticObject registries (objects here are the values themselves)",
+)
