@@ -13,10 +13,24 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from sdar_tamp.textfile import read_text
-from sdar_tamp.world._yaml import file_error
+from sdar_tamp.errors import SourceLocation
 from sdar_tamp.world.errors import KinematicsError, SceneError
 from sdar_tamp.world.transforms import FloatArray
+from sdar_tamp.world.urdf import read_urdf
+
+
+def build_model(urdf_path: Path, text: str) -> tuple[Any, Any]:
+    """The pinocchio model and collision geometry of the URDF ``text`` read from
+    ``urdf_path`` (its mesh paths absolute); pinocchio's errors become located ones."""
+    try:
+        model = pin.buildModelFromXML(text)
+        geometry = pin.buildGeomFromUrdfString(model, text, pin.COLLISION)
+    except (RuntimeError, ValueError) as error:
+        detail = " ".join(str(error).split())
+        raise SceneError(
+            f"the robot description does not load: {detail}", SourceLocation(str(urdf_path), 1, 1)
+        ) from None
+    return model, geometry
 
 
 def se3_to_array(M: Any) -> FloatArray:
@@ -39,11 +53,15 @@ class PinRobot:
     data: Any = field(repr=False)
 
     @staticmethod
-    def load(urdf_path: Path) -> PinRobot:
-        """Parse a URDF file (collision geometry included)."""
-        text = read_text(urdf_path, file_error(SceneError))
-        model = pin.buildModelFromXML(text)
-        geometry = pin.buildGeomFromUrdfString(model, text, pin.COLLISION)
+    def load(urdf_path: Path, package_dirs: tuple[Path, ...] = ()) -> PinRobot:
+        """Parse a URDF file (collision geometry included, meshes too), its ``package://``
+        URIs looked up in ``package_dirs`` (:func:`sdar_tamp.world.urdf.read_urdf`).
+
+        Raises:
+            SceneError: the file cannot be read or parsed, a mesh is missing, or pinocchio
+                rejects the description (located at the file).
+        """
+        model, geometry = build_model(urdf_path, read_urdf(urdf_path, package_dirs))
         return PinRobot(urdf_path, model, geometry, model.createData())
 
     @property

@@ -55,7 +55,9 @@ class ArmKinematics:
     @staticmethod
     def from_scene(scene: Scene, arm: str) -> ArmKinematics:
         return ArmKinematics(
-            scene.arm(arm), PinRobot.load(scene.robot_urdf), scene.gripper.tcp_offset
+            scene.arm(arm),
+            PinRobot.load(scene.robot_urdf, scene.package_dirs),
+            scene.gripper.tcp_offset,
         )
 
     @property

@@ -65,8 +65,8 @@ class ArmFK:
     @staticmethod
     def from_scene(scene: Scene, arm: str) -> ArmFK:
         spec = scene.arm(arm)
-        spheres = arm_spheres(scene.robot_urdf)
-        coarse = arm_spheres(scene.robot_urdf, coarse=True)
+        spheres = arm_spheres(scene.robot_urdf, package_dirs=scene.package_dirs)
+        coarse = arm_spheres(scene.robot_urdf, coarse=True, package_dirs=scene.package_dirs)
         q = sx_sym("q", 6)
         frames = joint_frames(q, spec.T_world_base)
         tool0 = frames[5]
