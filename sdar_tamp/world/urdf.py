@@ -2,11 +2,12 @@
 
 A URDF names its meshes by ``package://<package>/<path>`` URIs (as ROS tools do), by
 ``file://`` URIs or by paths relative to the URDF file. :func:`read_urdf` returns the text with
-every mesh ``filename`` made an absolute path, so pinocchio and coal load the meshes whatever
-the working directory. A package is looked up in the package directories the scene names, then
-in those of ``ROS_PACKAGE_PATH`` (see :func:`package_dirs_from_env`): a directory whose own name
-is the package, or a directory holding a folder of that name. Everything that goes wrong raises
-:class:`~sdar_tamp.world.errors.SceneError` at the URDF's ``file:line:col``.
+every collision mesh's ``filename`` made an absolute path, so pinocchio and coal load the
+meshes whatever the working directory. A package is looked up in the package directories the
+scene names, then in those of ``ROS_PACKAGE_PATH`` (see :func:`package_dirs_from_env`): a
+directory whose own name is the package, or a directory holding a folder of that name.
+Everything that goes wrong raises :class:`~sdar_tamp.world.errors.SceneError` at the URDF's
+``file:line:col``.
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ _SHAPE = re.compile(
     r"<collision\b[^>]*>(?:(?!</collision>).)*?<geometry\b[^>]*>\s*(?:<!--.*?-->\s*)*<(\w+)",
     re.DOTALL,
 )
-_FILENAME = re.compile(r"""(\bfilename\s*=\s*)(["'])(.*?)\2""", re.DOTALL)
+_COLLISION = re.compile(r"<collision\b.*?</collision>", re.DOTALL)
+_FILENAME = re.compile(r"""(<mesh\b[^>]*?\bfilename\s*=\s*)(["'])(.*?)\2""", re.DOTALL)
 
 
 def package_dirs_from_env(environ: Mapping[str, str] | None = None) -> tuple[Path, ...]:
@@ -79,7 +81,8 @@ def _location(file: Path, text: str, offset: int) -> SourceLocation:
 
 
 def read_urdf(urdf: Path, package_dirs: tuple[Path, ...] = ()) -> str:
-    """The text of the URDF at ``urdf`` with every mesh ``filename`` an absolute path.
+    """The text of the URDF at ``urdf`` with every collision mesh's ``filename`` an absolute
+    path (visual meshes are left as they are: the planner and the validator do not read them).
 
     Raises:
         SceneError: the file cannot be read, is not well-formed XML, has no ``<robot>`` root,
@@ -109,13 +112,15 @@ def read_urdf(urdf: Path, package_dirs: tuple[Path, ...] = ()) -> str:
             )
     base_dir = urdf.parent
 
-    def absolute(match: re.Match[str]) -> str:
-        uri = match.group(3).strip()
-        path, how = resolve_uri(uri, base_dir, package_dirs)
-        if path is None:
-            raise SceneError(
-                f"mesh {uri!r} not found ({how})", _location(urdf, text, match.start(3))
-            )
-        return f"{match.group(1)}{match.group(2)}{path}{match.group(2)}"
+    def collision(block: re.Match[str]) -> str:
+        def absolute(match: re.Match[str]) -> str:
+            uri = match.group(3).strip()
+            path, how = resolve_uri(uri, base_dir, package_dirs)
+            if path is None:
+                where = _location(urdf, text, block.start() + match.start(3))
+                raise SceneError(f"mesh {uri!r} not found ({how})", where)
+            return f"{match.group(1)}{match.group(2)}{path}{match.group(2)}"
 
-    return _FILENAME.sub(absolute, text)
+        return _FILENAME.sub(absolute, block.group(0))
+
+    return _COLLISION.sub(collision, text)

@@ -59,7 +59,9 @@ TOY = """<?xml version="1.0"?>
   </link>
   <link name="link2">
     <collision><geometry><mesh filename="{box}"/></geometry></collision>
+    <visual><geometry><mesh filename="package://elsewhere/link2.dae"/></geometry></visual>
   </link>
+  <gazebo><plugin name="control" filename="libgazebo_ros_control.so"/></gazebo>
   <joint name="j1" type="revolute">
     <parent link="base"/><child link="link1"/><origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>
     <limit lower="-3" upper="3" effort="1" velocity="1"/>
@@ -103,7 +105,10 @@ def test_package_path_from_the_environment() -> None:
 def test_mesh_paths_become_absolute(tmp_path: Path) -> None:
     urdf = toy_arm(tmp_path)
     text = read_urdf(urdf, (tmp_path,))
-    assert "package://" not in text
+    assert "package://toyarm" not in text
+    # visual meshes and plugins are not the planner's business: left as they are
+    assert 'filename="package://elsewhere/link2.dae"' in text
+    assert 'filename="libgazebo_ros_control.so"' in text
     assert f'filename="{(tmp_path / "toyarm" / "meshes" / "tet.stl").resolve()}"' in text
     assert f'filename="{(tmp_path / "toyarm" / "meshes" / "box.obj").resolve()}"' in text
     # a relative path is taken from the URDF's folder, a file:// URI as it is
