@@ -101,3 +101,82 @@ class PinRobot:
 
     def integrate(self, q: FloatArray, v: FloatArray) -> FloatArray:
         return np.asarray(pin.integrate(self.model, q, v), dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class ChainJoint:
+    """One actuated joint of a serial chain, as pinocchio reads it from the URDF.
+
+    The joint's frame is ``T_parent_joint @ motion(q)``, where ``motion`` turns by ``q`` [rad]
+    about ``axis`` (``revolute``) or slides by ``q`` [m] along it (``prismatic``).
+    """
+
+    name: str
+    T_parent_joint: FloatArray  # (4, 4): the joint frame at q = 0 in the previous joint's frame
+    axis: FloatArray  # (3,) unit vector in the joint frame
+    kind: str  # "revolute" or "prismatic"
+    q_index: int  # index of the joint's coordinate in the robot's configuration vector
+
+
+@dataclass(frozen=True)
+class Chain:
+    """The serial chain from the robot's root to one frame: joints in order, then the frame's
+    fixed placement ``T_joint_frame`` ``(4, 4)`` in the last joint's frame."""
+
+    joints: tuple[ChainJoint, ...]
+    T_joint_frame: FloatArray
+    frame: str
+
+    @property
+    def dof(self) -> int:
+        return len(self.joints)
+
+
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+def _joint_kind_axis(joint: Any) -> tuple[str, FloatArray] | None:
+    """``(kind, axis)`` of a one-coordinate revolute or prismatic pinocchio joint, else None."""
+    short = str(joint.shortname())
+    for prefix, kind in (("JointModelR", "revolute"), ("JointModelP", "prismatic")):
+        if short in (f"{prefix}X", f"{prefix}Y", f"{prefix}Z"):
+            return kind, np.array(_AXES[short[-1]])
+        if short.startswith(prefix) and short.endswith("Unaligned"):
+            return kind, np.asarray(joint.extract().axis, dtype=np.float64).copy()
+    return None
+
+
+def chain_to(robot: PinRobot, frame: str) -> Chain:
+    """The chain of ``robot`` from its root to ``frame``.
+
+    Raises:
+        KinematicsError: unknown frame, or a joint on the way that is neither a one-axis
+            revolute nor a prismatic joint (continuous and floating joints included).
+    """
+    model = robot.model
+    f = model.frames[robot.frame_id(frame)]
+    ids: list[int] = []
+    j = int(f.parentJoint)
+    while j != 0:
+        ids.append(j)
+        j = int(model.parents[j])
+    joints: list[ChainJoint] = []
+    for j in reversed(ids):
+        kind_axis = _joint_kind_axis(model.joints[j])
+        if kind_axis is None:
+            raise KinematicsError(
+                f"joint {model.names[j]!r} of {robot.urdf_path.name} is a "
+                f"{model.joints[j].shortname()}; a chain takes one-axis revolute or prismatic "
+                "joints"
+            )
+        kind, axis = kind_axis
+        joints.append(
+            ChainJoint(
+                str(model.names[j]),
+                se3_to_array(model.jointPlacements[j]),
+                axis,
+                kind,
+                int(model.joints[j].idx_q),
+            )
+        )
+    return Chain(tuple(joints), se3_to_array(f.placement), frame)

@@ -9,6 +9,7 @@ import site
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sdar_tamp.world._pin import PinRobot
@@ -54,3 +55,31 @@ def test_without_package_directories_the_missing_mesh_is_located() -> None:
     urdf = SHARE / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
     with pytest.raises(SceneError, match=r"panda\.urdf:\d+:\d+: mesh 'package://"):
         PinRobot.load(urdf)
+
+
+@pytest.mark.parametrize(
+    ("relative", "frame", "dof"),
+    [
+        ("panda_description/urdf/panda.urdf", "panda_hand_tcp", 7),
+        ("ur_description/urdf/ur10_robot.urdf", "tool0", 6),
+        ("xarm_description/urdf/xarm7.urdf", "link_eef", 7),
+    ],
+)
+def test_maker_chains_match_pinocchio(relative: str, frame: str, dof: int) -> None:
+    from sdar_tamp.world._pin import chain_to
+    from streams.motion._casadi import to_array
+    from streams.motion.fk_chain import chain_pose_function
+
+    assert SHARE is not None
+    robots = SHARE / "example-robot-data" / "robots"
+    robot = PinRobot.load(robots / relative, (robots, SHARE))
+    chain = chain_to(robot, frame)
+    assert chain.dof == dof
+    fk = chain_pose_function(chain, np.eye(4))
+    rng = np.random.default_rng(2)
+    lo, hi = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    for _ in range(30):
+        q = rng.uniform(np.maximum(lo, -np.pi), np.minimum(hi, np.pi))
+        expected = robot.frame_pose(q, robot.frame_id(frame))
+        got = to_array(fk(np.array([q[j.q_index] for j in chain.joints])))
+        assert np.abs(got - expected).max() < 1e-9
