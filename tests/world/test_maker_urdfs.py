@@ -83,3 +83,32 @@ def test_maker_chains_match_pinocchio(relative: str, frame: str, dof: int) -> No
         expected = robot.frame_pose(q, robot.frame_id(frame))
         got = to_array(fk(np.array([q[j.q_index] for j in chain.joints])))
         assert np.abs(got - expected).max() < 1e-9
+
+
+#: The makers' published DH lengths (d1, a2, a3, d4, d5, d6) [m] of the CB3 arms.
+PUBLISHED = {
+    "ur3_robot": (0.1519, -0.24365, -0.21325, 0.11235, 0.08535, 0.0819),
+    "ur5_robot": (0.089159, -0.425, -0.39225, 0.10915, 0.09465, 0.0823),
+    "ur10_robot": (0.1273, -0.612, -0.5723, 0.163941, 0.1157, 0.0922),
+}
+
+
+@pytest.mark.parametrize("name", sorted(PUBLISHED))
+def test_ur_parameters_read_from_maker_urdfs(name: str) -> None:
+    from sdar_tamp.world.ur_identify import ur_parameters
+
+    assert SHARE is not None
+    robots = SHARE / "example-robot-data" / "robots"
+    urdf = robots / f"ur_description/urdf/{name}.urdf"
+    found = ur_parameters(PinRobot.load(urdf, (robots, SHARE)))
+    assert found is not None
+    assert tuple(vars(found[0]).values()) == PUBLISHED[name]
+
+
+def test_the_panda_is_not_ur() -> None:
+    from sdar_tamp.world.ur_identify import ur_parameters
+
+    assert SHARE is not None
+    robots = SHARE / "example-robot-data" / "robots"
+    urdf = robots / "panda_description/urdf/panda.urdf"
+    assert ur_parameters(PinRobot.load(urdf, (robots, SHARE)), flange="panda_hand_tcp") is None
