@@ -36,15 +36,17 @@ class GripperBox:
     half: tuple[float, float, float]
 
 
-def gripper_boxes(urdf: Path, tcp_frame: str = "tcp") -> tuple[GripperBox, ...]:
+def gripper_boxes(
+    urdf: Path, tcp_frame: str = "tcp", package_dirs: tuple[Path, ...] = ()
+) -> tuple[GripperBox, ...]:
     """The collision boxes of the link carrying ``tcp_frame`` (fingers and gripper body)."""
-    robot = PinRobot.load(urdf)
+    robot = PinRobot.load(urdf, package_dirs)
     frame = robot.model.frames[robot.frame_id(tcp_frame)]
     T_tcp_joint = inverse(se3_to_array(frame.placement))
     joint = int(frame.parentJoint)
     return tuple(
         GripperBox(T_tcp_joint @ p.T_joint_shape, p.half)
-        for p in arm_primitives(urdf)
+        for p in arm_primitives(urdf, package_dirs)
         if p.joint == joint and p.kind == "box"
     )
 

@@ -123,7 +123,10 @@ class RearrangementStreams:
     def blocking(self) -> GraspBlocking:
         """The grasp-blocking tests of the scene's gripper (built on first use)."""
         if self._blocking is None:
-            self._blocking = GraspBlocking(gripper_boxes(self.ctx.scene.robot_urdf), IK_MARGIN)
+            self._blocking = GraspBlocking(
+                gripper_boxes(self.ctx.scene.robot_urdf, package_dirs=self.ctx.scene.package_dirs),
+                IK_MARGIN,
+            )
         return self._blocking
 
     def size(self, obj: str) -> Size:

@@ -62,7 +62,7 @@ class Timeline:
 
     @staticmethod
     def build(instance: Instance, plan: PlanLike | None, scene: Scene) -> Timeline:
-        robot = PinRobot.load(scene.robot_urdf)
+        robot = PinRobot.load(scene.robot_urdf, scene.package_dirs)
         if plan is None:
             drawings = tuple(
                 ArmDrawing.build(a.name, robot, a.T_world_base, _tcp_offset(scene))

@@ -13,10 +13,24 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from sdar_tamp.textfile import read_text
-from sdar_tamp.world._yaml import file_error
+from sdar_tamp.errors import SourceLocation
 from sdar_tamp.world.errors import KinematicsError, SceneError
 from sdar_tamp.world.transforms import FloatArray
+from sdar_tamp.world.urdf import read_urdf
+
+
+def build_model(urdf_path: Path, text: str) -> tuple[Any, Any]:
+    """The pinocchio model and collision geometry of the URDF ``text`` read from
+    ``urdf_path`` (its mesh paths absolute); pinocchio's errors become located ones."""
+    try:
+        model = pin.buildModelFromXML(text)
+        geometry = pin.buildGeomFromUrdfString(model, text, pin.COLLISION)
+    except (RuntimeError, ValueError) as error:
+        detail = " ".join(str(error).split())
+        raise SceneError(
+            f"the robot description does not load: {detail}", SourceLocation(str(urdf_path), 1, 1)
+        ) from None
+    return model, geometry
 
 
 def se3_to_array(M: Any) -> FloatArray:
@@ -39,11 +53,15 @@ class PinRobot:
     data: Any = field(repr=False)
 
     @staticmethod
-    def load(urdf_path: Path) -> PinRobot:
-        """Parse a URDF file (collision geometry included)."""
-        text = read_text(urdf_path, file_error(SceneError))
-        model = pin.buildModelFromXML(text)
-        geometry = pin.buildGeomFromUrdfString(model, text, pin.COLLISION)
+    def load(urdf_path: Path, package_dirs: tuple[Path, ...] = ()) -> PinRobot:
+        """Parse a URDF file (collision geometry included, meshes too), its ``package://``
+        URIs looked up in ``package_dirs`` (:func:`sdar_tamp.world.urdf.read_urdf`).
+
+        Raises:
+            SceneError: the file cannot be read or parsed, a mesh is missing, or pinocchio
+                rejects the description (located at the file).
+        """
+        model, geometry = build_model(urdf_path, read_urdf(urdf_path, package_dirs))
         return PinRobot(urdf_path, model, geometry, model.createData())
 
     @property
@@ -83,3 +101,82 @@ class PinRobot:
 
     def integrate(self, q: FloatArray, v: FloatArray) -> FloatArray:
         return np.asarray(pin.integrate(self.model, q, v), dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class ChainJoint:
+    """One actuated joint of a serial chain, as pinocchio reads it from the URDF.
+
+    The joint's frame is ``T_parent_joint @ motion(q)``, where ``motion`` turns by ``q`` [rad]
+    about ``axis`` (``revolute``) or slides by ``q`` [m] along it (``prismatic``).
+    """
+
+    name: str
+    T_parent_joint: FloatArray  # (4, 4): the joint frame at q = 0 in the previous joint's frame
+    axis: FloatArray  # (3,) unit vector in the joint frame
+    kind: str  # "revolute" or "prismatic"
+    q_index: int  # index of the joint's coordinate in the robot's configuration vector
+
+
+@dataclass(frozen=True)
+class Chain:
+    """The serial chain from the robot's root to one frame: joints in order, then the frame's
+    fixed placement ``T_joint_frame`` ``(4, 4)`` in the last joint's frame."""
+
+    joints: tuple[ChainJoint, ...]
+    T_joint_frame: FloatArray
+    frame: str
+
+    @property
+    def dof(self) -> int:
+        return len(self.joints)
+
+
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+def _joint_kind_axis(joint: Any) -> tuple[str, FloatArray] | None:
+    """``(kind, axis)`` of a one-coordinate revolute or prismatic pinocchio joint, else None."""
+    short = str(joint.shortname())
+    for prefix, kind in (("JointModelR", "revolute"), ("JointModelP", "prismatic")):
+        if short in (f"{prefix}X", f"{prefix}Y", f"{prefix}Z"):
+            return kind, np.array(_AXES[short[-1]])
+        if short.startswith(prefix) and short.endswith("Unaligned"):
+            return kind, np.asarray(joint.extract().axis, dtype=np.float64).copy()
+    return None
+
+
+def chain_to(robot: PinRobot, frame: str) -> Chain:
+    """The chain of ``robot`` from its root to ``frame``.
+
+    Raises:
+        KinematicsError: unknown frame, or a joint on the way that is neither a one-axis
+            revolute nor a prismatic joint (continuous and floating joints included).
+    """
+    model = robot.model
+    f = model.frames[robot.frame_id(frame)]
+    ids: list[int] = []
+    j = int(f.parentJoint)
+    while j != 0:
+        ids.append(j)
+        j = int(model.parents[j])
+    joints: list[ChainJoint] = []
+    for j in reversed(ids):
+        kind_axis = _joint_kind_axis(model.joints[j])
+        if kind_axis is None:
+            raise KinematicsError(
+                f"joint {model.names[j]!r} of {robot.urdf_path.name} is a "
+                f"{model.joints[j].shortname()}; a chain takes one-axis revolute or prismatic "
+                "joints"
+            )
+        kind, axis = kind_axis
+        joints.append(
+            ChainJoint(
+                str(model.names[j]),
+                se3_to_array(model.jointPlacements[j]),
+                axis,
+                kind,
+                int(model.joints[j].idx_q),
+            )
+        )
+    return Chain(tuple(joints), se3_to_array(f.placement), frame)

@@ -15,14 +15,13 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from sdar_tamp.textfile import read_text
 from sdar_tamp.world import _coal
-from sdar_tamp.world._pin import array_to_se3, se3_to_array
-from sdar_tamp.world._yaml import file_error
+from sdar_tamp.world._pin import array_to_se3, build_model, se3_to_array
 from sdar_tamp.world.errors import SceneError
 from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
+from sdar_tamp.world.urdf import read_urdf
 
 
 @dataclass(frozen=True)
@@ -60,13 +59,12 @@ def _prefixed_urdf(text: str, prefix: str) -> str:
 
 def build_dual_arm(scene: Scene) -> CellCollisionModel:
     """Both arms of ``scene`` in one pinocchio model, bases at their world poses."""
-    text = read_text(scene.robot_urdf, file_error(SceneError))
+    text = read_urdf(scene.robot_urdf, scene.package_dirs)
     model = pin.Model()
     geometry = pin.GeometryModel()
     for spec in scene.arms:
         arm_text = _prefixed_urdf(text, f"{spec.name}_")
-        arm_model = pin.buildModelFromXML(arm_text)
-        arm_geom = pin.buildGeomFromUrdfString(arm_model, arm_text, pin.COLLISION)
+        arm_model, arm_geom = build_model(scene.robot_urdf, arm_text)
         model, geometry = pin.appendModel(
             model, arm_model, geometry, arm_geom, 0, array_to_se3(spec.T_world_base)
         )

@@ -6,7 +6,7 @@ Frames: ``world`` -> ``base_link`` (arm base pose from the scene) -> DH base (pi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -15,7 +15,8 @@ from sdar_tamp.world.dls_ik import DlsOptions, DlsResult, dls_ik
 from sdar_tamp.world.errors import KinematicsError
 from sdar_tamp.world.scene import ArmSpec, Scene
 from sdar_tamp.world.transforms import BoolArray, FloatArray, inverse, rot_z, translation
-from sdar_tamp.world.ur_ik import UR5E, URParameters, ur_fk, ur_ik, wrap_into_limits
+from sdar_tamp.world.ur_identify import ur_parameters
+from sdar_tamp.world.ur_ik import URParameters, ur_fk, ur_ik, wrap_into_limits
 
 #: ``T_base_link_dh0``: the DH base frame is the ROS base_link turned by pi about z.
 T_BASE_DH = np.eye(4)
@@ -50,13 +51,27 @@ class ArmKinematics:
     spec: ArmSpec
     robot: PinRobot
     tcp_offset: float  # [m]
-    params: URParameters = UR5E
+    params: URParameters  # read from the URDF (:func:`.ur_identify.ur_parameters`)
+    T_base_dh: FloatArray = field(default_factory=lambda: T_BASE_DH.copy(), compare=False)
 
     @staticmethod
     def from_scene(scene: Scene, arm: str) -> ArmKinematics:
-        return ArmKinematics(
-            scene.arm(arm), PinRobot.load(scene.robot_urdf), scene.gripper.tcp_offset
-        )
+        """The arm's kinematics, its UR parameters read from the scene's robot description.
+
+        Raises:
+            KinematicsError: the chain from the root to ``tool0`` is not a UR-family arm (the
+                closed-form IK is the only one for now).
+        """
+        robot = PinRobot.load(scene.robot_urdf, scene.package_dirs)
+        found = ur_parameters(robot)
+        if found is None:
+            raise KinematicsError(
+                f"{scene.robot_urdf.name}: the chain to tool0 is not a UR-family arm "
+                "(six revolute joints with the UR geometry), the only kind with inverse "
+                "kinematics for now"
+            )
+        params, T_base_dh = found
+        return ArmKinematics(scene.arm(arm), robot, scene.gripper.tcp_offset, params, T_base_dh)
 
     @property
     def T_world_base(self) -> FloatArray:
@@ -81,7 +96,7 @@ class ArmKinematics:
     # -- batched closed form ---------------------------------------------------------------
     def fk_batch(self, q: FloatArray) -> FloatArray:
         """``T_world_tool0`` ``(n, 4, 4)`` for ``q`` ``(n, 6)``, closed form (numpy)."""
-        return self.T_world_base @ T_BASE_DH @ ur_fk(self.params, q)
+        return self.T_world_base @ self.T_base_dh @ ur_fk(self.params, q)
 
     def ik_tool0(self, T_world_tool0: FloatArray) -> IKSolutions:
         """All IK branches for flange poses ``(n, 4, 4)`` (or one ``(4, 4)``)."""
@@ -89,7 +104,7 @@ class ArmKinematics:
         if T.shape[-2:] != (4, 4):
             raise KinematicsError(f"expected poses of shape (n, 4, 4), got {T.shape}")
         T = T.reshape(-1, 4, 4)
-        T_dh = inverse(self.T_world_base @ T_BASE_DH) @ T
+        T_dh = inverse(self.T_world_base @ self.T_base_dh) @ T
         q, real = ur_ik(self.params, T_dh)
         q, fits = wrap_into_limits(q, self.spec.lower_array, self.spec.upper_array)
         return IKSolutions(q, real & fits)

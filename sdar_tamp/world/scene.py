@@ -6,6 +6,7 @@ frozen dataclasses. World frame: table centre at the origin, z up, table top at 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
 from importlib.resources import files
@@ -16,7 +17,9 @@ import numpy as np
 from sdar_tamp.world._yaml import Node, read_yaml
 from sdar_tamp.world.errors import SceneError
 from sdar_tamp.world.layout import ArmLayout
+from sdar_tamp.world.robot_check import JointRequest, check_robot
 from sdar_tamp.world.transforms import BoolArray, FloatArray, pose_xyz_yaw
+from sdar_tamp.world.urdf import package_dirs_from_env, resolve_uri
 
 #: Joint keys of ``joint_limits`` in the scene file, in joint order.
 JOINT_KEYS = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
@@ -123,6 +126,9 @@ class Scene:
     #: Fraction in (0, 1] of the velocity and acceleration limits a trajectory's time-optimal
     #: profile may use (the sampled trajectory keeps the full limits in any case).
     velocity_safety: float = DEFAULT_VELOCITY_SAFETY
+    #: Where the robot description's ``package://`` URIs are looked up: the scene's
+    #: ``packages`` (relative to the scene file), then ``ROS_PACKAGE_PATH``.
+    package_dirs: tuple[Path, ...] = ()
 
     @property
     def arm_names(self) -> tuple[str, ...]:
@@ -155,16 +161,31 @@ class Scene:
 _JOINT_FIELDS = ("lower", "upper", "velocity_limit", "acceleration_limit", "home")
 
 
-def load_scene(path: Path | None = None) -> Scene:
-    """Load a scene file (default: the shipped ``scene.yaml``)."""
+def load_scene(path: Path | None = None, environ: Mapping[str, str] | None = None) -> Scene:
+    """Load a scene file (default: the shipped ``scene.yaml``).
+
+    ``robot`` is a path relative to the scene file or a ``package://`` URI, looked up in the
+    scene's ``packages`` directories, then in ``ROS_PACKAGE_PATH`` of ``environ`` (default
+    ``os.environ``). The robot description is loaded and checked against the arms: every
+    joint and frame the scene uses exists, and the scene's joint limits lie within the URDF's.
+    """
     path = default_scene_path() if path is None else Path(path)
     root = read_yaml(path, SceneError)
     keys = root.mapping(
-        ["robot", "table", "workspace", "object_size", "gripper", "arms"], ["velocity_safety"]
+        ["robot", "table", "workspace", "object_size", "gripper", "arms"],
+        ["velocity_safety", "packages"],
     )
-    robot = path.parent / keys["robot"].as_str()
-    if not robot.is_file():
-        raise keys["robot"].error("a robot description file next to the scene file")
+    packages: tuple[Path, ...] = ()
+    if "packages" in keys:
+        packages = tuple(path.parent / node.as_str() for node in keys["packages"].items())
+        for node, directory in zip(keys["packages"].items(), packages, strict=True):
+            if not directory.is_dir():
+                raise node.error("a package directory (relative to the scene file)")
+    package_dirs = packages + package_dirs_from_env(environ)
+    robot_path, how = resolve_uri(keys["robot"].as_str(), path.parent, package_dirs)
+    if robot_path is None:
+        raise keys["robot"].error(f"a robot description file ({how})")
+    robot = robot_path
     tx, ty, tz = (
         keys["table"].mapping(["size"])["size"].as_floats(3, "[x, y, thickness]", positive=True)
     )
@@ -190,8 +211,23 @@ def load_scene(path: Path | None = None) -> Scene:
         safety = node.as_float()
         if not 0.0 < safety <= 1.0:
             raise node.error("a number in (0, 1], the share of the joint limits a motion uses")
-    return Scene(str(path), robot, table, workspace, size, gripper, arms,  # type: ignore[arg-type]
-                 safety)  # fmt: skip
+    scene = Scene(str(path), robot, table, workspace, size, gripper, arms,  # type: ignore[arg-type]
+                  safety, package_dirs)  # fmt: skip
+    check_robot(robot, package_dirs, keys["robot"], _joint_requests(arms, arm_nodes), FRAMES)
+    return scene
+
+
+#: The frames of the robot description the planner uses: the flange and the tool centre point.
+FRAMES = ("tool0", "tcp")
+
+
+def _joint_requests(arms: tuple[ArmSpec, ...], nodes: list[Node]) -> list[JointRequest]:
+    out: list[JointRequest] = []
+    for arm, node in zip(arms, nodes, strict=True):
+        limits = node.mapping(_ARM_KEYS)["joint_limits"].mapping(list(JOINT_KEYS))
+        for i, key in enumerate(JOINT_KEYS):
+            out.append(JointRequest(f"{key}_joint", arm.lower[i], arm.upper[i], limits[key]))
+    return out
 
 
 _ARM_KEYS = ["name", "base", "joint_limits", "velocity_limit", "acceleration_limit", "home"]

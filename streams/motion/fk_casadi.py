@@ -14,10 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from sdar_tamp.world.kinematics import T_BASE_DH
+from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
-from sdar_tamp.world.ur_ik import UR5E, URParameters
+from sdar_tamp.world.ur_ik import URParameters
 from streams.motion._casadi import ca, function, sx_sym, to_array
 from streams.motion.spheres import ArmSpheres, arm_spheres
 
@@ -35,12 +35,15 @@ def _tx_rx(a: float, alpha: float) -> FloatArray:
     return np.array([[1, 0, 0, a], [0, ca_, -sa, 0], [0, sa, ca_, 0], [0, 0, 0, 1.0]])
 
 
-def joint_frames(q: Any, T_world_base: FloatArray, params: URParameters = UR5E) -> list[Any]:
-    """World poses (SX ``4x4``) of joint frames 1..6 for the SX vector ``q`` ``(6,)``."""
+def joint_frames(
+    q: Any, T_world_base: FloatArray, params: URParameters, T_base_dh: FloatArray
+) -> list[Any]:
+    """World poses (SX ``4x4``) of joint frames 1..6 for the SX vector ``q`` ``(6,)``; the
+    DH base at ``T_base_dh`` ``(4, 4)`` in the arm's base frame."""
     h = np.pi / 2
     rows = ((params.d1, 0.0, h), (0.0, params.a2, 0.0), (0.0, params.a3, 0.0),
             (params.d4, 0.0, h), (params.d5, 0.0, -h), (params.d6, 0.0, 0.0))  # fmt: skip
-    T: Any = ca.SX(T_world_base @ T_BASE_DH)
+    T: Any = ca.SX(T_world_base @ T_base_dh)
     frames = []
     for i, (d, a, alpha) in enumerate(rows):
         T = T @ _rz_tz(q[i], d)
@@ -55,6 +58,8 @@ class ArmFK:
 
     T_world_base: FloatArray
     tcp_offset: float
+    params: URParameters  # read from the URDF
+    T_base_dh: FloatArray  # (4, 4) the DH base in the arm's base frame
     spheres: ArmSpheres
     coarse: ArmSpheres  # fewer, larger spheres (arm-arm pairs of the optimiser)
     tcp_fn: Any  # casadi Function q(6) -> 4x4
@@ -65,16 +70,19 @@ class ArmFK:
     @staticmethod
     def from_scene(scene: Scene, arm: str) -> ArmFK:
         spec = scene.arm(arm)
-        spheres = arm_spheres(scene.robot_urdf)
-        coarse = arm_spheres(scene.robot_urdf, coarse=True)
+        spheres = arm_spheres(scene.robot_urdf, package_dirs=scene.package_dirs)
+        coarse = arm_spheres(scene.robot_urdf, coarse=True, package_dirs=scene.package_dirs)
+        kinematics = ArmKinematics.from_scene(scene, arm)
         q = sx_sym("q", 6)
-        frames = joint_frames(q, spec.T_world_base)
+        frames = joint_frames(q, spec.T_world_base, kinematics.params, kinematics.T_base_dh)
         tool0 = frames[5]
         tcp = tool0 @ ca.SX(translation(0.0, 0.0, scene.gripper.tcp_offset))
         centres = sphere_centres(frames, spheres)
         return ArmFK(
             spec.T_world_base,
             scene.gripper.tcp_offset,
+            kinematics.params,
+            kinematics.T_base_dh,
             spheres,
             coarse,
             function("tcp", [q], [tcp]),

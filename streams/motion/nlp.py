@@ -111,7 +111,7 @@ def _knot_rows(ctx: WorldContext, lay: ParameterLayout, q: Any, p: Any) -> Any:
     arms = ctx.layout
     m = lay.sym(p, "margin")
     frames = [
-        joint_frames(q[sl], ctx.fk[arm].T_world_base)
+        joint_frames(q[sl], ctx.fk[arm].T_world_base, ctx.fk[arm].params, ctx.fk[arm].T_base_dh)
         for arm, sl in zip(ctx.arm_names, arms.slices, strict=True)
     ]
     (cl, rl), (cr, rr) = (_slot_centres(lay, frames[i], p, "aa", i) for i in (0, 1))

@@ -88,9 +88,11 @@ class TrajectoryOptimiser:
         from sdar_tamp.world import kinematics, ur_ik
         from streams.motion import _casadi, fk_casadi, nlp
 
-        parts = [repr(self.options), repr(self.ctx.layout), repr(ur_ik.UR5E)]
+        parts = [repr(self.options), repr(self.ctx.layout)]
         for arm in self.ctx.arm_names:
-            parts.append(np.asarray(self.ctx.fk[arm].T_world_base).tobytes().hex())
+            fk = self.ctx.fk[arm]
+            parts.append(repr(fk.params) + np.asarray(fk.T_base_dh).tobytes().hex())
+            parts.append(np.asarray(fk.T_world_base).tobytes().hex())
         for module in (_casadi, fk_casadi, kinematics, ur_ik, nlp):
             parts.append(Path(module.__file__ or "").read_text(encoding="utf-8"))
         parts.append(Path(__file__).read_text(encoding="utf-8"))

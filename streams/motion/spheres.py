@@ -75,7 +75,9 @@ def _gripper_box(prims: list[Primitive]) -> tuple[FloatArray, FloatArray]:
     return (lo + hi) / 2.0, (hi - lo) / 2.0
 
 
-def arm_spheres(urdf: Path, coarse: bool = False) -> ArmSpheres:
+def arm_spheres(
+    urdf: Path, coarse: bool = False, package_dirs: tuple[Path, ...] = ()
+) -> ArmSpheres:
     """The sphere model of one arm (links 1..6 and the gripper) from the URDF's primitives.
 
     ``coarse``: fewer, larger spheres (cylinders 2 radii apart, the whole gripper as one box),
@@ -84,7 +86,7 @@ def arm_spheres(urdf: Path, coarse: bool = False) -> ArmSpheres:
     joints: list[int] = []
     centres: list[FloatArray] = []
     radii: list[FloatArray] = []
-    prims = [p for p in arm_primitives(urdf) if p.joint != 0]
+    prims = [p for p in arm_primitives(urdf, package_dirs) if p.joint != 0]
     if coarse:
         grip = [p for p in prims if p.name.startswith(_GRIPPER_PREFIX)]
         prims = [p for p in prims if not p.name.startswith(_GRIPPER_PREFIX)]

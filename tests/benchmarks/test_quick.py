@@ -63,6 +63,11 @@ def _motion_hard(out: Summary) -> None:
         assert {"optimiser", "ompl", "ladder", "sdar-m"} <= out[kind].keys()
 
 
+def _numeric_ik(out: Summary) -> None:
+    ur = out["arms"]["ur5e"]
+    assert ur["poses"] == 100 and ur["within_limits"] is True and ur["success_rate"] >= 0.95
+
+
 def _parser(out: Summary) -> None:
     assert out["init_facts"] > 0 and out["problem_mb_per_s"] > 0
 
@@ -96,6 +101,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_feasibility", ()): _feasibility,
     ("bench_motion", ()): _motion,
     ("bench_motion", ("--hard", "1")): _motion_hard,
+    ("bench_numeric_ik", ()): _numeric_ik,
     ("bench_parser", ()): _parser,
     ("bench_pddlstream_compat", ()): _pddlstream,
     ("bench_sdar", ()): _sdar,

@@ -137,3 +137,54 @@ def test_error_location_points_at_the_line(tmp_path: Path) -> None:
 def test_unknown_arm(scene: object) -> None:
     with pytest.raises(SceneError, match="unknown arm 'middle'"):
         load_scene().arm("middle")
+
+
+def _robot_variant(tmp_path: Path, old: str, new: str) -> Path:
+    """A scene whose robot is the shipped URDF with ``old`` replaced by ``new``."""
+    text = domain_path("ur5e_2f85.urdf").read_text(encoding="utf-8")
+    assert old in text
+    (tmp_path / "robot.urdf").write_text(text.replace(old, new), encoding="utf-8")
+    data = _data()
+    data["robot"] = "robot.urdf"
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def test_limits_outside_the_urdf_are_located(tmp_path: Path) -> None:
+    data = _data()
+    data["arms"][0]["joint_limits"] = dict(data["arms"][0]["joint_limits"], elbow=[0.0, 3.5])
+    data["arms"][0]["home"][2] = 3.2
+    msg = _error(tmp_path, data)
+    assert "arms[0].joint_limits.elbow: expected limits within the URDF's" in msg
+    assert "[-3.141592653589793, 3.141592653589793] of elbow_joint" in msg
+
+
+def test_a_missing_joint_is_located(tmp_path: Path) -> None:
+    path = _robot_variant(tmp_path, 'joint name="wrist_2_joint"', 'joint name="wrist_2"')
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    message = str(info.value)
+    assert "scene.yaml:" in message and "arms[0].joint_limits.wrist_2: expected a joint" in message
+    assert "'wrist_2_joint' in robot.urdf" in message
+
+
+def test_a_missing_frame_is_located(tmp_path: Path) -> None:
+    path = _robot_variant(tmp_path, '<child link="tcp"/>', '<child link="tip"/>')
+    path.parent.joinpath("robot.urdf").write_text(
+        path.parent.joinpath("robot.urdf")
+        .read_text()
+        .replace('<link name="tcp"/>', '<link name="tip"/>')
+    )
+    with pytest.raises(
+        SceneError,
+        match=r"scene\.yaml:1:\d+: robot: expected a robot description "
+        r"with a frame 'tcp'",
+    ):
+        load_scene(path)
+
+
+def test_a_robot_that_does_not_load_is_located(tmp_path: Path) -> None:
+    path = _robot_variant(tmp_path, "</robot>", "")
+    with pytest.raises(SceneError, match=r"robot\.urdf:\d+:\d+: not a well-formed"):
+        load_scene(path)

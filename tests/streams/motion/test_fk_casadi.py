@@ -25,7 +25,7 @@ def test_casadi_fk_equals_pinocchio(ctx: WorldContext, arm: str) -> None:
 def test_joint_frames_are_the_urdf_link_frames(ctx: WorldContext, arm: str) -> None:
     kin = ctx.kinematics[arm]
     q = sx_sym("q", 6)
-    f = function("frames", [q], joint_frames(q, kin.T_world_base))
+    f = function("frames", [q], joint_frames(q, kin.T_world_base, kin.params, kin.T_base_dh))
     rng = np.random.default_rng(2)
     for qv in rng.uniform(-np.pi, np.pi, (5, 6)):
         frames = f(qv)

@@ -1,0 +1,225 @@
+"""Batched numeric inverse kinematics of any serial chain (6 or 7 DoF and others).
+
+Forward kinematics and the geometric Jacobian of a :class:`~sdar_tamp.world._pin.Chain` are
+evaluated with numpy for a whole batch at once. The solver is damped least squares
+(Levenberg-Marquardt with a fixed damping) on the pose error ``(p_t - p, log(R_t R^T))`` in the
+root frame; for a redundant arm the step also moves, in the Jacobian's null space, toward the
+reference configuration (the home, or the centre of the limits). Joints are clamped into their
+limits after every step. Every target is tried from several seeds (the reference first, then
+uniform draws inside the limits), and the targets no seed solved get fresh seeds in up to
+``rounds`` rounds; of the seeds that converge, the one closest to the reference is kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sdar_tamp.world._pin import Chain
+from sdar_tamp.world.errors import KinematicsError
+from sdar_tamp.world.transforms import BoolArray, FloatArray
+
+
+@dataclass(frozen=True)
+class NumericIKOptions:
+    """Tolerances [m], [rad] and effort of :func:`numeric_ik`."""
+
+    seeds: int = 8
+    iterations: int = 200
+    position_tolerance: float = 1e-6  # [m]
+    rotation_tolerance: float = 1e-6  # [rad]
+    damping: float = 1e-2  # initial; adapted per row (Levenberg-Marquardt)
+    max_step: float = 0.5  # [rad] or [m] per joint and iteration
+    null_space_gain: float = 0.1
+    rounds: int = 6  # fresh seeds for the targets not yet solved
+
+
+@dataclass(frozen=True)
+class NumericIKResult:
+    """``q`` ``(n, dof)`` [rad]; ``ok`` ``(n,)`` where a seed converged."""
+
+    q: FloatArray
+    ok: BoolArray
+
+    @property
+    def success_rate(self) -> float:
+        return float(np.mean(self.ok)) if len(self.ok) else 1.0
+
+
+def _rotations(axis: FloatArray, angle: FloatArray) -> FloatArray:
+    """Rotation matrices ``(n, 3, 3)`` about the unit ``axis`` ``(3,)`` by ``angle`` ``(n,)``."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    out: FloatArray = np.eye(3) + s * k + (1.0 - c) * (k @ k)
+    return out
+
+
+def chain_fk(chain: Chain, q: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Joint frames ``(n, dof, 4, 4)`` and end-frame poses ``(n, 4, 4)`` in the root frame
+    for configurations ``q`` ``(n, dof)``."""
+    q = np.atleast_2d(np.asarray(q, dtype=np.float64))
+    n = len(q)
+    T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+    frames = np.empty((n, chain.dof, 4, 4))
+    for i, joint in enumerate(chain.joints):
+        motion = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+        axis = joint.axis / np.linalg.norm(joint.axis)
+        if joint.kind == "prismatic":
+            motion[:, :3, 3] = q[:, i, None] * axis
+        else:
+            motion[:, :3, :3] = _rotations(axis, q[:, i])
+        T = T @ joint.T_parent_joint @ motion
+        frames[:, i] = T
+    return frames, T @ chain.T_joint_frame
+
+
+def chain_jacobian(chain: Chain, frames: FloatArray, end: FloatArray) -> FloatArray:
+    """Geometric Jacobians ``(n, 6, dof)`` (linear rows first) of the end frame, root frame."""
+    n = len(end)
+    J = np.zeros((n, 6, chain.dof))
+    for i, joint in enumerate(chain.joints):
+        z = frames[:, i, :3, :3] @ (joint.axis / np.linalg.norm(joint.axis))
+        if joint.kind == "prismatic":
+            J[:, :3, i] = z
+        else:
+            J[:, :3, i] = np.cross(z, end[:, :3, 3] - frames[:, i, :3, 3])
+            J[:, 3:, i] = z
+    return J
+
+
+def rotation_log(R: FloatArray) -> FloatArray:
+    """Rotation vectors ``(n, 3)`` (axis times angle [rad]) of rotation matrices ``(n, 3, 3)``."""
+    cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos)
+    vee = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
+    sin = np.sin(angle)
+    small = sin < 1e-9
+    scale = np.where(small, 0.5, angle / (2.0 * np.where(small, 1.0, sin)))
+    out: FloatArray = vee * scale[:, None]
+    near_pi = small & (cos < 0.0)
+    if near_pi.any():  # angle pi: the axis is the column of R + I of largest norm
+        B = R[near_pi] + np.eye(3)
+        col = np.argmax(np.linalg.norm(B, axis=1), axis=1)
+        axis = B[np.arange(len(B)), :, col]
+        out[near_pi] = np.pi * axis / np.linalg.norm(axis, axis=1, keepdims=True)
+    return out
+
+
+def pose_error(T_target: FloatArray, T: FloatArray) -> FloatArray:
+    """``(n, 6)``: position error [m] then rotation error [rad] (root frame)."""
+    dp = T_target[:, :3, 3] - T[:, :3, 3]
+    dr = rotation_log(T_target[:, :3, :3] @ np.transpose(T[:, :3, :3], (0, 2, 1)))
+    return np.concatenate([dp, dr], axis=1)
+
+
+def _step(
+    J: FloatArray, err: FloatArray, damping: FloatArray, to_ref: FloatArray, opts: NumericIKOptions
+) -> FloatArray:
+    """Damped least-squares steps ``(m, dof)``, plus the null-space pull ``to_ref`` for a
+    redundant chain, clipped to ``max_step``."""
+    Jt = np.transpose(J, (0, 2, 1))
+    JJt = J @ Jt + (damping**2)[:, None, None] * np.eye(6)
+    J_pinv = Jt @ np.linalg.inv(JJt)  # (m, dof, 6)
+    step = (J_pinv @ err[:, :, None])[:, :, 0]
+    if J.shape[2] > 6:
+        null = np.eye(J.shape[2]) - J_pinv @ J
+        step += opts.null_space_gain * (null @ to_ref[:, :, None])[:, :, 0]
+    out: FloatArray = np.clip(step, -opts.max_step, opts.max_step)
+    return out
+
+
+def _converged(err: FloatArray, opts: NumericIKOptions) -> BoolArray:
+    position = np.linalg.norm(err[:, :3], axis=1) < opts.position_tolerance
+    rotation = np.linalg.norm(err[:, 3:], axis=1) < opts.rotation_tolerance
+    return np.asarray(position & rotation, dtype=np.bool_)
+
+
+def numeric_ik(
+    chain: Chain,
+    T_root_target: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    q_ref: FloatArray | None = None,
+    options: NumericIKOptions | None = None,
+    seed: int = 0,
+) -> NumericIKResult:
+    """IK of ``chain``'s end frame for targets ``(n, 4, 4)`` in the root frame, joints within
+    ``[lower, upper]`` ``(dof,)``; redundancy resolved toward ``q_ref`` ``(dof,)`` (default:
+    the centre of the limits). Deterministic in ``seed``.
+
+    Raises:
+        KinematicsError: shapes that do not match the chain, or ``lower > upper``.
+    """
+    opts = NumericIKOptions() if options is None else options
+    T_t = np.asarray(T_root_target, dtype=np.float64).reshape(-1, 4, 4)
+    lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
+    ref = (lo + hi) / 2.0 if q_ref is None else np.asarray(q_ref, dtype=np.float64)
+    if lo.shape != (chain.dof,) or hi.shape != lo.shape or ref.shape != lo.shape:
+        raise KinematicsError(f"expected limits and reference of shape ({chain.dof},)")
+    if np.any(lo > hi):
+        raise KinematicsError("lower limits above upper limits")
+    n, dof = len(T_t), chain.dof
+    rng = np.random.default_rng(seed)
+    q_out = np.repeat(ref[None], n, axis=0)
+    ok = np.zeros(n, dtype=bool)
+    for round_ in range(max(1, opts.rounds)):
+        todo = np.flatnonzero(~ok)
+        if len(todo) == 0:
+            break
+        s = max(1, opts.seeds)
+        draws = rng.uniform(lo, hi, (len(todo), s, dof))
+        if round_ == 0:
+            draws[:, 0] = ref  # the reference is the first seed of every target
+        q, done = _descend(chain, T_t[todo], draws, lo, hi, ref, opts)
+        distance = np.where(done, np.linalg.norm(q - ref, axis=2), np.inf)
+        best = np.argmin(distance, axis=1)
+        q_out[todo] = q[np.arange(len(todo)), best]
+        ok[todo] = np.isfinite(distance[np.arange(len(todo)), best])
+    return NumericIKResult(q_out, np.asarray(ok, dtype=np.bool_))
+
+
+def _descend(
+    chain: Chain,
+    T_t: FloatArray,
+    starts: FloatArray,
+    lo: FloatArray,
+    hi: FloatArray,
+    ref: FloatArray,
+    opts: NumericIKOptions,
+) -> tuple[FloatArray, BoolArray]:
+    """Damped least squares from ``starts`` ``(n, s, dof)`` toward targets ``(n, 4, 4)``:
+    final ``q`` ``(n, s, dof)`` and which converged ``(n, s)``."""
+    n, s, dof = starts.shape
+    q = starts.reshape(n * s, dof).copy()
+    targets = np.repeat(T_t, s, axis=0)
+    refs = np.broadcast_to(ref, q.shape)
+    damping = np.full(n * s, opts.damping)
+    frames, end = chain_fk(chain, q)
+    err = pose_error(targets, end)
+    cost = np.einsum("ij,ij->i", err, err)
+    done = _converged(err, opts)
+    for _ in range(opts.iterations):
+        if done.all():
+            break
+        J = chain_jacobian(chain, frames, end)
+        step = _step(J, err, damping, refs - q, opts)
+        # a joint at a limit that the step pushes outward is frozen: solve without it
+        blocked = ((q <= lo) & (step < 0.0)) | ((q >= hi) & (step > 0.0))
+        if blocked.any():
+            J = np.where(blocked[:, None, :], 0.0, J)
+            step = np.where(blocked, 0.0, _step(J, err, damping, refs - q, opts))
+        trial = np.clip(q + step, lo, hi)
+        t_frames, t_end = chain_fk(chain, trial)
+        t_err = pose_error(targets, t_end)
+        t_cost = np.einsum("ij,ij->i", t_err, t_err)
+        better = (t_cost < cost) & ~done
+        # Levenberg-Marquardt: accept and trust the model more, or refuse and damp more
+        damping = np.where(better, np.maximum(damping / 3.0, 1e-6), np.minimum(damping * 4, 1e2))
+        q = np.where(better[:, None], trial, q)
+        frames = np.where(better[:, None, None, None], t_frames, frames)
+        end = np.where(better[:, None, None], t_end, end)
+        err = np.where(better[:, None], t_err, err)
+        cost = np.where(better, t_cost, cost)
+        done = _converged(err, opts)
+    return q.reshape(n, s, dof), done.reshape(n, s)

@@ -1,0 +1,114 @@
+"""Makers' robot descriptions from ``example-robot-data`` (BSD-3-Clause; optional: about
+130 MB to download, 415 MB installed). The tests skip when it is not installed; the
+environment variable ``EXAMPLE_ROBOT_DATA_SHARE`` may name its ``share`` directory."""
+
+from __future__ import annotations
+
+import os
+import site
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sdar_tamp.world._pin import PinRobot
+from sdar_tamp.world.errors import SceneError
+from streams._pin_geometry import arm_primitives
+
+
+def _share() -> Path | None:
+    given = os.environ.get("EXAMPLE_ROBOT_DATA_SHARE")
+    roots = [Path(given)] if given else []
+    for prefix in [*site.getsitepackages(), sys.prefix]:
+        roots += [Path(prefix) / "cmeel.prefix" / "share", Path(prefix) / "share"]
+    return next((r for r in roots if (r / "example-robot-data" / "robots").is_dir()), None)
+
+
+SHARE = _share()
+pytestmark = pytest.mark.skipif(SHARE is None, reason="example-robot-data is not installed")
+
+ARMS = {
+    "ur_description/urdf/ur10_robot.urdf": 6,
+    "ur_description/urdf/ur5_robot.urdf": 6,
+    "panda_description/urdf/panda.urdf": 9,
+    "xarm_description/urdf/xarm7.urdf": 7,
+}
+
+
+@pytest.mark.parametrize("relative", sorted(ARMS))
+def test_maker_arms_load_with_their_meshes(relative: str) -> None:
+    assert SHARE is not None
+    robots = SHARE / "example-robot-data" / "robots"
+    urdf = robots / relative
+    robot = PinRobot.load(urdf, (robots, SHARE))
+    assert robot.nq == ARMS[relative]
+    kinds = {type(o.geometry).__name__ for o in robot.geometry.geometryObjects}
+    assert any(k.startswith("BVHModel") for k in kinds)
+    prims = arm_primitives(urdf, (robots, SHARE))
+    assert len(prims) == len(robot.geometry.geometryObjects)
+    assert all(p.kind == "box" and min(p.half) >= 0.0 for p in prims)
+
+
+def test_without_package_directories_the_missing_mesh_is_located() -> None:
+    assert SHARE is not None
+    urdf = SHARE / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
+    with pytest.raises(SceneError, match=r"panda\.urdf:\d+:\d+: mesh 'package://"):
+        PinRobot.load(urdf)
+
+
+@pytest.mark.parametrize(
+    ("relative", "frame", "dof"),
+    [
+        ("panda_description/urdf/panda.urdf", "panda_hand_tcp", 7),
+        ("ur_description/urdf/ur10_robot.urdf", "tool0", 6),
+        ("xarm_description/urdf/xarm7.urdf", "link_eef", 7),
+    ],
+)
+def test_maker_chains_match_pinocchio(relative: str, frame: str, dof: int) -> None:
+    from sdar_tamp.world._pin import chain_to
+    from streams.motion._casadi import to_array
+    from streams.motion.fk_chain import chain_pose_function
+
+    assert SHARE is not None
+    robots = SHARE / "example-robot-data" / "robots"
+    robot = PinRobot.load(robots / relative, (robots, SHARE))
+    chain = chain_to(robot, frame)
+    assert chain.dof == dof
+    fk = chain_pose_function(chain, np.eye(4))
+    rng = np.random.default_rng(2)
+    lo, hi = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    for _ in range(30):
+        q = rng.uniform(np.maximum(lo, -np.pi), np.minimum(hi, np.pi))
+        expected = robot.frame_pose(q, robot.frame_id(frame))
+        got = to_array(fk(np.array([q[j.q_index] for j in chain.joints])))
+        assert np.abs(got - expected).max() < 1e-9
+
+
+#: The makers' published DH lengths (d1, a2, a3, d4, d5, d6) [m] of the CB3 arms.
+PUBLISHED = {
+    "ur3_robot": (0.1519, -0.24365, -0.21325, 0.11235, 0.08535, 0.0819),
+    "ur5_robot": (0.089159, -0.425, -0.39225, 0.10915, 0.09465, 0.0823),
+    "ur10_robot": (0.1273, -0.612, -0.5723, 0.163941, 0.1157, 0.0922),
+}
+
+
+@pytest.mark.parametrize("name", sorted(PUBLISHED))
+def test_ur_parameters_read_from_maker_urdfs(name: str) -> None:
+    from sdar_tamp.world.ur_identify import ur_parameters
+
+    assert SHARE is not None
+    robots = SHARE / "example-robot-data" / "robots"
+    urdf = robots / f"ur_description/urdf/{name}.urdf"
+    found = ur_parameters(PinRobot.load(urdf, (robots, SHARE)))
+    assert found is not None
+    assert tuple(vars(found[0]).values()) == PUBLISHED[name]
+
+
+def test_the_panda_is_not_ur() -> None:
+    from sdar_tamp.world.ur_identify import ur_parameters
+
+    assert SHARE is not None
+    robots = SHARE / "example-robot-data" / "robots"
+    urdf = robots / "panda_description/urdf/panda.urdf"
+    assert ur_parameters(PinRobot.load(urdf, (robots, SHARE)), flange="panda_hand_tcp") is None
