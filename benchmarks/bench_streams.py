@@ -14,9 +14,19 @@ cost in each mode; ``cpu`` is the process time [s] of a run (all threads).
         [--limit-probe 1.5]                       # the full run
     python benchmarks/bench_streams.py --quick    # seconds
 
+Then the 2-D kitchen (``domains/kitchen_2d``: two cups from a counter to a shelf, in
+PDDLStream's idiom) in its variants: a 1.0 m shelf (feasible) or a 0.5 m one (infeasible), a
+finite grid pose sampler or an endless random one, with or without ``StreamInfo(negate=True)``
+on the collision test; every algorithm on ``--kitchen-seeds`` seeds each, a run limited to
+``--kitchen-max-time``. A feasible row is met when every seed is solved within
+``FEASIBLE_SECONDS``; an infeasible one (finite samplers only: an endless sampler can prove
+nothing) when every seed ends ``infeasible`` within ``INFEASIBLE_SECONDS`` with the failing
+collision test named in the diagnosis. ``--kitchen-seeds 0`` skips these rows.
+
 ``--quick`` changes only the defaults: every algorithm on kitchen, dual_arm_swap and infeasible
-(pick_place_2d, the slow one, left out), a 0.2 s overrun probe and 2,000 calls for the call
-overhead; the JSON keys are the same, plus ``"quick": true``.
+(pick_place_2d, the slow one, left out), the 2-D kitchen on 2 seeds (3 s a run), a 0.2 s
+overrun probe and 2,000 calls for the call overhead; the JSON keys are the same, plus
+``"quick": true``.
 """
 
 from __future__ import annotations
@@ -30,6 +40,7 @@ import math
 import time
 from typing import Any
 
+from domains.kitchen_2d import samplers as kitchen_2d
 from sdar_tamp.language.generators import from_sampler, from_test
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solve import solve
@@ -46,7 +57,20 @@ QUICK = {
     "domains": ["kitchen", "dual_arm_swap", "infeasible"],
     "limit_probe": 0.2,
     "overhead_calls": 2_000,
+    "kitchen_seeds": 2,
+    "kitchen_max_time": 3.0,
 }
+#: The 2-D kitchen's variants: name -> (shelf width [m], pose sampler, negate the test)
+KITCHEN_VARIANTS: dict[str, tuple[float, str, bool]] = {
+    "feasible-grid": (1.0, "grid", False),
+    "feasible-grid-negate": (1.0, "grid", True),
+    "feasible-random": (1.0, "random", False),
+    "feasible-random-negate": (1.0, "random", True),
+    "infeasible-grid": (0.5, "grid", False),
+    "infeasible-grid-negate": (0.5, "grid", True),
+}
+FEASIBLE_SECONDS = 2.0  # [s] a feasible kitchen variant is solved within this, every seed
+INFEASIBLE_SECONDS = 5.0  # [s] an infeasible one is proved so within this, every seed
 
 
 def run(
@@ -78,6 +102,82 @@ def run(
         "length": len(solution.plan) if solution.plan is not None else None,
         "iterations": int(solution.statistics.get("iterations", 0)),
     }
+
+
+def kitchen_run(variant: str, algorithm: str, seed: int, max_time: float) -> dict[str, Any]:
+    """One solve of a 2-D kitchen variant."""
+    width, sampler, negate = KITCHEN_VARIANTS[variant]
+    problem = kitchen_2d.make_problem(width, sampler, seed)
+    start = time.perf_counter()
+    solution = solve(
+        problem,
+        algorithm=algorithm,
+        stream_info=kitchen_2d.stream_info(negate),
+        max_time=max_time,
+        seed=seed,
+        verbose=False,
+    )
+    elapsed = time.perf_counter() - start
+    iterations = int(solution.statistics.get("iterations", 0))
+    return {
+        "status": solution.status.value,
+        "time": round(elapsed, 3),
+        "iterations": iterations,
+        "rounds_per_s": round(iterations / elapsed, 1) if elapsed > 0 else None,
+        "stream_calls": sum(s.calls for s in solution.streams.values()),
+        "names_test": any("test-cfree" in reason for reason in solution.diagnosis),
+    }
+
+
+def kitchen_rows(algorithms: list[str], seeds: int, max_time: float) -> list[dict[str, Any]]:
+    """Per variant and algorithm: how many seeds ended as expected, and the times."""
+    rows = []
+    for variant, (width, _, _) in KITCHEN_VARIANTS.items():
+        feasible = width >= 2 * kitchen_2d.CUP
+        for algorithm in algorithms:
+            runs = [kitchen_run(variant, algorithm, seed, max_time) for seed in range(seeds)]
+            if feasible:
+                met = [r["status"] == "solved" and r["time"] <= FEASIBLE_SECONDS for r in runs]
+            else:
+                met = [
+                    r["status"] == "infeasible"
+                    and r["time"] <= INFEASIBLE_SECONDS
+                    and r["names_test"]
+                    for r in runs
+                ]
+            times = sorted(r["time"] for r in runs)
+            rates = [r["rounds_per_s"] for r in runs if r["rounds_per_s"] is not None]
+            rows.append(
+                {
+                    "variant": variant,
+                    "algorithm": algorithm,
+                    "expected": "solved" if feasible else "infeasible",
+                    "seeds": seeds,
+                    "met": sum(met),
+                    "statuses": [r["status"] for r in runs],
+                    "median_time": times[len(times) // 2],
+                    "max_time": times[-1],
+                    "rounds_per_s": round(sum(rates) / len(rates), 1) if rates else None,
+                    "stream_calls": [r["stream_calls"] for r in runs],
+                }
+            )
+    return rows
+
+
+def kitchen_table(rows: list[dict[str, Any]]) -> str:
+    header = (
+        f"{'kitchen_2d variant':<24} {'algorithm':<12} {'expected':<10} {'met':>5} "
+        f"{'median[s]':>9} {'max[s]':>7} {'rounds/s':>8}"
+    )
+    lines = [header, "-" * len(header)]
+    for row in rows:
+        rate = f"{row['rounds_per_s']:.1f}" if row["rounds_per_s"] is not None else "-"
+        lines.append(
+            f"{row['variant']:<24} {row['algorithm']:<12} {row['expected']:<10} "
+            f"{row['met']:>2}/{row['seeds']:<2} {row['median_time']:>9.3f} "
+            f"{row['max_time']:>7.3f} {rate:>8}"
+        )
+    return "\n".join(lines)
 
 
 _ENDLESS_DOMAIN = """(define (domain endless) (:requirements :strips)
@@ -163,6 +263,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--overhead-calls", type=int, default=20_000, help="calls timed for the call overhead"
     )
+    parser.add_argument(
+        "--kitchen-seeds", type=int, default=8, help="seeds per 2-D kitchen row; 0: skip them"
+    )
+    parser.add_argument(
+        "--kitchen-max-time", type=float, default=10.0, help="[s] per 2-D kitchen run"
+    )
     parser.add_argument("--quick", action="store_true", help="the fast domains, short probes")
     args = parser.parse_args(argv)
     if args.quick:  # explicit options still win
@@ -176,6 +282,13 @@ def main(argv: list[str] | None = None) -> int:
         for mode in args.call_modes
     ]
     print(table(rows))
+    kitchen = (
+        kitchen_rows(args.algorithms, args.kitchen_seeds, args.kitchen_max_time)
+        if args.kitchen_seeds > 0
+        else []
+    )
+    if kitchen:
+        print(kitchen_table(kitchen))
     probes = (
         [limit_overrun(algorithm, args.limit_probe) for algorithm in args.algorithms]
         if args.limit_probe > 0
@@ -204,6 +317,9 @@ def main(argv: list[str] | None = None) -> int:
         "call_overhead_us": overhead,
         "all_expected": all(r["status"] == r["expected"] for r in rows),
         "runs": rows,
+        "kitchen_2d": kitchen,
+        "kitchen_2d_met": sum(r["met"] for r in kitchen),
+        "kitchen_2d_runs": sum(r["seeds"] for r in kitchen),
         "max_time_probes": probes,
         "max_time_overrun_max": max((p["overrun"] for p in probes), default=None),
         "quick": args.quick,

@@ -61,6 +61,7 @@ class SolveContext:
         self.best: tuple[float, PlanSteps, frozenset[Atom]] | None = None
         self.calls = 0  # stream calls made so far (the queue's work is counted in calls)
         self.unreachable = False  # the last plan search found the goal relaxed-unreachable
+        self.searched = 0  # facts the last plan search planned over
         self._order = 0
 
     def next_order(self) -> int:
@@ -98,6 +99,7 @@ class SolveContext:
         """A classical plan over ``facts``; None when there is none. With ``effort_weight``,
         each action of the optimistic ``world`` also pays for the stream effort behind it."""
         self.check_time()
+        self.searched = len(facts)
         limit = min(self.remaining(), self.options.max_planner_time)
         domain = self.blocks.domain()
         extra = None
@@ -157,6 +159,37 @@ class SolveContext:
         produced = self.engine.sample(state)
         self.stats.sample_time += time.perf_counter() - start
         return produced
+
+    def sweep_test(self, failed: InstanceState, disable: bool) -> int:
+        """A test instance of a candidate plan failed: call the test's other uncalled real
+        instances within the complexity level, in the order they were made, up to
+        ``search_sample_ratio`` times the facts of the last plan search (the next search costs
+        about that much; each failure it is spared saves a search). Returns the calls made.
+
+        Without this, each search finds the next untested combination, one per search; a
+        test is cheap next to a search, so a failed one has its siblings evaluated in a batch.
+        ``disable``: a failed sibling is disabled until the level rises (focused, binding).
+        """
+        external = failed.instance.external
+        if external.declaration.outputs or external.declaration.fluents:
+            return 0
+        budget = self.options.search_sample_ratio * max(self.searched, 1)
+        level = self.stats.complexity
+        calls = 0
+        for key in self.engine.instance_keys:
+            if calls >= budget:
+                break
+            if key[0] != external.name:
+                continue
+            state = self.engine.instances[key]
+            instance = state.instance
+            if instance.calls or instance.exhausted or state.next_level > level:
+                continue
+            self.check_time()
+            calls += 1
+            if not self.sample(state) and disable:
+                self.failed(state)
+        return calls
 
     def real_check(
         self, actions: PlanSteps, trusted: frozenset[Atom] = frozenset()

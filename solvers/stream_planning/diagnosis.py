@@ -80,7 +80,9 @@ def diagnose(
                 f"stream '{name}' was called {external.counters.calls} time(s) and "
                 "never produced an output"
             )
+    reasons.extend(_failed_tests(engine))
     states = list(engine.instances.values())
+    reasons.extend(_dry_streams(engine))
     dry = [
         s.instance
         for s in states
@@ -103,3 +105,37 @@ def diagnose(
             f"no plan exists over every fact the streams could certify (complexity {complexity:g})"
         )
     return reasons
+
+
+def _failed_tests(engine: Engine) -> list[str]:
+    """How often each test stream failed (a negated one: answered False)."""
+    found = []
+    for name, external in sorted(engine.streams.items()):
+        counters = external.counters
+        if external.declaration.is_test and counters.successes < counters.calls:
+            found.append(
+                f"test '{name}' failed {counters.calls - counters.successes} of "
+                f"{counters.calls} call(s)"
+            )
+    for function in sorted(engine.functions.values(), key=lambda f: f.name):
+        if function.stream is not None and function.values:
+            false = sum(1 for value in function.values.values() if not value)
+            if false:
+                found.append(
+                    f"test '{function.stream}' (negate=True) was false on {false} of "
+                    f"{len(function.values)} input tuple(s)"
+                )
+    return found
+
+
+def _dry_streams(engine: Engine) -> list[str]:
+    """The generators whose instances all ran dry (nothing more to sample)."""
+    made: dict[str, list[bool]] = {}
+    for (name, _), state in engine.instances.items():
+        if not state.instance.external.declaration.is_test:
+            made.setdefault(name, []).append(state.instance.exhausted)
+    return [
+        f"stream '{name}' is exhausted: all {len(flags)} of its instance(s) gave all they had"
+        for name, flags in sorted(made.items())
+        if all(flags)
+    ]

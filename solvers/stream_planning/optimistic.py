@@ -25,6 +25,7 @@ predicates on placeholders are optimistically true unless the domain uses them n
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -66,6 +67,8 @@ class OptimisticWorld:
     # later calls of some instance were left out for the limit (see OptimisticBuilder._further):
     # no plan proves nothing unless the goal is not even relaxed-reachable
     more_calls: bool = False
+    # the lowest level at which something left out for the limit would enter (inf: none)
+    next_level: float = math.inf
 
 
 class OptimisticBuilder:
@@ -174,6 +177,7 @@ class OptimisticBuilder:
                 next_level = level + engine.calls(state) + first_call_level(external)
             if next_level > limit:
                 self._left_out(inputs, world)
+                world.next_level = min(world.next_level, next_level)
                 return []
             generator = external.info.opt_gen_fn
             if callable(generator) and external.declaration.outputs:
@@ -274,6 +278,7 @@ class OptimisticBuilder:
                 continue
             if not wanted:
                 world.more_calls = True
+                world.next_level = min(world.next_level, result.level + 1)
                 continue
             shared = external.info.opt_gen_fn == "shared"
             k = 1
@@ -281,6 +286,7 @@ class OptimisticBuilder:
                 level = result.level + k
                 if level > limit:
                     world.more_calls = True
+                    world.next_level = min(world.next_level, level)
                     break
                 base: tuple[object, ...] = (
                     (result.external,) if shared else (result.external, result.inputs)

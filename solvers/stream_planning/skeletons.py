@@ -52,6 +52,7 @@ class SkeletonBinder:
             self.context.check_time()
             if not self.context.sample(state):
                 self.context.failed(state)
+                self.context.sweep_test(state, disable=True)
 
     def instance(
         self, skeleton: Skeleton, index: int, inputs: tuple[str, ...], bindings: Mapping[str, str]
@@ -147,6 +148,8 @@ class SkeletonBinder:
         if len(results) == before:
             if fluent or self.disable_failures:
                 self.context.failed(state)
+            if not fluent:
+                self.context.sweep_test(state, self.disable_failures)
             return None
         skeleton.used[index] = len(results)
         return results[-1].outputs

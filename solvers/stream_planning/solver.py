@@ -84,7 +84,10 @@ class StreamSolver:
         # only a goal that is not relaxed-reachable proves that they would not help
         if world.more_calls and not context.unreachable:
             return False
-        if any(s.instance.disabled for s in context.engine.instances.values()):
+        if any(
+            s.instance.disabled and not s.instance.exhausted
+            for s in context.engine.instances.values()
+        ):
             return False
         return not self.policy.lazy or all(
             s.instance.exhausted or s.instance.external.declaration.fluents
@@ -116,6 +119,9 @@ class StreamSolver:
                 if not policy.waiting and self._complete(world):
                     return Status.INFEASIBLE
                 level += options.complexity_step
+                if not policy.lazy and level < world.next_level < math.inf:
+                    # the levels between add nothing to the optimistic world: skip them
+                    level = int(world.next_level)
                 if level > options.max_complexity:
                     return Status.INFEASIBLE
                 context.lift()
