@@ -52,13 +52,52 @@ def test_a_sampler_that_yields_nothing_ends_infeasible(algorithm: str) -> None:
     assert not any("time limit" in r for r in solution.diagnosis)
 
 
-def test_a_test_failing_on_every_pair_ends_infeasible_and_is_named() -> None:
+def test_a_test_used_negated_under_a_derived_predicate_is_named_with_its_false_count() -> None:
+    """The domain reads ``cfree`` through ``(not (unsafe ...))``: as in PDDLStream the test is
+    negated automatically, and the diagnosis says how often it was false."""
     solution = solve(_problem(4, cfree=False), algorithm="incremental", verbose=False)
     assert solution.status is Status.INFEASIBLE, solution.diagnosis
-    stats = solution.streams["test-cfree"]
-    failed = stats.calls - stats.successes
-    assert failed > 0
-    assert f"test 'test-cfree' failed {failed} of {stats.calls} call(s)" in solution.diagnosis
+    assert any(
+        r.startswith("test 'test-cfree' (negate=True) was false on") for r in solution.diagnosis
+    )
+
+
+LINE_DOMAIN = """(define (domain line) (:requirements :strips)
+  (:predicates (block ?b) (region ?r) (pose ?b ?p) (in ?b ?p ?r) (at ?b ?p) (holding ?b)
+               (free) (done ?b ?r) (safe ?p))
+  (:action pick :parameters (?b ?p) :precondition (and (at ?b ?p) (free))
+     :effect (and (holding ?b) (not (at ?b ?p)) (not (free))))
+  (:action place :parameters (?b ?p ?r)
+     :precondition (and (holding ?b) (in ?b ?p ?r) (safe ?p))
+     :effect (and (at ?b ?p) (done ?b ?r) (free) (not (holding ?b)))))"""
+
+LINE_STREAMS = """(define (stream line)
+  (:stream sample-pose :inputs (?b ?r) :domain (and (block ?b) (region ?r))
+     :outputs (?p) :certified (and (pose ?b ?p) (in ?b ?p ?r)))
+  (:stream test-safe :inputs (?b ?p) :domain (pose ?b ?p) :certified (safe ?p)))"""
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
+def test_a_plain_test_failing_everywhere_ends_infeasible_and_is_named(algorithm: str) -> None:
+    """A test whose fact the domain uses positively, false on every pose the finite sampler
+    has: no plan, and the diagnosis says how often the test failed."""
+
+    def sample_pose(block: str, region: str):  # type: ignore[no-untyped-def]
+        yield from ((x,) for x in (2.0, 2.5))
+
+    problem = PDDLProblem(
+        LINE_DOMAIN,
+        {},
+        LINE_STREAMS,
+        {"sample-pose": from_gen_fn(sample_pose), "test-safe": from_test(lambda b, p: p > 2.6)},
+        [("free",), ("block", "cup"), ("region", "shelf"), ("at", "cup", 0.0)],
+        ("done", "cup", "shelf"),
+    )
+    solution = solve(problem, algorithm=algorithm, max_time=60, verbose=False)
+    assert solution.status is Status.INFEASIBLE, solution.diagnosis
+    stats = solution.streams["test-safe"]
+    assert stats.calls > 0 and stats.successes == 0
+    assert f"test 'test-safe' failed {stats.calls} of {stats.calls} call(s)" in solution.diagnosis
 
 
 @pytest.mark.parametrize("algorithm", ALGORITHMS)
