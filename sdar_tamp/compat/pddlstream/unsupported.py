@@ -15,7 +15,14 @@ from typing import Any, NoReturn
 
 from sdar_tamp.errors import SdarError
 
-__all__ = ["NotProvidedError", "not_provided", "unsupported_function"]
+__all__ = ["SCHEDULING_INTERNALS", "NotProvidedError", "not_provided", "unsupported_function"]
+
+#: Why the modules of ``pddlstream.algorithms.scheduling`` provide nothing.
+SCHEDULING_INTERNALS = (
+    "PDDLStream's stream-plan scheduling internals (it recovers stream plans from Fast "
+    "Downward's output); the solvers here schedule streams themselves "
+    "(solvers.stream_planning)"
+)
 
 _PREFIX = "sdar_tamp.compat."
 _DOCS = "docs/pddlstream.md"
