@@ -150,3 +150,14 @@ def test_abstrips_layer_checks_its_arguments() -> None:
         ABSTRIPSLayer(horizon=0)
     with pytest.raises(NotProvidedError, match="effect layers"):
         ABSTRIPSLayer(pos_eff=["AtBConf"])
+
+
+def test_a_submodule_is_imported_from_a_package_that_provides_nothing() -> None:
+    """``from pkg import submodule`` asks the package's ``__getattr__`` first: it imports the
+    submodule, and a name that is no submodule still raises NotProvidedError."""
+    from sdar_tamp.compat.pddlstream.algorithms import scheduling
+    from sdar_tamp.compat.pddlstream.algorithms.scheduling import negative
+
+    assert negative.__name__.endswith("scheduling.negative")
+    with pytest.raises(NotProvidedError, match="scheduling internals"):
+        scheduling.no_such_name  # noqa: B018

@@ -10,6 +10,9 @@ import must succeed) is an :func:`unsupported_function`: importing it works, cal
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
+import sys
 from collections.abc import Callable
 from typing import Any, NoReturn
 
@@ -37,12 +40,17 @@ def _public(module: str) -> str:
 
 
 def not_provided(module: str, why: str) -> Callable[[str], Any]:
-    """A module ``__getattr__``: underscore names are missing as usual, every other name
-    raises :class:`NotProvidedError` saying ``why``."""
+    """A module ``__getattr__``: underscore names are missing as usual, a submodule of a
+    package is imported (``from pkg import submodule`` asks the package first), every other
+    name raises :class:`NotProvidedError` saying ``why``."""
 
     def __getattr__(name: str) -> Any:  # noqa: N807 (the module protocol's name)
         if name.startswith("_"):
             raise AttributeError(f"module {module!r} has no attribute {name!r}")
+        package = sys.modules.get(module)
+        is_package = package is not None and hasattr(package, "__path__")
+        if is_package and importlib.util.find_spec(f"{module}.{name}") is not None:
+            return importlib.import_module(f"{module}.{name}")
         raise NotProvidedError(
             f"{_public(module)}.{name} is not provided by sdar_tamp.compat.pddlstream: {why} "
             f"(see {_DOCS})"
