@@ -18,13 +18,31 @@ from typing import Any, NoReturn
 
 from sdar_tamp.errors import SdarError
 
-__all__ = ["SCHEDULING_INTERNALS", "NotProvidedError", "not_provided", "unsupported_function"]
+__all__ = [
+    "FAST_DOWNWARD_INTERNALS",
+    "SCHEDULING_INTERNALS",
+    "SKELETON_INTERNALS",
+    "NotProvidedError",
+    "not_provided",
+    "unsupported_function",
+]
 
 #: Why the modules of ``pddlstream.algorithms.scheduling`` provide nothing.
 SCHEDULING_INTERNALS = (
     "PDDLStream's stream-plan scheduling internals (it recovers stream plans from Fast "
     "Downward's output); the solvers here schedule streams themselves "
     "(solvers.stream_planning)"
+)
+
+#: Why the modules of PDDLStream's skeleton queue provide nothing.
+SKELETON_INTERNALS = (
+    "PDDLStream's skeleton queue and stream-plan internals; the adaptive algorithm here "
+    "keeps its own (solvers.stream_planning)"
+)
+#: Why the modules of PDDLStream's Fast Downward interface provide nothing.
+FAST_DOWNWARD_INTERNALS = (
+    "Fast Downward's translator and search internals; planning here is the core classical"
+    " planner (solvers.classical)"
 )
 
 _PREFIX = "sdar_tamp.compat."

@@ -5,14 +5,8 @@ here keeps its own (solvers.stream_planning). The module exists so that PDDLStre
 is complete; any public name of it raises
 :class:`~sdar_tamp.compat.pddlstream.unsupported.NotProvidedError` saying so."""
 
-from sdar_tamp.compat.pddlstream.unsupported import not_provided
+from sdar_tamp.compat.pddlstream.unsupported import SKELETON_INTERNALS, not_provided
 
 __all__: list[str] = []
 
-__getattr__ = not_provided(
-    __name__,
-    (
-        "PDDLStream's skeleton queue and stream-plan internals; the adaptive algorithm here "
-        "keeps its own (solvers.stream_planning)"
-    ),
-)
+__getattr__ = not_provided(__name__, SKELETON_INTERNALS)

@@ -6,14 +6,8 @@ classical planner (solvers.classical). The module exists so that PDDLStream's mo
 complete; any public name of it raises
 :class:`~sdar_tamp.compat.pddlstream.unsupported.NotProvidedError` saying so."""
 
-from sdar_tamp.compat.pddlstream.unsupported import not_provided
+from sdar_tamp.compat.pddlstream.unsupported import FAST_DOWNWARD_INTERNALS, not_provided
 
 __all__: list[str] = []
 
-__getattr__ = not_provided(
-    __name__,
-    (
-        "Fast Downward's translator and search internals; planning here is the core classical"
-        " planner (solvers.classical)"
-    ),
-)
+__getattr__ = not_provided(__name__, FAST_DOWNWARD_INTERNALS)
