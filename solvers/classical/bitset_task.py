@@ -57,52 +57,60 @@ class _Node:
 
 
 #: Strata with at least this many rules are closed by :class:`_CountedStratum`.
-COUNTED_STRATUM = 64
+COUNTED_STRATUM = 16
 
 
 class _CountedStratum:
-    """One stratum's rules, closed by counting (semi-naive): every rule starts with the number
-    of its body facts false in the state; a head that becomes true lowers the count of the
-    rules of this stratum that need it, and a rule whose count reaches zero (with its negative
-    body false, which lower strata and fluents fix) makes its head true."""
+    """One stratum's rules, closed from the facts that can fire them: a rule is looked at
+    only when one of its body facts is true, so a state's closure costs what its true facts
+    touch, not the size of the stratum.
+
+    A rule whose body has no head of this stratum is looked at when its *trigger* (its body
+    fact that the fewest rules share, the least likely to be true) is true in the state; one
+    that needs a head of this stratum is looked at again each time such a head becomes true
+    (its count of missing heads reaches zero then). A rule fires when its whole body is true
+    and its negative body (fixed by lower strata and fluents) false."""
 
     def __init__(self, axioms: list[GroundAxiom]) -> None:
+        own = {a.head for a in axioms}
+        shared = Counter(f for a in axioms for f in set(a.body))
+        # (head bit, body mask, negative body mask) of each rule
+        self.rules = [(1 << a.head, mask(a.body), mask(a.negative_body)) for a in axioms]
+        self.always: list[int] = []  # rules with an empty body
+        self.triggers: dict[int, list[int]] = {}  # fact -> rules it triggers
+        self.watchers: dict[int, list[int]] = {}  # head of this stratum -> rules needing it
+        for i, axiom in enumerate(axioms):
+            needs = sorted({f for f in axiom.body if f in own})
+            if needs:
+                for fact in needs:
+                    self.watchers.setdefault(fact, []).append(i)
+            elif axiom.body:
+                trigger = min(axiom.body, key=lambda f: (shared[f], f))
+                self.triggers.setdefault(trigger, []).append(i)
+            else:
+                self.always.append(i)
+        self.trigger_mask = mask(self.triggers)
         self.heads = [a.head for a in axioms]
-        self.bodies = [a.body for a in axioms]
-        self.negatives = [a.negative_body for a in axioms]
-        own = set(self.heads)
-        watchers: dict[int, list[int]] = {}
-        for i, body in enumerate(self.bodies):
-            for fact in set(body):
-                if fact in own:
-                    watchers.setdefault(fact, []).append(i)
-        self.watchers = watchers
 
     def close(self, state: int) -> int:
-        true = set(bits(state))
-        missing = [0] * len(self.heads)
+        rules, heads, watchers = self.rules, self.heads, self.watchers
         queue: list[int] = []
-        heads, watchers = self.heads, self.watchers
-        for i, (body, negative) in enumerate(zip(self.bodies, self.negatives, strict=True)):
-            if any(f in true for f in negative):
-                missing[i] = -1  # blocked for good in this stratum
-                continue
-            count = len({f for f in body if f not in true})
-            missing[i] = count
-            if count == 0 and heads[i] not in true:
-                true.add(heads[i])
-                queue.append(heads[i])
-        added = list(queue)
+
+        def look(indices: Iterable[int], state: int) -> int:
+            for i in indices:
+                head, body, negative = rules[i]
+                if not state & head and state & body == body and not state & negative:
+                    state |= head
+                    queue.append(heads[i])
+            return state
+
+        state = look(self.always, state)
+        triggers = self.triggers
+        for fact in bits(state & self.trigger_mask):
+            state = look(triggers[fact], state)
         while queue:
-            fact = queue.pop()
-            for i in watchers.get(fact, ()):
-                if missing[i] > 0:
-                    missing[i] -= 1
-                    if missing[i] == 0 and heads[i] not in true:
-                        true.add(heads[i])
-                        queue.append(heads[i])
-                        added.append(heads[i])
-        return state | mask(added)
+            state = look(watchers.get(queue.pop(), ()), state)
+        return state
 
 
 class CompiledTask:

@@ -12,6 +12,7 @@ from typing import Any
 
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import Atom, FunctionTerm
+from sdar_tamp.language.generators import SINGLE_CALL
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
 from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
@@ -189,6 +190,45 @@ class SolveContext:
             calls += 1
             if not self.sample(state) and disable:
                 self.failed(state)
+        return calls
+
+    def drain(self, level: int) -> int:
+        """No new plan at ``level`` while some samplers could still give more: call them.
+
+        The real instances of streams with outputs that may answer more than once (not
+        fluent, not single-answer adapters, no callable ``opt_gen_fn``), within the level
+        after ``level``, are called in the order they were made, in passes, until none is
+        left or the calls reach ``search_sample_ratio`` times the facts of the last search
+        (the next search costs about that much). Without this, a focused algorithm calls an
+        instance only when a plan needs it, so a finite sampler whose values no plan wants
+        keeps later calls on offer, and the world grows with every level, for ever. Returns
+        the calls made."""
+        budget = self.options.search_sample_ratio * max(self.searched, 1)
+        limit = level + self.options.complexity_step
+        calls = 0
+        progress = True
+        while progress and calls < budget:
+            progress = False
+            for key in list(self.engine.instance_keys):
+                if calls >= budget:
+                    break
+                state = self.engine.instances[key]
+                instance = state.instance
+                external = instance.external
+                if (
+                    instance.exhausted
+                    or instance.disabled
+                    or state.next_level > limit
+                    or not external.declaration.outputs
+                    or external.declaration.fluents
+                    or getattr(external.gen_fn, SINGLE_CALL, False)
+                    or callable(external.info.opt_gen_fn)
+                ):
+                    continue
+                self.check_time()
+                calls += 1
+                progress = True
+                self.sample(state)
         return calls
 
     def real_check(

@@ -118,6 +118,8 @@ class StreamSolver:
                     return Status.SOLVED
                 if not policy.waiting and self._complete(world):
                     return Status.INFEASIBLE
+                if not policy.lazy and not policy.waiting and world.more_calls:
+                    context.drain(level)
                 level += options.complexity_step
                 if not policy.lazy and level < world.next_level < math.inf:
                     # the levels between add nothing to the optimistic world: skip them
