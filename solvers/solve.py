@@ -191,7 +191,10 @@ def solve(
             restored when ``solve`` returns. The solvers draw no random numbers themselves.
         verbose: log a one-line summary of the result at INFO on the ``sdar_tamp.solvers``
             logger (else at DEBUG). Logger levels and handlers are the application's:
-            ``solve`` never changes them.
+            ``solve`` never changes them. With the stream algorithms, also print one line per
+            round (level, outcome, stream calls and new facts, time) and the final counts
+            (per stream, and why no plan was found) on standard output
+            (:mod:`solvers.stream_planning.progress`).
 
     Every numeric argument is checked (with ``algorithm="sdar"`` too) by the rules of
     :mod:`sdar_tamp.arguments`: NaN is refused everywhere; ``inf`` means "no limit" for the
@@ -254,6 +257,7 @@ def solve(
         effort_weight=effort_weight,
         unit_efforts=bool(unit_efforts),
         enforce_max_time=bool(enforce_max_time),
+        verbose=bool(verbose),
     )
     if constraints is not None:
         options = dataclasses.replace(options, max_cost=constraints.max_cost)

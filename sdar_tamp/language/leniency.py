@@ -30,8 +30,12 @@ logged), and reject it only with ``strict=True`` (:class:`StrictModeError`). The
     (``(Cost ?a ?b)``), as PDDLStream programs do: the first use gives its arity, which a
     stream file's ``(:function (Cost ?a ?b) ...)`` must then match.
 
-``undeclared-parent-type``, ``init-type`` and ``function-arity`` are more likely mistakes than
-dialect, so they are logged as warnings; the others at info level.
+``unused-certified``, ``unachievable-predicate``
+    a stream file checked against its domain (:mod:`sdar_tamp.language.cross_check`): a
+    certified predicate nothing reads, a predicate the domain reads that nothing makes true.
+
+``undeclared-parent-type``, ``init-type``, ``function-arity`` and the two cross-checks are more
+likely mistakes than dialect, so they are logged as warnings; the others at info level.
 """
 
 from __future__ import annotations
@@ -55,6 +59,8 @@ UNDECLARED_PARENT_TYPE = "undeclared-parent-type"
 INIT_TYPE = "init-type"
 FREE_VARIABLE = "free-variable"
 FUNCTION_ARITY = "function-arity"
+UNUSED_CERTIFIED = "unused-certified"
+UNACHIEVABLE_PREDICATE = "unachievable-predicate"
 
 KINDS = (
     GLUED_VARIABLE,
@@ -66,8 +72,12 @@ KINDS = (
     INIT_TYPE,
     FREE_VARIABLE,
     FUNCTION_ARITY,
+    UNUSED_CERTIFIED,
+    UNACHIEVABLE_PREDICATE,
 )
-_WARNING_KINDS = frozenset({UNDECLARED_PARENT_TYPE, INIT_TYPE, FUNCTION_ARITY})
+_WARNING_KINDS = frozenset(
+    {UNDECLARED_PARENT_TYPE, INIT_TYPE, FUNCTION_ARITY, UNUSED_CERTIFIED, UNACHIEVABLE_PREDICATE}
+)
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.cross_check import cross_check, has_streams
 from sdar_tamp.language.domain_model import Domain, TypeHierarchy
 from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.errors import (
@@ -43,7 +44,7 @@ from sdar_tamp.language.formula_model import (
     Or,
     Parameter,
 )
-from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, Leniency, LeniencyLog
+from sdar_tamp.language.leniency import IMPLICIT_PREDICATE, LOGGER, Leniency, LeniencyLog
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.stream_model import StreamFile
 from sdar_tamp.language.streams import parse_stream_file
@@ -104,6 +105,11 @@ class PDDLProblem:
         self.objects = ObjectTable(constants)
         self.stream_map = _check_stream_map(self.stream_map, self.streams)
         self.facts, self.leniencies = _ground(self)
+        if has_streams(self.streams):
+            found = cross_check(self.domain, self.streams, self.facts.init, self.facts.goal)
+            for item in found:
+                LOGGER.log(item.level, "%s", item)
+            self.leniencies += found
 
     def __iter__(self) -> Iterator[Any]:
         """Unpacks as PDDLStream's tuple: domain, constants, streams, stream map, init, goal."""

@@ -29,3 +29,4 @@ class StreamOptions:
     effort_weight: float | None = None  # optimistic actions pay weight * stream effort
     unit_efforts: bool = False  # every stream call has effort 1
     enforce_max_time: bool = True  # user calls in a worker thread, abandoned at max_time
+    verbose: bool = False  # one line per round and the final counts on stdout

@@ -32,6 +32,7 @@ from solvers.stream_planning.optimistic import OptimisticWorld, OptResult, is_pl
 from solvers.stream_planning.options import StreamOptions
 from solvers.stream_planning.policies import policy_for
 from solvers.stream_planning.preimage import simulate
+from solvers.stream_planning.progress import RoundLog
 from solvers.stream_planning.skeletons import Skeleton
 from solvers.stream_planning.stream_plans import extract_stream_plan, stream_plan_effort
 
@@ -50,6 +51,7 @@ class StreamSolver:
     ) -> None:
         self.context = SolveContext(problem, options, stream_info)
         self.policy = policy_for(self.context)
+        self.log = RoundLog(options.verbose)
 
     def solve(self) -> Solution:
         context = self.context
@@ -62,7 +64,20 @@ class StreamSolver:
             context.runner.close()
         if context.best is not None:
             status = Status.SOLVED
-        return self._solution(status)
+        self._end(status.value)  # a round the time limit ended
+        solution = self._solution(status)
+        self.log.summary(
+            context.options.algorithm,
+            solution.status.value,
+            solution.statistics,
+            solution.streams,
+            solution.diagnosis,
+        )
+        return solution
+
+    def _end(self, outcome: str) -> None:
+        """The current round ended with ``outcome`` (its line, with ``verbose``)."""
+        self.log.end(outcome, self.context.calls, len(self.context.engine.store))
 
     def _world(self, level: int) -> OptimisticWorld:
         """The facts to plan over: the optimistic world, or in incremental without fluent
@@ -103,39 +118,63 @@ class StreamSolver:
         policy = self.policy
         level = options.initial_complexity
         tried: set[tuple[object, ...]] = set()  # (plan, optimistic results) met at this level
+        barren = 0  # searches in a row that found no plan at all
+        log = self.log
         while True:
             if stats.iterations >= options.max_iterations:
                 return Status.TIMEOUT
             stats.iterations += 1
             stats.complexity = level
+            log.begin(stats.iterations, level, context.calls, len(context.engine.store))
             policy.prepare(level)
             world, found = self._plan_at(level)
             ordered = None if found is None else self._new_plan(world, found[0], tried)
+            if found is not None:
+                barren = 0
             if found is None or ordered is None:
                 # no new plan: work on the queued skeletons, and raise the level (what they
                 # wait for may lie above it)
+                missed = "no plan" if found is None else "plan met before"
                 if policy.no_new_plan(len(world.facts)):
+                    self._end(f"{missed}; a queued skeleton is solved")
                     return Status.SOLVED
                 if not policy.waiting and self._complete(world):
+                    self._end(f"{missed}; nothing is left out: infeasible")
                     return Status.INFEASIBLE
                 if not policy.lazy and not policy.waiting and world.more_calls:
                     context.drain(level)
-                level += options.complexity_step
+                # searches that find no plan at all, one level after the other: the level
+                # rises by twice as much each time (a search's cost grows with its world, and
+                # a proof of infeasibility needs the level at which nothing is left out)
+                barren = barren + 1 if found is None and not policy.lazy else 0
+                raised = level + options.complexity_step * 2 ** max(barren - 1, 0)
+                if barren > 1 and level < options.max_complexity < raised:
+                    raised = int(options.max_complexity)
+                level = raised
                 if not policy.lazy and level < world.next_level < math.inf:
                     # the levels between add nothing to the optimistic world: skip them
                     level = int(world.next_level)
                 if level > options.max_complexity:
+                    self._end(f"{missed}; max_complexity reached")
                     return Status.INFEASIBLE
+                self._end(f"{missed}; level -> {level}")
                 context.lift()
                 tried.clear()
                 continue
             actions, cost = found
             if context.builder.refine(ordered.stream_plan):
-                continue  # it uses shared placeholders: plan again with the instances' own
+                # it uses shared placeholders: plan again with the instances' own
+                self._end("plan on shared placeholders: refined")
+                continue
             if not any(r.kind == "stream" for r in ordered.stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
             ):
                 valid, check = context.real_check(actions)
+                self._end(
+                    f"real plan ({len(actions)} actions, cost {cost:g})"
+                    if valid
+                    else "real plan failed validation"
+                )
                 if valid and context.record(actions, check):
                     return Status.SOLVED
                 if not valid:
@@ -150,7 +189,13 @@ class StreamSolver:
                     tried.clear()
                 continue
             stats.skeletons += 1
-            if policy.take(self._skeleton(ordered, cost)):
+            solved = policy.take(self._skeleton(ordered, cost))
+            streams = sum(r.kind == "stream" for r in ordered.stream_plan)
+            self._end(
+                f"new skeleton ({len(actions)} actions, {streams} stream results"
+                f"{', bound: solved' if solved else ''})"
+            )
+            if solved:
                 return Status.SOLVED
 
     def _plan_at(self, level: int) -> tuple[OptimisticWorld, tuple[PlanSteps, float] | None]:
