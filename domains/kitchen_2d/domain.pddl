@@ -24,7 +24,7 @@
 
   (:action move
     :parameters (?q1 ?t ?q2)
-    :precondition (and (Motion ?q1 ?t ?q2) (AtConf ?q1) (CanMove))
+    :precondition (and (Motion ?q1 ?t ?q2) (Traj ?t) (AtConf ?q1) (CanMove))
     :effect (and (AtConf ?q2) (not (AtConf ?q1)) (not (CanMove))
                  (increase (total-cost) (Distance ?q1 ?q2))))
   (:action pick

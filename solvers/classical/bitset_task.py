@@ -12,7 +12,7 @@ from collections import Counter
 from collections.abc import Iterable
 
 from sdar_tamp.logs import get_logger
-from solvers.classical import jit
+from solvers.classical import jit, jit_successors
 from solvers.classical.jit_successors import JitSuccessors
 from solvers.classical.task import GroundAxiom, GroundTask
 
@@ -155,6 +155,9 @@ class CompiledTask:
         self._calls = 0
         self._jit: JitSuccessors | None = None
         self._jit_pending = len(task.operators) >= JIT_MIN_OPERATORS and jit.available()
+        if self._jit_pending and jit_successors.kernel_loaded():
+            # an earlier task of this process loaded the compiled walk: use it at once
+            self._calls = JIT_AFTER_CALLS
 
     def _build_trie(self) -> Trie:
         frequency = Counter(f for op in self.task.operators for f in op.precondition)

@@ -35,7 +35,7 @@ from math import inf
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
-from solvers.classical import jit
+from solvers.classical import jit, jit_relaxed
 from solvers.classical.bitset_task import CompiledTask, bits, mask
 from solvers.classical.complements import complements, relaxed_operators
 from solvers.classical.jit_relaxed import JitRelaxed
@@ -48,7 +48,8 @@ ENGINES = ("auto", "python", "numpy", "numba")
 # compiled engine's one-off cost, importing numba and loading its code, is about 0.5 s)
 VECTOR_MIN_SIZE = 4000
 # under "auto", a large task switches to the compiled engine once the queue has spent this long
-# [s] (CPU) on it: the same values, without numba's import for searches that end sooner
+# [s] (CPU) on it: the same values, without numba's import for searches that end sooner (at once
+# when an earlier task of the process loaded the compiled code)
 JIT_AFTER_SECONDS = 0.5
 
 # "lmcount": landmark count; "ff-lmcount": h_FF and landmark count in alternating queues
@@ -117,7 +118,10 @@ class RelaxedHeuristic:
                 raise ParameterError(f"engine 'numba' is unavailable: {jit.why_unavailable()}")
             self.use_compiled()
         elif self.jit_pending:
-            pass
+            if jit_relaxed.kernel_loaded():
+                # an earlier task of this process loaded the compiled code (the rounds of a
+                # stream planning solve ground one task each): switch at once, same values
+                self.use_compiled()
         elif name in ("add", "ff") and (engine == "numpy" or large):
             self.vector = VectorHAdd(count, upre, ueff, ucost)
             if engine == "auto" and not self._vector_is_faster(comp.extend(compiled.init)):

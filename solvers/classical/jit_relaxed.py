@@ -241,6 +241,13 @@ def _kernel() -> Any:
     return compile_kernel(_evaluate)
 
 
+def kernel_loaded() -> bool:
+    """Whether this process has loaded the compiled evaluator already (a later task then
+    switches to it at no cost: only its arrays are built)."""
+    info = getattr(_kernel, "cache_info", None)  # (None: the kernel was replaced)
+    return info is not None and info().currsize > 0
+
+
 class JitRelaxed:
     """The relaxed task as arrays and the compiled evaluator over it.
 

@@ -70,6 +70,12 @@ def _applicable_kernel() -> Any:
     return compile_kernel(_applicable)
 
 
+def kernel_loaded() -> bool:
+    """Whether this process has loaded the compiled trie walk already."""
+    info = getattr(_applicable_kernel, "cache_info", None)  # (None: the kernel was replaced)
+    return info is not None and info().currsize > 0
+
+
 class JitSuccessors:
     """A successor-generator trie as arrays, walked by compiled code.
 

@@ -118,7 +118,6 @@ class StreamSolver:
         policy = self.policy
         level = options.initial_complexity
         tried: set[tuple[object, ...]] = set()  # (plan, optimistic results) met at this level
-        barren = 0  # searches in a row that found no plan at all
         log = self.log
         while True:
             if stats.iterations >= options.max_iterations:
@@ -129,8 +128,6 @@ class StreamSolver:
             policy.prepare(level)
             world, found = self._plan_at(level)
             ordered = None if found is None else self._new_plan(world, found[0], tried)
-            if found is not None:
-                barren = 0
             if found is None or ordered is None:
                 # no new plan: work on the queued skeletons, and raise the level (what they
                 # wait for may lie above it)
@@ -143,14 +140,7 @@ class StreamSolver:
                     return Status.INFEASIBLE
                 if not policy.lazy and not policy.waiting and world.more_calls:
                     context.drain(level)
-                # searches that find no plan at all, one level after the other: the level
-                # rises by twice as much each time (a search's cost grows with its world, and
-                # a proof of infeasibility needs the level at which nothing is left out)
-                barren = barren + 1 if found is None and not policy.lazy else 0
-                raised = level + options.complexity_step * 2 ** max(barren - 1, 0)
-                if barren > 1 and level < options.max_complexity < raised:
-                    raised = int(options.max_complexity)
-                level = raised
+                level += options.complexity_step
                 if not policy.lazy and level < world.next_level < math.inf:
                     # the levels between add nothing to the optimistic world: skip them
                     level = int(world.next_level)

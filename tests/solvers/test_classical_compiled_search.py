@@ -159,3 +159,18 @@ def test_numba_that_cannot_be_imported_is_remembered(monkeypatch: pytest.MonkeyP
         jit.compile_kernel(jit_relaxed._evaluate)
     assert not jit.available()
     assert "numba failed in this process (_evaluate:" in jit.why_unavailable()
+
+
+@needs_numba
+def test_a_later_task_walks_its_trie_compiled_at_once() -> None:
+    """Once the process loaded the compiled trie walk, a new large task uses it from its first
+    successor list (the rounds of a stream planning solve ground one task each)."""
+    from solvers.classical import jit_successors
+
+    compiled = CompiledTask(ground(_gripper(100)))
+    compiled.use_compiled_successors()
+    assert jit_successors.kernel_loaded()
+    later = CompiledTask(ground(_gripper(100)))
+    first = later.applicable(later.init)
+    assert later._jit is not None  # compiled from the first call
+    assert first == compiled.applicable(compiled.init)
