@@ -11,9 +11,10 @@ and what the domain reads that nothing can make true.
     use of it is false (often a typo in the domain or the stream file). Located at the first
     action or derived predicate that reads it.
 
-Both are :class:`~sdar_tamp.language.leniency.Leniency` warnings: ``PDDLProblem.leniencies``
-records them for a problem with streams, and ``sdar check`` prints them (``--strict`` makes
-them errors).
+Both are :class:`~sdar_tamp.language.leniency.Leniency` items: ``PDDLProblem.leniencies``
+records them for a problem with streams (logged: ``unachievable-predicate`` as a warning,
+``unused-certified`` at info level), and ``sdar check`` prints both as warnings (``--strict``
+makes them errors).
 """
 
 from __future__ import annotations

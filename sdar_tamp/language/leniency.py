@@ -34,8 +34,10 @@ logged), and reject it only with ``strict=True`` (:class:`StrictModeError`). The
     a stream file checked against its domain (:mod:`sdar_tamp.language.cross_check`): a
     certified predicate nothing reads, a predicate the domain reads that nothing makes true.
 
-``undeclared-parent-type``, ``init-type``, ``function-arity`` and the two cross-checks are more
-likely mistakes than dialect, so they are logged as warnings; the others at info level.
+``undeclared-parent-type``, ``init-type``, ``function-arity`` and ``unachievable-predicate``
+are more likely mistakes than dialect, so they are logged as warnings; the others at info
+level (``unused-certified`` too: PDDLStream programs often certify type-like facts such as
+``(Grasp ?o ?g)`` that nothing reads; ``sdar check`` still prints it as a warning).
 """
 
 from __future__ import annotations
@@ -76,7 +78,7 @@ KINDS = (
     UNACHIEVABLE_PREDICATE,
 )
 _WARNING_KINDS = frozenset(
-    {UNDECLARED_PARENT_TYPE, INIT_TYPE, FUNCTION_ARITY, UNUSED_CERTIFIED, UNACHIEVABLE_PREDICATE}
+    {UNDECLARED_PARENT_TYPE, INIT_TYPE, FUNCTION_ARITY, UNACHIEVABLE_PREDICATE}
 )
 
 
