@@ -85,6 +85,18 @@ def union_volume(centre: FloatArray, radius: FloatArray, resolution: int = 40) -
     return float(inside.mean() * np.prod(hi - lo))
 
 
+def surface_points(triangles: FloatArray, n: int, rng: np.random.Generator) -> FloatArray:
+    """``n`` points ``(n, 3)`` drawn uniformly on the surface of ``triangles`` ``(m, 3, 3)``."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    pick = rng.choice(len(triangles), n, p=area / area.sum())
+    u, v = rng.uniform(size=n), rng.uniform(size=n)
+    flip = u + v > 1.0
+    u[flip], v[flip] = 1.0 - u[flip], 1.0 - v[flip]
+    out: FloatArray = a[pick] + u[:, None] * (b - a)[pick] + v[:, None] * (c - a)[pick]
+    return out
+
+
 def subdivide(triangles: FloatArray, max_edge: float) -> FloatArray:
     """``triangles`` ``(m, 3, 3)`` split at their edge midpoints (four by four) until no edge
     is longer than ``max_edge`` [m]; the surface is the same."""
@@ -148,14 +160,30 @@ def enclosing_sphere(points: FloatArray) -> tuple[FloatArray, float]:
     return best_c.copy(), best_r
 
 
-def _fit_k(triangles: FloatArray, k: int, tolerance: float) -> tuple[FloatArray, FloatArray]:
-    centroids = triangles.mean(axis=1)
-    cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    area = np.linalg.norm(cross, axis=1) / 2.0
-    weights = area + 1e-12 * max(float(area.max()), 1.0)
+@dataclass(frozen=True)
+class _Surface:
+    """Split triangles as the clustering reads them: centroids ``(m, 3)``, area weights
+    ``(m,)``, the distinct vertices ``(v, 3)`` and each triangle's vertex indices ``(m, 3)``."""
+
+    centroid: FloatArray
+    weight: FloatArray
+    vertex: FloatArray
+    corner: NDArray[np.int64]
+
+    @staticmethod
+    def of(triangles: FloatArray) -> _Surface:
+        cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+        area = np.linalg.norm(cross, axis=1) / 2.0
+        weight = area + 1e-12 * max(float(area.max()), 1.0)
+        vertex, inverse = np.unique(triangles.reshape(-1, 3), axis=0, return_inverse=True)
+        corner = inverse.reshape(-1, 3).astype(np.int64)
+        return _Surface(triangles.mean(axis=1), weight, vertex, corner)
+
+
+def _fit_k(surface: _Surface, k: int, tolerance: float) -> tuple[FloatArray, FloatArray]:
     centres, radii = [], []
-    for members in _clusters(centroids, weights, k):
-        c, r = enclosing_sphere(np.unique(triangles[members].reshape(-1, 3), axis=0))
+    for members in _clusters(surface.centroid, surface.weight, k):
+        c, r = enclosing_sphere(surface.vertex[np.unique(surface.corner[members])])
         centres.append(c)
         radii.append(r + tolerance)
     return np.array(centres), np.array(radii)
@@ -184,9 +212,10 @@ def fit_spheres(
     hull = hull_volume(vertices)
     if diagonal > 0.0:
         tri = subdivide(tri, options.edge_fraction * diagonal)
+    surface = _Surface.of(tri)
     best: tuple[float, FloatArray, FloatArray] | None = None
     for k in range(1, min(options.max_spheres, len(tri)) + 1):
-        centres, radii = _fit_k(tri, k, tolerance)
+        centres, radii = _fit_k(surface, k, tolerance)
         volume = union_volume(centres, radii)
         if best is None or volume < best[0]:
             best = (volume, centres, radii)

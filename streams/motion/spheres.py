@@ -114,10 +114,27 @@ def _shape_triangles(p: Primitive) -> tuple[FloatArray, float]:
     return tri @ p.T_joint_shape[:3, :3].T + p.T_joint_shape[:3, 3], tolerance
 
 
-def _fitted(group: list[Primitive], options: FitOptions) -> tuple[FloatArray, FloatArray]:
+def link_surface(group: list[Primitive]) -> tuple[FloatArray, float]:
+    """The triangles ``(m, 3, 3)`` of one link's shapes ``group`` in their joint frame (a
+    box's or cylinder's tessellated), and the largest distance [m] from the shapes' true
+    surface to them: what :func:`~streams.motion.sphere_fit.fit_spheres` covers."""
     parts = [_shape_triangles(p) for p in group]
-    tri = np.concatenate([t for t, _ in parts])
-    fit = fit_spheres(tri, options, max(tol for _, tol in parts))
+    return np.concatenate([t for t, _ in parts]), max(tol for _, tol in parts)
+
+
+def fitted_links(prims: list[Primitive], fit: str) -> dict[tuple[int, str], list[Primitive]]:
+    """The shapes whose link gets fitted spheres (``fit``: ``"meshes"`` or ``"all"``),
+    grouped by ``(joint, link)`` in the shapes' order."""
+    groups: dict[tuple[int, str], list[Primitive]] = {}
+    for p in prims:
+        if fit == "all" or p.triangles is not None:
+            groups.setdefault((p.joint, p.link), []).append(p)
+    return groups
+
+
+def _fitted(group: list[Primitive], options: FitOptions) -> tuple[FloatArray, FloatArray]:
+    tri, tolerance = link_surface(group)
+    fit = fit_spheres(tri, options, tolerance)
     return fit.centre, fit.radius
 
 
@@ -125,10 +142,7 @@ def _covered_shapes(
     prims: list[Primitive], coarse: bool, fit: str, options: FitOptions
 ) -> tuple[list[int], list[FloatArray], list[FloatArray]]:
     """Joint, centres and radii of each shape's (or fitted link's) spheres, in shape order."""
-    groups: dict[tuple[int, str], list[Primitive]] = {}
-    for p in prims:
-        if fit == "all" or p.triangles is not None:
-            groups.setdefault((p.joint, p.link), []).append(p)
+    groups = fitted_links(prims, fit)
     link_options = (
         replace(options, max_spheres=max(1, options.max_spheres // 2)) if coarse else options
     )

@@ -18,6 +18,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world._coal import hull_volume
 from sdar_tamp.world.scene import load_scene
 from streams._pin_geometry import Primitive, arm_primitives
+from streams.motion import sphere_fit
 from streams.motion import spheres as spheres_module
 from streams.motion.sphere_fit import (
     FitOptions,
@@ -42,15 +43,7 @@ MESH_ARM = MESHES / "mesharm" / "urdf" / "mesh_arm.urdf"
 
 
 def surface_points(triangles: np.ndarray, n: int, seed: int) -> np.ndarray:
-    """``n`` points uniform on the surface of ``triangles`` ``(m, 3, 3)``."""
-    rng = np.random.default_rng(seed)
-    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
-    area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    pick = rng.choice(len(triangles), n, p=area / area.sum())
-    u, v = rng.uniform(size=n), rng.uniform(size=n)
-    flip = u + v > 1.0
-    u[flip], v[flip] = 1.0 - u[flip], 1.0 - v[flip]
-    return a[pick] + u[:, None] * (b - a)[pick] + v[:, None] * (c - a)[pick]
+    return sphere_fit.surface_points(triangles, n, np.random.default_rng(seed))
 
 
 def covered(points: np.ndarray, centre: np.ndarray, radius: np.ndarray) -> np.ndarray:
