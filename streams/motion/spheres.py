@@ -21,6 +21,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.transforms import FloatArray
 from sdar_tamp.world.urdf import read_urdf
 from streams._pin_geometry import Primitive, arm_primitives
+from streams.motion import sphere_cache
 from streams.motion.sphere_fit import (
     FitOptions,
     box_triangles,
@@ -198,8 +199,9 @@ def arm_spheres(
     ``options.max_spheres`` per link).
     ``coarse``: fewer, larger spheres (cylinders 2 radii apart, half the fitted spheres per
     link, the whole gripper -- :func:`gripper_shapes` -- as one box), used for the arm-arm
-    pairs of the optimiser. Models are kept by :func:`model_digest` and the parameters: the
-    same description is fitted once per process.
+    pairs of the optimiser. Models are kept by :func:`model_digest` and the parameters, in
+    memory and (fitted ones) on disk (:mod:`streams.motion.sphere_cache`): the same
+    description is fitted once.
 
     Raises:
         ParameterError: ``fit`` is neither ``"meshes"`` nor ``"all"``.
@@ -220,6 +222,27 @@ def _arm_spheres(
     fit: str,
     options: FitOptions,
 ) -> ArmSpheres:
+    key = sphere_cache.cache_key(digest, coarse, fit, options)
+    stored = sphere_cache.load(key)
+    model = (
+        ArmSpheres(*stored)
+        if stored is not None
+        else _build(urdf, coarse, package_dirs, fit, options, key)
+    )
+    for array in (model.joint, model.centre, model.radius):
+        array.flags.writeable = False
+    return model
+
+
+def _build(
+    urdf: Path,
+    coarse: bool,
+    package_dirs: tuple[Path, ...],
+    fit: str,
+    options: FitOptions,
+    key: str,
+) -> ArmSpheres:
+    """The model of :func:`arm_spheres`, kept on disk under ``key`` when a link was fitted."""
     prims = [p for p in arm_primitives(urdf, package_dirs) if p.joint != 0]
     grip: list[Primitive] = []
     if coarse:
@@ -235,8 +258,8 @@ def _arm_spheres(
     model = ArmSpheres(
         np.array(joints, dtype=np.int64), np.concatenate(centres), np.concatenate(radii)
     )
-    for array in (model.joint, model.centre, model.radius):
-        array.flags.writeable = False
+    if fitted_links(prims, fit):
+        sphere_cache.store(key, model.joint, model.centre, model.radius)
     return model
 
 

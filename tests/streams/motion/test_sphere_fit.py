@@ -18,7 +18,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world._coal import hull_volume
 from sdar_tamp.world.scene import load_scene
 from streams._pin_geometry import Primitive, arm_primitives
-from streams.motion import sphere_fit
+from streams.motion import sphere_cache, sphere_fit
 from streams.motion import spheres as spheres_module
 from streams.motion.sphere_fit import (
     FitOptions,
@@ -138,6 +138,55 @@ def test_models_are_cached_by_content(tmp_path: Path) -> None:
     changed = arm_spheres(urdf, package_dirs=(tmp_path,))
     assert changed is not first
     assert changed.centre[:, 0].max() > first.centre[:, 0].max()
+
+
+def test_fitted_models_are_kept_on_disk(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SDAR_TAMP_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv(sphere_cache.ENV_SWITCH, "1")
+    spheres_module._arm_spheres.cache_clear()
+    first = arm_spheres(MESH_ARM, package_dirs=(MESHES,))
+    kept = sorted((tmp_path / "cache").glob("spheres-*.npz"))
+    assert len(kept) == 1
+    spheres_module._arm_spheres.cache_clear()
+
+    def no_fit(*args: object) -> None:
+        raise AssertionError("fitted again")
+
+    monkeypatch.setattr(spheres_module, "_build", no_fit)
+    second = arm_spheres(MESH_ARM, package_dirs=(MESHES,))
+    np.testing.assert_array_equal(first.centre, second.centre)
+    np.testing.assert_array_equal(first.radius, second.radius)
+    np.testing.assert_array_equal(first.joint, second.joint)
+    monkeypatch.undo()
+    spheres_module._arm_spheres.cache_clear()
+
+
+def test_a_broken_or_switched_off_disk_cache_is_skipped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("SDAR_TAMP_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv(sphere_cache.ENV_SWITCH, "1")
+    key = sphere_cache.cache_key("some model")
+    sphere_cache.cache_path(key).parent.mkdir(parents=True)
+    sphere_cache.cache_path(key).write_bytes(b"not an npz")
+    assert sphere_cache.load(key) is None
+    joint, centre, radius = np.array([1]), np.zeros((1, 3)), np.ones(1)
+    np.savez(sphere_cache.cache_path(key), joint=joint, centre=np.zeros((2, 3)), radius=radius)
+    assert sphere_cache.load(key) is None  # shapes that disagree
+    sphere_cache.store(key, joint, centre, radius)
+    stored = sphere_cache.load(key)
+    assert stored is not None and np.array_equal(stored[2], radius)
+    monkeypatch.setenv(sphere_cache.ENV_SWITCH, "off")
+    assert sphere_cache.load(key) is None
+    other = sphere_cache.cache_key("another model")
+    sphere_cache.store(other, joint, centre, radius)
+    assert not sphere_cache.cache_path(other).exists()
+    # a cache folder that cannot be made: the model is not kept, and nothing is raised
+    monkeypatch.setenv(sphere_cache.ENV_SWITCH, "1")
+    (tmp_path / "file").write_text("", encoding="utf-8")
+    monkeypatch.setenv("SDAR_TAMP_CACHE", str(tmp_path / "file" / "cache"))
+    sphere_cache.store(other, joint, centre, radius)
+    assert sphere_cache.load(other) is None
 
 
 def test_spheres_per_link_are_bounded() -> None:
