@@ -2,8 +2,10 @@
 
 Every sphere set *covers* its primitive: a cylinder of radius ``r`` and length ``L`` becomes
 ``n`` spheres on its axis, spacing ``s = L / n``, radius ``sqrt(r^2 + (s/2)^2)``; a box becomes a
-grid of cells, one sphere per cell circumscribing it. The optimiser keeps these spheres apart;
-the exact coal check (:mod:`streams.motion.exact_check`) decides in the end.
+grid of cells, one sphere per cell circumscribing it (a sphere of the URDF is its bounding
+box). A link whose shapes are meshes gets spheres fitted to its surface
+(:mod:`streams.motion.sphere_fit`). The optimiser keeps these spheres apart; the exact coal
+check (:mod:`streams.motion.exact_check`) decides in the end.
 """
 
 from __future__ import annotations

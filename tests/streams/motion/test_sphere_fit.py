@@ -354,6 +354,13 @@ def test_bad_fit_inputs_are_errors() -> None:
         arm_spheres(MESH_ARM, package_dirs=(MESHES,), fit="some")
 
 
+def test_a_missing_mesh_is_located(tmp_path: Path) -> None:
+    from sdar_tamp.world.errors import SceneError
+
+    with pytest.raises(SceneError, match=r"mesh_arm\.urdf:\d+:\d+: mesh 'package://mesharm/"):
+        arm_spheres(MESH_ARM, package_dirs=(tmp_path,))
+
+
 def test_a_single_point_mesh_gets_one_sphere() -> None:
     fit = fit_spheres(np.zeros((1, 3, 3)))
     assert len(fit.radius) == 1 and fit.radius[0] == 0.0 and fit.hull_volume == 0.0
