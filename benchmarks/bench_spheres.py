@@ -3,14 +3,14 @@
 
 Per model and per fitted link: the spheres' count, their coverage of points drawn uniformly
 on the link's collision surface (another seed than anything the fit uses; it uses none), and
-the volume of the spheres' union over the convex hull's; per model: the sphere counts of the
-fine and the coarse model and the time to build the model: cold (no cache), from the disk
-cache (in a temporary folder of its own) and from the in-memory cache. Models: the test arm
-of meshes (``tests/streams/motion/meshes``), the shipped UR5e with every primitive fitted
-(``fit="all"``; its default model keeps its primitive spheres), and, when
-``example-robot-data`` is installed (or ``EXAMPLE_ROBOT_DATA_SHARE`` names its ``share``
-folder), its UR10 and Franka Panda. Prints a
-table, then as its last line one JSON object.
+the volume of the spheres' union (and their volumes added up) over the convex hull's; per
+model: the sphere counts of the fine and the coarse model and the time to build the model:
+cold (no cache), from the disk cache (in a temporary folder of its own) and from the
+in-memory cache. Models: the test arm of meshes (``tests/streams/motion/meshes``), the
+shipped UR5e with every primitive fitted (``fit="all"``; its default model keeps its
+primitive spheres), and, when ``example-robot-data`` is installed (or
+``EXAMPLE_ROBOT_DATA_SHARE`` names its ``share`` folder), its UR10 and Franka Panda. Prints
+a table, then as its last line one JSON object.
 
     python benchmarks/bench_spheres.py            # 20000 surface points per link
     python benchmarks/bench_spheres.py --quick    # 2000 points, the UR10 skipped: seconds
@@ -96,6 +96,12 @@ def bench_model(
             "coverage": float(inside.mean()),
             "volume_ratio": union_volume(fitted.centre, fitted.radius)
             / hull_volume(tri.reshape(-1, 3)),
+            # the spheres' volumes added up (overlaps counted twice) over the hull's
+            "summed_ratio": 4.0
+            / 3.0
+            * np.pi
+            * float(np.sum(fitted.radius**3))
+            / hull_volume(tri.reshape(-1, 3)),
         }
     return {
         "spheres": len(fine),
@@ -121,17 +127,19 @@ def main() -> None:
     folder = tempfile.TemporaryDirectory(prefix="bench-spheres-")
     os.environ["SDAR_TAMP_CACHE"] = folder.name
     os.environ[sphere_cache.ENV_SWITCH] = "1"
-    print(f"{'model':9} {'link':16} {'spheres':>7} {'coverage':>9} {'vol/hull':>8}")
+    print(
+        f"{'model':9} {'link':20} {'spheres':>7} {'coverage':>9} {'union/hull':>10} {'sum/hull':>8}"
+    )
     for name, urdf, package_dirs, fit in _models(args.quick):
         row = bench_model(urdf, package_dirs, fit, n, args.seed)
         out["models"][name] = row
         for link, v in row["links"].items():
             print(
-                f"{name:9} {link:16} {v['spheres']:>7} {v['coverage']:>9.4%} "
-                f"{v['volume_ratio']:>8.2f}"
+                f"{name:9} {link:20} {v['spheres']:>7} {v['coverage']:>9.4%} "
+                f"{v['volume_ratio']:>10.2f} {v['summed_ratio']:>8.2f}"
             )
         print(
-            f"{name:9} {'(model)':16} {row['spheres']:>7} fine, {row['coarse_spheres']} coarse; "
+            f"{name:9} {'(model)':20} {row['spheres']:>7} fine, {row['coarse_spheres']} coarse; "
             f"cold {row['cold_s']:.2f} s, from disk {row['disk_s'] * 1e3:.1f} ms, "
             f"in memory {row['cached_s'] * 1e3:.2f} ms"
         )
