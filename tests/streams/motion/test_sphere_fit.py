@@ -103,6 +103,25 @@ def test_mesh_links_are_covered_within_three_hulls() -> None:
     assert set(seen) == {"link1", "link2", "hand"}
 
 
+@pytest.mark.parametrize("coarse", [False, True])
+def test_the_test_links_are_covered_inside_too(coarse: bool) -> None:
+    """The fit covers surfaces; on the test arm's closed links the inside is covered too."""
+    model = arm_spheres(MESH_ARM, coarse=coarse, package_dirs=(MESHES,))
+    rng = np.random.default_rng(3)
+    # the capsule of link1 (joint 1 frame): its 16-gon's inscribed radius, 0.2 m up
+    p = rng.uniform([-0.04, -0.04, 0.01], [0.04, 0.04, 0.39], (20000, 3))
+    z = p[:, 2] - 0.2
+    inner = 0.04 * np.cos(np.pi / 16) * 0.999
+    capsule = p[np.hypot(p[:, 0], p[:, 1]) ** 2 + (z - np.clip(z, -0.15, 0.15)) ** 2 <= inner**2]
+    # the L of link2 (joint 2 frame)
+    q = rng.uniform([0.0, -0.025, -0.025], [0.25, 0.15, 0.025], (20000, 3))
+    ell = q[(q[:, 1] <= 0.025) | (q[:, 0] <= 0.05)]
+    for joint, points in ((1, capsule), (2, ell)):
+        mine = model.joint == joint
+        assert len(points) > 5000
+        assert covered(points, model.centre[mine], model.radius[mine]).all()
+
+
 def test_the_fit_covers_every_triangle_exactly() -> None:
     tri = next(p.triangles for p in arm_primitives(MESH_ARM, (MESHES,)) if p.link == "link2")
     assert tri is not None
