@@ -1,8 +1,9 @@
 """Typed adapter reading the arm's collision primitives from its pinocchio geometry model.
 
 Cylinders and boxes are read as they are. A mesh (the collision geometry makers ship) and a
-sphere become the box that bounds them in their own frame: a conservative stand-in for the
-optimiser's sphere model, while the validator keeps checking the exact shapes with coal.
+sphere become the box that bounds them in their own frame: a conservative stand-in, while the
+validator keeps checking the exact shapes with coal. A mesh also keeps its triangles (in the
+joint frame), from which :mod:`streams.motion.sphere_fit` fits the optimiser's spheres.
 """
 
 from __future__ import annotations
@@ -28,6 +29,11 @@ class Primitive:
     T_joint_shape: FloatArray  # (4, 4)
     kind: str  # "cylinder" or "box"
     half: tuple[float, float, float]  # cylinder: (radius, radius, half length); box: half sides
+    link: str = ""  # the URDF link holding the shape
+    #: the link hangs from its joint through fixed joints (a tool, a gripper, a flange), rather
+    #: than being the child link of the joint itself
+    fixed_to_joint: bool = False
+    triangles: FloatArray | None = None  # a mesh's triangles (m, 3, 3) in the joint frame
 
 
 def arm_primitives(urdf: Path, package_dirs: tuple[Path, ...] = ()) -> tuple[Primitive, ...]:
@@ -38,11 +44,16 @@ def arm_primitives(urdf: Path, package_dirs: tuple[Path, ...] = ()) -> tuple[Pri
             sphere and mesh (naming the shape and the URDF).
     """
     robot = PinRobot.load(urdf, package_dirs)
+    model = robot.model
     out: list[Primitive] = []
     for obj in robot.geometry.geometryObjects:
         geom = obj.geometry
         kind = type(geom).__name__.lower()
         T = se3_to_array(obj.placement)
+        frame = model.frames[int(obj.parentFrame)]
+        previous = model.frames[int(frame.parentFrame)]
+        fixed = int(obj.parentJoint) != 0 and str(previous.type.name) != "JOINT"
+        triangles = None
         if kind == "cylinder":
             r, h = float(geom.radius), float(geom.halfLength)
             half = (r, r, h)
@@ -52,13 +63,27 @@ def arm_primitives(urdf: Path, package_dirs: tuple[Path, ...] = ()) -> tuple[Pri
             r = float(geom.radius)
             kind, half = "box", (r, r, r)
         elif kind.startswith("bvhmodel") or kind == "convex":
-            kind, T, half = "box", *_bounding_box(T, _vertices(geom, obj.name, urdf))
+            points = _vertices(geom, obj.name, urdf)
+            if kind.startswith("bvhmodel"):
+                triangles = _triangles(geom, points) @ T[:3, :3].T + T[:3, 3]
+            kind, T, half = "box", *_bounding_box(T, points)
         else:  # pragma: no cover - read_urdf lets only box, cylinder, sphere and mesh through
             raise SceneError(
                 f"{urdf}: collision shape {str(obj.name)!r} is a {kind}; the supported shapes "
                 "are box, cylinder, sphere and mesh"
             )
-        out.append(Primitive(str(obj.name), int(obj.parentJoint), T, kind, half))
+        out.append(
+            Primitive(
+                str(obj.name),
+                int(obj.parentJoint),
+                T,
+                kind,
+                half,
+                str(frame.name),
+                fixed,
+                triangles,
+            )
+        )
     return tuple(out)
 
 
@@ -72,6 +97,15 @@ def _vertices(geom: Any, name: str, urdf: Path) -> FloatArray:
     if len(points) == 0:
         raise SceneError(f"{urdf}: collision mesh {name!r} has no vertices")
     return points
+
+
+def _triangles(geom: Any, points: FloatArray) -> FloatArray:
+    """The triangles ``(m, 3, 3)`` of a coal mesh whose vertices are ``points``."""
+    index = np.array(
+        [[int(t[0]), int(t[1]), int(t[2])] for t in map(geom.tri_indices, range(geom.num_tris))],
+        dtype=np.int64,
+    ).reshape(-1, 3)
+    return points[index]
 
 
 def _bounding_box(

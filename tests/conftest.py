@@ -13,7 +13,7 @@ from types import ModuleType
 import pytest
 
 from streams.context import WorldContext
-from streams.motion import codegen
+from streams.motion import codegen, sphere_cache
 from streams.motion.optimiser_cache import OptimiserCache
 from streams.motion.planner import MotionPlanner
 
@@ -21,6 +21,9 @@ from streams.motion.planner import MotionPlanner
 # values as compiled, tests/streams/motion/test_codegen.py): a fresh machine would otherwise
 # spend about 20 s of CPU compiling them beside the tests. Subprocesses inherit the switch.
 os.environ[codegen.ENV_SWITCH] = "0"
+# Fitted sphere models are not kept in the user's cache folder by the suite (the tests of the
+# disk cache switch it on in a folder of their own).
+os.environ[sphere_cache.ENV_SWITCH] = "0"
 
 #: Most of the suite's time is spent in a few long planning tests; beyond four processes the
 #: start-up of each (pinocchio, CasADi, the optimiser build) outweighs what they share out.

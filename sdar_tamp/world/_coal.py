@@ -32,3 +32,20 @@ def shape_distance(
     result = coal.DistanceResult()
     coal.distance(shape_a, _transform(T_world_a), shape_b, _transform(T_world_b), request, result)
     return float(result.min_distance)
+
+
+def hull_volume(points: FloatArray) -> float:
+    """The volume [m^3] of the convex hull of ``points`` ``(n, 3)`` (coal's qhull); 0 when
+    they span less than three dimensions (qhull is not called then: it fails on them)."""
+    pts = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+    if len(pts) < 4:
+        return 0.0
+    spread = np.linalg.svd(pts - pts.mean(axis=0), compute_uv=False)
+    if spread[2] <= 1e-9 * max(float(spread[0]), 1e-300):
+        return 0.0
+    model = coal.BVHModelOBBRSS()
+    model.beginModel(0, len(pts))
+    model.addVertices(pts)
+    model.endModel()
+    model.buildConvexHull(True, "Qt")
+    return float(model.convex.computeVolume())

@@ -2,22 +2,39 @@
 
 Every sphere set *covers* its primitive: a cylinder of radius ``r`` and length ``L`` becomes
 ``n`` spheres on its axis, spacing ``s = L / n``, radius ``sqrt(r^2 + (s/2)^2)``; a box becomes a
-grid of cells, one sphere per cell circumscribing it. The optimiser keeps these spheres apart;
-the exact coal check (:mod:`streams.motion.exact_check`) decides in the end.
+grid of cells, one sphere per cell circumscribing it (a sphere of the URDF is its bounding
+box). A link whose shapes are meshes gets spheres fitted to its surface
+(:mod:`streams.motion.sphere_fit`). The optimiser keeps these spheres apart; the exact coal
+check (:mod:`streams.motion.exact_check`) decides in the end.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+import hashlib
+import re
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.transforms import FloatArray
+from sdar_tamp.world.urdf import read_urdf
 from streams._pin_geometry import Primitive, arm_primitives
+from streams.motion import sphere_cache
+from streams.motion.sphere_fit import (
+    FitOptions,
+    box_triangles,
+    cylinder_triangles,
+    fit_spheres,
+)
 
-_GRIPPER_PREFIX = "gripper"
+#: Which shapes get fitted spheres: only meshes, or every shape.
+FITS = ("meshes", "all")
+_COLLISION = re.compile(r"<collision\b.*?</collision>", re.DOTALL)
+_FILENAME = re.compile(r"""<mesh\b[^>]*?\bfilename\s*=\s*["']([^"']*)["']""", re.DOTALL)
 
 IntArray = NDArray[np.int64]
 
@@ -62,7 +79,8 @@ def box_spheres(half: FloatArray, max_per_axis: int = 3) -> tuple[FloatArray, Fl
 
 
 def _gripper_box(prims: list[Primitive]) -> tuple[FloatArray, FloatArray]:
-    """Centre and half sides of the joint-frame bounding box of the gripper primitives."""
+    """Centre and half sides of the joint-frame bounding box of the gripper primitives (a
+    mesh's primitive is its bounding box, so meshes are bounded too)."""
     pts = []
     for p in prims:
         h = np.array(p.half)
@@ -75,27 +93,75 @@ def _gripper_box(prims: list[Primitive]) -> tuple[FloatArray, FloatArray]:
     return (lo + hi) / 2.0, (hi - lo) / 2.0
 
 
-def arm_spheres(
-    urdf: Path, coarse: bool = False, package_dirs: tuple[Path, ...] = ()
-) -> ArmSpheres:
-    """The sphere model of one arm (links 1..6 and the gripper) from the URDF's primitives.
+def gripper_shapes(prims: list[Primitive]) -> list[Primitive]:
+    """The shapes of the tool: the tool joint is the last joint (by pinocchio's depth-first
+    index) holding a link fixed to it through fixed joints (the UR5e's gripper base and
+    fingers on the wrist, the Panda's hand on joint 7); the tool is every shape on such a
+    link of that joint, and every shape of the joints after it (a Panda's finger joints).
+    None when no link is fixed to a moving joint."""
+    fixed = [p.joint for p in prims if p.fixed_to_joint and p.joint != 0]
+    if not fixed:
+        return []
+    tool = max(fixed)
+    return [p for p in prims if (p.joint == tool and p.fixed_to_joint) or p.joint > tool]
 
-    ``coarse``: fewer, larger spheres (cylinders 2 radii apart, the whole gripper as one box),
-    used for the arm-arm pairs of the optimiser.
-    """
+
+def _shape_triangles(p: Primitive) -> tuple[FloatArray, float]:
+    """A shape's triangles in its joint frame and how far its true surface strays from them."""
+    if p.triangles is not None:
+        return p.triangles, 0.0
+    if p.kind == "cylinder":
+        tri, tolerance = cylinder_triangles(p.half[0], p.half[2])
+    else:
+        tri, tolerance = box_triangles(np.array(p.half)), 0.0
+    return tri @ p.T_joint_shape[:3, :3].T + p.T_joint_shape[:3, 3], tolerance
+
+
+def link_surface(group: list[Primitive]) -> tuple[FloatArray, float]:
+    """The triangles ``(m, 3, 3)`` of one link's shapes ``group`` in their joint frame (a
+    box's or cylinder's tessellated), and the largest distance [m] from the shapes' true
+    surface to them: what :func:`~streams.motion.sphere_fit.fit_spheres` covers."""
+    parts = [_shape_triangles(p) for p in group]
+    return np.concatenate([t for t, _ in parts]), max(tol for _, tol in parts)
+
+
+def fitted_links(prims: list[Primitive], fit: str) -> dict[tuple[int, str], list[Primitive]]:
+    """The shapes whose link gets fitted spheres (``fit``: ``"meshes"`` or ``"all"``),
+    grouped by ``(joint, link)`` in the shapes' order."""
+    groups: dict[tuple[int, str], list[Primitive]] = {}
+    for p in prims:
+        if fit == "all" or p.triangles is not None:
+            groups.setdefault((p.joint, p.link), []).append(p)
+    return groups
+
+
+def _fitted(group: list[Primitive], options: FitOptions) -> tuple[FloatArray, FloatArray]:
+    tri, tolerance = link_surface(group)
+    fit = fit_spheres(tri, options, tolerance)
+    return fit.centre, fit.radius
+
+
+def _covered_shapes(
+    prims: list[Primitive], coarse: bool, fit: str, options: FitOptions
+) -> tuple[list[int], list[FloatArray], list[FloatArray]]:
+    """Joint, centres and radii of each shape's (or fitted link's) spheres, in shape order."""
+    groups = fitted_links(prims, fit)
+    link_options = (
+        replace(options, max_spheres=max(1, options.max_spheres // 2)) if coarse else options
+    )
     joints: list[int] = []
     centres: list[FloatArray] = []
     radii: list[FloatArray] = []
-    prims = [p for p in arm_primitives(urdf, package_dirs) if p.joint != 0]
-    if coarse:
-        grip = [p for p in prims if p.name.startswith(_GRIPPER_PREFIX)]
-        prims = [p for p in prims if not p.name.startswith(_GRIPPER_PREFIX)]
-        centre, half = _gripper_box(grip)
-        T = np.eye(4)
-        T[:3, 3] = centre
-        box = (float(half[0]), float(half[1]), float(half[2]))
-        prims.append(Primitive("gripper", grip[0].joint, T, "box", box))
     for p in prims:
+        if fit == "all" or p.triangles is not None:
+            group = groups.pop((p.joint, p.link), None)
+            if group is None:
+                continue  # the link's spheres are out already
+            c, r = _fitted(group, link_options)
+            joints.extend([p.joint] * len(r))
+            centres.append(c)
+            radii.append(r)
+            continue
         if p.kind == "cylinder":
             c, r = cylinder_spheres(p.half[0], p.half[2], 2.0 if coarse else 1.2)
         else:
@@ -104,9 +170,99 @@ def arm_spheres(
         joints.extend([p.joint] * len(r))
         centres.append(world)
         radii.append(r)
-    return ArmSpheres(
+    return joints, centres, radii
+
+
+def model_digest(urdf: Path, package_dirs: tuple[Path, ...] = ()) -> str:
+    """A SHA-256 of the URDF's text (its collision meshes resolved) and of every collision
+    mesh file it names: two descriptions with the same digest have the same geometry."""
+    text = read_urdf(urdf, package_dirs)
+    digest = hashlib.sha256(text.encode("utf-8"))
+    for block in _COLLISION.findall(text):
+        for name in _FILENAME.findall(block):
+            path = Path(name)
+            if path.is_file():
+                digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def arm_spheres(
+    urdf: Path,
+    coarse: bool = False,
+    package_dirs: tuple[Path, ...] = (),
+    fit: str = "meshes",
+    options: FitOptions | None = None,
+) -> ArmSpheres:
+    """The sphere model of one arm (its moving links and the gripper) from the URDF.
+
+    Boxes and cylinders get spheres that cover them by construction; meshes (with
+    ``fit="all"``, every shape) get spheres fitted to their link's collision surface
+    (:mod:`streams.motion.sphere_fit`; ``options`` default to :class:`FitOptions`; at most
+    ``options.max_spheres`` per link).
+    ``coarse``: fewer, larger spheres (cylinders 2 radii apart, half the fitted spheres per
+    link, the whole gripper -- :func:`gripper_shapes` -- as one box), used for the arm-arm
+    pairs of the optimiser. Models are kept by :func:`model_digest` and the parameters, in
+    memory and (fitted ones) on disk (:mod:`streams.motion.sphere_cache`): the same
+    description is fitted once.
+
+    Raises:
+        ParameterError: ``fit`` is neither ``"meshes"`` nor ``"all"``.
+        SceneError: the URDF does not load (see :func:`streams._pin_geometry.arm_primitives`).
+    """
+    if fit not in FITS:
+        raise ParameterError(f"fit must be one of {', '.join(FITS)}, got {fit!r}")
+    digest = model_digest(urdf, package_dirs)
+    return _arm_spheres(digest, urdf, coarse, package_dirs, fit, options or FitOptions())
+
+
+@functools.lru_cache(maxsize=16)
+def _arm_spheres(
+    digest: str,
+    urdf: Path,
+    coarse: bool,
+    package_dirs: tuple[Path, ...],
+    fit: str,
+    options: FitOptions,
+) -> ArmSpheres:
+    key = sphere_cache.cache_key(digest, coarse, fit, options)
+    stored = sphere_cache.load(key)
+    model = (
+        ArmSpheres(*stored)
+        if stored is not None
+        else _build(urdf, coarse, package_dirs, fit, options, key)
+    )
+    for array in (model.joint, model.centre, model.radius):
+        array.flags.writeable = False
+    return model
+
+
+def _build(
+    urdf: Path,
+    coarse: bool,
+    package_dirs: tuple[Path, ...],
+    fit: str,
+    options: FitOptions,
+    key: str,
+) -> ArmSpheres:
+    """The model of :func:`arm_spheres`, kept on disk under ``key`` when a link was fitted."""
+    prims = [p for p in arm_primitives(urdf, package_dirs) if p.joint != 0]
+    grip: list[Primitive] = []
+    if coarse:
+        grip = gripper_shapes(prims)
+        prims = [p for p in prims if not any(p is g for g in grip)]
+    joints, centres, radii = _covered_shapes(prims, coarse, fit, options)
+    if grip:
+        centre, half = _gripper_box(grip)
+        c, r = box_spheres(half)
+        joints.extend([min(g.joint for g in grip)] * len(r))  # the tool joint
+        centres.append(c + centre)
+        radii.append(r)
+    model = ArmSpheres(
         np.array(joints, dtype=np.int64), np.concatenate(centres), np.concatenate(radii)
     )
+    if fitted_links(prims, fit):
+        sphere_cache.store(key, model.joint, model.centre, model.radius)
+    return model
 
 
 def object_spheres(

@@ -84,6 +84,12 @@ def _solve(out: Summary) -> None:
     assert out["runs"] == 1 and out["this"]["all_valid"] is True
 
 
+def _spheres(out: Summary) -> None:
+    for model in out["models"].values():
+        assert model["min_coverage"] >= 0.999 and model["max_volume_ratio"] <= 3.0
+    assert {"mesh_arm", "ur5e_all"} <= out["models"].keys()
+
+
 def _streams(out: Summary) -> None:
     assert out["runs"] and out["all_expected"] is True and out["max_time_probes"]
 
@@ -106,6 +112,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_pddlstream_compat", ()): _pddlstream,
     ("bench_sdar", ()): _sdar,
     ("bench_solve", ()): _solve,
+    ("bench_spheres", ()): _spheres,
     ("bench_streams", ()): _streams,
     ("bench_world", ()): _world,
 }
