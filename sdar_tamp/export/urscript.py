@@ -40,8 +40,8 @@ from sdar_tamp.export.timeline import (
     positions_at,
 )
 from sdar_tamp.plan_file import PlanFile, plan_joint_names
-from sdar_tamp.world.arm_access import arm_robot_file
-from sdar_tamp.world.scene import JOINT_KEYS, Scene
+from sdar_tamp.world.arm_access import arm_robot_file, ur_joint_names
+from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
 
@@ -155,7 +155,7 @@ def check_ur_arms(plan: PlanFile, scene: Scene | None = None) -> None:
                     "joint-trajectory or csv for this arm"
                 )
             continue
-        ur = plan_joint_names(info.name, [f"{key}_joint" for key in JOINT_KEYS])
+        ur = plan_joint_names(info.name, ur_joint_names())
         if info.joints != ur:
             raise ParameterError(
                 f"urscript: arm {info.name!r} is not a Universal Robots arm: its "

@@ -17,6 +17,12 @@ from sdar_tamp.world.errors import SceneError
 from sdar_tamp.world.scene import JOINT_KEYS, ArmSpec, Scene
 
 
+def ur_joint_names() -> tuple[str, ...]:
+    """The joints of a Universal Robots arm, base to wrist (``shoulder_pan_joint`` to
+    ``wrist_3_joint``)."""
+    return tuple(f"{key}_joint" for key in JOINT_KEYS)
+
+
 def arm_joint_names(spec: ArmSpec) -> tuple[str, ...]:
     """The robot description's names of the arm's joints, in configuration order (one per
     entry of ``spec.home``)."""
@@ -24,7 +30,7 @@ def arm_joint_names(spec: ArmSpec) -> tuple[str, ...]:
     if names:
         named = tuple(str(n) for n in names)
     elif len(spec.home) == len(JOINT_KEYS):
-        named = tuple(f"{key}_joint" for key in JOINT_KEYS)
+        named = ur_joint_names()
     else:
         raise SceneError(
             f"arm {spec.name!r}: {len(spec.home)} joints and no joint names; name them in the "
