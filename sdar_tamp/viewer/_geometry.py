@@ -174,10 +174,10 @@ class ArmDrawing:
             np.asarray(T_tool0_tcp, dtype=np.float64).reshape(4, 4),
             shapes,
             links,
-            np.vstack(verts),
-            np.concatenate(vlink),
-            np.vstack(faces),
-            np.concatenate(fshape),
+            np.vstack(verts) if verts else np.zeros((0, 3)),
+            np.concatenate(vlink) if vlink else np.zeros(0, dtype=np.int64),
+            np.vstack(faces) if faces else np.zeros((0, 3), dtype=np.int64),
+            np.concatenate(fshape) if fshape else np.zeros(0, dtype=np.int64),
             segments,
             _q_index(robot, joints),
         )
@@ -190,6 +190,15 @@ class ArmDrawing:
                 self.name, self.robot, self.T_world_base, self.T_tool0_tcp, self.segments, shapes
             ),
             q_index=self.q_index,
+        )
+
+    def static_links(self) -> tuple[str, ...]:
+        """The drawn links no joint moves (fixed to the robot's root: ``base_link``)."""
+        model = self.robot.model
+        return tuple(
+            link
+            for link in self.links
+            if int(model.frames[self.robot.frame_id(link)].parentJoint) == 0
         )
 
     @property

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import PANDA_JOINTS, PANDA_UPPER, PANDA_VELOCITY, mixed_plan
+from mixed_cell import PANDA_JOINTS, PANDA_UPPER, PANDA_VELOCITY, mixed_plan
 
 from sdar_tamp.plan_file import PlanFile, PlanFileError
 from sdar_tamp.plan_reading import load_plan
@@ -214,3 +214,14 @@ def test_the_dwell_names_the_arms_joint(plan: PlanFile, cell: Scene) -> None:
 
 def test_mixed_plan_is_deterministic(cell: Scene) -> None:
     assert plan_to_dict(mixed_plan(cell)) == plan_to_dict(mixed_plan(cell))
+
+
+def test_the_plan_schema_takes_arms_of_any_joint_count(plan: PlanFile) -> None:
+    jsonschema = pytest.importorskip("jsonschema")
+    from sdar_tamp.schemas import schema
+
+    validator = jsonschema.Draft202012Validator(schema("plan"))
+    document = json.loads(json.dumps(plan_to_dict(plan)))
+    assert [e.message for e in validator.iter_errors(document)] == []
+    document["arms"][1]["home"] = []
+    assert list(validator.iter_errors(document))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-from conftest import PANDA_URDF, PANDA_VELOCITY
+from mixed_cell import PANDA_URDF, PANDA_VELOCITY
 
 from sdar_tamp.app.execution import path_timer
 from sdar_tamp.errors import ParameterError
