@@ -207,15 +207,15 @@ class ArmDrawing:
         return len(self.q_index) if self.q_index is not None else self.robot.nq
 
     def chain_frames(self) -> tuple[str, ...]:
-        """The frames the top-down stick figure joins: the robot's root, every joint of the
-        chain to ``tool0`` (at its child link's origin), ``tool0``, then the tool centre point
-        (``tcp`` when the robot names one)."""
+        """The frames the top-down stick figure joins, tool centre point aside: the robot's
+        root, every joint of the chain to ``tool0`` (at its child link's origin), ``tool0``."""
         joints = tuple(j.name for j in chain_to(self.robot, "tool0").joints)
         return (ROOT_FRAME, *joints, "tool0")
 
     def chain_points(self, q: FloatArray) -> FloatArray:
         """World positions ``(n, k + 3, 3)`` [m] of :meth:`chain_frames` and the tool centre
-        point at configurations ``q`` ``(n, dof)``."""
+        point (the robot's ``tcp`` frame, else ``tool0`` and ``T_tool0_tcp``) at configurations
+        ``q`` ``(n, dof)``."""
         has_tcp = self.robot.model.existFrame("tcp")
         frames = (*self.chain_frames(), "tcp") if has_tcp else self.chain_frames()
         T = self.frame_poses(q, frames)

@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 from mixed_cell import PANDA_JOINTS
 
+from sdar_tamp.errors import SdarError
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.viewer import write_html, write_storyboard
+from sdar_tamp.viewer._geometry import ArmDrawing
 from sdar_tamp.viewer._joints import joint_figure
 from sdar_tamp.viewer._story import grips, joint_curves
 from sdar_tamp.viewer._timeline import Timeline
@@ -62,3 +64,18 @@ def test_page_and_storyboard(
     assert "panda joint7" in text
     board = write_storyboard(instance, plan, tmp_path / "mixed.png", cell)
     assert board.stat().st_size > 0
+
+
+def test_an_arm_of_some_of_the_robots_joints(timeline: Timeline) -> None:
+    """The arm's joints placed into the robot's configuration by name (here the UR5e's in
+    reverse order: the same poses as in order)."""
+    left = timeline.arms[0]
+    names = left.robot.joint_names
+    backwards = ArmDrawing.build("b", left.robot, left.T_world_base, left.T_tool0_tcp,
+                                 joints=tuple(reversed(names)))  # fmt: skip
+    assert backwards.q_index == (5, 4, 3, 2, 1, 0) and backwards.dof == 6
+    q = np.linspace(-0.5, 0.5, 6)[None]
+    np.testing.assert_allclose(backwards.tcp_poses(q[:, ::-1]), left.tcp_poses(q), atol=1e-12)
+    with pytest.raises(SdarError, match="no joint named 'finger_joint'"):
+        ArmDrawing.build("b", left.robot, left.T_world_base, left.T_tool0_tcp,
+                         joints=("finger_joint",))  # fmt: skip
