@@ -225,3 +225,17 @@ def test_the_plan_schema_takes_arms_of_any_joint_count(plan: PlanFile) -> None:
     assert [e.message for e in validator.iter_errors(document)] == []
     document["arms"][1]["home"] = []
     assert list(validator.iter_errors(document))
+
+
+def test_validate_command_locates_a_plan_of_other_arms(
+    plan: PlanFile, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from sdar_tamp.cli import main
+    from sdar_tamp.world.suites import shipped_suite_dir
+
+    path = save_plan(plan, tmp_path / "mixed.json")
+    code = main(["validate", str(shipped_suite_dir("paper") / "D5.yaml"), str(path)])
+    err = capsys.readouterr().err
+    line = _line_of(path, '"right_panda_joint1"')
+    assert code == 2
+    assert f"{path}:{line}:" in err and "the cell's arm 'right' has 6 joints" in err
