@@ -58,7 +58,8 @@ def bench_ik(
 def realistic_configurations(
     scene_kins: list[ArmKinematics], rng: np.random.Generator, n: int
 ) -> FloatArray:
-    """Dual-arm configurations ``(n, 12)``: both tools top-down above random table points."""
+    """Dual-arm configurations ``(n, layout.dof)``: both tools top-down above random table
+    points."""
     cols = []
     for kin in scene_kins:
         m = 4 * n

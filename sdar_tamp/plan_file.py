@@ -4,9 +4,10 @@ Layout (``version`` 1; every length in m, angle in rad, time in s)::
 
     {"format": "sdar-plan", "version": 1, "units": {"length": "m", "angle": "rad", "time": "s"},
      "instance": "M1",
-     "arms": [{"name", "joints" (6 URDF joint names), "T_world_base" (4x4, the URDF base_link),
-               "T_tool0_tcp" (4x4), "home" (6)}, ...two arms, scene order],
-     "trajectory": {"t": [n times from 0, spacing <= 0.02], "q": [n rows of 12: arm 1, arm 2]},
+     "arms": [{"name", "joints" (the arm's k URDF joint names), "T_world_base" (4x4, the URDF
+               base_link), "T_tool0_tcp" (4x4), "home" (k)}, ...two arms, scene order],
+     "trajectory": {"t": [n times from 0, spacing <= 0.02],
+                    "q": [n rows of k1 + k2 joints: arm 1's, then arm 2's]},
      "events": [{"t", "arm", "type": "grasp" | "release", "object", "T_tcp_object" (4x4)}],
                 # after its gripper event an arm stands still GRIPPER_DWELL (0.5 s)
      "final_poses": {"o1": [x, y, yaw]},
@@ -14,12 +15,14 @@ Layout (``version`` 1; every length in m, angle in rad, time in s)::
      "steps": [{"t_start", "t_end", "level", "objects", "kind"}]}   # optional
 
 :func:`~sdar_tamp.plan_reading.load_plan` checks the shape of everything and raises
-:class:`PlanFileError` naming the file and the key path (``plan.json: trajectory.q[3]: expected
-12 numbers, got 11``); :func:`~sdar_tamp.plan_writing.save_plan` writes a plan;
-:func:`~sdar_tamp.plan_building.build_plan_file` assembles one from motion segments and gripper
-events. This module holds the values: :class:`PlanFile` and its parts (the metrics are a
-:class:`~sdar_tamp.plan_metrics.PlanMetrics`). Values holding arrays compare by identity
-(their arrays are read-only copies); compare
+:class:`PlanFileError` naming the file, the line and column, and the key path
+(``plan.json:40:7: trajectory.q[3]: expected 12 numbers, got 11``). Each arm has as many joints
+as its ``joints`` list names (six for a UR5e, seven for a Panda); given a cell's arm layout the
+reader also checks each arm's joint count against it. :func:`~sdar_tamp.plan_writing.save_plan`
+writes a plan; :func:`~sdar_tamp.plan_building.build_plan_file` assembles one from motion
+segments and gripper events. This module holds the values: :class:`PlanFile` and its parts
+(the metrics are a :class:`~sdar_tamp.plan_metrics.PlanMetrics`). Values holding arrays compare
+by identity (their arrays are read-only copies); compare
 :func:`~sdar_tamp.plan_writing.plan_to_dict` outputs for equality.
 """
 
@@ -46,9 +49,9 @@ MAX_DEPTH = 64  #: deepest nesting of JSON lists and objects a plan file may hav
 #: the 2F-85 takes about half a second). :func:`~sdar_tamp.plan_building.build_plan_file` keeps
 #: both arms still.
 GRIPPER_DWELL = 0.5
-#: Arms of a version-1 plan file, and joints per arm (the in-memory plan goes by its layout).
+#: Arms of a version-1 plan file (each with its own joint count; the in-memory plan goes by
+#: its layout).
 FILE_ARMS = 2
-FILE_ARM_JOINTS = 6
 
 
 def plan_joint_names(arm: str, robot_joints: Sequence[str]) -> tuple[str, ...]:

@@ -1,8 +1,13 @@
 """Reading plan files: the JSON checked key by key into a :class:`~sdar_tamp.plan_file.PlanFile`.
 
-Every failure is a :class:`~sdar_tamp.plan_file.PlanFileError` naming the file and the key path
-(``plan.json: trajectory.q[3]: expected 12 numbers, got 11``); JSON nested deeper than
-:data:`~sdar_tamp.plan_file.MAX_DEPTH` levels is refused at its first bracket too deep.
+Every failure is a :class:`~sdar_tamp.plan_file.PlanFileError` naming the file, the line and
+column of the value at fault and its key path (``plan.json:40:7: trajectory.q[3]: expected 12
+numbers, got 11``); JSON nested deeper than :data:`~sdar_tamp.plan_file.MAX_DEPTH` levels is
+refused at its first bracket too deep. Each arm has as many joints as its ``joints`` names; its
+``home`` and its share of every ``trajectory.q`` row follow. Given the cell's
+:class:`~sdar_tamp.world.layout.ArmLayout`, each arm must have the joint count of the cell's arm
+in its place (``plan.json:31:17: arms[1].joints: the cell's arm 'right' has 7 joints, the plan's
+arm 'right' 6 (...)``); names and frames are the validator's scene rule.
 """
 
 from __future__ import annotations
@@ -18,7 +23,6 @@ import numpy as np
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.plan_file import (
     EVENT_TYPES,
-    FILE_ARM_JOINTS,
     FILE_ARMS,
     FORMAT,
     MAX_DEPTH,
@@ -99,8 +103,9 @@ def _show(v: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def load_plan(path: Path) -> PlanFile:
-    """Read and check a plan file (see the module docstring)."""
+def load_plan(path: Path, layout: ArmLayout | None = None) -> PlanFile:
+    """Read and check a plan file (see the module docstring); ``layout``: the cell's arms, whose
+    joint counts the plan's arms must have, in order."""
     path = Path(path)
     text = read_text(path, _file_error)
     try:
@@ -114,7 +119,13 @@ def load_plan(path: Path) -> PlanFile:
         raise PlanFileError(str(path), "", f"invalid JSON: {exc}") from None
     if _nesting_exceeds(data, MAX_DEPTH):
         raise _too_deep(text, str(path))
-    return plan_from_dict(data, str(path))
+    try:
+        return plan_from_dict(data, str(path), layout)
+    except PlanFileError as err:
+        spot = locate_key(text, err.key) if err.key else None
+        if spot is None:
+            raise
+        raise PlanFileError(f"{path}:{spot[0]}:{spot[1]}", err.key, err.detail) from None
 
 
 def _file_error(detail: str, file: str, location: SourceLocation | None) -> PlanFileError:
@@ -160,8 +171,9 @@ _TOP = ["format", "version", "units", "instance", "arms", "trajectory", "events"
 _TOP += ["final_poses", "metrics"]
 
 
-def plan_from_dict(data: Any, source: str = "<plan>") -> PlanFile:
-    """A :class:`PlanFile` from its JSON value; ``source`` names it in error messages."""
+def plan_from_dict(data: Any, source: str = "<plan>", layout: ArmLayout | None = None) -> PlanFile:
+    """A :class:`PlanFile` from its JSON value; ``source`` names it in error messages;
+    ``layout``: the cell's arms, whose joint counts the plan's arms must have, in order."""
     r = _Reader(source)
     top = r.obj(data, "", _TOP, ("steps",))
     if top["format"] != FORMAT:
@@ -175,9 +187,11 @@ def plan_from_dict(data: Any, source: str = "<plan>") -> PlanFile:
     for i, arm in enumerate(arms):
         if arm.name in (a.name for a in arms[:i]):
             raise r.fail(f"arms[{i}].name", f"expected a name different from {arm.name!r}")
-    layout = ArmLayout(tuple(a.name for a in arms), tuple(len(a.home) for a in arms))
-    t, q = _trajectory(r, top["trajectory"], layout.dof)
-    events = _events(r, top["events"], layout.names, float(t[-1]))
+    if layout is not None:
+        _match_cell(r, arms, layout)
+    own = ArmLayout(tuple(a.name for a in arms), tuple(len(a.home) for a in arms))
+    t, q = _trajectory(r, top["trajectory"], own.dof)
+    events = _events(r, top["events"], own.names, float(t[-1]))
     final: dict[str, tuple[float, float, float]] = {}
     for name, pose in r.mapping(top["final_poses"], "final_poses", "object poses").items():
         x, y, yaw = r.vec(pose, f"final_poses.{name}", 3)
@@ -195,7 +209,9 @@ def plan_from_dict(data: Any, source: str = "<plan>") -> PlanFile:
 
 def _arm(r: _Reader, v: Any, key: str) -> ArmInfo:
     a = r.obj(v, key, ["name", "joints", "T_world_base", "T_tool0_tcp", "home"])
-    joints = r.items(a["joints"], f"{key}.joints", FILE_ARM_JOINTS, "joint names")
+    joints = r.items(a["joints"], f"{key}.joints", what="joint names")
+    if not joints:
+        raise r.fail(f"{key}.joints", "expected the arm's joint names, got an empty list")
     return ArmInfo(
         r.text(a["name"], f"{key}.name"),
         tuple(r.text(j, f"{key}.joints[{i}]") for i, j in enumerate(joints)),
@@ -203,6 +219,20 @@ def _arm(r: _Reader, v: Any, key: str) -> ArmInfo:
         r.pose(a["T_tool0_tcp"], f"{key}.T_tool0_tcp"),
         r.vec(a["home"], f"{key}.home", len(joints)),
     )
+
+
+def _match_cell(r: _Reader, arms: tuple[ArmInfo, ...], layout: ArmLayout) -> None:
+    """Every arm of the plan has as many joints as the cell's arm in its place (the names and
+    the rest of the arms' frames are the validator's scene rule)."""
+    if len(arms) != len(layout):
+        raise r.fail("arms", f"the cell has {len(layout)} arms, the plan {len(arms)}")
+    for i, (info, name, dof) in enumerate(zip(arms, layout.names, layout.dofs, strict=True)):
+        if len(info.joints) != dof:
+            raise r.fail(
+                f"arms[{i}].joints",
+                f"the cell's arm {name!r} has {dof} joints, the plan's arm {info.name!r} "
+                f"{len(info.joints)} ({', '.join(info.joints)})",
+            )
 
 
 def _trajectory(r: _Reader, v: Any, dof: int) -> tuple[FloatArray, FloatArray]:
@@ -273,3 +303,59 @@ def _step(r: _Reader, v: Any, key: str) -> StepRecord:
         tuple(r.text(o, f"{key}.objects[{i}]") for i, o in enumerate(objects)),
         s["kind"],
     )
+
+
+_JSON_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"|[\[\]{}:,]|[^\s\[\]{}:,"]+')
+_KEY_PART = re.compile(r"\[(\d+)\]|\.?([^.\[\]]+)")
+
+
+def _key_parts(key: str) -> list[str | int] | None:
+    """``arms[1].joints`` as ``["arms", 1, "joints"]`` (None when ``key`` does not parse)."""
+    parts: list[str | int] = []
+    end = 0
+    for m in _KEY_PART.finditer(key):
+        if m.start() != end:
+            return None
+        parts.append(int(m.group(1)) if m.group(1) is not None else m.group(2))
+        end = m.end()
+    return parts if end == len(key) else None
+
+
+def locate_key(text: str, key: str) -> tuple[int, int] | None:
+    """Line and column (from 1) where the value at the key path ``key`` (as in
+    :class:`~sdar_tamp.plan_file.PlanFileError`) starts in the JSON ``text``; None when the
+    path is not there (a missing key) or names an object key holding ``.``, ``[`` or ``]``."""
+    target = _key_parts(key)
+    if target is None:
+        return None
+    frames: list[list[Any]] = []  # [is_object, key or index, awaiting a key]
+    for m in _JSON_TOKEN.finditer(text):
+        token = m.group()
+        top = frames[-1] if frames else None
+        if top is not None and top[0] and top[2]:
+            if token.startswith('"'):
+                top[1], top[2] = json.loads(token), False
+            elif token == "}":
+                frames.pop()
+            continue
+        if token == ":":
+            continue
+        if token == ",":
+            if top is not None:
+                if top[0]:
+                    top[2] = True
+                else:
+                    top[1] += 1
+            continue
+        if token in ("]", "}"):
+            frames.pop()
+            continue
+        if [f[1] for f in frames] == target:
+            start = m.start()
+            line = text.count("\n", 0, start) + 1
+            return line, start - (text.rfind("\n", 0, start) + 1) + 1
+        if token == "[":
+            frames.append([False, 0, False])
+        elif token == "{":
+            frames.append([True, None, True])
+    return None

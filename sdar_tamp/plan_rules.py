@@ -25,9 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from sdar_tamp.plan_file import EVENT_TYPES, GRIPPER_DWELL, MAX_DT, PlanFile, plan_joint_names
+from sdar_tamp.world.arm_access import arm_joint_names, arm_tcp_offset
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance
-from sdar_tamp.world.scene import JOINT_KEYS, Scene
+from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
 
 LIMIT_RTOL = 1e-6  #: relative tolerance of the velocity and acceleration limits
@@ -108,9 +109,10 @@ def check_format(plan: PlanFile) -> Violation | None:
     return None
 
 
-def check_scene(plan: PlanFile, scene: Scene, urdf_joints: tuple[str, ...]) -> Violation | None:
-    """Arm names and order, joint names (``urdf_joints``: the robot's joints, in order), base
-    poses, tool frames and home configurations equal the scene's."""
+def check_scene(plan: PlanFile, scene: Scene) -> Violation | None:
+    """Arm names and order, joint names (each arm's robot joints, in order, as
+    :func:`~sdar_tamp.world.arm_access.arm_joint_names` reads them), base poses, tool frames and
+    home configurations equal the scene's."""
     if plan.arm_names != scene.arm_names:
         return Violation(
             0.0,
@@ -118,16 +120,15 @@ def check_scene(plan: PlanFile, scene: Scene, urdf_joints: tuple[str, ...]) -> V
             f"arms {list(plan.arm_names)} differ from the "
             f"scene's {list(scene.arm_names)} (names and order)",
         )
-    tcp = translation(0.0, 0.0, scene.gripper.tcp_offset)
     for i, (info, spec) in enumerate(zip(plan.arms, scene.arms, strict=True)):
-        expected = plan_joint_names(spec.name, urdf_joints)
+        expected = plan_joint_names(spec.name, arm_joint_names(spec))
         if info.joints != expected:
             if len(info.joints) != len(expected):
                 return Violation(
                     0.0,
                     "scene",
-                    f"arms[{i}].joints: expected the {len(expected)} joints of the scene's "
-                    f"robot {list(expected)}, got {len(info.joints)} names",
+                    f"arms[{i}].joints: the scene's arm {spec.name!r} has {len(expected)} "
+                    f"joints {list(expected)}, the plan's {len(info.joints)}",
                 )
             k = next(
                 k for k, (a, b) in enumerate(zip(info.joints, expected, strict=True)) if a != b
@@ -138,6 +139,7 @@ def check_scene(plan: PlanFile, scene: Scene, urdf_joints: tuple[str, ...]) -> V
                 f"arms[{i}].joints[{k}]: expected {expected[k]!r}, got {info.joints[k]!r} (the "
                 f"joints of the scene's robot, in order: {list(expected)})",
             )
+        tcp = translation(0.0, 0.0, arm_tcp_offset(scene, spec))
         for label, T, ref in (
             ("T_world_base", info.T_world_base, spec.T_world_base),
             ("T_tool0_tcp", info.T_tool0_tcp, tcp),
@@ -187,9 +189,15 @@ def check_timeline(
     return min(found, key=lambda v: v.t) if found else None  # min keeps the first on ties
 
 
+def joint_label(name: str) -> str:
+    """A robot joint's name as messages show it (``shoulder_pan_joint`` -> ``shoulder_pan``)."""
+    return name[: -len("_joint")] if name.endswith("_joint") and name != "_joint" else name
+
+
 def _joint(scene: Scene, j: int) -> str:
+    """``arm joint`` of entry ``j`` of the scene's configuration vector."""
     arm, k = scene.layout.locate(j)
-    return f"{arm} {JOINT_KEYS[k]}"
+    return f"{arm} {joint_label(arm_joint_names(scene.arm(arm))[k])}"
 
 
 def _joint_limits(plan: PlanFile, scene: Scene) -> Violation | None:

@@ -94,15 +94,12 @@ class PlanValidator:
         self.scene, self.step, self.dwell = scene, max_tcp_step, dwell
         self.v_tol, self.a_tol = velocity_tolerance, acceleration_tolerance
         self.kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
-        self.robot_joints = self.kins[scene.arm_names[0]].robot.joint_names
         self.world = CollisionWorld(scene)
 
     def validate(self, instance: Instance, plan: PlanFile) -> ReplayReport:
         """Replay ``plan`` on ``instance``: ok, or the first violation in time."""
         first = (
-            check_format(plan)
-            or check_scene(plan, self.scene, self.robot_joints)
-            or check_instance(plan, instance)
+            check_format(plan) or check_scene(plan, self.scene) or check_instance(plan, instance)
         )
         if first is not None:
             return ReplayReport(False, first, 0)

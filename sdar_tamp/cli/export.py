@@ -24,7 +24,9 @@ def cmd_export(args: argparse.Namespace) -> int:
     gripper commands (joint-trajectory), a CSV table at 50 Hz (csv) or one URScript program per
     arm (urscript: servoj stream, gripper calls, the base-to-base transform in the header).
     Without -o the output goes next to the plan (PLAN.trajectory.json, PLAN.csv, folder
-    PLAN.urscript); existing files are refused unless --force."""
+    PLAN.urscript); existing files are refused unless --force. URScript is for UR arms only:
+    an arm that is not one is refused (by the robot description of --scene, else by its joint
+    names)."""
     from sdar_tamp.export.plan_files import export_plan_file
     from sdar_tamp.export.urscript import ServoSettings
 
@@ -36,8 +38,13 @@ def cmd_export(args: argparse.Namespace) -> int:
         raise ParameterError("--rate applies to --format csv only")
     servo = ServoSettings(**{k: v for k, v in servo_options.items() if v is not None})
     rate = CSV_RATE if args.rate is None else args.rate
+    scene = None
+    if args.scene is not None:
+        from sdar_tamp.world.scene import load_scene
+
+        scene = load_scene(args.scene)
     paths = export_plan_file(
-        args.plan, args.format, args.output, force=args.force, servo=servo, rate=rate
+        args.plan, args.format, args.output, force=args.force, servo=servo, rate=rate, scene=scene
     )
     for path in paths:
         print(f"wrote {path}")
@@ -61,6 +68,13 @@ def add_export_parser(sub: argparse._SubParsersAction[Any]) -> None:
         help="file (.json, .csv), or folder for urscript (default: next to the plan)",
     )
     export.add_argument("--force", action="store_true", help=FORCE_HELP)
+    export.add_argument(
+        "--scene",
+        type=Path,
+        default=None,
+        help="the plan's cell (scene YAML): its arms are checked against the plan's, and "
+        "urscript checks their robot descriptions (default: none)",
+    )
     export.add_argument(
         "--rate", type=FPS.parse, default=None, help=f"csv rows per second (default: {CSV_RATE:g})"
     )

@@ -18,8 +18,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from sdar_tamp.world.scene import load_scene
 
     instance = load_instance(args.instance)
-    plan = load_plan(args.plan)
     scene = load_scene(instance.scene_path(Path(args.instance)))
+    plan = load_plan(args.plan, scene.layout)
     report = validate_plan(instance, plan, scene)
     v = report.violation
     if args.json:

@@ -7,14 +7,17 @@ Document layout (``version`` 1; SI units)::
      "units": {"length": "m", "angle": "rad", "time": "s"}, "instance": "M1",
      "arms": [{"name": "left", "T_world_base": 4x4, "joint_trajectory": {
                  "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": "left_base_link"},
-                 "joint_names": [6 names],
-                 "points": [{"positions": [6], "velocities": [6], "accelerations": [6],
+                 "joint_names": [k names],
+                 "points": [{"positions": [k], "velocities": [k], "accelerations": [k],
                              "effort": [], "time_from_start": {"sec", "nanosec"}}, ...]}},
               ...],
      "gripper_commands": [{"time_from_start": {"sec", "nanosec"}, "t": 1.25,
                            "arm": "left", "command": "close", "object": "o3"}, ...]}
 
-Each message field has the name and shape of its ROS 2 counterpart (``builtin_interfaces/
+``k`` is the arm's joint count and ``joint_names`` are the plan's names of the arm's joints (the
+arm's name, ``_``, the joint's name in the arm's robot description), so a 6-DoF and a 7-DoF arm
+side by side get messages of their own sizes. Each message field has the name and shape of its
+ROS 2 counterpart (``builtin_interfaces/
 Duration`` is ``sec`` and ``nanosec``), so a node can fill a message from it key by key. The
 points are the plan's own samples; velocities and accelerations as in
 :mod:`sdar_tamp.export.timeline`. A zero ``stamp`` means "start when received".

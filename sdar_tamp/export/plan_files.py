@@ -17,6 +17,7 @@ from sdar_tamp.export.formats import CSV_RATE, FORMATS
 if TYPE_CHECKING:
     from sdar_tamp.export.urscript import ServoSettings
     from sdar_tamp.plan_file import PlanFile
+    from sdar_tamp.world.scene import Scene
 
 #: What ``-o`` names per format, and the default name next to the plan.
 _DEFAULT_SUFFIX = {"joint-trajectory": ".trajectory.json", "csv": ".csv", "urscript": ".urscript"}
@@ -38,9 +39,11 @@ def export_plan(
     *,
     servo: ServoSettings | None = None,
     rate: float = CSV_RATE,
+    scene: Scene | None = None,
 ) -> list[Path]:
     """Write ``plan`` as ``fmt`` (one of :data:`FORMATS`) to ``output`` (a file; a folder for
-    ``urscript``); returns the files written."""
+    ``urscript``); returns the files written. ``scene``: the plan's cell (``urscript`` checks
+    its robot descriptions: UR arms only)."""
     from sdar_tamp.export.joint_trajectory import write_joint_trajectory
     from sdar_tamp.export.table import write_csv
     from sdar_tamp.export.urscript import write_urscript
@@ -50,7 +53,7 @@ def export_plan(
         return [write_joint_trajectory(plan, output)]
     if fmt == "csv":
         return [write_csv(plan, output, rate)]
-    return write_urscript(plan, output, servo)
+    return write_urscript(plan, output, servo, scene)
 
 
 def export_plan_file(
@@ -61,14 +64,16 @@ def export_plan_file(
     force: bool = False,
     servo: ServoSettings | None = None,
     rate: float = CSV_RATE,
+    scene: Scene | None = None,
 ) -> list[Path]:
-    """Read ``plan_path``, check where the output goes (existing files are refused unless
-    ``force``) and export; returns the files written."""
+    """Read ``plan_path`` (its arms checked against ``scene``'s when given), check where the
+    output goes (existing files are refused unless ``force``) and export; returns the files
+    written."""
     from sdar_tamp.export.urscript import script_name
     from sdar_tamp.plan_reading import load_plan
 
     _check_format(fmt)
-    plan = load_plan(plan_path)
+    plan = load_plan(plan_path, scene.layout if scene is not None else None)
     target = Path(output) if output is not None else default_output(plan_path, fmt)
     if fmt == "urscript":
         output_folder(target)
@@ -82,7 +87,7 @@ def export_plan_file(
     else:
         suffix = ".json" if fmt == "joint-trajectory" else ".csv"
         output_file(target, suffixes=(suffix,), force=force)
-    return export_plan(plan, fmt, target, servo=servo, rate=rate)
+    return export_plan(plan, fmt, target, servo=servo, rate=rate, scene=scene)
 
 
 def _check_format(fmt: str) -> None:

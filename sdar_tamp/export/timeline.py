@@ -53,7 +53,8 @@ def sample_derivatives(t: FloatArray, q: FloatArray) -> tuple[FloatArray, FloatA
 
 
 def positions_at(plan: PlanFile, times: FloatArray) -> FloatArray:
-    """Configurations ``(len(times), 12)`` [rad] at ``times`` [s], linear between samples;
+    """Configurations ``(len(times), dof)`` [rad] (every arm's joints, the plan's layout) at
+    ``times`` [s], linear between samples;
     before 0 and after the end the robot stands at the first and last sample."""
     times = np.asarray(times, dtype=np.float64)
     return np.stack([np.interp(times, plan.t, plan.q[:, j]) for j in range(plan.q.shape[1])], 1)
@@ -70,18 +71,18 @@ def controller_grid(duration: float, period: float) -> FloatArray:
 
 @dataclass(frozen=True)
 class GripperState:
-    """Per sample time and arm (plan order): ``closed`` ``(n, 2)`` and the object ``held``
+    """Per sample time and arm (plan order): ``closed`` ``(n, arms)`` and the object ``held``
     (``""`` when open). A gripper is open at the start; an event at ``t_e`` counts from
     ``t_e`` on (within :data:`TIME_TOL`)."""
 
     closed: BoolArray
-    held: tuple[tuple[str, str], ...]
+    held: tuple[tuple[str, ...], ...]
 
 
 def gripper_states(plan: PlanFile, times: FloatArray) -> GripperState:
-    """The commanded gripper state of both arms at ``times`` [s]."""
+    """The commanded gripper state of every arm at ``times`` [s]."""
     names = plan.arm_names
-    held: list[tuple[str, str]] = []
+    held: list[tuple[str, ...]] = []
     events = plan.events  # sorted by time (load_plan checks it)
     k, now = 0, {name: "" for name in names}
     for time in np.asarray(times, dtype=np.float64):
@@ -89,8 +90,9 @@ def gripper_states(plan: PlanFile, times: FloatArray) -> GripperState:
             e = events[k]
             now[e.arm] = e.object if e.type == "grasp" else ""
             k += 1
-        held.append((now[names[0]], now[names[1]]))
-    closed = np.array([[bool(a), bool(b)] for a, b in held], dtype=bool).reshape(-1, 2)
+        held.append(tuple(now[name] for name in names))
+    closed = np.array([[bool(h) for h in row] for row in held], dtype=bool)
+    closed = closed.reshape(-1, len(names))
     return GripperState(closed, tuple(held))
 
 

@@ -14,6 +14,12 @@ non-blocking commands (for a Robotiq URCap, for example, ``rq_close()`` and ``rq
 
 The header comment states the units, the parameters and the base-to-base transform; the
 ``Base`` frame of the UR controller is the URDF ``base_link`` rotated by pi about z.
+
+URScript runs on Universal Robots controllers only: every arm must be a UR-family arm. Given
+the cell (``scene``), each arm's robot description is checked (its chain to ``tool0`` has the
+UR geometry, :func:`~sdar_tamp.world.ur_identify.ur_parameters`); without it, each arm's
+joints must be the six UR joints. Any other arm (a Panda, say) is refused with an error naming
+the arm and, given the cell, its robot file.
 """
 
 from __future__ import annotations
@@ -33,7 +39,9 @@ from sdar_tamp.export.timeline import (
     controller_grid,
     positions_at,
 )
-from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_file import PlanFile, plan_joint_names
+from sdar_tamp.world.arm_access import arm_robot_file, ur_joint_names
+from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
 
@@ -70,9 +78,13 @@ def script_name(arm: str) -> str:
     return f"{arm}.script"
 
 
-def urscript_programs(plan: PlanFile, settings: ServoSettings | None = None) -> dict[str, str]:
-    """Arm name -> URScript program text (see the module docstring)."""
+def urscript_programs(
+    plan: PlanFile, settings: ServoSettings | None = None, scene: Scene | None = None
+) -> dict[str, str]:
+    """Arm name -> URScript program text (see the module docstring); ``scene``: the cell, whose
+    robot descriptions tell whether each arm is a UR arm (default: the plan's joint names)."""
     settings = settings or ServoSettings()
+    check_ur_arms(plan, scene)
     _check_names(plan)
     grid = controller_grid(plan.duration, settings.period)
     q = positions_at(plan, grid)
@@ -104,17 +116,53 @@ def urscript_programs(plan: PlanFile, settings: ServoSettings | None = None) -> 
 
 
 def write_urscript(
-    plan: PlanFile, folder: Path, settings: ServoSettings | None = None
+    plan: PlanFile,
+    folder: Path,
+    settings: ServoSettings | None = None,
+    scene: Scene | None = None,
 ) -> list[Path]:
-    """Write one ``<arm>.script`` per arm into ``folder`` (created if missing)."""
+    """Write one ``<arm>.script`` per arm into ``folder`` (created if missing); nothing is
+    written when an arm is not a UR arm (:func:`check_ur_arms`)."""
+    programs = urscript_programs(plan, settings, scene)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
-    for arm, text in urscript_programs(plan, settings).items():
+    for arm, text in programs.items():
         path = folder / script_name(arm)
         path.write_text(text, encoding="utf-8")
         paths.append(path)
     return paths
+
+
+def check_ur_arms(plan: PlanFile, scene: Scene | None = None) -> None:
+    """Raise :class:`ParameterError` naming the first arm of ``plan`` that is not a UR arm: by
+    its robot description in ``scene`` when the scene has an arm of that name, else by its
+    joint names (the six UR joints, ``<arm>_shoulder_pan_joint`` to ``<arm>_wrist_3_joint``)."""
+    from sdar_tamp.world._pin import PinRobot  # pinocchio: imported on use
+    from sdar_tamp.world.ur_identify import ur_parameters
+
+    checked: dict[Path, bool] = {}
+    for info in plan.arms:
+        if scene is not None and info.name in scene.arm_names:
+            path = arm_robot_file(scene, scene.arm(info.name))
+            if path not in checked:
+                checked[path] = ur_parameters(PinRobot.load(path, scene.package_dirs)) is not None
+            if not checked[path]:
+                raise ParameterError(
+                    f"urscript: arm {info.name!r} is not a Universal Robots arm: its robot "
+                    f"description {path} has no UR-family chain to tool0 (six revolute joints "
+                    "with the UR geometry); URScript runs on UR controllers only, export "
+                    "joint-trajectory or csv for this arm"
+                )
+            continue
+        ur = plan_joint_names(info.name, ur_joint_names())
+        if info.joints != ur:
+            raise ParameterError(
+                f"urscript: arm {info.name!r} is not a Universal Robots arm: its "
+                f"{len(info.joints)} joints are {list(info.joints)}, a UR arm's {list(ur)}; "
+                "URScript runs on UR controllers only (pass the cell with --scene to check its "
+                "robot description), export joint-trajectory or csv for this arm"
+            )
 
 
 #: The controller's ``Base`` frame in the URDF ``base_link`` frame.

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import FILE_ARM_JOINTS, FILE_ARMS, PlanEvent, PlanFile, StepRecord
+from sdar_tamp.plan_file import PlanEvent, PlanFile, StepRecord
 from sdar_tamp.plan_rules import STILL_TOL
 from sdar_tamp.schedule.retiming import ArmRetimer, on_ticks
 from sdar_tamp.world.kinematics import ArmKinematics
@@ -27,19 +27,20 @@ from sdar_tamp.world.transforms import FloatArray
 STEP_TOL = 1e-9  #: [s] two sampling steps closer than this belong to one uniform grid
 
 
-def arm_columns(arm: int) -> slice:
-    """The columns of arm ``arm`` (scene order) in a plan file's ``q`` (the file format holds
-    ``FILE_ARMS`` arms of ``FILE_ARM_JOINTS`` joints each)."""
-    if not 0 <= arm < FILE_ARMS:
-        raise ParameterError(f"arm: expected an index in [0, {FILE_ARMS}), got {arm!r}")
-    return slice(FILE_ARM_JOINTS * arm, FILE_ARM_JOINTS * (arm + 1))
+def arm_columns(plan: PlanFile, arm: int) -> slice:
+    """The columns of arm ``arm`` (plan order) in the plan's ``q`` (its layout: every arm with
+    its own number of joints)."""
+    if isinstance(arm, bool) or not isinstance(arm, int) or not 0 <= arm < len(plan.arms):
+        raise ParameterError(f"arm: expected an index in [0, {len(plan.arms)}), got {arm!r}")
+    return plan.layout.slice(arm)
 
 
 @dataclass(frozen=True, eq=False)
 class Block:
     """One arm's rest-to-rest motion, then optionally its gripper event.
 
-    ``q`` ``(n + 1, 6)`` [rad]: the motion sampled every tick (one row: no motion);
+    ``q`` ``(n + 1, k)`` [rad] (``k``: the arm's joints): the motion sampled every tick (one
+    row: no motion);
     ``q_sync``: the same motion at its synchronous pace (:func:`on_ticks`); ``event``: the
     event at its end (its ``t`` is the synchronous plan's); ``sync_start`` and ``sync_end``
     [s]: when the motion ran in the synchronous plan, from its sample ``sync_index``;
@@ -96,9 +97,13 @@ def arm_blocks(
     that is shorter."""
     spec = scene.arms[arm]
     v, a = np.array(spec.velocity_limit), np.array(spec.acceleration_limit)
-    if retimer is None:
+    if retimer is None and retimed:
         retimer = ArmRetimer(ArmKinematics.from_scene(scene, spec.name), v, a, tick)
-    t, q = plan.t, plan.q[:, arm_columns(arm)]
+    t, q = plan.t, plan.q[:, arm_columns(plan, arm)]
+    if q.shape[1] != len(v):
+        raise ParameterError(
+            f"arm {spec.name!r}: the plan holds {q.shape[1]} joints, the scene's arm {len(v)}"
+        )
     moving = np.any(np.abs(np.diff(q, axis=0)) > STILL_TOL, axis=1)
     cuts: list[tuple[int, int]] = []
     for i, j in _runs(moving):
@@ -119,7 +124,7 @@ def arm_blocks(
     for k, (i, j) in enumerate(cuts):
         sync = on_ticks(t[i : j + 1], q[i : j + 1], tick, v, a)
         samples = sync
-        if retimed:
+        if retimer is not None and retimed:
             slow_start = bool(after.get(k - 1)) or (k - 1) in attached
             slow_end = k in attached
             samples = retimer.retime(t[i : j + 1], q[i : j + 1], slow_start, slow_end)

@@ -23,13 +23,25 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.schedule.spline import retime
-from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.transforms import FloatArray
+
+
+class ToolKinematics(Protocol):
+    """What re-timing reads of an arm's kinematics (an
+    :class:`~sdar_tamp.world.kinematics.ArmKinematics` is one): the flange poses
+    ``(m, 4, 4)`` at configurations ``(m, k)`` and the tool centre point in the flange frame."""
+
+    def fk_batch(self, q: FloatArray) -> FloatArray: ...
+
+    @property
+    def T_tool0_tcp(self) -> FloatArray: ...
+
 
 #: ``(path (m, k) [rad], v_max (k,) [rad/s], a_max (k,) [rad/s^2], path_speed (m,) [rad/s] or
 #: None, dt [s]) -> (t (n + 1,), q (n + 1, k))``: a rest-to-rest motion along the path, every
@@ -43,14 +55,14 @@ PathTimer = Callable[
 def on_ticks(
     t: FloatArray, q: FloatArray, tick: float, v_max: FloatArray, a_max: FloatArray
 ) -> FloatArray:
-    """The rest-to-rest motion ``q`` ``(m, 6)`` at ``t`` ``(m,)`` on a grid of ``tick`` [s].
+    """The rest-to-rest motion ``q`` ``(m, k)`` at ``t`` ``(m,)`` on a grid of ``tick`` [s].
 
     When no sampling step exceeds ``tick``, the same samples one tick apart: every step gets
     ``c = tick / h >= 1`` times longer, velocities shrink by ``1 / c`` and accelerations
     (second divided differences, with the arm at rest one tick before and after) by at least
     as much, so the motion meets every limit the original met. Otherwise the smooth motion
     through the samples at its own pace or slower, within ``v_max`` [rad/s] and ``a_max``
-    [rad/s^2] ``(6,)`` (:func:`~sdar_tamp.schedule.spline.retime`)."""
+    [rad/s^2] ``(k,)`` (:func:`~sdar_tamp.schedule.spline.retime`)."""
     if np.all(np.diff(t) <= tick + 1e-12):
         return np.array(q)
     return retime(t, q, v_max, a_max, tick, max_rate=1.0)
@@ -76,12 +88,12 @@ class ArmRetimer:
     """Re-times one arm's rest-to-rest motions (see the module docstring).
 
     ``kinematics``: the arm's (for the tool centre point near gripper events); ``v_max``
-    [rad/s] and ``a_max`` [rad/s^2] ``(6,)``: its limits; ``tick`` [s]: the grid; ``timer``:
+    [rad/s] and ``a_max`` [rad/s^2] ``(k,)``: its limits; ``tick`` [s]: the grid; ``timer``:
     the path timer (None: uniform re-timing only); ``straight`` [m] and ``grasp_speed``
     [m/s]: the slow tool travel at a gripper event; ``spacing`` [rad]: the least distance of
     the path's waypoints."""
 
-    kinematics: ArmKinematics
+    kinematics: ToolKinematics
     v_max: FloatArray
     a_max: FloatArray
     tick: float
@@ -97,8 +109,8 @@ class ArmRetimer:
                 raise ParameterError(f"{name}: expected a finite number > 0, got {value!r}")
 
     def retime(self, t: FloatArray, q: FloatArray, slow_start: bool, slow_end: bool) -> FloatArray:
-        """The motion ``q`` ``(m, 6)`` at ``t`` ``(m,)`` as samples one tick apart ``(n + 1,
-        6)``, as fast as the arm alone may go; ``slow_start`` / ``slow_end``: the motion leaves
+        """The motion ``q`` ``(m, k)`` at ``t`` ``(m,)`` as samples one tick apart ``(n + 1,
+        k)``, as fast as the arm alone may go; ``slow_start`` / ``slow_end``: the motion leaves
         / reaches a gripper event (the tool moves slowly there)."""
         best = on_ticks(t, q, self.tick, self.v_max, self.a_max)
         if self.timer is None:
@@ -116,7 +128,7 @@ class ArmRetimer:
         return best
 
     def tool_caps(self, path: FloatArray, slow_start: bool, slow_end: bool) -> FloatArray | None:
-        """Per waypoint of ``path`` ``(m, 6)``: the joint-space path speed [rad/s] at which the
+        """Per waypoint of ``path`` ``(m, k)``: the joint-space path speed [rad/s] at which the
         tool centre point moves at most ``grasp_speed`` on the segments within ``straight`` of
         a slow end (``inf`` elsewhere); None when neither end is slow."""
         if not (slow_start or slow_end):

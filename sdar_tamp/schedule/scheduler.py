@@ -112,7 +112,8 @@ class Schedule:
 
 @dataclass(frozen=True, eq=False)
 class _Entry:
-    """A block to place, as samples ``q`` ``(n + 1, 6)``, ``offset`` ticks after the start
+    """A block to place, as samples ``q`` ``(n + 1, k)`` (the arm's ``k`` joints), ``offset``
+    ticks after the start
     of its group."""
 
     arm: int
@@ -141,7 +142,7 @@ def schedule_async(
     options = options or ScheduleOptions()
     blocks = [
         arm_blocks(plan, scene, i, options.tick, options.retime, retimer(scene, i, options))
-        for i in range(2)
+        for i in range(len(scene.arms))
     ]
     sweep = WorldSweep(instance, scene, options.max_tcp_step)
     reasons = []
@@ -210,7 +211,9 @@ class _Placement:
         self.dwell = math.ceil(options.dwell / options.tick - 1e-9)
         self.max_wait = math.ceil(options.max_wait / options.tick)
         self.max_checks = options.max_checks
-        self.traj: list[list[FloatArray]] = [[plan.q[0, arm_columns(i)]] for i in range(2)]
+        self.arms = range(len(plan.arms))
+        self.columns = [arm_columns(plan, i) for i in self.arms]
+        self.traj: list[list[FloatArray]] = [[plan.q[0, self.columns[i]]] for i in self.arms]
         self.events: list[TimedEvent] = []
         self.event_tick: dict[int, int] = {}  # id(sync event) -> tick
         self.steps: list[StepRecord] = []
@@ -302,7 +305,7 @@ class _Placement:
         return s - entry.offset
 
     def rows(self, arm: int, k0: int, k1: int) -> FloatArray:
-        """Arm ``arm``'s configurations ``(k1 - k0 + 1, 6)`` at ticks ``k0 .. k1`` (standing
+        """Arm ``arm``'s configurations ``(k1 - k0 + 1, k)`` at ticks ``k0 .. k1`` (standing
         at its last one after its horizon)."""
         traj = self.traj[arm]
         idx = np.minimum(np.arange(k0, k1 + 1), len(traj) - 1)
@@ -327,12 +330,12 @@ class _Placement:
         conflict: Conflict | None = None
         for s in range(start, stop + 1):
             ends = [s + e.offset + self.length(e) for e in entries]
-            k1 = max(*ends, *(self.horizon(a) for a in range(2)))
-            q = np.concatenate([self.rows(0, k0, k1), self.rows(1, k0, k1)], axis=1)
+            k1 = max(*ends, *(self.horizon(a) for a in self.arms))
+            q = np.concatenate([self.rows(a, k0, k1) for a in self.arms], axis=1)
             new: list[TimedEvent] = []
             for e in sorted(entries, key=lambda e: (e.arm, e.offset)):
                 begin = s + e.offset
-                cols = arm_columns(e.arm)
+                cols = self.columns[e.arm]
                 q[begin - k0 : begin - k0 + len(e.q), cols] = e.q
                 q[begin - k0 + len(e.q) :, cols] = e.q[-1]
                 if e.block.event is not None:
@@ -343,11 +346,11 @@ class _Placement:
             if conflict is None:
                 placed = zip(entries, ends, _events_of(entries, new), strict=True)
                 for e, end, timed in sorted(placed, key=lambda x: (x[0].arm, x[0].offset)):
-                    self.commit(e, s + e.offset, q[: end - k0 + 1, arm_columns(e.arm)], k0, timed)
+                    self.commit(e, s + e.offset, q[: end - k0 + 1, self.columns[e.arm]], k0, timed)
                 return
             if conflict.tick < s:  # while an arm waits for its start: later is no better
                 break
-            if all(s > self.horizon(a) for a in range(2) if a not in arms):
+            if all(s > self.horizon(a) for a in self.arms if a not in arms):
                 break  # the other arm stands still from now on: nothing changes
         block = entries[0].block
         detail = (
@@ -373,8 +376,8 @@ class _Placement:
             self.steps.append(StepRecord(t0, t1, st.level, st.objects, st.kind))
 
     def assemble(self) -> PlanFile:
-        n = max(self.horizon(0), self.horizon(1))
-        q = np.concatenate([self.rows(0, 0, n), self.rows(1, 0, n)], axis=1)
+        n = max(self.horizon(a) for a in self.arms)
+        q = np.concatenate([self.rows(a, 0, n) for a in self.arms], axis=1)
         t = np.arange(n + 1, dtype=np.float64) * np.float64(self.tick)
         events = tuple(
             PlanEvent(float(t[e.tick]), e.event.arm, e.event.type, e.event.object,

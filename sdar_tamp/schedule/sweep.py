@@ -40,7 +40,8 @@ SWEEP_INTERVALS = 50_000
 
 @dataclass(frozen=True, eq=False)
 class TimedEvent:
-    """A gripper event at tick ``tick``, the arm at ``q_arm`` ``(6,)`` [rad]."""
+    """A gripper event at tick ``tick``, the arm at ``q_arm`` ``(k,)`` [rad] (its
+    ``k`` joints)."""
 
     tick: int
     event: PlanEvent

@@ -6,6 +6,7 @@ frame); the link frames come from pinocchio through :class:`sdar_tamp.world._pin
 
 from __future__ import annotations
 
+import dataclasses
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,25 +15,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sdar_tamp.errors import SdarError
-from sdar_tamp.world._pin import PinRobot
+from sdar_tamp.world._pin import PinRobot, chain_to
 from sdar_tamp.world.transforms import FloatArray
 
 IntArray = NDArray[np.int64]
 
-#: Frames joined by the top-down stick figure of an arm, base to tool centre point.
-CHAIN_FRAMES = (
-    "base_link",
-    "shoulder_link",
-    "upper_arm_link",
-    "forearm_link",
-    "wrist_1_link",
-    "wrist_2_link",
-    "wrist_3_link",
-    "tool0",
-    "tcp",
-)
-#: The two finger frames (drawn as the gripper's jaw line).
+#: The two finger frames (drawn as the gripper's jaw line, when the robot has them).
 FINGER_FRAMES = ("gripper_left_finger", "gripper_right_finger")
+#: The robot description's root frame (pinocchio's name for it).
+ROOT_FRAME = "universe"
 
 
 @dataclass(frozen=True)
@@ -147,6 +138,9 @@ class ArmDrawing:
     faces: IntArray = field(repr=False)
     face_shape: IntArray = field(repr=False)
     segments: int = 10
+    #: Where the arm's joints go in the robot's configuration (None: the arm is the whole
+    #: robot); the robot's other joints (a hand's fingers, say) stay at 0.
+    q_index: tuple[int, ...] | None = None
 
     @staticmethod
     def build(
@@ -156,9 +150,12 @@ class ArmDrawing:
         T_tool0_tcp: FloatArray,
         segments: int = 10,
         shapes: tuple[Shape, ...] | None = None,
+        joints: tuple[str, ...] | None = None,
     ) -> ArmDrawing:
         """The arm ``name`` of ``robot``, placed at ``T_world_base``; cylinders get ``segments``
-        sides. ``shapes``: a subset of the robot's collision shapes (default: all of them)."""
+        sides. ``shapes``: a subset of the robot's collision shapes (default: all of them);
+        ``joints``: the robot's joints the arm's configuration holds, in order (default: all
+        of them)."""
         shapes = collision_shapes(robot.urdf_path) if shapes is None else shapes
         links = tuple(dict.fromkeys(s.link for s in shapes))
         verts, vlink, faces, fshape = [], [], [], []
@@ -177,26 +174,68 @@ class ArmDrawing:
             np.asarray(T_tool0_tcp, dtype=np.float64).reshape(4, 4),
             shapes,
             links,
-            np.vstack(verts),
-            np.concatenate(vlink),
-            np.vstack(faces),
-            np.concatenate(fshape),
+            np.vstack(verts) if verts else np.zeros((0, 3)),
+            np.concatenate(vlink) if vlink else np.zeros(0, dtype=np.int64),
+            np.vstack(faces) if faces else np.zeros((0, 3), dtype=np.int64),
+            np.concatenate(fshape) if fshape else np.zeros(0, dtype=np.int64),
             segments,
+            _q_index(robot, joints),
         )
 
     def select(self, links: tuple[str, ...], keep: bool = True) -> ArmDrawing:
         """The same arm drawing only the shapes of ``links`` (``keep=False``: all others)."""
         shapes = tuple(s for s in self.shapes if (s.link in links) == keep)
-        return ArmDrawing.build(
-            self.name, self.robot, self.T_world_base, self.T_tool0_tcp, self.segments, shapes
+        return dataclasses.replace(
+            ArmDrawing.build(
+                self.name, self.robot, self.T_world_base, self.T_tool0_tcp, self.segments, shapes
+            ),
+            q_index=self.q_index,
         )
 
+    def static_links(self) -> tuple[str, ...]:
+        """The drawn links no joint moves (fixed to the robot's root: ``base_link``)."""
+        model = self.robot.model
+        return tuple(
+            link
+            for link in self.links
+            if int(model.frames[self.robot.frame_id(link)].parentJoint) == 0
+        )
+
+    @property
+    def dof(self) -> int:
+        """Joints of the arm's configuration."""
+        return len(self.q_index) if self.q_index is not None else self.robot.nq
+
+    def chain_frames(self) -> tuple[str, ...]:
+        """The frames the top-down stick figure joins, tool centre point aside: the robot's
+        root, every joint of the chain to ``tool0`` (at its child link's origin), ``tool0``."""
+        joints = tuple(j.name for j in chain_to(self.robot, "tool0").joints)
+        return (ROOT_FRAME, *joints, "tool0")
+
+    def chain_points(self, q: FloatArray) -> FloatArray:
+        """World positions ``(n, k + 3, 3)`` [m] of :meth:`chain_frames` and the tool centre
+        point (the robot's ``tcp`` frame, else ``tool0`` and ``T_tool0_tcp``) at configurations
+        ``q`` ``(n, dof)``."""
+        has_tcp = self.robot.model.existFrame("tcp")
+        frames = (*self.chain_frames(), "tcp") if has_tcp else self.chain_frames()
+        T = self.frame_poses(q, frames)
+        if not has_tcp:
+            T = np.concatenate([T, (T[:, -1] @ self.T_tool0_tcp)[:, None]], axis=1)
+        out: FloatArray = T[..., :3, 3]
+        return out
+
     def frame_poses(self, q: FloatArray, frames: tuple[str, ...]) -> FloatArray:
-        """``T_world_frame`` ``(n, k, 4, 4)`` of ``frames`` at configurations ``q`` ``(n, 6)``."""
+        """``T_world_frame`` ``(n, k, 4, 4)`` of ``frames`` at configurations ``q``
+        ``(n, dof)``."""
         ids = tuple(self.robot.frame_id(f) for f in frames)
-        qs = np.asarray(q, dtype=np.float64).reshape(-1, 6)
+        qs = np.asarray(q, dtype=np.float64).reshape(-1, self.dof)
+        full = np.zeros((len(qs), self.robot.nq))
+        if self.q_index is None:
+            full[:] = qs
+        else:
+            full[:, list(self.q_index)] = qs
         out = np.empty((len(qs), len(ids), 4, 4))
-        for i, qi in enumerate(qs):
+        for i, qi in enumerate(full):
             out[i] = self.robot.frame_poses(np.ascontiguousarray(qi), ids)
         posed: FloatArray = self.T_world_base @ out
         return posed
@@ -207,7 +246,18 @@ class ArmDrawing:
         return out
 
     def mesh_vertices(self, q: FloatArray) -> FloatArray:
-        """World vertices ``(n, m, 3)`` [m] of the merged mesh at configurations ``(n, 6)``."""
+        """World vertices ``(n, m, 3)`` [m] of the merged mesh at configurations ``(n, dof)``."""
         T = self.frame_poses(q, self.links)[:, self.vertex_link]  # (n, m, 4, 4)
         out: FloatArray = np.einsum("nmij,mj->nmi", T[..., :3, :3], self.vertices)
         return out + T[..., :3, 3]
+
+
+def _q_index(robot: PinRobot, joints: tuple[str, ...] | None) -> tuple[int, ...] | None:
+    """Configuration indices of ``joints`` in ``robot`` (None: every joint, in order)."""
+    if joints is None or tuple(joints) == robot.joint_names:
+        return None
+    model = robot.model
+    missing = [j for j in joints if not model.existJointName(j)]
+    if missing:
+        raise SdarError(f"{robot.urdf_path.name}: no joint named {missing[0]!r}")
+    return tuple(int(model.joints[model.getJointId(j)].idx_q) for j in joints)

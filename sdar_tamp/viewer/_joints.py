@@ -1,4 +1,4 @@
-"""The joint-space panel of the 3-D page: per arm, q and q-dot of the six joints against the
+"""The joint-space panel of the 3-D page: per arm, q and q-dot of its joints against the
 scene's limits, on the plan's time axis, with the steps shaded and a cursor at the current time.
 
 Positions are drawn as a fraction of each joint's range (0 = lower, 1 = upper limit) and
@@ -10,12 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from sdar_tamp.plan_rules import joint_label
 from sdar_tamp.viewer._plotly import JSON, typed_array
 from sdar_tamp.viewer._story import JointCurves
-from sdar_tamp.world.scene import JOINT_KEYS
 
-#: Joint colours (shoulder pan to wrist 3).
-JOINT_COLOURS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#a6761d")
+#: Joint colours, first joint to last (used in turn past the eighth).
+JOINT_COLOURS = (
+    "#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#a6761d", "#e6ab02", "#666666"
+)  # fmt: skip
 #: Shape indices in the panel's layout: the time cursor, then the violation line (if any).
 CURSOR_SHAPE = 0
 _LIMIT = "#c0392b"
@@ -27,9 +29,10 @@ def joint_figure(
     steps: Sequence[tuple[float, float]],
     violation_t: float | None,
 ) -> JSON:
-    """The panel as a plotly figure: four stacked plots (q then q-dot, first arm then second);
-    ``x`` holds the times of every curve (a typed-array spec), which the curves leave out."""
-    rows = [(a, kind) for a in range(2) for kind in ("q", "qd")]
+    """The panel as a plotly figure: two stacked plots per arm (q then q-dot, arm after arm),
+    one curve per joint of the arm, named after it; ``x`` holds the times of every curve (a
+    typed-array spec), which the curves leave out."""
+    rows = [(a, kind) for a in range(len(curves.position)) for kind in ("q", "qd")]
     n = len(rows)
     gap = 0.035
     height = (1.0 - gap * (n - 1)) / n
@@ -55,25 +58,28 @@ def joint_figure(
     shapes: list[JSON] = [_vline(t0, "#222222", "solid", 1.5)]  # the cursor, CURSOR_SHAPE
     if violation_t is not None:
         shapes.append(_vline(violation_t, _LIMIT, "solid", 2))
+    shown: set[str] = set()  # joints already in the legend
     for k, (a, kind) in enumerate(rows):
         suffix = "" if k == 0 else str(k + 1)
         top = 1.0 - k * (height + gap)
         values = curves.position[a] if kind == "q" else curves.velocity[a]
-        for j, joint in enumerate(JOINT_KEYS):
+        for j in range(values.shape[1]):
+            joint = _label(curves, a, j)
             data.append(
                 {
                     "type": "scatter",
                     "mode": "lines",
                     "name": joint.replace("_", " "),
                     "legendgroup": joint,
-                    "showlegend": k == 0,
+                    "showlegend": joint not in shown,
                     "y": typed_array(values[:, j]),
                     "xaxis": f"x{suffix}",
                     "yaxis": f"y{suffix}",
-                    "line": {"color": JOINT_COLOURS[j], "width": 1.4},
+                    "line": {"color": JOINT_COLOURS[j % len(JOINT_COLOURS)], "width": 1.4},
                     "hovertemplate": "%{y:.2f}<extra>" + joint + "</extra>",
                 }
             )
+            shown.add(joint)
         label = f"{arm_names[a]} q" if kind == "q" else f"{arm_names[a]} q̇"
         layout[f"yaxis{suffix}"] = {
             "domain": [top - height, top],
@@ -126,6 +132,14 @@ def joint_figure(
     layout["shapes"] = shapes
     # the times are sent once (``x``); the page gives them to every curve
     return {"data": data, "layout": layout, "x": t}
+
+
+def _label(curves: JointCurves, arm: int, j: int) -> str:
+    """Joint ``j`` of arm ``arm`` as the legend shows it (``shoulder_pan``; ``joint 3`` when
+    the curves name no joints)."""
+    if arm < len(curves.joints) and j < len(curves.joints[arm]):
+        return joint_label(curves.joints[arm][j])
+    return f"joint {j + 1}"
 
 
 def _vline(t: float, colour: str, dash: str, width: float) -> JSON:

@@ -15,6 +15,7 @@ import numpy as np
 from sdar_tamp.plan_file import GRIPPER_DWELL
 from sdar_tamp.viewer._geometry import FINGER_FRAMES, ArmDrawing
 from sdar_tamp.viewer._timeline import Timeline
+from sdar_tamp.world.arm_access import arm_joint_names
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
@@ -95,14 +96,15 @@ class Grip:
     width: FloatArray = field(repr=False)
 
 
-def grips(timeline: Timeline, times: FloatArray) -> tuple[Grip, Grip]:
-    """Both grippers at ``times``: closing over :data:`GRIPPER_DWELL` after a grasp, opening
-    over it after a release; the width is the grasped object's extent across the jaws."""
+def grips(timeline: Timeline, times: FloatArray) -> tuple[Grip, ...]:
+    """Every arm's gripper (timeline order) at ``times``: closing over :data:`GRIPPER_DWELL`
+    after a grasp, opening over it after a release; the width is the grasped object's extent
+    across the jaws."""
     plan = timeline.plan
     names = [a.name for a in plan.arms] if plan is not None else []
     sizes = {o.name: np.asarray(o.size, dtype=np.float64) for o in timeline.instance.objects}
     out = []
-    for a in range(2):
+    for a in range(len(timeline.arms)):
         closure = np.zeros(len(times))
         width = np.zeros(len(times))
         events = sorted(
@@ -116,11 +118,11 @@ def grips(timeline: Timeline, times: FloatArray) -> tuple[Grip, Grip]:
             R = np.asarray(e.T_tcp_object, dtype=np.float64).reshape(4, 4)[:3, :3]
             width[after] = float(np.abs(R[1]) @ sizes[e.object])
         out.append(Grip(closure, width))
-    return out[0], out[1]
+    return tuple(out)
 
 
 def link_poses(arm: ArmDrawing, q: FloatArray, grip: Grip) -> FloatArray:
-    """``T_world_link`` ``(k, L, 4, 4)`` of ``arm.links`` at ``q`` ``(k, 6)``; the fingers
+    """``T_world_link`` ``(k, L, 4, 4)`` of ``arm.links`` at ``q`` ``(k, arm.dof)``; the fingers
     slide towards each other as ``grip`` closes (on the object's width)."""
     T = arm.frame_poses(q, arm.links)
     fingers = [arm.links.index(f) for f in FINGER_FRAMES if f in arm.links]
@@ -156,15 +158,17 @@ def object_holds(timeline: Timeline) -> list[list[tuple[float, int, FloatArray]]
 @dataclass(frozen=True)
 class JointCurves:
     """Joint-space curves at ``t`` ``(k,)`` [s]: per arm, position as a fraction of its range
-    (0 lower, 1 upper limit) and velocity as a fraction of its limit (-1 to 1), ``(k, 6)``."""
+    (0 lower, 1 upper limit) and velocity as a fraction of its limit (-1 to 1), ``(k, arm
+    dof)``; ``joints``: per arm, its joints' names in the robot description."""
 
     t: FloatArray = field(repr=False)
-    position: tuple[FloatArray, FloatArray] = field(repr=False)
-    velocity: tuple[FloatArray, FloatArray] = field(repr=False)
+    position: tuple[FloatArray, ...] = field(repr=False)
+    velocity: tuple[FloatArray, ...] = field(repr=False)
+    joints: tuple[tuple[str, ...], ...] = ()
 
 
 def joint_curves(timeline: Timeline, scene: Scene, rate: float = JOINT_RATE) -> JointCurves:
-    """q and q-dot of both arms against the scene's limits for the arms of the plan (by name;
+    """q and q-dot of every arm against the scene's limits for the arms of the plan (by name;
     the scene's arms in order when a name is unknown)."""
     t, q = timeline.t, timeline.q
     keep = np.concatenate([[True], np.diff(t) > 1e-9])
@@ -173,11 +177,11 @@ def joint_curves(timeline: Timeline, scene: Scene, rate: float = JOINT_RATE) -> 
     times = timeline.sample_times(rate)
     q_s = timeline.q_at(times)
     qd_s = (
-        np.column_stack([np.interp(times, t_u, qd[:, j]) for j in range(12)])
+        np.column_stack([np.interp(times, t_u, qd[:, j]) for j in range(q.shape[1])])
         if len(t_u) > 1
-        else np.zeros((len(times), 12))
+        else np.zeros((len(times), q.shape[1]))
     )
-    positions, velocities = [], []
+    positions, velocities, joints = [], [], []
     names = scene.arm_names
     for a, drawing in enumerate(timeline.arms):
         spec = scene.arm(drawing.name) if drawing.name in names else scene.arms[a]
@@ -186,4 +190,5 @@ def joint_curves(timeline: Timeline, scene: Scene, rate: float = JOINT_RATE) -> 
         vmax = np.asarray(spec.velocity_limit, dtype=np.float64)
         positions.append((timeline.arm_q(q_s, a) - lower) / span)
         velocities.append(timeline.arm_q(qd_s, a) / np.where(vmax > 0, vmax, 1.0))
-    return JointCurves(times, (positions[0], positions[1]), (velocities[0], velocities[1]))
+        joints.append(arm_joint_names(spec))
+    return JointCurves(times, tuple(positions), tuple(velocities), tuple(joints))

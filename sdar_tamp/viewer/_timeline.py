@@ -10,6 +10,7 @@ from __future__ import annotations
 import itertools
 import logging
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -18,10 +19,11 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.viewer._geometry import ArmDrawing
 from sdar_tamp.viewer._plan import PlanLike, StepLike
 from sdar_tamp.world._pin import PinRobot
+from sdar_tamp.world.arm_access import arm_joint_names, arm_robot_file, arm_tcp_offset
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.layout import ArmLayout
-from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.scene import ArmSpec, Scene
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
 
 IntArray = NDArray[np.int64]
@@ -62,11 +64,13 @@ class Timeline:
 
     @staticmethod
     def build(instance: Instance, plan: PlanLike | None, scene: Scene) -> Timeline:
-        robot = PinRobot.load(scene.robot_urdf, scene.package_dirs)
+        """The plan on ``instance`` in ``scene`` (without a plan: the arms at home). Every arm
+        is drawn from its own robot description with its own joints (the scene's arm of the
+        plan arm's name, else the scene's arm in its place)."""
+        robots: dict[Path, PinRobot] = {}  # one load per robot description
         if plan is None:
             drawings = tuple(
-                ArmDrawing.build(a.name, robot, a.T_world_base, _tcp_offset(scene))
-                for a in scene.arms
+                _drawing(scene, a, a.name, a.T_world_base, None, robots) for a in scene.arms
             )
             return Timeline(instance, drawings, scene.layout, np.zeros(1), scene.home[None])
         if plan.instance != instance.name:
@@ -75,24 +79,30 @@ class Timeline:
             raise ParameterError(
                 f"plan.arms: expected {len(scene.arms)} arms (the scene's), got {len(plan.arms)}"
             )
+        names = scene.arm_names
+        specs = [scene.arm(a.name) if a.name in names else scene.arms[i]
+                 for i, a in enumerate(plan.arms)]  # fmt: skip
         try:
-            layout = ArmLayout.uniform([a.name for a in plan.arms], robot.nq)
+            layout = ArmLayout(tuple(a.name for a in plan.arms), tuple(len(s.home) for s in specs))
         except ArmLayoutError as e:
             raise ParameterError(f"plan.arms: {e}") from None
         drawings = tuple(
-            ArmDrawing.build(
+            _drawing(
+                scene,
+                spec,
                 a.name,
-                robot,
                 np.asarray(a.T_world_base, dtype=np.float64),
                 np.asarray(a.T_tool0_tcp, dtype=np.float64),
+                robots,
             )
-            for a in plan.arms
+            for a, spec in zip(plan.arms, specs, strict=True)
         )
         t = np.asarray(plan.t, dtype=np.float64).reshape(-1)
         q = np.asarray(plan.q, dtype=np.float64)
         if len(t) == 0 or q.shape != (len(t), layout.dof) or np.any(np.diff(t) < 0):
             raise ParameterError(
-                f"plan: expected increasing times (n,) and configurations (n, {layout.dof}), "
+                f"plan: expected increasing times (n,) and configurations (n, {layout.dof}) "
+                f"(joints per arm: {dict(zip(layout.names, layout.dofs, strict=True))}), "
                 f"got t {t.shape} and q {q.shape}"
             )
         timeline = Timeline(instance, drawings, layout, t, q, plan)
@@ -222,10 +232,24 @@ def _step_label(step: StepLike) -> str:
     return ", ".join(parts)
 
 
-def _tcp_offset(scene: Scene) -> FloatArray:
-    T = np.eye(4)
-    T[2, 3] = scene.gripper.tcp_offset
-    return T
+def _drawing(
+    scene: Scene,
+    spec: ArmSpec,
+    name: str,
+    T_world_base: FloatArray,
+    T_tool0_tcp: FloatArray | None,
+    robots: dict[Path, PinRobot],
+) -> ArmDrawing:
+    """Arm ``name`` drawn from ``spec``'s robot description (loaded into ``robots`` once) and
+    joints; ``T_tool0_tcp`` default: the arm's gripper's."""
+    path = arm_robot_file(scene, spec)
+    robot = robots.get(path)
+    if robot is None:
+        robot = robots[path] = PinRobot.load(path, scene.package_dirs)
+    if T_tool0_tcp is None:
+        T_tool0_tcp = np.eye(4)
+        T_tool0_tcp[2, 3] = arm_tcp_offset(scene, spec)
+    return ArmDrawing.build(name, robot, T_world_base, T_tool0_tcp, joints=arm_joint_names(spec))
 
 
 def yaw_of(T: FloatArray) -> FloatArray:

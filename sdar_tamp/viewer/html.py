@@ -47,7 +47,6 @@ OBJECT_COLOURS = (
 ARM_COLOURS = ("#5b8fd1", "#e08a4f")
 _DARK = "#4d4d4d"
 _DIV = "sdar-viewer"
-_STATIC = ("base_link",)
 #: Metrics named in the page title when the plan has them.
 _TITLE_METRICS = ("actions", "steps", "dual_arm_steps", "planning_time")
 
@@ -105,8 +104,8 @@ def page_data(
     q = timeline.q_at(times)
     grip = grips(timeline, times)
     # the bases never move: drawn once; the rest of each arm moves by its link poses
-    bases = [a.select(_STATIC) for a in timeline.arms]
-    moving = [a.select(_STATIC, keep=False) for a in timeline.arms]
+    bases = [a.select(a.static_links()) for a in timeline.arms]
+    moving = [a.select(a.static_links(), keep=False) for a in timeline.arms]
     poses = [link_poses(a, timeline.arm_q(q, i), grip[i]) for i, a in enumerate(moving)]
     tcps = [a.tcp_poses(timeline.arm_q(q, i)) for i, a in enumerate(timeline.arms)]
 
@@ -322,9 +321,9 @@ def _object_mesh(instance: Instance) -> tuple[FloatArray, Any, list[str]]:
 
 
 def _arm_trace(arm: ArmDrawing, name: str, vertices: FloatArray, colour: str) -> JSON:
+    static = arm.static_links()
     shade = [
-        _DARK if s.link.startswith("gripper") or s.link == "base_link" else colour
-        for s in arm.shapes
+        _DARK if s.link.startswith("gripper") or s.link in static else colour for s in arm.shapes
     ]
     return {
         "type": "mesh3d",

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.viewer._geometry import CHAIN_FRAMES, FINGER_FRAMES
+from sdar_tamp.viewer._geometry import FINGER_FRAMES
 from sdar_tamp.viewer._plan import PlanLike
 from sdar_tamp.viewer._timeline import Segment, Timeline, yaw_of
 from sdar_tamp.viewer.errors import require
@@ -196,11 +196,12 @@ def _update(view: _Artists, timeline: Timeline, t: float) -> None:
     q = timeline.q_at(times)
     for a, arm_drawing in enumerate(timeline.arms):
         qa = timeline.arm_q(q, a)
-        chain = arm_drawing.frame_poses(qa, CHAIN_FRAMES)[0, :, :2, 3]
-        fingers = arm_drawing.frame_poses(qa, FINGER_FRAMES)[0, :, :2, 3]
+        chain = arm_drawing.chain_points(qa)[0, :, :2]
         view.arms[a].set_data(chain[:, 0], chain[:, 1])
         view.joints[a].set_data(chain[1:-2, 0], chain[1:-2, 1])
-        view.jaws[a].set_data(fingers[:, 0], fingers[:, 1])
+        if all(arm_drawing.robot.model.existFrame(f) for f in FINGER_FRAMES):
+            fingers = arm_drawing.frame_poses(qa, FINGER_FRAMES)[0, :, :2, 3]
+            view.jaws[a].set_data(fingers[:, 0], fingers[:, 1])
 
 
 def _tcp_paths(ax: Any, timeline: Timeline, seg: Segment) -> None:

@@ -6,8 +6,9 @@ Checked pairs:
 * one arm against itself, links at least two joints apart (adjacent links are excluded);
 * arm against table (except ``base_link`` and ``shoulder_link``, which stand on it);
 * arm against every resting object;
-* a held object against the other arm, its own arm up to ``wrist_2`` (never its own wrist_3
-  link and gripper, which hold it), the table, every resting object and the other held object.
+* a held object against the other arm, its own arm up to the link before its last (never its
+  own last link, ``wrist_3`` on a UR arm, and gripper, which hold it), the table, every
+  resting object and the other held object.
 
 Resting objects are not checked against each other or the table (that is the arrangement's
 job, see :mod:`sdar_tamp.world.instance`). Object boxes are shrunk by ``tolerance`` on every
@@ -260,9 +261,11 @@ class CollisionWorld:
                 pairs.append((a.name, "table"))
             pairs.extend((a.name, f"object:{o}") for o in self._resting)
         held = list(self._held.items())
+        layout = self._arms.layout
         for k, (arm, (name, _, _)) in enumerate(held):
             h = f"held:{name}"
-            pairs.extend((s.name, h) for s in shapes if s.arm != arm or s.link_index < 6)
+            last = layout.dofs[layout.index(arm)]  # the link of the arm's last joint + gripper
+            pairs.extend((s.name, h) for s in shapes if s.arm != arm or s.link_index < last)
             pairs.append((h, "table"))
             pairs.extend((h, f"object:{o}") for o in self._resting)
             pairs.extend((h, f"held:{other}") for _, (other, _, _) in held[k + 1 :])

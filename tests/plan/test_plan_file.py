@@ -15,7 +15,7 @@ import pytest
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file, resample
 from sdar_tamp.plan_file import PlanFile, PlanFileError
-from sdar_tamp.plan_reading import load_plan, plan_from_dict
+from sdar_tamp.plan_reading import load_plan, locate_key, plan_from_dict
 from sdar_tamp.plan_rules import check_timeline
 from sdar_tamp.plan_writing import plan_to_dict, save_plan
 from sdar_tamp.world.kinematics import ArmKinematics
@@ -112,7 +112,8 @@ BAD: dict[str, tuple[Callable[[dict[str, Any]], object], str]] = {
     "units": (_set(["units", "length"], "mm"), ": units: expected"),
     "arm count": (lambda d: d["arms"].pop(), ": arms: expected 2 items, got 1"),
     "arm names": (_set(["arms", 1, "name"], "left"), ": arms[1].name: expected a name"),
-    "joints": (_set(["arms", 0, "joints"], ["a"]), ": arms[0].joints: expected 6 joint names"),
+    "joints": (_set(["arms", 0, "joints"], []), ": arms[0].joints: expected the arm's joint"),
+    "joints and home": (_set(["arms", 0, "joints"], ["a"]), ": arms[0].home: expected 1 numbers"),
     "rigid": (_set(["arms", 0, "T_world_base", 0, 0], 2.0), ": arms[0].T_world_base: expected"),
     "home": (_set(["arms", 1, "home"], [0.0] * 5), ": arms[1].home: expected 6 numbers, got 5"),
     "row length": (_drop_last_joint, ": trajectory.q[3]: expected 12 numbers, got 11"),
@@ -143,11 +144,16 @@ def test_each_load_error_names_file_and_key(plan: PlanFile, tmp_path: Path, case
     data = plan_to_dict(plan)
     edit(data)
     path = tmp_path / "plan.json"
-    path.write_text(json.dumps(data))
+    path.write_text(json.dumps(data, indent=1))
     with pytest.raises(PlanFileError) as info:
         load_plan(path)
-    assert str(info.value).startswith(f"{path}: ")
-    assert expected in str(info.value)
+    err = info.value
+    if err.key and locate_key(path.read_text(), err.key) is not None:  # located at the value
+        line, column = locate_key(path.read_text(), err.key) or (0, 0)
+        assert str(err).startswith(f"{path}:{line}:{column}: {err.key}: ")
+    else:  # a missing key: the file
+        assert str(err).startswith(f"{path}: ")
+    assert expected in str(err)
 
 
 def test_exact_message_of_a_short_row(plan: PlanFile) -> None:

@@ -70,7 +70,7 @@ def _dwell_overlaps(plan: PlanFile) -> int:
     """Events during whose dwell the other arm moves (impossible in a synchronous plan)."""
     count = 0
     for e in plan.events:
-        other = arm_columns(1 - plan.arm_names.index(e.arm))
+        other = arm_columns(plan, 1 - plan.arm_names.index(e.arm))
         inside = (plan.t >= e.t) & (plan.t <= e.t + GRIPPER_DWELL)
         count += bool(np.abs(np.diff(plan.q[inside][:, other], axis=0)).max() > STILL_TOL)
     return count
@@ -155,7 +155,7 @@ def test_a_per_arm_dwell_violation_is_rejected(uneven: Solved) -> None:
         if np.abs(
             np.diff(
                 plan.q[(plan.t >= e.t) & (plan.t <= e.t + GRIPPER_DWELL)][
-                    :, arm_columns(1 - plan.arm_names.index(e.arm))
+                    :, arm_columns(plan, 1 - plan.arm_names.index(e.arm))
                 ],
                 axis=0,
             )
@@ -163,7 +163,7 @@ def test_a_per_arm_dwell_violation_is_rejected(uneven: Solved) -> None:
         > STILL_TOL
     )
     k = int(np.searchsorted(plan.t, e.t))
-    mine = arm_columns(plan.arm_names.index(e.arm))
+    mine = arm_columns(plan, plan.arm_names.index(e.arm))
     q = np.array(plan.q)
     bump = 1e-4 * np.sin(np.linspace(0.0, np.pi, 26)) ** 2
     q[k : k + 26, mine.start] += bump  # the arm of the event moves during its dwell
@@ -306,7 +306,7 @@ def test_a_schedule_the_replay_rejects_is_dropped(
     e = good.plan.events[0]
     k = int(np.searchsorted(good.plan.t, e.t))
     q = np.array(good.plan.q)
-    q[k + 1 : k + 5, arm_columns(good.plan.arm_names.index(e.arm)).start] += 1e-3
+    q[k + 1 : k + 5, arm_columns(good.plan, good.plan.arm_names.index(e.arm)).start] += 1e-3
     bad = dataclasses.replace(good, plan=dataclasses.replace(good.plan, q=q))
 
     def broken(*args: object, **kwargs: object) -> Schedule:

@@ -1005,13 +1005,13 @@ def test_format_rules_for_plans_built_in_memory(base: Base) -> None:
             dataclasses.replace(
                 plan, arms=(left, dataclasses.replace(right, joints=right.joints[:5]))
             ),
-            "arms[1].joints: expected the 6 joints of the scene's robot",
+            "arms[1].joints: the scene's arm 'right' has 6 joints",
         ),
         "seven joints": (
             dataclasses.replace(
                 plan, arms=(dataclasses.replace(left, joints=(*left.joints, "x")), right)
             ),
-            "arms[0].joints: expected the 6 joints",
+            "arms[0].joints: the scene's arm 'left' has 6 joints",
         ),
     }
     for name, (mutant, text) in cases.items():
