@@ -188,12 +188,13 @@ def _descend(
     ref: FloatArray,
     opts: NumericIKOptions,
 ) -> tuple[FloatArray, BoolArray]:
-    """Damped least squares from ``starts`` ``(n, s, dof)`` toward targets ``(n, 4, 4)``:
-    final ``q`` ``(n, s, dof)`` and which converged ``(n, s)``."""
+    """Damped least squares from ``starts`` ``(n, s, dof)`` toward targets ``(n, 4, 4)``, the
+    null space pulled toward ``ref`` ``(dof,)`` or one per start ``(n, s, dof)``: final ``q``
+    ``(n, s, dof)`` and which converged ``(n, s)``."""
     n, s, dof = starts.shape
     q = starts.reshape(n * s, dof).copy()
     targets = np.repeat(T_t, s, axis=0)
-    refs = np.broadcast_to(ref, q.shape)
+    refs = np.broadcast_to(ref, starts.shape).reshape(n * s, dof)
     damping = np.full(n * s, opts.damping)
     frames, end = chain_fk(chain, q)
     err = pose_error(targets, end)
@@ -223,3 +224,96 @@ def _descend(
         cost = np.where(better, t_cost, cost)
         done = _converged(err, opts)
     return q.reshape(n, s, dof), done.reshape(n, s)
+
+
+def _checked(
+    chain: Chain, T_root_target: FloatArray, lower: FloatArray, upper: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    T_t = np.asarray(T_root_target, dtype=np.float64).reshape(-1, 4, 4)
+    lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
+    if lo.shape != (chain.dof,) or hi.shape != lo.shape:
+        raise KinematicsError(f"expected limits of shape ({chain.dof},), got {lo.shape}")
+    if np.any(lo > hi):
+        raise KinematicsError("lower limits above upper limits")
+    return T_t, lo, hi
+
+
+def numeric_ik_branches(
+    chain: Chain,
+    T_root_target: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    q_ref: FloatArray,
+    branches: int,
+    options: NumericIKOptions | None = None,
+    seed: int = 0,
+    distinct: float = 1e-3,
+) -> tuple[FloatArray, BoolArray]:
+    """Up to ``branches`` distinct solutions per target (``(n, 4, 4)`` in the root frame):
+    ``q`` ``(n, branches, dof)`` and ``valid`` ``(n, branches)``. Every target is solved from
+    ``options.seeds`` starts (``q_ref`` first, then uniform draws inside the limits); targets
+    no start solved get fresh starts for up to ``options.rounds`` rounds. Solutions closer
+    than ``distinct`` [rad] on every joint count once; they are ordered by their distance
+    from ``q_ref`` (nearest first). Invalid rows hold ``q_ref``. Deterministic in ``seed``.
+
+    Raises:
+        KinematicsError: shapes that do not match the chain, ``lower > upper`` or
+            ``branches < 1``.
+    """
+    opts = NumericIKOptions() if options is None else options
+    T_t, lo, hi = _checked(chain, T_root_target, lower, upper)
+    ref = np.asarray(q_ref, dtype=np.float64)
+    if ref.shape != lo.shape:
+        raise KinematicsError(f"expected a reference of shape ({chain.dof},), got {ref.shape}")
+    if branches < 1:
+        raise KinematicsError(f"branches must be >= 1, got {branches}")
+    n, dof, s = len(T_t), chain.dof, max(1, opts.seeds)
+    rng = np.random.default_rng(seed)
+    q_out = np.repeat(np.repeat(ref[None, None], n, axis=0), branches, axis=1)
+    valid = np.zeros((n, branches), dtype=bool)
+    for round_ in range(max(1, opts.rounds)):
+        todo = np.flatnonzero(~valid.any(axis=1))
+        if len(todo) == 0:
+            break
+        draws = rng.uniform(lo, hi, (len(todo), s, dof))
+        if round_ == 0:
+            draws[:, 0] = ref
+        q, done = _descend(chain, T_t[todo], draws, lo, hi, ref, opts)
+        order = np.argsort(np.where(done, np.linalg.norm(q - ref, axis=2), np.inf), axis=1)
+        for row, t in enumerate(todo):
+            kept: list[FloatArray] = []
+            for k in order[row]:
+                if not done[row, k] or len(kept) == branches:
+                    break
+                if all(np.abs(q[row, k] - other).max() >= distinct for other in kept):
+                    kept.append(q[row, k])
+            if kept:
+                q_out[t, : len(kept)] = kept
+                valid[t, : len(kept)] = True
+    return q_out, np.asarray(valid, dtype=np.bool_)
+
+
+def numeric_ik_from(
+    chain: Chain,
+    T_root_target: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    starts: FloatArray,
+    options: NumericIKOptions | None = None,
+) -> tuple[FloatArray, BoolArray]:
+    """Continue solutions: each target ``(n, 4, 4)`` solved from its own starts ``starts``
+    ``(n, b, dof)`` only, the null space pulled toward the start (the nearest solution of
+    the start's branch): ``q`` ``(n, b, dof)`` and which converged ``(n, b)``.
+
+    Raises:
+        KinematicsError: shapes that do not match the chain or ``lower > upper``.
+    """
+    opts = NumericIKOptions() if options is None else options
+    T_t, lo, hi = _checked(chain, T_root_target, lower, upper)
+    q0 = np.asarray(starts, dtype=np.float64)
+    if q0.ndim != 3 or q0.shape[0] != len(T_t) or q0.shape[2] != chain.dof:
+        raise KinematicsError(
+            f"expected starts of shape ({len(T_t)}, b, {chain.dof}), got {q0.shape}"
+        )
+    q0 = np.clip(q0, lo, hi)
+    return _descend(chain, T_t, q0, lo, hi, q0, opts)
