@@ -262,7 +262,8 @@ class CollisionWorld:
         held = list(self._held.items())
         for k, (arm, (name, _, _)) in enumerate(held):
             h = f"held:{name}"
-            pairs.extend((s.name, h) for s in shapes if s.arm != arm or s.link_index < 6)
+            last = self._arms.layout.dofs[self._arms.layout.index(arm)]
+            pairs.extend((s.name, h) for s in shapes if s.arm != arm or s.link_index < last)
             pairs.append((h, "table"))
             pairs.extend((h, f"object:{o}") for o in self._resting)
             pairs.extend((h, f"held:{other}") for _, (other, _, _) in held[k + 1 :])

@@ -129,6 +129,10 @@ def _step(
     return out
 
 
+#: Damping at which a row that still cannot improve has stalled (it stops descending).
+_MAX_DAMPING = 1e2
+
+
 def _converged(err: FloatArray, opts: NumericIKOptions) -> BoolArray:
     position = np.linalg.norm(err[:, :3], axis=1) < opts.position_tolerance
     rotation = np.linalg.norm(err[:, 3:], axis=1) < opts.rotation_tolerance
@@ -200,29 +204,34 @@ def _descend(
     err = pose_error(targets, end)
     cost = np.einsum("ij,ij->i", err, err)
     done = _converged(err, opts)
+    live = ~done  # rows still descending: neither converged nor stalled at the largest damping
     for _ in range(opts.iterations):
-        if done.all():
+        rows = np.flatnonzero(live)
+        if len(rows) == 0:
             break
-        J = chain_jacobian(chain, frames, end)
-        step = _step(J, err, damping, refs - q, opts)
+        qa, ea, da, fa, enda = q[rows], err[rows], damping[rows], frames[rows], end[rows]
+        J = chain_jacobian(chain, fa, enda)
+        step = _step(J, ea, da, refs[rows] - qa, opts)
         # a joint at a limit that the step pushes outward is frozen: solve without it
-        blocked = ((q <= lo) & (step < 0.0)) | ((q >= hi) & (step > 0.0))
+        blocked = ((qa <= lo) & (step < 0.0)) | ((qa >= hi) & (step > 0.0))
         if blocked.any():
             J = np.where(blocked[:, None, :], 0.0, J)
-            step = np.where(blocked, 0.0, _step(J, err, damping, refs - q, opts))
-        trial = np.clip(q + step, lo, hi)
+            step = np.where(blocked, 0.0, _step(J, ea, da, refs[rows] - qa, opts))
+        trial = np.clip(qa + step, lo, hi)
         t_frames, t_end = chain_fk(chain, trial)
-        t_err = pose_error(targets, t_end)
+        t_err = pose_error(targets[rows], t_end)
         t_cost = np.einsum("ij,ij->i", t_err, t_err)
-        better = (t_cost < cost) & ~done
+        better = t_cost < cost[rows]
         # Levenberg-Marquardt: accept and trust the model more, or refuse and damp more
-        damping = np.where(better, np.maximum(damping / 3.0, 1e-6), np.minimum(damping * 4, 1e2))
-        q = np.where(better[:, None], trial, q)
-        frames = np.where(better[:, None, None, None], t_frames, frames)
-        end = np.where(better[:, None, None], t_end, end)
-        err = np.where(better[:, None], t_err, err)
-        cost = np.where(better, t_cost, cost)
-        done = _converged(err, opts)
+        stalled = ~better & (da >= _MAX_DAMPING)
+        damping[rows] = np.where(
+            better, np.maximum(da / 3.0, 1e-6), np.minimum(da * 4, _MAX_DAMPING)
+        )
+        won = rows[better]
+        q[won], frames[won], end[won] = trial[better], t_frames[better], t_end[better]
+        err[won], cost[won] = t_err[better], t_cost[better]
+        done[rows] = _converged(err[rows], opts)
+        live[rows] = ~done[rows] & ~stalled
     return q.reshape(n, s, dof), done.reshape(n, s)
 
 
