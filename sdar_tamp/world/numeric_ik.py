@@ -131,6 +131,10 @@ def _step(
 
 #: Damping at which a row that still cannot improve has stalled (it stops descending).
 _MAX_DAMPING = 1e2
+#: A row whose squared pose error has not dropped below this share of its value
+#: :data:`_PROGRESS_WINDOW` iterations before is in a local minimum (it stops descending).
+_PROGRESS_RATIO = 0.5
+_PROGRESS_WINDOW = 10
 
 
 def _converged(err: FloatArray, opts: NumericIKOptions) -> BoolArray:
@@ -191,10 +195,13 @@ def _descend(
     hi: FloatArray,
     ref: FloatArray,
     opts: NumericIKOptions,
+    enough: int | None = None,
 ) -> tuple[FloatArray, BoolArray]:
     """Damped least squares from ``starts`` ``(n, s, dof)`` toward targets ``(n, 4, 4)``, the
     null space pulled toward ``ref`` ``(dof,)`` or one per start ``(n, s, dof)``: final ``q``
-    ``(n, s, dof)`` and which converged ``(n, s)``."""
+    ``(n, s, dof)`` and which converged ``(n, s)``. A start stops when it converges, when its
+    squared error has not fallen by :data:`_PROGRESS_RATIO` in :data:`_PROGRESS_WINDOW`
+    iterations, or (``enough``) when ``enough`` starts of its target have converged."""
     n, s, dof = starts.shape
     q = starts.reshape(n * s, dof).copy()
     targets = np.repeat(T_t, s, axis=0)
@@ -204,8 +211,15 @@ def _descend(
     err = pose_error(targets, end)
     cost = np.einsum("ij,ij->i", err, err)
     done = _converged(err, opts)
-    live = ~done  # rows still descending: neither converged nor stalled at the largest damping
-    for _ in range(opts.iterations):
+    live = ~done  # rows still descending: neither converged nor stalled
+    checkpoint = cost.copy()
+    for it in range(opts.iterations):
+        if it and it % _PROGRESS_WINDOW == 0:  # no real progress in a window: a local minimum
+            live &= cost < _PROGRESS_RATIO * checkpoint
+            checkpoint = cost.copy()
+        if enough is not None:  # targets with enough converged starts stop the others
+            solved = done.reshape(n, s).sum(axis=1) >= enough
+            live &= ~np.repeat(solved, s)
         rows = np.flatnonzero(live)
         if len(rows) == 0:
             break
@@ -287,7 +301,7 @@ def numeric_ik_branches(
         draws = rng.uniform(lo, hi, (len(todo), s, dof))
         if round_ == 0:
             draws[:, 0] = ref
-        q, done = _descend(chain, T_t[todo], draws, lo, hi, ref, opts)
+        q, done = _descend(chain, T_t[todo], draws, lo, hi, ref, opts, enough=branches)
         order = np.argsort(np.where(done, np.linalg.norm(q - ref, axis=2), np.inf), axis=1)
         for row, t in enumerate(todo):
             kept: list[FloatArray] = []
