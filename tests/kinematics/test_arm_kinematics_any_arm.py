@@ -175,3 +175,20 @@ def test_damped_least_squares_on_the_seven_dof_arm(kin7: ArmKinematics) -> None:
     res = kin7.ik_dls(target, home, frame="tcp")
     assert res.success
     np.testing.assert_allclose(kin7.fk_tcp(res.q), target, atol=1e-9)
+
+
+def test_numeric_branch_functions_check_their_input(kin7: ArmKinematics) -> None:
+    from sdar_tamp.world.numeric_ik import numeric_ik_from
+
+    lo, hi = kin7.spec.lower_array, kin7.spec.upper_array
+    home = np.array(kin7.spec.home)
+    with pytest.raises(KinematicsError, match=r"limits of shape \(7,\)"):
+        numeric_ik_branches(kin7.chain, np.eye(4), lo[:6], hi[:6], home, 2)
+    with pytest.raises(KinematicsError, match="lower limits above upper"):
+        numeric_ik_branches(kin7.chain, np.eye(4), hi, lo, home, 2)
+    with pytest.raises(KinematicsError, match=r"starts of shape \(1, b, 7\)"):
+        numeric_ik_from(kin7.chain, np.eye(4), lo, hi, np.zeros((2, 1, 7)))
+    # a start outside the limits is clamped into them first
+    target = kin7.fk_batch(home[None])[0]
+    q, _ = numeric_ik_from(kin7.chain, target, lo, hi, (home + 10.0)[None, None])
+    assert q.shape == (1, 1, 7) and np.all(q >= lo) and np.all(q <= hi)
