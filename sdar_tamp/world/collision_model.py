@@ -18,6 +18,7 @@ import pinocchio as pin
 from sdar_tamp.world import _coal
 from sdar_tamp.world._pin import array_to_se3, build_model, se3_to_array
 from sdar_tamp.world.errors import SceneError
+from sdar_tamp.world.kinematics import arm_description
 from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
@@ -71,7 +72,7 @@ def build_dual_arm(scene: Scene) -> CellCollisionModel:
     shapes: list[ArmGeometry] = []
     wrist: dict[str, int] = {}
     for spec in scene.arms:
-        joints = _chain_joints(model, f"{spec.name}_{getattr(spec, 'tool_frame', 'tool0')}")
+        joints = _chain_joints(model, f"{spec.name}_{arm_description(scene, spec.name).tool_frame}")
         wrist[spec.name] = int(joints[-1])
         for gi, obj in enumerate(geometry.geometryObjects):
             if not obj.name.startswith(f"{spec.name}_"):

@@ -40,6 +40,31 @@ NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=6)
 
 
 @dataclass(frozen=True)
+class ArmDescription:
+    """Where an arm of the scene comes from: its robot description, the tool frame its chain
+    ends at, its joints (None: the chain's) and the TCP offset along the tool frame's z [m]."""
+
+    urdf: Path
+    tool_frame: str
+    joint_names: tuple[str, ...] | None
+    tcp_offset: float
+
+
+def arm_description(scene: Scene, arm: str) -> ArmDescription:
+    """The description of the scene's arm ``arm``: the arm's own fields where the scene gives
+    them per arm, else the scene's robot, ``tool0`` and the scene's gripper (the one place that
+    reads them)."""
+    spec = scene.arm(arm)
+    gripper = getattr(spec, "gripper", scene.gripper)
+    return ArmDescription(
+        urdf=getattr(spec, "urdf", scene.robot_urdf),
+        tool_frame=getattr(spec, "tool_frame", "tool0"),
+        joint_names=getattr(spec, "joint_names", None),
+        tcp_offset=float(gripper.tcp_offset),
+    )
+
+
+@dataclass(frozen=True)
 class IKSolutions:
     """IK branches for ``n`` targets: ``q`` ``(n, b, dof)`` [rad], ``valid`` ``(n, b)``.
 
@@ -116,18 +141,14 @@ class ArmKinematics:
     @staticmethod
     def from_scene(scene: Scene, arm: str) -> ArmKinematics:
         """The kinematics of the scene's arm ``arm`` (see :meth:`from_model`)."""
-        spec = scene.arm(arm)
-        urdf: Path = getattr(spec, "urdf", scene.robot_urdf)
-        tool_frame: str = getattr(spec, "tool_frame", "tool0")
-        joint_names: tuple[str, ...] | None = getattr(spec, "joint_names", None)
-        gripper = getattr(spec, "gripper", scene.gripper)
+        d = arm_description(scene, arm)
         return ArmKinematics.from_model(
-            spec,
-            urdf,
-            tcp_offset=gripper.tcp_offset,
+            scene.arm(arm),
+            d.urdf,
+            tcp_offset=d.tcp_offset,
             package_dirs=scene.package_dirs,
-            tool_frame=tool_frame,
-            joint_names=joint_names,
+            tool_frame=d.tool_frame,
+            joint_names=d.joint_names,
         )
 
     @property
