@@ -36,7 +36,7 @@ T_BASE_DH[:3, :3] = rot_z(np.pi)
 CLOSED_FORM_BRANCHES = 8
 NUMERIC_BRANCHES = 4
 #: The numeric IK's effort in the planner (seeds per pose, rounds of fresh seeds).
-NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=6)
+NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=4)
 
 
 @dataclass(frozen=True)

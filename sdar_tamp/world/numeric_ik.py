@@ -60,18 +60,27 @@ def chain_fk(chain: Chain, q: FloatArray) -> tuple[FloatArray, FloatArray]:
     for configurations ``q`` ``(n, dof)``."""
     q = np.atleast_2d(np.asarray(q, dtype=np.float64))
     n = len(q)
-    T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
     frames = np.empty((n, chain.dof, 4, 4))
+    T = np.broadcast_to(np.eye(4), (n, 4, 4))
     for i, joint in enumerate(chain.joints):
-        motion = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+        T = T @ joint.T_parent_joint  # the joint frame at q = 0, then its motion
         axis = joint.axis / np.linalg.norm(joint.axis)
         if joint.kind == "prismatic":
-            motion[:, :3, 3] = q[:, i, None] * axis
+            T[:, :3, 3] += (T[:, :3, :3] @ axis) * q[:, i, None]
         else:
-            motion[:, :3, :3] = _rotations(axis, q[:, i])
-        T = T @ joint.T_parent_joint @ motion
+            T[:, :3, :3] = T[:, :3, :3] @ _rotations(axis, q[:, i])
         frames[:, i] = T
-    return frames, T @ chain.T_joint_frame
+    end: FloatArray = T @ chain.T_joint_frame
+    return frames, end
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Row-wise cross products of ``(n, 3)`` arrays (``np.cross`` without its axis handling)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
 
 
 def chain_jacobian(chain: Chain, frames: FloatArray, end: FloatArray) -> FloatArray:
@@ -83,7 +92,7 @@ def chain_jacobian(chain: Chain, frames: FloatArray, end: FloatArray) -> FloatAr
         if joint.kind == "prismatic":
             J[:, :3, i] = z
         else:
-            J[:, :3, i] = np.cross(z, end[:, :3, 3] - frames[:, i, :3, 3])
+            J[:, :3, i] = _cross(z, end[:, :3, 3] - frames[:, i, :3, 3])
             J[:, 3:, i] = z
     return J
 

@@ -1,5 +1,5 @@
 """Straight tool moves (approach and retreat) by IK interpolation (closed form, or the
-numeric IK continued step by step)."""
+numeric IK of every step solved from the start configuration)."""
 
 from __future__ import annotations
 
@@ -28,13 +28,12 @@ def straight_tool_move(
     T = np.repeat(T0[None], n, axis=0)
     T[:, :3, 3] += (distance * np.arange(1, n + 1) / n)[:, None] * T0[:3, 2][None]
     out = [q]
-    if not kin.closed_form:  # each step solved from the previous configuration
-        for k in range(n):
-            near = kin.ik_tcp_from(T[k : k + 1], out[-1][None, None])
-            if not near.valid[0, 0] or np.abs(near.q[0, 0] - out[-1]).max() > max_joint_step:
-                return None
-            out.append(near.q[0, 0])
-        return np.stack(out)
+    if not kin.closed_form:  # every step solved from q, its redundancy pulled toward q
+        near = kin.ik_tcp_from(T, np.repeat(q[None, None], n, axis=0))
+        path = np.concatenate([q[None], near.q[:, 0]])
+        if not near.valid.all() or np.abs(np.diff(path, axis=0)).max() > max_joint_step:
+            return None
+        return path
     sol = kin.ik_tcp(T)
     for k in range(n):
         d = np.where(sol.valid[k], np.abs(sol.q[k] - out[-1]).max(axis=1), np.inf)
