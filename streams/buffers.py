@@ -45,10 +45,9 @@ def reachable_top_down(
         return np.zeros(len(p), dtype=np.bool_)
     T_obj = pose_xyz_yaw(p[:, 0], p[:, 1], size[2] / 2.0, p[:, 2])  # (n, 4, 4)
     T_tcp = (T_obj[:, None] @ np.stack([g.T_object_tcp for g in top])[None]).reshape(-1, 4, 4)
-    both = ctx.kinematics[arm].ik_tcp(np.concatenate([T_tcp, pregrasp_offset(T_tcp, lift)]))
-    m = len(T_tcp)
-    ok = both.valid[:m] & both.valid[m:]
-    return np.asarray(ok.reshape(len(p), len(top), 8).any(axis=(1, 2)), dtype=np.bool_)
+    grasp, pre = ctx.kinematics[arm].ik_tcp_pair(T_tcp, pregrasp_offset(T_tcp, lift))
+    ok = grasp.valid & pre.valid
+    return np.asarray(ok.reshape(len(p), -1).any(axis=1), dtype=np.bool_)
 
 
 def sample_buffers(

@@ -102,8 +102,8 @@ class InfeasibilityProof:
 @dataclass(frozen=True)
 class _Candidate:
     arm: str
-    q: FloatArray  # (6,)
-    q_pre: FloatArray  # (6,)
+    q: FloatArray  # (dof,)
+    q_pre: FloatArray  # (dof,)
 
 
 class _Checker:
@@ -130,14 +130,10 @@ class _Checker:
         T_tcp = self.boxes[obj].T_world_obj @ np.stack([g.T_object_tcp for g in grasps])
         out: list[_Candidate] = []
         for arm in self.ctx.arm_names:
-            both = self.ctx.kinematics[arm].ik_tcp(
-                np.concatenate([T_tcp, pregrasp_offset(T_tcp, lift)])
-            )
-            n = len(grasps)
-            ok = both.valid[:n] & both.valid[n:]
-            rows, branches = np.nonzero(ok)
+            grasp, pre = self.ctx.kinematics[arm].ik_tcp_pair(T_tcp, pregrasp_offset(T_tcp, lift))
+            rows, branches = np.nonzero(grasp.valid & pre.valid)
             out.extend(
-                _Candidate(arm, both.q[gi, b], both.q[n + gi, b])
+                _Candidate(arm, grasp.q[gi, b], pre.q[gi, b])
                 for gi, b in zip(rows, branches, strict=True)
             )
         return out

@@ -1,7 +1,8 @@
 """Batched inverse kinematics for grasp candidates, filtered by collision and ranked.
 
-For many ``(arm, object pose, grasp)`` requests at once: the closed-form IK of the grasp pose
-and of its pre-grasp (``lift`` back along the approach) for every branch; a branch survives if
+For many ``(arm, object pose, grasp)`` requests at once: the IK of the grasp pose and of its
+pre-grasp (``lift`` back along the approach) for every branch (closed form or numeric, see
+:meth:`sdar_tamp.world.kinematics.ArmKinematics.ik_tcp_pair`); a branch survives if
 both are real and within the joint limits, the pre-grasp lies on the same branch (joint
 distance below ``max_branch_jump``), and neither configuration, nor the straight approach
 between them (checked every 1.5 cm), collides with the table, the other resting objects,
@@ -46,7 +47,7 @@ class IKRequest:
 
 @dataclass(frozen=True, eq=False)
 class IKCandidate:
-    """One collision-free IK branch: grasp and pre-grasp configurations ``(6,)`` [rad]."""
+    """One collision-free IK branch: grasp and pre-grasp configurations ``(dof,)`` [rad]."""
 
     arm: str
     obj: str
@@ -81,18 +82,18 @@ class GraspIK:
         self._kin = ctx.kinematics[arm]
         n = len(self.grasps)
         if n == 0:
-            self.q = self.q_pre = np.zeros((0, 0, 6))
-            self.ok = np.zeros((0, 0), dtype=np.bool_)
+            self.q = self.q_pre = np.zeros((0, self._kin.branches, self._kin.dof))
+            self.ok = np.zeros((0, self._kin.branches), dtype=np.bool_)
         else:
             T_tcp = box.T_world_obj @ np.stack([g.T_object_tcp for g in self.grasps])
-            both = self._kin.ik_tcp(np.concatenate([T_tcp, pregrasp_offset(T_tcp, lift)]))
-            self.q, self.q_pre = both.q[:n], both.q[n:]
-            ok = both.valid[:n] & both.valid[n:]
+            grasp, pre = self._kin.ik_tcp_pair(T_tcp, pregrasp_offset(T_tcp, lift))
+            self.q, self.q_pre = grasp.q, pre.q
+            ok = grasp.valid & pre.valid
             self.ok = ok & (np.abs(self.q - self.q_pre).max(axis=-1) < max_branch_jump)
         self._sweeps: dict[tuple[int, int], FloatArray | None] = {}
 
     def sweep(self, gi: int, b: int) -> FloatArray | None:
-        """Configurations ``(k, 6)`` of the straight approach of grasp ``gi`` on branch ``b``,
+        """Configurations ``(k, dof)`` of the straight approach of grasp ``gi`` on branch ``b``,
         from the grasp back to the pre-grasp (None: unreachable)."""
         key = (gi, b)
         if key not in self._sweeps:

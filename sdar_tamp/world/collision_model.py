@@ -2,8 +2,8 @@
 
 The arms are one pinocchio model whose joints follow the scene's :class:`ArmLayout`. Scene
 geometry is added as pinocchio geometry objects: the table and resting objects on the
-universe joint, held objects on the wrist_3 joint of the arm holding them. Collision pairs
-encode the filtering rules of :class:`sdar_tamp.world.collision.CollisionWorld`.
+universe joint, held objects on the last joint of the arm holding them (wrist_3 of a UR).
+Collision pairs encode the filtering rules of :class:`sdar_tamp.world.collision.CollisionWorld`.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import pinocchio as pin
 from sdar_tamp.world import _coal
 from sdar_tamp.world._pin import array_to_se3, build_model, se3_to_array
 from sdar_tamp.world.errors import SceneError
+from sdar_tamp.world.kinematics import arm_description
 from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, translation
@@ -30,7 +31,7 @@ class ArmGeometry:
 
     name: str
     arm: str
-    link_index: int  # 0 base_link, 1 shoulder ... 6 wrist_3 + gripper
+    link_index: int  # 0 base, then k: the link joint k of the chain moves (the last + gripper)
     index: int
 
 
@@ -43,9 +44,9 @@ class CellCollisionModel:
     arm_geometry: Any = field(repr=False)  # pin.GeometryModel holding the arm shapes only
     shapes: tuple[ArmGeometry, ...]
     layout: ArmLayout
-    wrist_joint: dict[str, int]  # arm -> joint id of wrist_3
+    wrist_joint: dict[str, int]  # arm -> joint id of the chain's last joint (wrist_3)
     tool0_frame: dict[str, int]  # arm -> frame id of tool0
-    T_wrist_tool0: FloatArray  # tool0 in the wrist_3 joint frame
+    T_wrist_tool0: FloatArray  # tool0 in the last joint's frame
 
     @property
     def arm_names(self) -> tuple[str, ...]:
@@ -71,7 +72,7 @@ def build_dual_arm(scene: Scene) -> CellCollisionModel:
     shapes: list[ArmGeometry] = []
     wrist: dict[str, int] = {}
     for spec in scene.arms:
-        joints = [model.getJointId(f"{spec.name}_{j}_joint") for j in _JOINTS]
+        joints = _chain_joints(model, f"{spec.name}_{arm_description(scene, spec.name).tool_frame}")
         wrist[spec.name] = int(joints[-1])
         for gi, obj in enumerate(geometry.geometryObjects):
             if not obj.name.startswith(f"{spec.name}_"):
@@ -104,7 +105,19 @@ def tool0_pose(arms: CellCollisionModel, q: FloatArray, arm: str) -> FloatArray:
     return se3_to_array(arms.data.oMf[arms.tool0_frame[arm]])
 
 
-_JOINTS = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
+def _chain_joints(model: Any, frame: str) -> list[int]:
+    """The ids of the joints from the root to ``frame``, root first (the arm's chain: joint
+    ``k`` of the list carries link ``k + 1``)."""
+    if not model.existFrame(frame):
+        raise SceneError(f"the robot description has no frame {frame!r}")
+    ids: list[int] = []
+    j = int(model.frames[model.getFrameId(frame)].parentJoint)
+    while j != 0:
+        ids.append(j)
+        j = int(model.parents[j])
+    if not ids:
+        raise SceneError(f"no joint moves the frame {frame!r} of the robot description")
+    return ids[::-1]
 
 
 @dataclass(frozen=True)

@@ -1,18 +1,29 @@
-"""World-frame kinematics of one arm of the scene: pinocchio FK, batched closed-form IK.
+"""World-frame kinematics of one arm: pinocchio FK, batched IK (closed form or numeric).
 
-Frames: ``world`` -> ``base_link`` (arm base pose from the scene) -> DH base (pi about z)
--> ``tool0`` (the flange) -> ``tcp`` (``tcp_offset`` along tool0 z, between the finger pads).
+Frames: ``world`` -> the robot's root link (the arm's base pose) -> ... -> the tool frame
+(``tool0``, the flange) -> ``tcp`` (``tcp_offset`` along the tool frame's z, between the finger
+pads). A UR-family chain (recognised from the URDF by :func:`.ur_identify.ur_parameters`) gets
+the closed form of :mod:`.ur_ik` (eight branches, the DH base turned by pi about z in ROS
+descriptions); any other serial chain the batched numeric IK of :mod:`.numeric_ik`, whose
+"branches" are distinct solutions found from several seeds, nearest the home first.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from sdar_tamp.world._pin import PinRobot
+from sdar_tamp.world._pin import Chain, PinRobot, chain_to
 from sdar_tamp.world.dls_ik import DlsOptions, DlsResult, dls_ik
 from sdar_tamp.world.errors import KinematicsError
+from sdar_tamp.world.numeric_ik import (
+    NumericIKOptions,
+    chain_fk,
+    numeric_ik_branches,
+    numeric_ik_from,
+)
 from sdar_tamp.world.scene import ArmSpec, Scene
 from sdar_tamp.world.transforms import BoolArray, FloatArray, inverse, rot_z, translation
 from sdar_tamp.world.ur_identify import ur_parameters
@@ -21,21 +32,52 @@ from sdar_tamp.world.ur_ik import URParameters, ur_fk, ur_ik, wrap_into_limits
 #: ``T_base_link_dh0``: the DH base frame is the ROS base_link turned by pi about z.
 T_BASE_DH = np.eye(4)
 T_BASE_DH[:3, :3] = rot_z(np.pi)
+#: Branches of the closed form (UR family) and distinct solutions kept by the numeric IK.
+CLOSED_FORM_BRANCHES = 8
+NUMERIC_BRANCHES = 4
+#: The numeric IK's effort in the planner (seeds per pose, rounds of fresh seeds).
+NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=4)
+
+
+@dataclass(frozen=True)
+class ArmDescription:
+    """Where an arm of the scene comes from: its robot description, the tool frame its chain
+    ends at, its joints (None: the chain's) and the TCP offset along the tool frame's z [m]."""
+
+    urdf: Path
+    tool_frame: str
+    joint_names: tuple[str, ...] | None
+    tcp_offset: float
+
+
+def arm_description(scene: Scene, arm: str) -> ArmDescription:
+    """The description of the scene's arm ``arm``: the arm's own fields where the scene gives
+    them per arm, else the scene's robot, ``tool0`` and the scene's gripper (the one place that
+    reads them)."""
+    spec = scene.arm(arm)
+    gripper = getattr(spec, "gripper", scene.gripper)
+    return ArmDescription(
+        urdf=getattr(spec, "urdf", scene.robot_urdf),
+        tool_frame=getattr(spec, "tool_frame", "tool0"),
+        joint_names=getattr(spec, "joint_names", None),
+        tcp_offset=float(gripper.tcp_offset),
+    )
 
 
 @dataclass(frozen=True)
 class IKSolutions:
-    """All IK branches for ``n`` targets: ``q`` ``(n, 8, 6)`` [rad], ``valid`` ``(n, 8)``.
+    """IK branches for ``n`` targets: ``q`` ``(n, b, dof)`` [rad], ``valid`` ``(n, b)``.
 
-    A branch is valid when it is a real solution and every joint fits the arm's limits
-    (after shifting by a multiple of 2 pi).
+    ``b`` depends on the solver: the closed form's eight branches (a branch is valid when it
+    is a real solution and every joint fits the arm's limits after shifting by a multiple of
+    2 pi), or the numeric IK's distinct solutions (valid where one converged within limits).
     """
 
     q: FloatArray
     valid: BoolArray
 
     def closest(self, q_ref: FloatArray) -> tuple[FloatArray, BoolArray]:
-        """Per target, the valid branch nearest to ``q_ref`` ``(6,)``: ``(n, 6)``, ``(n,)``."""
+        """Per target, the valid branch nearest to ``q_ref`` ``(dof,)``: ``(n, dof)``, ``(n,)``."""
         dist = np.linalg.norm(self.q - q_ref, axis=-1)
         dist = np.where(self.valid, dist, np.inf)
         best = np.argmin(dist, axis=1)
@@ -51,27 +93,81 @@ class ArmKinematics:
     spec: ArmSpec
     robot: PinRobot
     tcp_offset: float  # [m]
-    params: URParameters  # read from the URDF (:func:`.ur_identify.ur_parameters`)
+    chain: Chain  # the robot's root -> the tool frame
+    params: URParameters | None  # read from the URDF (UR family), else None: numeric IK
     T_base_dh: FloatArray = field(default_factory=lambda: T_BASE_DH.copy(), compare=False)
+    numeric: NumericIKOptions = NUMERIC_OPTIONS
+
+    @staticmethod
+    def from_model(
+        spec: ArmSpec,
+        urdf: Path,
+        *,
+        tcp_offset: float,
+        package_dirs: tuple[Path, ...] = (),
+        tool_frame: str = "tool0",
+        joint_names: tuple[str, ...] | None = None,
+        numeric: NumericIKOptions = NUMERIC_OPTIONS,
+    ) -> ArmKinematics:
+        """The kinematics of the arm ``spec`` (base pose, limits, home) described by ``urdf``
+        from its root link to ``tool_frame``: the closed form when the chain is a UR-family
+        arm, else the numeric IK.
+
+        Raises:
+            SceneError: the URDF does not load.
+            KinematicsError: ``tool_frame`` is missing, the chain holds a joint that is not a
+                one-axis revolute or prismatic joint, its joints are not ``joint_names`` (when
+                given), or its joint count is not the arm's.
+        """
+        robot = PinRobot.load(urdf, package_dirs)
+        chain = chain_to(robot, tool_frame)
+        names = tuple(j.name for j in chain.joints)
+        if joint_names is not None and tuple(joint_names) != names:
+            raise KinematicsError(
+                f"{urdf.name}: the joints from the root to {tool_frame!r} are {list(names)}, "
+                f"not {list(joint_names)}"
+            )
+        if chain.dof != len(spec.home):
+            raise KinematicsError(
+                f"{urdf.name}: the chain to {tool_frame!r} has {chain.dof} joints; arm "
+                f"{spec.name!r} has {len(spec.home)}"
+            )
+        found = ur_parameters(robot, tool_frame)
+        if found is None:
+            return ArmKinematics(spec, robot, tcp_offset, chain, None, np.eye(4), numeric)
+        params, T_base_dh = found
+        return ArmKinematics(spec, robot, tcp_offset, chain, params, T_base_dh, numeric)
 
     @staticmethod
     def from_scene(scene: Scene, arm: str) -> ArmKinematics:
-        """The arm's kinematics, its UR parameters read from the scene's robot description.
+        """The kinematics of the scene's arm ``arm`` (see :meth:`from_model`)."""
+        d = arm_description(scene, arm)
+        return ArmKinematics.from_model(
+            scene.arm(arm),
+            d.urdf,
+            tcp_offset=d.tcp_offset,
+            package_dirs=scene.package_dirs,
+            tool_frame=d.tool_frame,
+            joint_names=d.joint_names,
+        )
 
-        Raises:
-            KinematicsError: the chain from the root to ``tool0`` is not a UR-family arm (the
-                closed-form IK is the only one for now).
-        """
-        robot = PinRobot.load(scene.robot_urdf, scene.package_dirs)
-        found = ur_parameters(robot)
-        if found is None:
-            raise KinematicsError(
-                f"{scene.robot_urdf.name}: the chain to tool0 is not a UR-family arm "
-                "(six revolute joints with the UR geometry), the only kind with inverse "
-                "kinematics for now"
-            )
-        params, T_base_dh = found
-        return ArmKinematics(scene.arm(arm), robot, scene.gripper.tcp_offset, params, T_base_dh)
+    @property
+    def dof(self) -> int:
+        return self.chain.dof
+
+    @property
+    def tool_frame(self) -> str:
+        return self.chain.frame
+
+    @property
+    def closed_form(self) -> bool:
+        """True for a UR-family arm (closed-form IK, eight branches)."""
+        return self.params is not None
+
+    @property
+    def branches(self) -> int:
+        """Branches of :class:`IKSolutions` this arm's IK returns."""
+        return CLOSED_FORM_BRANCHES if self.closed_form else NUMERIC_BRANCHES
 
     @property
     def T_world_base(self) -> FloatArray:
@@ -82,37 +178,94 @@ class ArmKinematics:
         return translation(0.0, 0.0, self.tcp_offset)
 
     # -- forward kinematics (pinocchio) --------------------------------------------------
-    def fk(self, q: FloatArray, frame: str = "tool0") -> FloatArray:
-        """``T_world_frame`` ``(4, 4)`` for ``q`` ``(6,)`` [rad], any frame of the URDF."""
-        q = self._check_q(q)
-        return self.T_world_base @ self.robot.frame_pose(q, self.robot.frame_id(frame))
+    def fk(self, q: FloatArray, frame: str | None = None) -> FloatArray:
+        """``T_world_frame`` ``(4, 4)`` for ``q`` ``(dof,)`` [rad], any frame of the URDF
+        (default: the tool frame)."""
+        full = self._full(self._check_q(q))
+        fid = self.robot.frame_id(self.tool_frame if frame is None else frame)
+        return self.T_world_base @ self.robot.frame_pose(full, fid)
 
     def fk_tool0(self, q: FloatArray) -> FloatArray:
-        return self.fk(q, "tool0")
+        return self.fk(q)
 
     def fk_tcp(self, q: FloatArray) -> FloatArray:
-        return self.fk(q, "tcp")
+        """The TCP pose: the URDF's ``tcp`` frame if it has one, else ``tcp_offset`` along
+        the tool frame's z."""
+        if self.robot.model.existFrame("tcp"):
+            return self.fk(q, "tcp")
+        return self.fk(q) @ self.T_tool0_tcp
 
-    # -- batched closed form ---------------------------------------------------------------
+    # -- batched -------------------------------------------------------------------------
     def fk_batch(self, q: FloatArray) -> FloatArray:
-        """``T_world_tool0`` ``(n, 4, 4)`` for ``q`` ``(n, 6)``, closed form (numpy)."""
-        return self.T_world_base @ self.T_base_dh @ ur_fk(self.params, q)
+        """``T_world_tool0`` ``(n, 4, 4)`` for ``q`` ``(n, dof)`` (numpy: the closed form of a
+        UR arm, else the chain's)."""
+        if self.params is not None:
+            return self.T_world_base @ self.T_base_dh @ ur_fk(self.params, q)
+        _, end = chain_fk(self.chain, q)
+        out: FloatArray = self.T_world_base @ end
+        return out
 
     def ik_tool0(self, T_world_tool0: FloatArray) -> IKSolutions:
-        """All IK branches for flange poses ``(n, 4, 4)`` (or one ``(4, 4)``)."""
-        T = np.asarray(T_world_tool0, dtype=np.float64)
-        if T.shape[-2:] != (4, 4):
-            raise KinematicsError(f"expected poses of shape (n, 4, 4), got {T.shape}")
-        T = T.reshape(-1, 4, 4)
+        """IK branches for tool-frame poses ``(n, 4, 4)`` (or one ``(4, 4)``)."""
+        T = self._poses(T_world_tool0)
+        if self.params is None:
+            T_root = inverse(self.T_world_base) @ T
+            lo, hi = self.spec.lower_array, self.spec.upper_array
+            home = np.asarray(self.spec.home, dtype=np.float64)
+            q_n, ok = numeric_ik_branches(
+                self.chain, T_root, lo, hi, home, NUMERIC_BRANCHES, self.numeric
+            )
+            return IKSolutions(q_n, ok)
         T_dh = inverse(self.T_world_base @ self.T_base_dh) @ T
         q, real = ur_ik(self.params, T_dh)
         q, fits = wrap_into_limits(q, self.spec.lower_array, self.spec.upper_array)
         return IKSolutions(q, real & fits)
 
     def ik_tcp(self, T_world_tcp: FloatArray) -> IKSolutions:
-        """All IK branches for tool-centre-point poses ``(n, 4, 4)``."""
+        """IK branches for tool-centre-point poses ``(n, 4, 4)``."""
         T = np.asarray(T_world_tcp, dtype=np.float64)
         return self.ik_tool0(T @ inverse(self.T_tool0_tcp))
+
+    def ik_tcp_from(self, T_world_tcp: FloatArray, starts: FloatArray) -> IKSolutions:
+        """Solutions continuing given configurations: for TCP poses ``(n, 4, 4)`` and starts
+        ``(n, b, dof)``, the solution of each start's branch ``(n, b, dof)``: the valid closed-
+        form branch nearest to the start (largest joint difference), or the numeric IK from
+        the start itself."""
+        T = self._poses(T_world_tcp) @ inverse(self.T_tool0_tcp)
+        q0 = np.asarray(starts, dtype=np.float64)
+        if q0.ndim != 3 or q0.shape[0] != len(T) or q0.shape[2] != self.dof:
+            raise KinematicsError(
+                f"expected starts of shape ({len(T)}, b, {self.dof}), got {q0.shape}"
+            )
+        if self.params is None:
+            T_root = inverse(self.T_world_base) @ T
+            lo, hi = self.spec.lower_array, self.spec.upper_array
+            q_n, ok = numeric_ik_from(self.chain, T_root, lo, hi, q0, self.numeric)
+            return IKSolutions(q_n, ok)
+        sol = self.ik_tool0(T)
+        d = np.abs(sol.q[:, None, :, :] - q0[:, :, None, :]).max(axis=-1)  # (n, b, 8)
+        d = np.where(sol.valid[:, None, :], d, np.inf)
+        best = np.argmin(d, axis=2)
+        rows = np.arange(len(T))[:, None]
+        valid = np.asarray(np.isfinite(np.take_along_axis(d, best[..., None], 2)[..., 0]))
+        return IKSolutions(sol.q[rows, best], valid)
+
+    def ik_tcp_pair(
+        self, T_first: FloatArray, T_second: FloatArray
+    ) -> tuple[IKSolutions, IKSolutions]:
+        """IK of pose pairs ``(n, 4, 4)`` each (a grasp and its pre-grasp) where branch ``b``
+        of the second continues branch ``b`` of the first (for the closed form its own branch
+        index; for the numeric IK the solution from the first's configuration)."""
+        T1, T2 = self._poses(T_first), self._poses(T_second)
+        if len(T1) != len(T2):
+            raise KinematicsError(f"expected as many first as second poses, {len(T1)} != {len(T2)}")
+        if self.params is not None:
+            both = self.ik_tcp(np.concatenate([T1, T2]))
+            n = len(T1)
+            return IKSolutions(both.q[:n], both.valid[:n]), IKSolutions(both.q[n:], both.valid[n:])
+        first = self.ik_tcp(T1)
+        second = self.ik_tcp_from(T2, first.q)
+        return first, IKSolutions(second.q, second.valid & first.valid)
 
     # -- numerical IK (pinocchio) ----------------------------------------------------------
     def ik_dls(
@@ -122,7 +275,13 @@ class ArmKinematics:
         frame: str = "tool0",
         options: DlsOptions | None = None,
     ) -> DlsResult:
-        """Damped-least-squares IK for any frame, from the start guess ``q0`` [rad]."""
+        """Damped-least-squares IK for any frame, from the start guess ``q0`` [rad] (a robot
+        description whose only joints are the arm's)."""
+        if self.robot.nq != self.dof:
+            raise KinematicsError(
+                f"ik_dls: {self.robot.urdf_path.name} has {self.robot.nq} joints, the arm "
+                f"{self.dof}"
+            )
         T_base = inverse(self.T_world_base) @ np.asarray(T_world_frame, dtype=np.float64)
         return dls_ik(
             self.robot,
@@ -134,8 +293,25 @@ class ArmKinematics:
             options,
         )
 
+    def _poses(self, T: FloatArray) -> FloatArray:
+        Ta = np.asarray(T, dtype=np.float64)
+        if Ta.shape[-2:] != (4, 4):
+            raise KinematicsError(f"expected poses of shape (n, 4, 4), got {Ta.shape}")
+        return Ta.reshape(-1, 4, 4)
+
+    def _full(self, q: FloatArray) -> FloatArray:
+        """The robot's configuration vector ``(nq,)`` with the arm's joints at ``q``, any other
+        joint (fingers) at 0."""
+        if self.robot.nq == self.dof:
+            return q
+        full = np.zeros(self.robot.nq)
+        full[[j.q_index for j in self.chain.joints]] = q
+        return full
+
     def _check_q(self, q: FloatArray) -> FloatArray:
         qa = np.asarray(q, dtype=np.float64)
-        if qa.shape != (self.robot.nq,):
-            raise KinematicsError(f"expected a configuration of shape (6,), got {qa.shape}")
+        if qa.shape != (self.dof,):
+            raise KinematicsError(
+                f"expected a configuration of shape ({self.dof},), got {qa.shape}"
+            )
         return qa

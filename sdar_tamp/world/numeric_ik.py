@@ -60,18 +60,27 @@ def chain_fk(chain: Chain, q: FloatArray) -> tuple[FloatArray, FloatArray]:
     for configurations ``q`` ``(n, dof)``."""
     q = np.atleast_2d(np.asarray(q, dtype=np.float64))
     n = len(q)
-    T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
     frames = np.empty((n, chain.dof, 4, 4))
+    T = np.broadcast_to(np.eye(4), (n, 4, 4))
     for i, joint in enumerate(chain.joints):
-        motion = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+        T = T @ joint.T_parent_joint  # the joint frame at q = 0, then its motion
         axis = joint.axis / np.linalg.norm(joint.axis)
         if joint.kind == "prismatic":
-            motion[:, :3, 3] = q[:, i, None] * axis
+            T[:, :3, 3] += (T[:, :3, :3] @ axis) * q[:, i, None]
         else:
-            motion[:, :3, :3] = _rotations(axis, q[:, i])
-        T = T @ joint.T_parent_joint @ motion
+            T[:, :3, :3] = T[:, :3, :3] @ _rotations(axis, q[:, i])
         frames[:, i] = T
-    return frames, T @ chain.T_joint_frame
+    end: FloatArray = T @ chain.T_joint_frame
+    return frames, end
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Row-wise cross products of ``(n, 3)`` arrays (``np.cross`` without its axis handling)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
 
 
 def chain_jacobian(chain: Chain, frames: FloatArray, end: FloatArray) -> FloatArray:
@@ -83,7 +92,7 @@ def chain_jacobian(chain: Chain, frames: FloatArray, end: FloatArray) -> FloatAr
         if joint.kind == "prismatic":
             J[:, :3, i] = z
         else:
-            J[:, :3, i] = np.cross(z, end[:, :3, 3] - frames[:, i, :3, 3])
+            J[:, :3, i] = _cross(z, end[:, :3, 3] - frames[:, i, :3, 3])
             J[:, 3:, i] = z
     return J
 
@@ -127,6 +136,14 @@ def _step(
         step += opts.null_space_gain * (null @ to_ref[:, :, None])[:, :, 0]
     out: FloatArray = np.clip(step, -opts.max_step, opts.max_step)
     return out
+
+
+#: Damping at which a row that still cannot improve has stalled (it stops descending).
+_MAX_DAMPING = 1e2
+#: A row whose squared pose error has not dropped below this share of its value
+#: :data:`_PROGRESS_WINDOW` iterations before is in a local minimum (it stops descending).
+_PROGRESS_RATIO = 0.5
+_PROGRESS_WINDOW = 10
 
 
 def _converged(err: FloatArray, opts: NumericIKOptions) -> BoolArray:
@@ -187,39 +204,148 @@ def _descend(
     hi: FloatArray,
     ref: FloatArray,
     opts: NumericIKOptions,
+    enough: int | None = None,
 ) -> tuple[FloatArray, BoolArray]:
-    """Damped least squares from ``starts`` ``(n, s, dof)`` toward targets ``(n, 4, 4)``:
-    final ``q`` ``(n, s, dof)`` and which converged ``(n, s)``."""
+    """Damped least squares from ``starts`` ``(n, s, dof)`` toward targets ``(n, 4, 4)``, the
+    null space pulled toward ``ref`` ``(dof,)`` or one per start ``(n, s, dof)``: final ``q``
+    ``(n, s, dof)`` and which converged ``(n, s)``. A start stops when it converges, when its
+    squared error has not fallen by :data:`_PROGRESS_RATIO` in :data:`_PROGRESS_WINDOW`
+    iterations, or (``enough``) when ``enough`` starts of its target have converged."""
     n, s, dof = starts.shape
     q = starts.reshape(n * s, dof).copy()
     targets = np.repeat(T_t, s, axis=0)
-    refs = np.broadcast_to(ref, q.shape)
+    refs = np.broadcast_to(ref, starts.shape).reshape(n * s, dof)
     damping = np.full(n * s, opts.damping)
     frames, end = chain_fk(chain, q)
     err = pose_error(targets, end)
     cost = np.einsum("ij,ij->i", err, err)
     done = _converged(err, opts)
-    for _ in range(opts.iterations):
-        if done.all():
+    live = ~done  # rows still descending: neither converged nor stalled
+    checkpoint = cost.copy()
+    for it in range(opts.iterations):
+        if it and it % _PROGRESS_WINDOW == 0:  # no real progress in a window: a local minimum
+            live &= cost < _PROGRESS_RATIO * checkpoint
+            checkpoint = cost.copy()
+        if enough is not None:  # targets with enough converged starts stop the others
+            solved = done.reshape(n, s).sum(axis=1) >= enough
+            live &= ~np.repeat(solved, s)
+        rows = np.flatnonzero(live)
+        if len(rows) == 0:
             break
-        J = chain_jacobian(chain, frames, end)
-        step = _step(J, err, damping, refs - q, opts)
+        qa, ea, da, fa, enda = q[rows], err[rows], damping[rows], frames[rows], end[rows]
+        J = chain_jacobian(chain, fa, enda)
+        step = _step(J, ea, da, refs[rows] - qa, opts)
         # a joint at a limit that the step pushes outward is frozen: solve without it
-        blocked = ((q <= lo) & (step < 0.0)) | ((q >= hi) & (step > 0.0))
+        blocked = ((qa <= lo) & (step < 0.0)) | ((qa >= hi) & (step > 0.0))
         if blocked.any():
             J = np.where(blocked[:, None, :], 0.0, J)
-            step = np.where(blocked, 0.0, _step(J, err, damping, refs - q, opts))
-        trial = np.clip(q + step, lo, hi)
+            step = np.where(blocked, 0.0, _step(J, ea, da, refs[rows] - qa, opts))
+        trial = np.clip(qa + step, lo, hi)
         t_frames, t_end = chain_fk(chain, trial)
-        t_err = pose_error(targets, t_end)
+        t_err = pose_error(targets[rows], t_end)
         t_cost = np.einsum("ij,ij->i", t_err, t_err)
-        better = (t_cost < cost) & ~done
+        better = t_cost < cost[rows]
         # Levenberg-Marquardt: accept and trust the model more, or refuse and damp more
-        damping = np.where(better, np.maximum(damping / 3.0, 1e-6), np.minimum(damping * 4, 1e2))
-        q = np.where(better[:, None], trial, q)
-        frames = np.where(better[:, None, None, None], t_frames, frames)
-        end = np.where(better[:, None, None], t_end, end)
-        err = np.where(better[:, None], t_err, err)
-        cost = np.where(better, t_cost, cost)
-        done = _converged(err, opts)
+        stalled = ~better & (da >= _MAX_DAMPING)
+        damping[rows] = np.where(
+            better, np.maximum(da / 3.0, 1e-6), np.minimum(da * 4, _MAX_DAMPING)
+        )
+        won = rows[better]
+        q[won], frames[won], end[won] = trial[better], t_frames[better], t_end[better]
+        err[won], cost[won] = t_err[better], t_cost[better]
+        done[rows] = _converged(err[rows], opts)
+        live[rows] = ~done[rows] & ~stalled
     return q.reshape(n, s, dof), done.reshape(n, s)
+
+
+def _checked(
+    chain: Chain, T_root_target: FloatArray, lower: FloatArray, upper: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    T_t = np.asarray(T_root_target, dtype=np.float64).reshape(-1, 4, 4)
+    lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
+    if lo.shape != (chain.dof,) or hi.shape != lo.shape:
+        raise KinematicsError(f"expected limits of shape ({chain.dof},), got {lo.shape}")
+    if np.any(lo > hi):
+        raise KinematicsError("lower limits above upper limits")
+    return T_t, lo, hi
+
+
+def numeric_ik_branches(
+    chain: Chain,
+    T_root_target: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    q_ref: FloatArray,
+    branches: int,
+    options: NumericIKOptions | None = None,
+    seed: int = 0,
+    distinct: float = 1e-3,
+) -> tuple[FloatArray, BoolArray]:
+    """Up to ``branches`` distinct solutions per target (``(n, 4, 4)`` in the root frame):
+    ``q`` ``(n, branches, dof)`` and ``valid`` ``(n, branches)``. Every target is solved from
+    ``options.seeds`` starts (``q_ref`` first, then uniform draws inside the limits); targets
+    no start solved get fresh starts for up to ``options.rounds`` rounds. Solutions closer
+    than ``distinct`` [rad] on every joint count once; they are ordered by their distance
+    from ``q_ref`` (nearest first). Invalid rows hold ``q_ref``. Deterministic in ``seed``.
+
+    Raises:
+        KinematicsError: shapes that do not match the chain, ``lower > upper`` or
+            ``branches < 1``.
+    """
+    opts = NumericIKOptions() if options is None else options
+    T_t, lo, hi = _checked(chain, T_root_target, lower, upper)
+    ref = np.asarray(q_ref, dtype=np.float64)
+    if ref.shape != lo.shape:
+        raise KinematicsError(f"expected a reference of shape ({chain.dof},), got {ref.shape}")
+    if branches < 1:
+        raise KinematicsError(f"branches must be >= 1, got {branches}")
+    n, dof, s = len(T_t), chain.dof, max(1, opts.seeds)
+    rng = np.random.default_rng(seed)
+    q_out = np.repeat(np.repeat(ref[None, None], n, axis=0), branches, axis=1)
+    valid = np.zeros((n, branches), dtype=bool)
+    for round_ in range(max(1, opts.rounds)):
+        todo = np.flatnonzero(~valid.any(axis=1))
+        if len(todo) == 0:
+            break
+        draws = rng.uniform(lo, hi, (len(todo), s, dof))
+        if round_ == 0:
+            draws[:, 0] = ref
+        q, done = _descend(chain, T_t[todo], draws, lo, hi, ref, opts, enough=branches)
+        order = np.argsort(np.where(done, np.linalg.norm(q - ref, axis=2), np.inf), axis=1)
+        for row, t in enumerate(todo):
+            kept: list[FloatArray] = []
+            for k in order[row]:
+                if not done[row, k] or len(kept) == branches:
+                    break
+                if all(np.abs(q[row, k] - other).max() >= distinct for other in kept):
+                    kept.append(q[row, k])
+            if kept:
+                q_out[t, : len(kept)] = kept
+                valid[t, : len(kept)] = True
+    return q_out, np.asarray(valid, dtype=np.bool_)
+
+
+def numeric_ik_from(
+    chain: Chain,
+    T_root_target: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    starts: FloatArray,
+    options: NumericIKOptions | None = None,
+) -> tuple[FloatArray, BoolArray]:
+    """Continue solutions: each target ``(n, 4, 4)`` solved from its own starts ``starts``
+    ``(n, b, dof)`` only, the null space pulled toward the start (the nearest solution of
+    the start's branch): ``q`` ``(n, b, dof)`` and which converged ``(n, b)``.
+
+    Raises:
+        KinematicsError: shapes that do not match the chain or ``lower > upper``.
+    """
+    opts = NumericIKOptions() if options is None else options
+    T_t, lo, hi = _checked(chain, T_root_target, lower, upper)
+    q0 = np.asarray(starts, dtype=np.float64)
+    if q0.ndim != 3 or q0.shape[0] != len(T_t) or q0.shape[2] != chain.dof:
+        raise KinematicsError(
+            f"expected starts of shape ({len(T_t)}, b, {chain.dof}), got {q0.shape}"
+        )
+    q0 = np.clip(q0, lo, hi)
+    return _descend(chain, T_t, q0, lo, hi, q0, opts)

@@ -1,4 +1,5 @@
-"""Straight tool moves (approach and retreat) by closed-form IK interpolation."""
+"""Straight tool moves (approach and retreat) by IK interpolation (closed form, or the
+numeric IK of every step solved from the start configuration)."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ def straight_tool_move(
     step: float = 0.01,
     max_joint_step: float = 0.3,
 ) -> FloatArray | None:
-    """Configurations ``(n + 1, 6)`` [rad] moving the TCP by ``distance`` [m] along its own
+    """Configurations ``(n + 1, dof)`` [rad] moving the TCP by ``distance`` [m] along its own
     z axis (negative: backwards, i.e. a retreat), orientation fixed, starting at ``q``.
 
     Each step takes the IK branch nearest to the previous configuration; None when a step is
@@ -26,8 +27,14 @@ def straight_tool_move(
     n = max(1, int(np.ceil(abs(distance) / step)))
     T = np.repeat(T0[None], n, axis=0)
     T[:, :3, 3] += (distance * np.arange(1, n + 1) / n)[:, None] * T0[:3, 2][None]
-    sol = kin.ik_tcp(T)
     out = [q]
+    if not kin.closed_form:  # every step solved from q, its redundancy pulled toward q
+        near = kin.ik_tcp_from(T, np.repeat(q[None, None], n, axis=0))
+        path = np.concatenate([q[None], near.q[:, 0]])
+        if not near.valid.all() or np.abs(np.diff(path, axis=0)).max() > max_joint_step:
+            return None
+        return path
+    sol = kin.ik_tcp(T)
     for k in range(n):
         d = np.where(sol.valid[k], np.abs(sol.q[k] - out[-1]).max(axis=1), np.inf)
         b = int(np.argmin(d))
@@ -40,7 +47,7 @@ def straight_tool_move(
 def tool_pose_ik(
     kin: ArmKinematics, T_world_tcp: FloatArray, q_near: FloatArray
 ) -> FloatArray | None:
-    """The valid IK branch ``(6,)`` for a TCP pose nearest to ``q_near``, or None."""
+    """The valid IK branch ``(dof,)`` for a TCP pose nearest to ``q_near``, or None."""
     sol = kin.ik_tcp(T_world_tcp[None])
     if not sol.valid[0].any():
         return None

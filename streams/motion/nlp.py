@@ -25,11 +25,10 @@ from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
 from streams.motion._casadi import ca, sx_sym
-from streams.motion.fk_casadi import joint_frames
 from streams.motion.optimiser_records import TrajOptOptions
 
-#: Joint frames of an arm a sphere may hang on (frame ``j`` carries link ``j + 1``; tool0 is
-#: the last).
+#: Joint frames of a UR arm a sphere may hang on (frame ``j`` carries link ``j + 1``; tool0 is
+#: the last); another arm has its own count (:attr:`streams.motion.fk_casadi.ArmFK.n_frames`).
 FRAMES = 6
 
 
@@ -58,16 +57,20 @@ class ParameterLayout:
         p[start : start + rows * cols] = np.asarray(value, dtype=np.float64).reshape(rows * cols)
 
 
-def parameter_layout(arms: ArmLayout, o: TrajOptOptions) -> ParameterLayout:
+def parameter_layout(
+    arms: ArmLayout, o: TrajOptOptions, frames: tuple[int, ...] | None = None
+) -> ParameterLayout:
     """The blocks of the NLP's parameter vector: the end knots, every arm's slots (frame,
-    centre, radius per kind; the obstacle spheres of its arm-obstacle slots) and the margin."""
+    centre, radius per kind; the obstacle spheres of its arm-obstacle slots) and the margin.
+    ``frames``: per arm, the frames its spheres may hang on (default :data:`FRAMES` each)."""
     dof = arms.dof
+    per_arm = (FRAMES,) * len(arms) if frames is None else frames
     lay = ParameterLayout()
     lay.add("q0", 1, dof)
     lay.add("q1", 1, dof)
     for i in range(len(arms)):
         for kind, slots in slot_kinds(o):
-            lay.add(f"{kind}_frame{i}", slots, FRAMES)
+            lay.add(f"{kind}_frame{i}", slots, per_arm[i])
             lay.add(f"{kind}_centre{i}", slots, 3)
             lay.add(f"{kind}_radius{i}", slots, 1)
         lay.add(f"ao_obs{i}", o.obstacle_slots, 4)
@@ -110,10 +113,7 @@ def _knot_rows(ctx: WorldContext, lay: ParameterLayout, q: Any, p: Any) -> Any:
     and arm-table slots per arm."""
     arms = ctx.layout
     m = lay.sym(p, "margin")
-    frames = [
-        joint_frames(q[sl], ctx.fk[arm].T_world_base, ctx.fk[arm].params, ctx.fk[arm].T_base_dh)
-        for arm, sl in zip(ctx.arm_names, arms.slices, strict=True)
-    ]
+    frames = [ctx.fk[arm].frames(q[sl]) for arm, sl in zip(ctx.arm_names, arms.slices, strict=True)]
     (cl, rl), (cr, rr) = (_slot_centres(lay, frames[i], p, "aa", i) for i in (0, 1))
     g = [ca.sum2((cl - cr) ** 2) - (rl + rr + m) ** 2]
     for i in range(len(arms)):
@@ -131,7 +131,7 @@ def build_nlp(ctx: WorldContext, o: TrajOptOptions) -> TransferNLP:
     the clearance rows, their Jacobian and the Hessian of their weighted sum are small
     SX functions of one knot, mapped over the knots, so CasADi differentiates one knot,
     not the whole horizon (the collision Jacobian and Hessian are block diagonal)."""
-    lay = parameter_layout(ctx.layout, o)
+    lay = parameter_layout(ctx.layout, o, tuple(ctx.fk[a].n_frames for a in ctx.arm_names))
     dof, n = ctx.layout.dof, o.knots - 2
     q_k, p_k = sx_sym("q", dof), sx_sym("p", lay.size)
     rows_k = _knot_rows(ctx, lay, q_k, p_k)

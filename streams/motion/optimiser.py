@@ -50,8 +50,8 @@ class TrajectoryOptimiser:
     the parameters, mapped over the interior knots (``Function.map``), and so are their
     derivatives (see :func:`streams.motion.nlp.build_nlp`): the build differentiates one
     knot, not the whole horizon, and takes a fraction of a second. A slot names its
-    sphere by the joint frame it hangs on (a one-hot row over the six frames of its arm; a
-    held sphere hangs on tool0) and its centre [m] and radius [m] in that frame, so the
+    sphere by the joint frame it hangs on (a one-hot row over the frames of its arm; a
+    held sphere hangs on the tool frame) and its centre [m] and radius [m] in that frame, so the
     graph grows with the frames, not with every sphere of the arm."""
 
     def __init__(self, ctx: WorldContext, options: TrajOptOptions | None = None) -> None:
@@ -86,14 +86,14 @@ class TrajectoryOptimiser:
         poses, the kinematic parameters and the code that builds the expressions (the key of
         the compiled library; a loaded library is also checked by its values)."""
         from sdar_tamp.world import kinematics, ur_ik
-        from streams.motion import _casadi, fk_casadi, nlp
+        from streams.motion import _casadi, fk_casadi, fk_chain, nlp
 
         parts = [repr(self.options), repr(self.ctx.layout)]
         for arm in self.ctx.arm_names:
             fk = self.ctx.fk[arm]
-            parts.append(repr(fk.params) + np.asarray(fk.T_base_dh).tobytes().hex())
+            parts.append(fk.recipe())
             parts.append(np.asarray(fk.T_world_base).tobytes().hex())
-        for module in (_casadi, fk_casadi, kinematics, ur_ik, nlp):
+        for module in (_casadi, fk_casadi, fk_chain, kinematics, ur_ik, nlp):
             parts.append(Path(module.__file__ or "").read_text(encoding="utf-8"))
         parts.append(Path(__file__).read_text(encoding="utf-8"))
         return "\n".join(parts)
@@ -217,10 +217,6 @@ class TrajectoryOptimiser:
              np.tile(self._amax * dt * dt, K - 2)]
         )  # fmt: skip
         return p, lbg, ubg
-
-
-#: Joint frames of an arm a sphere may hang on (frame ``j`` carries link ``j + 1``; tool0 is
-#: the last).
 
 
 def _remove(library: Path) -> None:

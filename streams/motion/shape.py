@@ -192,7 +192,7 @@ def straight_end_deviation(
     kin: ArmKinematics, q: FloatArray, q_grasp: FloatArray, straight: float
 ) -> tuple[float, float]:
     """Largest lateral distance [m] of the TCP from the grasp's tool axis, and largest angle
-    [rad] of the tool from the grasp's orientation, over the samples ``q`` ``(m, 6)`` (in
+    [rad] of the tool from the grasp's orientation, over the samples ``q`` ``(m, dof)`` (in
     order from the grasp outwards) before the first one ``straight`` [m] away from the grasp;
     ``(inf, inf)`` when the samples never get that far."""
     T_g = kin.fk_tcp(np.asarray(q_grasp, dtype=np.float64))

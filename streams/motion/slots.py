@@ -16,7 +16,6 @@ import numpy as np
 
 from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
-from streams.motion.nlp import FRAMES
 from streams.motion.optimiser_records import TrajOptOptions, TransferQuery
 from streams.motion.sphere_pairs import (
     HeldSpheres,
@@ -30,26 +29,29 @@ from streams.motion.sphere_pairs import (
 @dataclass(frozen=True)
 class SphereTable:
     """Spheres of one arm as the optimiser's slots see them: frame index ``(n,)`` (0-based),
-    centre in that frame ``(n, 3)`` [m], radius ``(n,)`` [m]."""
+    centre in that frame ``(n, 3)`` [m], radius ``(n,)`` [m], of the arm's ``n_frames``
+    frames (a held object's spheres hang on the last, the tool frame)."""
 
     frame: Any
     centre: FloatArray
     radius: FloatArray
+    n_frames: int
 
     def plus(self, held: HeldSpheres) -> SphereTable:
         """With the held spheres appended (on tool0), as :func:`path_spheres` orders them."""
         n = len(held.radius)
         return SphereTable(
-            np.concatenate([self.frame, np.full(n, FRAMES - 1, dtype=np.int64)]),
+            np.concatenate([self.frame, np.full(n, self.n_frames - 1, dtype=np.int64)]),
             np.concatenate([self.centre, np.asarray(held.centre).reshape(n, 3)]),
             np.concatenate([self.radius, held.radius]),
+            self.n_frames,
         )
 
     def slots(self, idx: Any, slots: int) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Slot rows for spheres ``idx``: one-hot frames ``(slots, FRAMES)``, centres
+        """Slot rows for spheres ``idx``: one-hot frames ``(slots, n_frames)``, centres
         ``(slots, 3)``, radii ``(slots, 1)``; unused slots are zero."""
         idx = np.asarray(idx, dtype=np.int64)
-        frame = np.zeros((slots, FRAMES))
+        frame = np.zeros((slots, self.n_frames))
         centre, radius = np.zeros((slots, 3)), np.zeros((slots, 1))
         frame[np.arange(len(idx)), self.frame[idx]] = 1.0
         centre[: len(idx)] = self.centre[idx]
@@ -76,7 +78,9 @@ def arm_sphere_tables(ctx: WorldContext, arm: str) -> ArmSphereTables:
 
     def table(spheres: Any) -> SphereTable:
         frame = np.asarray(spheres.joint, dtype=np.int64) - 1
-        return SphereTable(frame, np.asarray(spheres.centre), np.asarray(spheres.radius))
+        return SphereTable(
+            frame, np.asarray(spheres.centre), np.asarray(spheres.radius), fk.n_frames
+        )
 
     return ArmSphereTables(table(fk.spheres), table(fk.coarse))
 

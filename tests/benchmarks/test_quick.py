@@ -38,6 +38,13 @@ MAY_SKIP = {("bench_pddlstream_compat", ()), ("bench_motion", ("--hard", "1"))}
 Summary = dict[str, Any]
 
 
+def _arm_ik(out: Summary) -> None:
+    ur, arm7 = out["arms"]["ur5e"], out["arms"]["arm7"]
+    assert ur["solver"] == "closed form" and ur["branches"] == 8 and ur["success_rate"] == 1.0
+    assert arm7["solver"] == "numeric" and arm7["dof"] == 7 and arm7["poses"] == 100
+    assert arm7["success_rate"] >= 0.95 and arm7["max_error"] < 1e-5
+
+
 def _async(out: Summary) -> None:
     assert out["instances"] == 1 and out["all_valid"] is True
     assert out["median_ratio"] <= 1.0  # the scheduler never returns a longer plan
@@ -102,6 +109,7 @@ def _world(out: Summary) -> None:
 
 #: What a run's summary must show (runs not named here: only the common checks)
 CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
+    ("bench_arm_ik", ()): _arm_ik,
     ("bench_async", ()): _async,
     ("bench_classical", ()): _classical,
     ("bench_feasibility", ()): _feasibility,

@@ -67,11 +67,10 @@ def test_other_arms_are_not_ur(tmp_path: Path) -> None:
     assert isinstance(UR5E, URParameters)
 
 
-def test_a_scene_whose_arm_is_not_ur_has_no_inverse_kinematics(tmp_path: Path) -> None:
-    import pytest
+def test_a_scene_whose_arm_is_not_ur_gets_the_numeric_ik(tmp_path: Path) -> None:
+    import numpy as np
 
-    from sdar_tamp.world.errors import KinematicsError
-    from sdar_tamp.world.kinematics import ArmKinematics
+    from sdar_tamp.world.kinematics import NUMERIC_BRANCHES, ArmKinematics
     from sdar_tamp.world.scene import default_scene_path, load_scene
 
     text = UR5E_URDF.read_text(encoding="utf-8").replace(
@@ -86,7 +85,12 @@ def test_a_scene_whose_arm_is_not_ur_has_no_inverse_kinematics(tmp_path: Path) -
         .replace("robot: ur5e_2f85.urdf", "robot: bent.urdf")
     )
     (tmp_path / "scene.yaml").write_text(scene, encoding="utf-8")
-    with pytest.raises(KinematicsError, match=r"bent\.urdf: the chain to tool0 is not a UR-family"):
-        ArmKinematics.from_scene(load_scene(tmp_path / "scene.yaml"), "left")
+    bent = ArmKinematics.from_scene(load_scene(tmp_path / "scene.yaml"), "left")
+    assert not bent.closed_form and bent.params is None and bent.branches == NUMERIC_BRANCHES
+    home = np.array(bent.spec.home)
+    target = bent.fk_tool0(home)
+    sol = bent.ik_tool0(target)
+    assert sol.q.shape == (1, NUMERIC_BRANCHES, 6) and sol.valid[0, 0]
+    np.testing.assert_allclose(bent.fk_tool0(sol.q[0, 0]), target, atol=1e-5)
     found = ArmKinematics.from_scene(load_scene(), "left")
-    assert found.params == UR5E
+    assert found.params == UR5E and found.closed_form
