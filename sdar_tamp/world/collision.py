@@ -4,10 +4,11 @@ Checked pairs:
 
 * arm against arm (every link and gripper shape of one arm against every one of the other);
 * one arm against itself, links at least two joints apart (adjacent links are excluded);
-* arm against table (except ``base_link`` and ``shoulder_link``, which stand on it);
+* arm against table (except the links fixed to the base and moved by the first joint, which
+  stand on it);
 * arm against every resting object;
-* a held object against the other arm, its own arm up to ``wrist_2`` (never its own wrist_3
-  link and gripper, which hold it), the table, every resting object and the other held object.
+* a held object against the other arm, its own arm's links but the last (never its last link
+  and gripper, which hold it), the table, every resting object and the other held object.
 
 Resting objects are not checked against each other or the table (that is the arrangement's
 job, see :mod:`sdar_tamp.world.instance`). Object boxes are shrunk by ``tolerance`` on every
@@ -262,7 +263,8 @@ class CollisionWorld:
         held = list(self._held.items())
         for k, (arm, (name, _, _)) in enumerate(held):
             h = f"held:{name}"
-            pairs.extend((s.name, h) for s in shapes if s.arm != arm or s.link_index < 6)
+            last = self.layout.slice(arm).stop - self.layout.slice(arm).start  # its dof
+            pairs.extend((s.name, h) for s in shapes if s.arm != arm or s.link_index < last)
             pairs.append((h, "table"))
             pairs.extend((h, f"object:{o}") for o in self._resting)
             pairs.extend((h, f"held:{other}") for _, (other, _, _) in held[k + 1 :])

@@ -12,7 +12,7 @@ from sdar_tamp.world.scene import domain_path
 from sdar_tamp.world.ur_identify import ur_parameters
 from sdar_tamp.world.ur_ik import UR5E, URParameters, ur_fk, ur_ik
 
-UR5E_URDF = domain_path("ur5e_2f85.urdf")
+UR5E_URDF = domain_path("robots/ur5e_2f85.urdf")
 
 
 def test_the_shipped_ur5e_reads_back_exactly() -> None:
@@ -83,7 +83,7 @@ def test_a_scene_whose_arm_is_not_ur_has_no_inverse_kinematics(tmp_path: Path) -
     scene = (
         default_scene_path()
         .read_text(encoding="utf-8")
-        .replace("robot: ur5e_2f85.urdf", "robot: bent.urdf")
+        .replace("robot: ../robots/ur5e_2f85.urdf", "robot: bent.urdf")
     )
     (tmp_path / "scene.yaml").write_text(scene, encoding="utf-8")
     with pytest.raises(KinematicsError, match=r"bent\.urdf: the chain to tool0 is not a UR-family"):
