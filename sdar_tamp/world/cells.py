@@ -49,6 +49,17 @@ def shipped_cells() -> tuple[CellEntry, ...]:
     return tuple(CellEntry(p.stem, p, describe(p)) for p in paths)
 
 
+def is_cell_file(path: Path) -> bool:
+    """Whether ``path`` is a scene file (a YAML mapping with ``arms``), not an instance."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return False
+    return isinstance(data, dict) and "arms" in data
+
+
 def cell_path(name: str) -> Path:
     """The scene file of the shipped cell ``name``.
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sdar_tamp.cli import main
@@ -47,3 +48,27 @@ def test_sdar_cells_lists_and_checks(capsys: pytest.CaptureFixture[str], tmp_pat
     assert main(["cells", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "bad.yaml:4:" in err and "robot: expected a robot description file" in err
+
+
+def test_sdar_show_draws_a_cell(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    out = tmp_path / "cell.png"
+    assert main(["show", str(default_scene_path()), "-o", str(out)]) == 0
+    assert out.stat().st_size > 10_000 and "wrote" in capsys.readouterr().out
+    assert main(["show", str(default_scene_path()), "-o", str(tmp_path / "cell.html")]) == 2
+    assert "a cell is drawn to one of .png" in capsys.readouterr().err
+
+
+def test_the_sampled_reach_covers_the_workspace() -> None:
+    """Every workspace corner has a sampled TCP of each arm within 10 cm (the shipped cell is
+    chosen so that both arms reach all of it)."""
+    from sdar_tamp.world.draw_cell import arm_points
+
+    scene = load_scene()
+    ws = scene.workspace
+    corners = np.array([(x, y) for x in ws.x for y in ws.y])
+    for arm in scene.arms:
+        chain, near = arm_points(scene, arm, samples=6000)
+        assert chain.shape == (arm.dof + 2, 3)
+        np.testing.assert_allclose(chain[0, :2], arm.base_xyz[:2], atol=1e-9)
+        gaps = np.linalg.norm(near[None, :, :2] - corners[:, None], axis=2).min(axis=1)
+        assert gaps.max() < 0.1, (arm.name, gaps)
