@@ -19,13 +19,15 @@ from sdar_tamp.world.suites import suite_members
 
 
 def cell_options(scene: Path | None, folder: Path) -> tuple[GeneratorOptions | None, str | None]:
-    """The generator's options for the cell ``scene`` (its workspace and default object;
-    None: the defaults) and the ``scene`` key of instances written to ``folder`` (the scene
-    file relative to it)."""
+    """The generator's options for the cell ``scene`` (its workspace, default object and
+    grippers; None: the defaults) and the ``scene`` key of instances written to ``folder``
+    (the scene file relative to it)."""
     if scene is None:
         return None, None
     cell = load_scene(Path(scene))
-    options = GeneratorOptions(size=cell.object_size, workspace=cell.workspace)
+    options = GeneratorOptions(
+        size=cell.object_size, workspace=cell.workspace, grasp=cell.grasp_limits
+    )
     key = os.path.relpath(Path(scene).resolve(), Path(folder).resolve())
     return options, Path(key).as_posix()
 

@@ -113,3 +113,21 @@ def test_sdar_bench_takes_the_scene_option(
     assert main([*argv, "--scene", str(cell)]) == 0
     record = read_settings(out)
     assert record is not None and str(cell.resolve()) in record.scene
+
+
+def test_generate_checks_objects_against_the_cells_gripper(tmp_path: Path) -> None:
+    """A cell with a wider gripper and object: instances the shipped gripper could not hold
+    are generated for it, and load against its grippers only."""
+    from sdar_tamp.world.errors import InstanceError
+    from sdar_tamp.world.instance_files import generate
+
+    cell = _cell(tmp_path, "wide.yaml")
+    data = yaml.safe_load(cell.read_text(encoding="utf-8"))
+    data["gripper"].update(max_opening=0.09, stroke=0.09)
+    data["object_size"] = [0.08, 0.07, 0.05]
+    cell.write_text(yaml.safe_dump(data), encoding="utf-8")
+    path = generate("R", 2, 0, tmp_path / "R2.yaml", scene=cell)
+    with pytest.raises(InstanceError, match="cannot be grasped"):
+        load_instance(path)
+    instance = load_instance(path, load_scene(cell).grasp_limits)
+    assert {o.size for o in instance.objects} == {(0.08, 0.07, 0.05)}
