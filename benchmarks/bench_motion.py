@@ -89,9 +89,7 @@ def hard_set(instance: str, seed: int, count: int, quick: bool = False) -> None:
         "sdar-m": (ladder, warm_started_strategies()),
     }
     alone.trajopt  # noqa: B018  (wait for the build: not part of any planning time)
-    grasps = {
-        n: sample_grasps(objects[n].size, ctx.scene.gripper.max_graspable_width) for n in names
-    }
+    grasps = {n: sample_grasps(objects[n].size, ctx.scene.grasp_limits) for n in names}
     cands = {
         (a, n): solve_ik_candidates(
             ctx, world, objects, [IKRequest(a, n, objects[n], grasps[n])], home
@@ -205,7 +203,7 @@ def main(argv: list[str] | None = None) -> None:
     rng = np.random.default_rng(args.seed)
     world = ctx.new_world()
     check_world = ctx.new_world()
-    grasps = {n: sample_grasps(start[n].size, ctx.scene.gripper.max_graspable_width) for n in names}
+    grasps = {n: sample_grasps(start[n].size, ctx.scene.grasp_limits) for n in names}
     home = {a: ctx.home(a) for a in ctx.arm_names}
     left, right = ctx.arm_names
 

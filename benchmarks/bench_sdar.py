@@ -10,6 +10,11 @@ planner's one-off set-up (building the optimiser) is excluded and printed separa
     python benchmarks/bench_sdar.py [--suite paper] [--max-objects 12] [--time-limit 60]
                                     [--task-planner sdar] [--motion-planner sdar] [--only M1,R4]
     python benchmarks/bench_sdar.py --quick    # R4 alone: seconds
+    python benchmarks/bench_sdar.py --scene CELL.yaml [--folder SUITE_DIR]   # another cell
+
+``--scene`` solves in that cell (a scene file, e.g. of ``sdar cells``) instead of the
+instances' own; ``--folder`` takes the instances of a folder (e.g. a suite generated for the
+cell by ``sdar generate --suite paper --scene CELL.yaml``) instead of a shipped suite.
 
 Prints one row per instance, a summary, then one JSON object on the last line.
 
@@ -34,14 +39,19 @@ from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.suites import SUITES
 
 
+def _order(p: Path) -> tuple[str, int]:
+    digits = re.sub(r"\D", "", p.stem)
+    return (p.stem[0], int(digits) if digits else 0)
+
+
 def _suite_files(suite: str) -> list[Path]:
     folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
+    return sorted(folder.glob("*.yaml"), key=_order)
 
-    def key(p: Path) -> tuple[str, int]:
-        digits = re.sub(r"\D", "", p.stem)
-        return (p.stem[0], int(digits) if digits else 0)
 
-    return sorted(folder.glob("*.yaml"), key=key)
+def _folder_files(folder: Path) -> list[Path]:
+    """The instance files of ``folder``, by family then object count."""
+    return sorted(Path(folder).glob("*.yaml"), key=_order)
 
 
 #: ``--quick``'s defaults
@@ -56,6 +66,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--task-planner", default="sdar", choices=("sdar", "baseline"))
     ap.add_argument("--motion-planner", default="sdar", choices=("sdar", "plain", "sequential"))
     ap.add_argument("--only", default="", help="comma-separated instance names")
+    ap.add_argument("--scene", type=Path, default=None, help="a cell replacing the instances'")
+    ap.add_argument("--folder", type=Path, default=None, help="instances of this folder instead")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument(
         "--compare-adaptive",
@@ -80,7 +92,7 @@ def main(argv: list[str] | None = None) -> None:
     start = time.perf_counter()
     print(f"{'instance':>9} {'n':>3} {'ok':>3} {'actions':>7} {'steps':>5} {'exec s':>7} "
           f"{'plan s':>7} {'step med':>8} {'levels'}")  # fmt: skip
-    for path in _suite_files(args.suite):
+    for path in _suite_files(args.suite) if args.folder is None else _folder_files(args.folder):
         if wanted and path.stem not in wanted:
             continue
         if args.max_objects is not None and len(load_instance(path).objects) > args.max_objects:
@@ -92,6 +104,7 @@ def main(argv: list[str] | None = None) -> None:
             task_planner=args.task_planner,
             motion_planner=args.motion_planner,
             cache=cache,
+            scene=args.scene,
         )
         n = len(outcome.instance.objects)
         f = outcome.figures
@@ -134,7 +147,8 @@ def main(argv: list[str] | None = None) -> None:
     per_instance = [float(r["planning_time"]) / int(r["steps"]) for r in solved if r["steps"]]
     summary = {
         "benchmark": "sdar",
-        "suite": args.suite,
+        "suite": args.suite if args.folder is None else str(args.folder),
+        "scene": None if args.scene is None else str(args.scene),
         "task_planner": args.task_planner,
         "motion_planner": args.motion_planner,
         "time_limit": args.time_limit,

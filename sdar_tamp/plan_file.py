@@ -45,9 +45,9 @@ UNITS = {"length": "m", "angle": "rad", "time": "s"}
 MAX_DT = 0.02  #: largest spacing of trajectory samples [s]
 EVENT_TYPES = ("grasp", "release")
 MAX_DEPTH = 64  #: deepest nesting of JSON lists and objects a plan file may have
-#: After its gripper event an arm stands still this long [s] (the gripper closes or opens;
-#: the 2F-85 takes about half a second). :func:`~sdar_tamp.plan_building.build_plan_file` keeps
-#: both arms still.
+#: After its gripper event an arm stands still this long [s] (the gripper closes or opens; a
+#: parallel gripper takes about half a second). :func:`~sdar_tamp.plan_building.build_plan_file`
+#: keeps both arms still.
 GRIPPER_DWELL = 0.5
 #: Arms of a version-1 plan file (each with its own joint count; the in-memory plan goes by
 #: its layout).

@@ -36,11 +36,7 @@ def reachable_top_down(
     p = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
     if len(p) == 0:
         return np.zeros(0, dtype=np.bool_)
-    top = [
-        g
-        for g in (grasps or sample_grasps(size, ctx.scene.gripper.max_graspable_width, ()))
-        if g.is_top_down
-    ]
+    top = [g for g in (grasps or sample_grasps(size, ctx.scene.grasp_limits, ())) if g.is_top_down]
     if not top:
         return np.zeros(len(p), dtype=np.bool_)
     T_obj = pose_xyz_yaw(p[:, 0], p[:, 1], size[2] / 2.0, p[:, 2])  # (n, 4, 4)

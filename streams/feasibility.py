@@ -230,9 +230,9 @@ def prove_infeasible(
     """A proof that ``instance`` cannot be solved with the grasp set ``grasps`` and the
     clearance ``margin`` [m] (first picks, then last placements), or ``None`` when these
     tests find none."""
-    width = ctx.scene.gripper.max_graspable_width
+    limits = ctx.scene.grasp_limits
     sets = {
-        o.name: sample_grasps(o.size, width, grasps.tilts, grasps.symmetric)
+        o.name: sample_grasps(o.size, limits, grasps.tilts, grasps.symmetric)
         for o in instance.objects
     }
     moving = {o.name for o in instance.objects if not _stays(o.start, o.goal)}

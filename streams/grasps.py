@@ -30,6 +30,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.graspability import (
     MIN_FINGER_CONTACT,
     WIDTH_TOLERANCE,
+    GraspLimits,
     finger_contact,
     fits_between_fingers,
     grasp_height,
@@ -113,7 +114,7 @@ def grasp_rotation(closing_axis: int, tilt: float, flipped: bool) -> FloatArray:
 
 def sample_grasps(
     size: tuple[float, float, float],
-    max_width: float,
+    limits: GraspLimits,
     tilts: Sequence[float] = DEFAULT_TILTS,
     symmetric: bool = True,
     min_width: float = 0.0,
@@ -121,7 +122,8 @@ def sample_grasps(
 ) -> tuple[Grasp, ...]:
     """All grasps of a cuboid of ``size`` (lx, ly, lz) [m], in the order described above.
 
-    ``max_width`` [m]: the largest side the fingers can close on (opening minus margin);
+    ``limits``: the gripper's (the largest side its fingers close on, their reach and width;
+    :attr:`sdar_tamp.world.scene.Scene.grasp_limits` for the grasps every arm can use);
     ``tilts`` [rad]: growing positive tilt angles, each tried as ``+t`` then ``-t``;
     ``pair_tilts`` [rad]: the same, appended after every grasp of ``tilts`` (an angle of
     ``tilts`` is not repeated).
@@ -132,21 +134,22 @@ def sample_grasps(
     axes = [
         a
         for a in sorted((0, 1), key=lambda a: size[a])
-        if min_width - WIDTH_TOLERANCE <= size[a] and fits_between_fingers(size[a], max_width)
+        if min_width - WIDTH_TOLERANCE <= size[a]
+        and fits_between_fingers(size[a], limits.max_width)
     ]
     extra = sorted(t for t in set(pair_tilts) if not any(abs(t - u) < 1e-9 for u in tilts))
     angles = [0.0] + [s * t for t in (*sorted(tilts), *extra) for s in (1.0, -1.0)]
     flips = (False, True) if symmetric else (False,)
     out: list[Grasp] = []
     for tilt in angles:
-        if finger_contact(size[2], tilt) < MIN_FINGER_CONTACT - WIDTH_TOLERANCE:
+        if finger_contact(size[2], limits, tilt) < MIN_FINGER_CONTACT - WIDTH_TOLERANCE:
             continue  # too little of a short object would be left between the fingers
         for axis in axes:
             for flip in flips:
                 R = grasp_rotation(axis, tilt, flip)
                 T = np.eye(4)
                 T[:3, :3] = R
-                T[2, 3] = grasp_height(size[2], tilt) - 0.5 * size[2]
+                T[2, 3] = grasp_height(size[2], limits, tilt) - 0.5 * size[2]
                 out.append(Grasp(len(out), T, float(size[axis]), R[:, 2].copy(), tilt, axis, flip))
     return tuple(out)
 

@@ -147,7 +147,7 @@ class RearrangementStreams:
             options = self.grasp_options
             self._grasps[obj] = sample_grasps(
                 self.size(obj),
-                self.ctx.scene.gripper.max_graspable_width,
+                self.ctx.scene.grasp_limits,
                 options.tilts,
                 options.symmetric,
                 pair_tilts=options.pair_tilts,
@@ -155,7 +155,7 @@ class RearrangementStreams:
             self._set_sizes[obj] = len(
                 sample_grasps(
                     self.size(obj),
-                    self.ctx.scene.gripper.max_graspable_width,
+                    self.ctx.scene.grasp_limits,
                     options.tilts,
                     options.symmetric,
                 )

@@ -110,13 +110,15 @@ def _instance(tmp_path: Path) -> Path:
 READERS: dict[str, tuple[Callable[[Path], Path], Callable[[Path], object], type[SdarError]]] = {
     "instance": (_instance, load_instance, InstanceError),
     "scene": (
-        lambda tmp: _bad_copy(domain_file("dual_arm_rearrangement", "scene.yaml"), tmp / "s.yaml"),
+        lambda tmp: _bad_copy(
+            domain_file("dual_arm_rearrangement", "cells/ur5e_facing.yaml"), tmp / "s.yaml"
+        ),
         load_scene,
         SceneError,
     ),
     "robot description": (
         lambda tmp: _bad_copy(
-            domain_file("dual_arm_rearrangement", "ur5e_2f85.urdf"), tmp / "robot.urdf"
+            domain_file("dual_arm_rearrangement", "robots/ur5e_2f85.urdf"), tmp / "robot.urdf"
         ),
         PinRobot.load,
         SceneError,

@@ -43,6 +43,7 @@ def solve_instance(
     progress: Callable[[int, int], None] | None = None,
     stage: Callable[[str], None] | None = None,
     cache: PlannerCache | None = None,
+    scene: Path | None = None,
 ) -> SolveOutcome:
     """Solve the instance in ``instance_path`` and validate the plan.
 
@@ -54,6 +55,9 @@ def solve_instance(
     ``progress(done, total)``: called as objects reach their goals; ``stage(text)``: called
     when the work after planning starts (``"scheduling"`` for asynchronous execution, then
     ``"validating"``).
+
+    ``scene``: a scene file (cell) that replaces the instance's (its objects are then checked
+    against that cell's grippers).
 
     ``cache``: keeps the world and the motion planner between calls with the same scene
     (building the optimiser takes a few tenths of a second; it is reported as ``setup_time``, not as
@@ -79,8 +83,10 @@ def solve_instance(
         motion_planner=motion_planner,
         execution=execution,
     )
-    instance = load_instance(instance_path)
-    world = (cache or PlannerCache()).world(instance.scene_path(instance_path), config.trajopt)
+    instance = load_instance(instance_path, grasp=None)
+    scene_path = Path(scene) if scene is not None else instance.scene_path(Path(instance_path))
+    world = (cache or PlannerCache()).world(scene_path, config.trajopt)
+    instance = load_instance(instance_path, world.ctx.scene.grasp_limits)
     rearrangement = rearrangement_problem(instance, world.ctx, config=config, planner=world.planner)
     solution = solve_rearrangement(rearrangement, progress=progress)
     stats = solution.statistics

@@ -124,9 +124,9 @@ def rearrangement_problem(
 
 def grasp_set_sizes(instance: Instance, ctx: WorldContext, config: PlannerConfig) -> dict[str, int]:
     """Object name -> number of grasps in its grasp set (``config.grasps``)."""
-    width = ctx.scene.gripper.max_graspable_width
+    limits = ctx.scene.grasp_limits
     return {
-        o.name: len(sample_grasps(o.size, width, config.grasps.tilts, config.grasps.symmetric))
+        o.name: len(sample_grasps(o.size, limits, config.grasps.tilts, config.grasps.symmetric))
         for o in instance.objects
     }
 

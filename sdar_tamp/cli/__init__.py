@@ -14,6 +14,7 @@ from typing import NoReturn
 
 from sdar_tamp import __version__
 from sdar_tamp.cli.bench import add_bench_parser
+from sdar_tamp.cli.cells import add_cells_parser
 from sdar_tamp.cli.check import add_check_parser
 from sdar_tamp.cli.demo import add_demo_parser
 from sdar_tamp.cli.export import add_export_parser
@@ -50,6 +51,7 @@ def build_parser() -> argparse.ArgumentParser:
         add_show_parser,
         add_validate_parser,
         add_bench_parser,
+        add_cells_parser,
         add_demo_parser,
         add_export_parser,
     ):

@@ -16,6 +16,7 @@ from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 from sdar_tamp.arguments import COUNT, SEED, TIME_LIMIT
+from sdar_tamp.cli.log_options import SCENE_HELP
 from sdar_tamp.errors import SdarError
 
 if TYPE_CHECKING:
@@ -83,7 +84,7 @@ def _bench(args: argparse.Namespace) -> int:
             args.suite, args.out, args.combos, workers=args.workers, time_limit=args.time_limit,
             instances=only, max_objects=args.max_objects, seed=args.seed,
             progress=not args.quiet, restart=args.restart,
-            backend=args.backend, address=args.address, shard=args.shard,
+            backend=args.backend, address=args.address, shard=args.shard, scene=args.scene,
         )  # fmt: skip
     print(f"results: {results}")
     return _redraw(results.parent, args.out)
@@ -154,6 +155,7 @@ def add_bench_parser(sub: argparse._SubParsersAction[Any]) -> None:
         "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="s per run (default: 60)"
     )
     bench.add_argument("--only", default="", help="comma-separated instance names")
+    bench.add_argument("--scene", type=Path, default=None, help=SCENE_HELP)
     bench.add_argument(
         "--max-objects", type=COUNT.parse, default=None, help="skip larger instances"
     )

@@ -17,9 +17,15 @@ CLI_SUITES = ("paper", "stress", "dense")
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
-    """Generate a rearrangement instance (one family) or a whole suite of instance files."""
+    """Generate a rearrangement instance (one family) or a whole suite of instance files.
+    With --scene, inside that cell: its workspace and default object, its arms' reach (the
+    acceptance test plans with its robots), the instances naming it. Shipped cells:
+    `sdar cells`."""
     from sdar_tamp.world.instance_files import generate, generate_suite, suite_files
+    from streams.context import WorldContext
     from streams.feasibility import ProofCheck  # refuses samples proven unsolvable
+
+    check = ProofCheck(WorldContext.load(args.scene) if args.scene is not None else None)
 
     if args.suite is not None:
         if args.family is not None or args.objects is not None:
@@ -31,13 +37,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
                 f"--output: {len(taken)} instance file(s) of suite {args.suite!r} exist in "
                 f"{str(args.output)!r} (e.g. {taken[0].name}); pass --force to replace them"
             )
-        paths = generate_suite(args.suite, args.output, ProofCheck())
+        paths = generate_suite(args.suite, args.output, check, args.scene)
         print(f"wrote {len(paths)} instances of suite {args.suite!r} to {args.output}")
         return 0
     if args.family is None or args.objects is None:
         raise SdarError("sdar generate needs --family and --objects, or --suite")
     output_file(args.output, suffixes=(".yaml", ".yml"), force=args.force)
-    path = generate(args.family, args.objects, args.seed, args.output, ProofCheck())
+    path = generate(args.family, args.objects, args.seed, args.output, check, args.scene)
     print(f"wrote {path}")
     return 0
 
@@ -59,4 +65,10 @@ def add_generate_parser(sub: argparse._SubParsersAction[Any]) -> None:
         help="instance file (.yaml), or folder with --suite",
     )
     generate.add_argument("--force", action="store_true", help=FORCE_HELP)
+    generate.add_argument(
+        "--scene",
+        type=Path,
+        default=None,
+        help="generate inside this cell (scene file; the shipped ones: `sdar cells`)",
+    )
     generate.set_defaults(func=cmd_generate)

@@ -11,6 +11,7 @@ LOG_LEVELS = ("debug", "info", "warning", "error")
 #: Help texts shared by several commands.
 FORCE_HELP = "replace output files that exist (default: refuse)"
 JSON_HELP = "print one JSON object (machine-readable) instead of the text summary"
+SCENE_HELP = "a scene file (cell) replacing the instances' own scene (see `sdar cells`)"
 
 
 def add_logging_options(parser: argparse.ArgumentParser) -> None:

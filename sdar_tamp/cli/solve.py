@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from sdar_tamp.arguments import COUNT, SEED, TIME_LIMIT, output_file
-from sdar_tamp.cli.log_options import FORCE_HELP, JSON_HELP
+from sdar_tamp.cli.log_options import FORCE_HELP, JSON_HELP, SCENE_HELP
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
@@ -35,7 +35,11 @@ def cmd_solve(args: argparse.Namespace) -> int:
         if args.grasps is not None:
             config = config.replace(sdar=dataclasses.replace(config.sdar, grasps=args.grasps))
         outcome = solve_instance(
-            args.instance, config, progress=bar, stage=bar.stage if bar is not None else None
+            args.instance,
+            config,
+            progress=bar,
+            stage=bar.stage if bar is not None else None,
+            scene=args.scene,
         )
     finally:
         if bar is not None:
@@ -62,6 +66,7 @@ def add_solve_parser(sub: argparse._SubParsersAction[Any]) -> None:
     )
     solve.add_argument("instance", type=Path, help="instance YAML")
     solve.add_argument("-o", "--output", type=Path, default=None, help="plan file (.json)")
+    solve.add_argument("--scene", type=Path, default=None, help=SCENE_HELP)
     solve.add_argument("--force", action="store_true", help=FORCE_HELP)
     solve.add_argument(
         "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="seconds (default: 60)"

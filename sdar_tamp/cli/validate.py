@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from sdar_tamp.cli.log_options import JSON_HELP
+from sdar_tamp.cli.log_options import JSON_HELP, SCENE_HELP
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -17,8 +17,10 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from sdar_tamp.world.instance import load_instance
     from sdar_tamp.world.scene import load_scene
 
-    instance = load_instance(args.instance)
-    scene = load_scene(instance.scene_path(Path(args.instance)))
+    instance = load_instance(args.instance, grasp=None)
+    scene_path = args.scene if args.scene is not None else instance.scene_path(args.instance)
+    scene = load_scene(scene_path)
+    instance = load_instance(args.instance, scene.grasp_limits)
     plan = load_plan(args.plan, scene.layout)
     report = validate_plan(instance, plan, scene)
     v = report.violation
@@ -50,5 +52,6 @@ def add_validate_parser(sub: argparse._SubParsersAction[Any]) -> None:
     )
     validate.add_argument("instance", type=Path, help="instance YAML")
     validate.add_argument("plan", type=Path, help="plan JSON")
+    validate.add_argument("--scene", type=Path, default=None, help=SCENE_HELP)
     validate.add_argument("--json", action="store_true", help=JSON_HELP)
     validate.set_defaults(func=cmd_validate)

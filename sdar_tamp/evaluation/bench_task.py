@@ -36,6 +36,7 @@ class BenchTask:
     time_limit: float
     seed: int
     files: InstanceFiles | None = None  # the instance as text, for a machine without the suite
+    scene: Path | None = None  # a scene file (cell) replacing the instance's own
 
 
 @functools.cache
@@ -78,6 +79,7 @@ def run_task(task: BenchTask) -> RunAnswer:
         outcome = solve_instance(
             path, time_limit=task.time_limit, seed=task.seed, task_planner=c.task_planner,
             motion_planner=c.motion_planner, execution=c.execution, cache=_worker_cache(),
+            scene=task.scene,
         )  # fmt: skip
     except Exception as error:  # one broken run is recorded as such, not the end of the bench
         log.exception("%s with %s raised", e.name, c.id)

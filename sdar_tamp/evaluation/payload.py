@@ -63,7 +63,8 @@ def pack(instance_path: Path) -> InstanceFiles:
             )
         scene = instance.scene_path(path)
         assert scene is not None
-        paths += [scene.resolve(), load_scene(scene).robot_urdf.resolve()]
+        urdfs = dict.fromkeys(arm.urdf.resolve() for arm in load_scene(scene).arms)
+        paths += [scene.resolve(), *urdfs]
     base = Path(os.path.commonpath([p.parent for p in paths]))
     files = tuple((p.relative_to(base).as_posix(), read_text(p)) for p in paths)
     return InstanceFiles(files[0][0], files)

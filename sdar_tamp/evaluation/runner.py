@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING
 
 from sdar_tamp import __version__
 from sdar_tamp.arguments import COUNT, SEED, TIME_LIMIT
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.evaluation.backends import check_backend, open_backend
 from sdar_tamp.evaluation.bench_task import BenchTask, run_task, task_row
 from sdar_tamp.evaluation.payload import InstanceFiles, pack
@@ -102,6 +103,7 @@ def run_bench(
     backend: str = "process",
     address: str | None = None,
     shard: Shard | str | None = None,
+    scene: Path | None = None,
 ) -> Path:
     """Solve every (instance, combination) of ``suite`` not yet in ``out_dir/results.csv``
     with ``time_limit`` [s] per run; returns the results file.
@@ -114,7 +116,8 @@ def run_bench(
     :class:`SettingsMismatch` is raised before anything runs, unless ``restart`` discards
     them first. ``hard_limit`` [s] (default :func:`default_hard_limit`) bounds one run. An
     exception (``KeyboardInterrupt``) kills the runs in progress and leaves every finished
-    row in place."""
+    row in place. ``scene``: a scene file (cell) replacing every instance's own (local
+    processes only; recorded in the settings with its content's digest)."""
     from tqdm import tqdm
 
     chosen = parse_combos(combos)
@@ -130,6 +133,15 @@ def run_bench(
     hard_limit = TIME_LIMIT.check("hard_limit", hard_limit)
     if isinstance(shard, str):
         shard = parse_shard(shard)
+    scene_record = ""
+    if scene is not None:
+        if backend == "ray":
+            raise ParameterError(
+                "scene: a replacing scene file runs with the process backend only; with Ray, "
+                "name the scene in the instance files (they travel with them)"
+            )
+        scene = Path(scene).resolve()
+        scene_record = f"{scene} sha256:{file_digest(scene)}"
     entries = suite_entries(suite, instances, max_objects)
     runs = open_backend(backend, run_task, workers, hard_limit=hard_limit, address=address)
     out = Path(out_dir)
@@ -143,7 +155,7 @@ def run_bench(
         version=__version__, suite=suite_label(suite), seed=seed, time_limit_s=time_limit,
         workers=recorded_workers, instances={e.name: file_digest(e.path) for e in entries},
         backend=backend, shard=str(shard) if shard is not None else "",
-        extras=plan_extras(),
+        extras=plan_extras(), scene=scene_record,
     )  # fmt: skip
     write_settings(out, reconcile(out, wanted, load_results(out)))
     done = finished_pairs(out)
@@ -157,7 +169,7 @@ def run_bench(
     for e, _ in pending if backend == "ray" else []:
         if e.name not in carried:
             carried[e.name] = pack(e.path)
-    tasks = [BenchTask(e, c, time_limit, seed, carried.get(e.name)) for e, c in pending]
+    tasks = [BenchTask(e, c, time_limit, seed, carried.get(e.name), scene) for e, c in pending]
     if not tasks:
         return out / RESULTS
     bar = tqdm(total=len(tasks), desc="bench", unit="run", file=sys.stderr, disable=not progress)

@@ -63,12 +63,14 @@ class BenchSettings:
     backend: str = "process"
     shard: str = ""
     extras: Mapping[str, str] = field(default_factory=dict)
+    #: The scene file replacing the instances' own (its path and content digest), or "".
+    scene: str = ""
 
     def to_json(self) -> dict[str, Any]:
         return dict(
             format=FORMAT, version=self.version, suite=self.suite, seed=self.seed,
             time_limit_s=self.time_limit_s, workers=self.workers, backend=self.backend,
-            shard=self.shard, extras=dict(sorted(self.extras.items())),
+            shard=self.shard, extras=dict(sorted(self.extras.items())), scene=self.scene,
             instances=dict(sorted(self.instances.items())),
         )  # fmt: skip
 
@@ -109,6 +111,7 @@ def read_settings(out_dir: Path) -> BenchSettings | None:
             instances={str(k): str(v) for k, v in dict(data["instances"]).items()},
             backend=str(data.get("backend", "process")), shard=str(data.get("shard", "")),
             extras={str(k): str(v) for k, v in dict(data.get("extras", {})).items()},
+            scene=str(data.get("scene", "")),
         )  # fmt: skip
     except (ValueError, KeyError, TypeError, AttributeError) as error:
         raise SdarError(
@@ -148,6 +151,7 @@ def differences(old: BenchSettings, new: BenchSettings, *, shard: bool = True) -
         ("time limit", _limit(old.time_limit_s), _limit(new.time_limit_s)),
         ("workers", _workers(old.workers), _workers(new.workers)),
         ("backend", old.backend, new.backend),
+        ("scene", old.scene or "the instances' own", new.scene or "the instances' own"),
     ]
     if shard:
         pairs.append(("shard", _shard(old.shard), _shard(new.shard)))

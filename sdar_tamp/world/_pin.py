@@ -72,6 +72,10 @@ class PinRobot:
     def joint_names(self) -> tuple[str, ...]:
         return tuple(str(self.model.names[i]) for i in range(1, self.model.njoints))
 
+    def neutral(self) -> FloatArray:
+        """The description's neutral configuration ``(nq,)`` (zero angles)."""
+        return np.asarray(pin.neutral(self.model), dtype=np.float64)
+
     def frame_id(self, name: str) -> int:
         if not self.model.existFrame(name):
             raise KinematicsError(f"unknown frame {name!r} in {self.urdf_path.name}")

@@ -4,11 +4,11 @@ Checked pairs:
 
 * arm against arm (every link and gripper shape of one arm against every one of the other);
 * one arm against itself, links at least two joints apart (adjacent links are excluded);
-* arm against table (except ``base_link`` and ``shoulder_link``, which stand on it);
+* arm against table (except the links fixed to the base and moved by the first joint, which
+  stand on it);
 * arm against every resting object;
-* a held object against the other arm, its own arm up to the link before its last (never its
-  own last link, ``wrist_3`` on a UR arm, and gripper, which hold it), the table, every
-  resting object and the other held object.
+* a held object against the other arm, its own arm's links but the last (never its last link
+  and gripper, which hold it), the table, every resting object and the other held object.
 
 Resting objects are not checked against each other or the table (that is the arrangement's
 job, see :mod:`sdar_tamp.world.instance`). Object boxes are shrunk by ``tolerance`` on every

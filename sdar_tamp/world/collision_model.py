@@ -1,14 +1,15 @@
 """Typed adapter building the pinocchio model of both arms and the scene geometry.
 
-The arms are one pinocchio model whose joints follow the scene's :class:`ArmLayout`. Scene
-geometry is added as pinocchio geometry objects: the table and resting objects on the
-universe joint, held objects on the last joint of the arm holding them (wrist_3 of a UR).
-Collision pairs encode the filtering rules of :class:`sdar_tamp.world.collision.CollisionWorld`.
+The arms are one pinocchio model whose joints follow the scene's :class:`ArmLayout`, each arm
+built from its own robot description with its link and joint names prefixed by the arm's
+name. Scene geometry is added as pinocchio geometry objects: the table and resting objects on
+the universe joint, held objects on the last joint of the arm holding them. Collision pairs
+encode the filtering rules of :class:`sdar_tamp.world.collision.CollisionWorld`.
 """
 
 from __future__ import annotations
 
-import re
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,10 +19,9 @@ import pinocchio as pin
 from sdar_tamp.world import _coal
 from sdar_tamp.world._pin import array_to_se3, build_model, se3_to_array
 from sdar_tamp.world.errors import SceneError
-from sdar_tamp.world.kinematics import arm_description
 from sdar_tamp.world.layout import ArmLayout
-from sdar_tamp.world.scene import Scene
-from sdar_tamp.world.transforms import FloatArray, translation
+from sdar_tamp.world.scene import ArmSpec, Scene
+from sdar_tamp.world.transforms import FloatArray, inverse, translation
 from sdar_tamp.world.urdf import read_urdf
 
 
@@ -31,7 +31,7 @@ class ArmGeometry:
 
     name: str
     arm: str
-    link_index: int  # 0 base, then k: the link joint k of the chain moves (the last + gripper)
+    link_index: int  # 0: fixed to the base; k: moved by the arm's k-th joint (1-based)
     index: int
 
 
@@ -44,80 +44,99 @@ class CellCollisionModel:
     arm_geometry: Any = field(repr=False)  # pin.GeometryModel holding the arm shapes only
     shapes: tuple[ArmGeometry, ...]
     layout: ArmLayout
-    wrist_joint: dict[str, int]  # arm -> joint id of the chain's last joint (wrist_3)
-    tool0_frame: dict[str, int]  # arm -> frame id of tool0
-    T_wrist_tool0: FloatArray  # tool0 in the last joint's frame
+    wrist_joint: dict[str, int]  # arm -> joint id of its last joint
+    tool0_frame: dict[str, int]  # arm -> frame id of its tool (flange) frame
+    T_wrist_tool: dict[str, FloatArray]  # arm -> its tool frame in its last joint's frame
 
     @property
     def arm_names(self) -> tuple[str, ...]:
         return self.layout.names
 
 
-def _prefixed_urdf(text: str, prefix: str) -> str:
-    text = re.sub(r'(<(?:link|joint)\s+name=")', rf"\g<1>{prefix}", text)
-    return re.sub(r'(<(?:parent|child)\s+link=")', rf"\g<1>{prefix}", text)
+def prefixed_urdf(text: str, prefix: str) -> str:
+    """The URDF ``text`` with every link and joint name (and every reference to one)
+    prefixed by ``prefix``, so that several arms' descriptions live in one model."""
+    root = ET.fromstring(text)
+    for element in root.iter():
+        tag = element.tag
+        if tag in ("link", "joint") and element.get("name") is not None:
+            element.set("name", prefix + str(element.get("name")))
+        elif tag in ("parent", "child") and element.get("link") is not None:
+            element.set("link", prefix + str(element.get("link")))
+        elif tag == "mimic" and element.get("joint") is not None:
+            element.set("joint", prefix + str(element.get("joint")))
+    return ET.tostring(root, encoding="unicode")
+
+
+def _arm_model(spec: ArmSpec, text: str) -> tuple[Any, Any, FloatArray]:
+    """The arm's model and geometry with every joint but its own locked (at the arm's
+    ``locked_joints`` values), and the pose ``T_root_base`` of its base frame in the
+    description's root."""
+    prefix = f"{spec.name}_"
+    model, geometry = build_model(spec.urdf, prefixed_urdf(text, prefix))
+    keep = {prefix + j for j in spec.joint_names}
+    lock = [j for j in range(1, model.njoints) if str(model.names[j]) not in keep]
+    q0 = np.asarray(pin.neutral(model), dtype=np.float64)
+    for name, value in spec.locked_joints:
+        q0[int(model.idx_qs[model.getJointId(prefix + name)])] = value
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q0)
+    T_root_base = se3_to_array(data.oMf[model.getFrameId(prefix + spec.base_frame)])
+    if lock:
+        model, geometry = pin.buildReducedModel(model, geometry, lock, q0)
+    return model, geometry, T_root_base
 
 
 def build_dual_arm(scene: Scene) -> CellCollisionModel:
-    """Both arms of ``scene`` in one pinocchio model, bases at their world poses."""
-    text = read_urdf(scene.robot_urdf, scene.package_dirs)
+    """The arms of ``scene`` in one pinocchio model, each from its own robot description and
+    joints (any other joint of the description locked, see ``ArmSpec.locked_joints``), bases
+    at their world poses."""
+    texts = {u: read_urdf(u, scene.package_dirs) for u in dict.fromkeys(a.urdf for a in scene.arms)}
     model = pin.Model()
     geometry = pin.GeometryModel()
     for spec in scene.arms:
-        arm_text = _prefixed_urdf(text, f"{spec.name}_")
-        arm_model, arm_geom = build_model(scene.robot_urdf, arm_text)
+        arm_model, arm_geom, T_root_base = _arm_model(spec, texts[spec.urdf])
         model, geometry = pin.appendModel(
-            model, arm_model, geometry, arm_geom, 0, array_to_se3(spec.T_world_base)
-        )
+            model, arm_model, geometry, arm_geom, 0,
+            array_to_se3(spec.T_world_base @ inverse(T_root_base)),
+        )  # fmt: skip
     shapes: list[ArmGeometry] = []
     wrist: dict[str, int] = {}
+    tool: dict[str, int] = {}
+    T_wrist_tool: dict[str, FloatArray] = {}
     for spec in scene.arms:
-        joints = _chain_joints(model, f"{spec.name}_{arm_description(scene, spec.name).tool_frame}")
-        wrist[spec.name] = int(joints[-1])
+        joints = [int(model.getJointId(f"{spec.name}_{j}")) for j in spec.joint_names]
+        wrist[spec.name] = joints[-1]
+        tool[spec.name] = int(model.getFrameId(f"{spec.name}_{spec.tool_frame}"))
+        frame = model.frames[tool[spec.name]]
+        if int(frame.parentJoint) != joints[-1]:
+            raise SceneError(
+                f"{scene.file}: arm {spec.name!r}: the tool frame {spec.tool_frame!r} is not "
+                "fixed to the arm's last joint"
+            )
+        T_wrist_tool[spec.name] = se3_to_array(frame.placement)
         for gi, obj in enumerate(geometry.geometryObjects):
             if not obj.name.startswith(f"{spec.name}_"):
                 continue
-            link = joints.index(obj.parentJoint) + 1 if obj.parentJoint in joints else 0
+            parent = int(obj.parentJoint)
+            link = joints.index(parent) + 1 if parent in joints else 0
             shapes.append(ArmGeometry(str(obj.name), spec.name, link, gi))
-    tool0 = {a.name: int(model.getFrameId(f"{a.name}_tool0")) for a in scene.arms}
-    T_wrist_tool0 = se3_to_array(model.frames[tool0[scene.arms[0].name]].placement)
     layout = scene.layout
-    if model.nq != layout.dof:
+    if model.nq != layout.dof:  # the reduction keeps exactly the arms' joints
         raise SceneError(
-            f"{scene.file}: the robot description has {model.nq // len(layout)} joints per arm; "
-            f"the scene's arms have {list(layout.dofs)}"
+            f"{scene.file}: the robot descriptions give {model.nq} joints; the scene's arms "
+            f"have {list(layout.dofs)}"
         )
     return CellCollisionModel(
-        model,
-        model.createData(),
-        geometry,
-        tuple(shapes),
-        layout,
-        wrist,
-        tool0,
-        T_wrist_tool0,
+        model, model.createData(), geometry, tuple(shapes), layout, wrist, tool, T_wrist_tool
     )
 
 
 def tool0_pose(arms: CellCollisionModel, q: FloatArray, arm: str) -> FloatArray:
-    """``T_world_tool0`` of ``arm`` at the configuration ``q`` ``(layout.dof,)``."""
+    """``T_world_tool`` of ``arm``'s tool (flange) frame at the configuration ``q``
+    ``(layout.dof,)``."""
     pin.framesForwardKinematics(arms.model, arms.data, q)
     return se3_to_array(arms.data.oMf[arms.tool0_frame[arm]])
-
-
-def _chain_joints(model: Any, frame: str) -> list[int]:
-    """The ids of the joints from the root to ``frame``, root first (the arm's chain: joint
-    ``k`` of the list carries link ``k + 1``)."""
-    if not model.existFrame(frame):
-        raise SceneError(f"the robot description has no frame {frame!r}")
-    ids: list[int] = []
-    j = int(model.frames[model.getFrameId(frame)].parentJoint)
-    while j != 0:
-        ids.append(j)
-        j = int(model.parents[j])
-    if not ids:
-        raise SceneError(f"no joint moves the frame {frame!r} of the robot description")
-    return ids[::-1]
 
 
 @dataclass(frozen=True)
@@ -152,7 +171,7 @@ def build_scene_geometry(
             pin.GeometryObject(f"object:{name}", 0, array_to_se3(T), _coal.box(size))
         )
     for arm, (name, T_tool0_obj, size) in held.items():
-        placement = array_to_se3(arms.T_wrist_tool0 @ T_tool0_obj)
+        placement = array_to_se3(arms.T_wrist_tool[arm] @ T_tool0_obj)
         geometry.addGeometryObject(
             pin.GeometryObject(f"held:{name}", arms.wrist_joint[arm], placement, _coal.box(size))
         )

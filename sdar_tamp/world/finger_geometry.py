@@ -10,14 +10,14 @@ pads (``opening``) and the enclosing box's corners (``envelope``). Lengths are r
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from sdar_tamp.world._pin import PinRobot, se3_to_array
 from sdar_tamp.world.errors import KinematicsError
-from sdar_tamp.world.transforms import FloatArray, inverse
+from sdar_tamp.world.transforms import FloatArray, inverse, translation
 
 #: Decimals [m] the measured lengths are rounded to (1 um: mesh vertices are often stored in
 #: single precision, about 1e-8 m at these sizes).
@@ -40,15 +40,21 @@ def _box_corners(half: FloatArray) -> FloatArray:
     return out
 
 
-def _finger_corners(robot: PinRobot, link: str, T_tcp_root: FloatArray, joint: int) -> FloatArray:
+def _finger_corners(
+    robot: PinRobot, link: str, T_tcp_root: FloatArray, joint: int, locked: Collection[str]
+) -> FloatArray:
     """Corners ``(8 k, 3)`` of the collision shapes of ``link`` in the TCP frame."""
     fid = robot.frame_id(link)
     frame = robot.model.frames[fid]
-    if int(frame.parentJoint) != joint:
-        raise KinematicsError(
-            f"finger link {link!r} of {robot.urdf_path.name} moves relative to the tool centre "
-            "point; the fingers must be fixed to the link that carries it"
-        )
+    j = int(frame.parentJoint)
+    while j != joint:  # only locked joints may lie between the TCP's link and the finger
+        if j == 0 or str(robot.model.names[j]) not in locked:
+            raise KinematicsError(
+                f"finger link {link!r} of {robot.urdf_path.name} moves relative to the tool "
+                "centre point; the fingers must be fixed to the link that carries it (or hang "
+                "on joints the arm holds locked)"
+            )
+        j = int(robot.model.parents[j])
     corners = []
     for obj in robot.geometry.geometryObjects:
         if int(obj.parentFrame) != fid:
@@ -74,9 +80,17 @@ def _finger_corners(robot: PinRobot, link: str, T_tcp_root: FloatArray, joint: i
 
 
 def finger_geometry(
-    robot: PinRobot, finger_links: Sequence[str], tcp_frame: str = "tcp"
+    robot: PinRobot,
+    finger_links: Sequence[str],
+    tcp_frame: str = "tcp",
+    tcp_offset: float = 0.0,
+    q: FloatArray | None = None,
+    locked: Collection[str] = (),
 ) -> FingerGeometry:
     """The measures of the fingers ``finger_links`` (two: one either side of the TCP on y).
+    The TCP is ``tcp_offset`` [m] along the z axis of the frame ``tcp_frame``; the fingers
+    are measured at the configuration ``q`` ``(nq,)`` (default: neutral), and may hang on
+    the joints ``locked`` (held at their value in ``q``, such as a gripper's slides).
 
     Raises:
         KinematicsError: not two fingers, an unknown link or frame, a finger without a box or
@@ -85,10 +99,10 @@ def finger_geometry(
     if len(finger_links) != 2:
         raise KinematicsError(f"expected two finger links, got {list(finger_links)}")
     tcp = robot.frame_id(tcp_frame)
-    robot.frame_pose(np.zeros(robot.nq), tcp)  # places every frame (the fingers too)
-    T_tcp_root = inverse(se3_to_array(robot.data.oMf[tcp]))
+    robot.frame_pose(robot.neutral() if q is None else q, tcp)  # places every frame
+    T_tcp_root = inverse(se3_to_array(robot.data.oMf[tcp]) @ translation(0.0, 0.0, tcp_offset))
     joint = int(robot.model.frames[tcp].parentJoint)
-    fingers = [_finger_corners(robot, link, T_tcp_root, joint) for link in finger_links]
+    fingers = [_finger_corners(robot, link, T_tcp_root, joint, locked) for link in finger_links]
     allp = np.concatenate(fingers)
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     left, right = sorted(fingers, key=lambda c: float(c[:, 1].mean()))

@@ -46,9 +46,11 @@ from sdar_tamp.world.dense import (
 )
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.errors import GenerationError
+from sdar_tamp.world.graspability import GraspLimits
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, validate_instance
 from sdar_tamp.world.placement import random_arrangement
 from sdar_tamp.world.scene import Workspace
+from sdar_tamp.world.shipped_cell import SHIPPED_GRASP
 from sdar_tamp.world.structured_goals import structured_goals, successor_map
 from sdar_tamp.world.transforms import FloatArray
 
@@ -77,6 +79,8 @@ class GeneratorOptions:
     # give up after this many attempts in a row in which the random placement of the start
     # (or, for R, the goal) arrangement found no room for every object: the table is too full
     crowded_attempts: int = 5
+    # the gripper the objects must suit (None: the shipped cell's, as the instance loader's)
+    grasp: GraspLimits | None = None
 
     def __post_init__(self) -> None:
         for name in ("attempts", "samples", "crowded_attempts"):
@@ -139,7 +143,7 @@ def generate_instance(
             continue
         crowded = 0
         if inst is not None and _verified(family, inst):
-            validate_instance(inst)
+            validate_instance(inst, SHIPPED_GRASP if opts.grasp is None else opts.grasp)
             why = accept(inst) if accept is not None else None
             if why is None:
                 return inst
@@ -160,7 +164,7 @@ def _smallest(opts: GeneratorOptions) -> GeneratorOptions:
     """The options with the smallest footprint of the dense family's sizes: the area bound of
     a table of mixed sizes."""
     small = min(DENSE_SIZES, key=lambda s: s[0] * s[1])
-    return GeneratorOptions(size=small, workspace=opts.workspace, gap=opts.gap)
+    return GeneratorOptions(size=small, workspace=opts.workspace, gap=opts.gap, grasp=opts.grasp)
 
 
 def _extent(opts: GeneratorOptions) -> str:

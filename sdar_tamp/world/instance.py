@@ -28,13 +28,11 @@ from sdar_tamp.errors import SourceLocation
 from sdar_tamp.world._yaml import Node, parse_yaml, read_yaml
 from sdar_tamp.world.errors import InstanceError
 from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
-from sdar_tamp.world.graspability import grasp_problem
+from sdar_tamp.world.graspability import GraspLimits, grasp_problem
 from sdar_tamp.world.scene import Workspace
+from sdar_tamp.world.shipped_cell import SHIPPED_GRASP
 from sdar_tamp.world.transforms import FloatArray
 
-#: Default largest graspable side: 0.060 m pre-grasp opening minus 0.01 m margin (as the
-#: shipped scene).
-DEFAULT_MAX_GRASP_WIDTH = 0.05
 _NAME = re.compile(r"[A-Za-z0-9_.\-]+")
 
 
@@ -97,10 +95,12 @@ class Instance:
 
 def validate_instance(
     instance: Instance,
-    max_grasp_width: float = DEFAULT_MAX_GRASP_WIDTH,
+    grasp: GraspLimits | None = SHIPPED_GRASP,
     locations: dict[str, SourceLocation] | None = None,
 ) -> None:
-    """Raise :class:`InstanceError` naming the first object that breaks a rule."""
+    """Raise :class:`InstanceError` naming the first object that breaks a rule. ``grasp``:
+    the gripper the objects must suit (default: the shipped cell's; None: not checked, for a
+    caller that checks against its cell once it knows it)."""
     loc = locations or {}
     seen: set[str] = set()
     for o in instance.objects:
@@ -112,7 +112,7 @@ def validate_instance(
         if o.name in seen:
             raise InstanceError(f"object {o.name!r}: duplicate name", loc.get(o.name))
         seen.add(o.name)
-        problem = grasp_problem(o.size, max_grasp_width)
+        problem = None if grasp is None else grasp_problem(o.size, grasp)
         if problem is not None:
             raise InstanceError(
                 f"object {o.name!r}: size {list(o.size)} cannot be grasped: {problem}",
@@ -140,16 +140,16 @@ def validate_instance(
             )
 
 
-def load_instance(path: Path, max_grasp_width: float = DEFAULT_MAX_GRASP_WIDTH) -> Instance:
+def load_instance(path: Path, grasp: GraspLimits | None = SHIPPED_GRASP) -> Instance:
     """Read and validate an instance file."""
-    return _from_node(read_yaml(Path(path), InstanceError), max_grasp_width)
+    return _from_node(read_yaml(Path(path), InstanceError), grasp)
 
 
 def parse_instance(
-    text: str, name: str = "<string>", max_grasp_width: float = DEFAULT_MAX_GRASP_WIDTH
+    text: str, name: str = "<string>", grasp: GraspLimits | None = SHIPPED_GRASP
 ) -> Instance:
     """Parse and validate instance YAML text; ``name`` is used in messages."""
-    return _from_node(parse_yaml(text, name, InstanceError), max_grasp_width)
+    return _from_node(parse_yaml(text, name, InstanceError), grasp)
 
 
 def _pose(node: Node) -> Pose2D:
@@ -157,7 +157,7 @@ def _pose(node: Node) -> Pose2D:
     return Pose2D(x, y, yaw)
 
 
-def _from_node(root: Node, max_grasp_width: float) -> Instance:
+def _from_node(root: Node, grasp: GraspLimits | None) -> Instance:
     keys = root.mapping(["name", "workspace", "objects"], ["scene", "family", "seed"])
     ws = keys["workspace"].mapping(["x", "y"])
     objects: list[ObjectSpec] = []
@@ -179,7 +179,7 @@ def _from_node(root: Node, max_grasp_width: float) -> Instance:
         family=keys["family"].as_str() if "family" in keys else None,
         seed=int(seed.value) if seed is not None else None,  # type: ignore[call-overload]
     )
-    validate_instance(instance, max_grasp_width, locations)
+    validate_instance(instance, grasp, locations)
     return instance
 
 

@@ -1,29 +1,36 @@
-"""The dual-arm scene: table, arms (two, for now), workspace, default object, gripper.
+"""The cell: table, workspace, default object and the arms (two, for now), each with its
+robot description, chain, limits and gripper.
 
-Loaded from ``scene.yaml`` (the shipped one lives in ``domains/dual_arm_rearrangement``) into
-frozen dataclasses. World frame: table centre at the origin, z up, table top at z = 0.
+Loaded from a scene file (the shipped cells live in ``domains/dual_arm_rearrangement/cells``,
+see :mod:`.cells`) into frozen dataclasses. World frame: table centre at the origin, z up,
+table top at z = 0. The file form is described in ``docs/robots.md``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from functools import cached_property
 from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 
+from sdar_tamp.world._pin import PinRobot
 from sdar_tamp.world._yaml import Node, read_yaml
+from sdar_tamp.world.arm_spec import ArmSpec, read_arm
 from sdar_tamp.world.errors import SceneError
+from sdar_tamp.world.graspability import GraspLimits, grasp_problem
+from sdar_tamp.world.gripper import Gripper
 from sdar_tamp.world.layout import ArmLayout
-from sdar_tamp.world.robot_check import JointRequest, check_robot
-from sdar_tamp.world.transforms import BoolArray, FloatArray, pose_xyz_yaw
+from sdar_tamp.world.shipped_cell import LEGACY_JOINT_KEYS
+from sdar_tamp.world.transforms import BoolArray, FloatArray
 from sdar_tamp.world.urdf import package_dirs_from_env, resolve_uri
 
-#: Joint keys of ``joint_limits`` in the scene file, in joint order.
-JOINT_KEYS = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
-Vec6 = tuple[float, float, float, float, float, float]
+__all__ = ["ArmSpec", "Gripper", "Scene", "Table", "Workspace", "load_scene"]
+
+#: Deprecated: the short ``joint_limits`` keys of the first scene form (the shipped UR5e's
+#: joints); code names an arm's joints by ``scene.arm(name).joint_names``.
+JOINT_KEYS = LEGACY_JOINT_KEYS
 #: Default ``velocity_safety``: the full limits (the time parameterisation slows a profile
 #: whose samples would break them, so the validator's numerical tolerance suffices).
 DEFAULT_VELOCITY_SAFETY = 1.0
@@ -35,7 +42,8 @@ def domain_path(name: str) -> Path:
 
 
 def default_scene_path() -> Path:
-    return domain_path("scene.yaml")
+    """The shipped UR5e cell, the scene of every instance that names none."""
+    return domain_path("cells/ur5e_facing.yaml")
 
 
 @dataclass(frozen=True)
@@ -68,67 +76,36 @@ class Workspace:
 
 
 @dataclass(frozen=True)
-class Gripper:
-    """Two-finger gripper: opening between the pads and TCP offset along tool0 z [m]."""
-
-    max_opening: float
-    tcp_offset: float
-    grasp_margin: float  # the grasped side must be <= max_opening - grasp_margin [m]
-
-    @property
-    def max_graspable_width(self) -> float:
-        return self.max_opening - self.grasp_margin
-
-
-@dataclass(frozen=True)
-class ArmSpec:
-    """One arm: name, base pose in the world, joint limits and home configuration."""
-
-    name: str
-    base_xyz: tuple[float, float, float]  # [m]
-    base_yaw: float  # [rad]
-    lower: Vec6  # [rad]
-    upper: Vec6  # [rad]
-    velocity_limit: Vec6  # [rad/s]
-    acceleration_limit: Vec6  # [rad/s^2]
-    home: Vec6  # [rad]
-
-    @property
-    def T_world_base(self) -> FloatArray:
-        """The base pose ``(4, 4)`` in the world (a copy)."""
-        return self._T_world_base.copy()
-
-    @cached_property
-    def _T_world_base(self) -> FloatArray:
-        x, y, z = self.base_xyz
-        return pose_xyz_yaw(x, y, z, self.base_yaw)
-
-    @property
-    def lower_array(self) -> FloatArray:
-        return np.array(self.lower)
-
-    @property
-    def upper_array(self) -> FloatArray:
-        return np.array(self.upper)
-
-
-@dataclass(frozen=True)
 class Scene:
-    """Everything static about the dual-arm world."""
+    """Everything static about the cell: table, workspace, default object, arms."""
 
     file: str
-    robot_urdf: Path
     table: Table
     workspace: Workspace
     object_size: tuple[float, float, float]  # default cuboid lx, ly, lz [m]
-    gripper: Gripper
     arms: tuple[ArmSpec, ...]
     #: Fraction in (0, 1] of the velocity and acceleration limits a trajectory's time-optimal
     #: profile may use (the sampled trajectory keeps the full limits in any case).
     velocity_safety: float = DEFAULT_VELOCITY_SAFETY
-    #: Where the robot description's ``package://`` URIs are looked up: the scene's
+    #: Where the robot descriptions' ``package://`` URIs are looked up: the scene's
     #: ``packages`` (relative to the scene file), then ``ROS_PACKAGE_PATH``.
     package_dirs: tuple[Path, ...] = ()
+
+    @property
+    def robot_urdf(self) -> Path:
+        """Deprecated: the FIRST arm's robot description (use ``arm(name).urdf``)."""
+        return self.arms[0].urdf
+
+    @property
+    def gripper(self) -> Gripper:
+        """Deprecated: the FIRST arm's gripper (use ``arm(name).gripper``)."""
+        return self.arms[0].gripper
+
+    @property
+    def grasp_limits(self) -> GraspLimits:
+        """The limits a grasp must meet for every arm's gripper (grasps are shared by the
+        arms: the narrowest opening, the deepest and widest fingers)."""
+        return GraspLimits.shared(a.gripper.limits for a in self.arms)
 
     @property
     def arm_names(self) -> tuple[str, ...]:
@@ -137,7 +114,7 @@ class Scene:
     @property
     def layout(self) -> ArmLayout:
         """The arms' joints in a configuration vector, in the scene's arm order."""
-        return ArmLayout(self.arm_names, tuple(len(a.home) for a in self.arms))
+        return ArmLayout(self.arm_names, tuple(a.dof for a in self.arms))
 
     @property
     def home(self) -> FloatArray:
@@ -159,106 +136,77 @@ class Scene:
 
 
 _JOINT_FIELDS = ("lower", "upper", "velocity_limit", "acceleration_limit", "home")
+#: How many arms a cell has (the planner's count, checked in this one place).
+ARM_COUNT = 2
+
+
+def _packages(path: Path, keys: dict[str, Node]) -> tuple[Path, ...]:
+    if "packages" not in keys:
+        return ()
+    packages = tuple(path.parent / node.as_str() for node in keys["packages"].items())
+    for node, directory in zip(keys["packages"].items(), packages, strict=True):
+        if not directory.is_dir():
+            raise node.error("a package directory (relative to the scene file)")
+    return packages
 
 
 def load_scene(path: Path | None = None, environ: Mapping[str, str] | None = None) -> Scene:
-    """Load a scene file (default: the shipped ``scene.yaml``).
+    """Load a scene file (default: the shipped UR5e cell, :func:`default_scene_path`).
 
-    ``robot`` is a path relative to the scene file or a ``package://`` URI, looked up in the
-    scene's ``packages`` directories, then in ``ROS_PACKAGE_PATH`` of ``environ`` (default
-    ``os.environ``). The robot description is loaded and checked against the arms: every
-    joint and frame the scene uses exists, and the scene's joint limits lie within the URDF's.
+    A ``robot`` (top level: the default of every arm; per arm: its own) is a path relative to
+    the scene file or a ``package://`` URI, looked up in the scene's ``packages``
+    directories, then in ``ROS_PACKAGE_PATH`` of ``environ`` (default ``os.environ``). Each
+    robot description is loaded and checked against its arms: frames and joints exist, the
+    scene's joint limits lie within the URDF's, home lies within the limits, and each arm's
+    gripper can hold the default object.
     """
     path = default_scene_path() if path is None else Path(path)
     root = read_yaml(path, SceneError)
     keys = root.mapping(
-        ["robot", "table", "workspace", "object_size", "gripper", "arms"],
-        ["velocity_safety", "packages"],
+        ["table", "workspace", "object_size", "arms"],
+        ["robot", "gripper", "velocity_safety", "packages"],
     )
-    packages: tuple[Path, ...] = ()
-    if "packages" in keys:
-        packages = tuple(path.parent / node.as_str() for node in keys["packages"].items())
-        for node, directory in zip(keys["packages"].items(), packages, strict=True):
-            if not directory.is_dir():
-                raise node.error("a package directory (relative to the scene file)")
-    package_dirs = packages + package_dirs_from_env(environ)
-    robot_path, how = resolve_uri(keys["robot"].as_str(), path.parent, package_dirs)
-    if robot_path is None:
-        raise keys["robot"].error(f"a robot description file ({how})")
-    robot = robot_path
+    package_dirs = _packages(path, keys) + package_dirs_from_env(environ)
     tx, ty, tz = (
         keys["table"].mapping(["size"])["size"].as_floats(3, "[x, y, thickness]", positive=True)
     )
     table = Table((tx, ty, tz))
     ws = keys["workspace"].mapping(["x", "y"])
     workspace = Workspace(ws["x"].as_interval(), ws["y"].as_interval())
-    size = keys["object_size"].as_floats(3, "[lx, ly, lz]", positive=True)
-    g = keys["gripper"].mapping(["max_opening", "tcp_offset", "grasp_margin"])
-    gripper = Gripper(
-        g["max_opening"].as_float(positive=True),
-        g["tcp_offset"].as_float(positive=True),
-        g["grasp_margin"].as_float(),
-    )
+    sx, sy, sz = keys["object_size"].as_floats(3, "[lx, ly, lz]", positive=True)
+    size = (sx, sy, sz)
     arm_nodes = keys["arms"].items()
-    if len(arm_nodes) != 2:
-        raise keys["arms"].error("a list of exactly two arms", show_value=False)
-    arms = tuple(_arm(node) for node in arm_nodes)
-    if arms[0].name == arms[1].name:
-        raise arm_nodes[1].mapping(_ARM_KEYS)["name"].error("a name different from arms[0].name")
+    if len(arm_nodes) != ARM_COUNT:
+        raise keys["arms"].error(f"a list of exactly {ARM_COUNT} arms", show_value=False)
+    robots: dict[Path, PinRobot] = {}
+    arms: list[ArmSpec] = []
+    for node in arm_nodes:
+        entry = node.value if isinstance(node.value, dict) else {}
+        robot_node = node.mapping([], list(entry))["robot"] if "robot" in entry else None
+        robot_node = robot_node or keys.get("robot")
+        if robot_node is None:
+            raise node.error("key 'robot' (here or at the top of the scene)", show_value=False)
+        urdf, how = resolve_uri(robot_node.as_str(), path.parent, package_dirs)
+        if urdf is None:
+            raise robot_node.error(f"a robot description file ({how})")
+        if urdf not in robots:
+            robots[urdf] = PinRobot.load(urdf, package_dirs)
+        arm = read_arm(node, urdf, robots[urdf], keys.get("gripper"))
+        if arm.name in {a.name for a in arms}:
+            name = node.mapping([], list(entry))["name"]
+            raise name.error("a name different from the other arms'")
+        problem = grasp_problem(size, arm.gripper.limits)
+        if problem is not None:
+            where = node.mapping([], list(entry)).get("gripper") or keys["gripper"]
+            raise where.error(
+                f"a gripper that holds the default object {list(size)}: {problem}",
+                show_value=False,
+            )
+        arms.append(arm)
     safety = DEFAULT_VELOCITY_SAFETY
     if "velocity_safety" in keys:
         node = keys["velocity_safety"]
         safety = node.as_float()
         if not 0.0 < safety <= 1.0:
             raise node.error("a number in (0, 1], the share of the joint limits a motion uses")
-    scene = Scene(str(path), robot, table, workspace, size, gripper, arms,  # type: ignore[arg-type]
-                  safety, package_dirs)  # fmt: skip
-    check_robot(robot, package_dirs, keys["robot"], _joint_requests(arms, arm_nodes), FRAMES)
-    return scene
-
-
-#: The frames of the robot description the planner uses: the flange and the tool centre point.
-FRAMES = ("tool0", "tcp")
-
-
-def _joint_requests(arms: tuple[ArmSpec, ...], nodes: list[Node]) -> list[JointRequest]:
-    out: list[JointRequest] = []
-    for arm, node in zip(arms, nodes, strict=True):
-        limits = node.mapping(_ARM_KEYS)["joint_limits"].mapping(list(JOINT_KEYS))
-        for i, key in enumerate(JOINT_KEYS):
-            out.append(JointRequest(f"{key}_joint", arm.lower[i], arm.upper[i], limits[key]))
-    return out
-
-
-_ARM_KEYS = ["name", "base", "joint_limits", "velocity_limit", "acceleration_limit", "home"]
-
-
-def _per_joint(node: Node) -> Vec6:
-    """A positive scalar for every joint, or a list of six positive numbers."""
-    if isinstance(node.value, list):
-        return node.as_floats(6, "a number > 0 or a list of six", positive=True)  # type: ignore[return-value]
-    v = node.as_float(positive=True)
-    return (v, v, v, v, v, v)
-
-
-def _arm(node: Node) -> ArmSpec:
-    k = node.mapping(_ARM_KEYS)
-    base = k["base"].mapping(["xyz", "yaw"])
-    limits = k["joint_limits"].mapping(list(JOINT_KEYS))
-    intervals = [limits[j].as_interval() for j in JOINT_KEYS]
-    lower = tuple(lo for lo, _ in intervals)
-    upper = tuple(hi for _, hi in intervals)
-    home = k["home"].as_floats(6, "a list of six joint angles [rad]")
-    for i, (v, lo, hi) in enumerate(zip(home, lower, upper, strict=True)):
-        if not lo <= v <= hi:
-            raise k["home"].items()[i].error(f"{JOINT_KEYS[i]} within [{lo}, {hi}]")
-    return ArmSpec(
-        name=k["name"].as_str(),
-        base_xyz=base["xyz"].as_floats(3, "[x, y, z]"),  # type: ignore[arg-type]
-        base_yaw=base["yaw"].as_float(),
-        lower=lower,  # type: ignore[arg-type]
-        upper=upper,  # type: ignore[arg-type]
-        velocity_limit=_per_joint(k["velocity_limit"]),
-        acceleration_limit=_per_joint(k["acceleration_limit"]),
-        home=home,  # type: ignore[arg-type]
-    )
+    return Scene(str(path), table, workspace, size, tuple(arms), safety, package_dirs)

@@ -13,6 +13,7 @@ shipped copies live in ``domains/dual_arm_rearrangement/suites/<suite>/``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
@@ -63,15 +64,19 @@ def suite_members(suite: str) -> tuple[SuiteMember, ...]:
     raise SuiteError(f"unknown suite {suite!r}; expected one of {list(SUITES)}")
 
 
-def build_suite(suite: str, accept: Acceptance | None = None) -> tuple[Instance, ...]:
+def build_suite(
+    suite: str, accept: Acceptance | None = None, options: GeneratorOptions | None = None
+) -> tuple[Instance, ...]:
     """Generate every instance of a suite in memory (``accept``: the generator's acceptance
-    test, see :func:`~sdar_tamp.world.generators.generate_instance`)."""
+    test, see :func:`~sdar_tamp.world.generators.generate_instance`; ``options``: the
+    generator's, e.g. another cell's workspace and object, each member's gap applied)."""
+    base = options or GeneratorOptions()
     return tuple(
         generate_instance(
             m.family,
             m.n_objects,
             m.seed,
-            GeneratorOptions() if m.gap is None else GeneratorOptions(gap=m.gap),
+            base if m.gap is None else dataclasses.replace(base, gap=m.gap),
             name=m.name,
             accept=accept,
         )
@@ -79,10 +84,20 @@ def build_suite(suite: str, accept: Acceptance | None = None) -> tuple[Instance,
     )
 
 
-def generate_suite(suite: str, out_dir: Path, accept: Acceptance | None = None) -> list[Path]:
-    """Write a suite as ``out_dir/<name>.yaml`` files; returns the paths in suite order."""
+def generate_suite(
+    suite: str,
+    out_dir: Path,
+    accept: Acceptance | None = None,
+    options: GeneratorOptions | None = None,
+    scene: str | None = None,
+) -> list[Path]:
+    """Write a suite as ``out_dir/<name>.yaml`` files; returns the paths in suite order.
+    ``scene``: the instances' ``scene`` key (a scene file relative to ``out_dir``)."""
     out = Path(out_dir)
-    return [save_instance(i, out / f"{i.name}.yaml") for i in build_suite(suite, accept)]
+    return [
+        save_instance(dataclasses.replace(i, scene=scene), out / f"{i.name}.yaml")
+        for i in build_suite(suite, accept, options)
+    ]
 
 
 def shipped_suite_dir(suite: str) -> Path:

@@ -42,7 +42,10 @@ def grasp_lifts(
             held = None
             if h is not None:
                 held = ObjectBox(kin.fk_tool0(q) @ h.T_tool0_obj, h.size)
-            found = clearance_lift(kin.fk_tcp(q), request.objects, held, shape, xy[1 - side])
+            envelope = ctx.scene.arm(arm).gripper.envelope
+            found = clearance_lift(
+                kin.fk_tcp(q), envelope, request.objects, held, shape, xy[1 - side]
+            )
             out[side].append(found if found is not None else shape.default_lift)
     return out
 

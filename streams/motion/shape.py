@@ -34,12 +34,6 @@ from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.transforms import FloatArray
 
-#: Corners ``(8, 3)`` [m] of a box enclosing both fingers of the shipped gripper
-#: (``ur5e_2f85.urdf``: pads 0.036 m either side of the TCP along y, tips 0.017 m beyond it
-#: along z), in the TCP frame.
-FINGER_ENVELOPE = np.array(
-    [[x, y, z] for x in (-0.011, 0.011) for y in (-0.042, 0.042) for z in (-0.048, 0.017)]
-)
 #: Spacing [m] of the points on the way to the motion's other end tested for neighbours.
 CORRIDOR_STEP = 0.01
 #: Below this vertical share of the tool axis the lift is not from clearance (side grasps).
@@ -86,21 +80,23 @@ class ShapeOptions:
 
 def clearance_lift(
     T_world_tcp: FloatArray,
+    envelope: FloatArray,
     objects: Mapping[str, ObjectBox],
     held: ObjectBox | None,
     options: ShapeOptions,
     toward: FloatArray | None = None,
 ) -> float | None:
     """The straight lift [m] along the tool axis that clears the neighbours of a grasp at
-    ``T_world_tcp`` ``(4, 4)`` (``held``: the held object's box at that pose) on the way to
-    the point ``toward`` ``(2,)`` [m] on the table (the other end of the motion; default: the
-    grasp's own neighbourhood only), or None for a grasp whose tool axis is too far from
-    vertical (the caller keeps its fixed lift)."""
+    ``T_world_tcp`` ``(4, 4)`` by a gripper whose fingers ``envelope`` ``(8, 3)`` encloses in
+    the TCP frame (:attr:`sdar_tamp.world.gripper.Gripper.envelope`; ``held``: the held
+    object's box at that pose) on the way to the point ``toward`` ``(2,)`` [m] on the table
+    (the other end of the motion; default: the grasp's own neighbourhood only), or None for a
+    grasp whose tool axis is too far from vertical (the caller keeps its fixed lift)."""
     T = np.asarray(T_world_tcp, dtype=np.float64)
     rise = -float(T[2, 2])  # height gained per metre of retreat (tool z points down)
     if rise < MIN_RISE:
         return None
-    points = FINGER_ENVELOPE @ T[:3, :3].T + T[:3, 3]
+    points = np.asarray(envelope, dtype=np.float64) @ T[:3, :3].T + T[:3, 3]
     if held is not None:
         points = np.concatenate([points, box_corners(held)])
     z_low = float(points[:, 2].min())

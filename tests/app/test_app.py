@@ -258,7 +258,7 @@ def test_planner_cache_builds_once_per_scene_and_optimiser_options() -> None:
     assert again.ctx is first.ctx and again.planner is first.planner and cache.builds == 1
     other = cache.world(None, TrajOptOptions(knots=12))
     assert other.planner is not first.planner and cache.builds == 2
-    scene = Path(domain_file("dual_arm_rearrangement").parent / "scene.yaml")
+    scene = Path(domain_file("dual_arm_rearrangement", "cells/ur5e_facing.yaml"))
     if scene.exists():
         cache.world(scene, TrajOptOptions(knots=12))
         assert cache.builds == 3

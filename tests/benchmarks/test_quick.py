@@ -31,7 +31,12 @@ SCRIPTS = sorted((ROOT / "benchmarks").glob("bench_*.py"))
 HANG_GUARD = 900.0  # [s]
 
 #: Runs besides ``--quick`` alone (their arguments after ``--quick``): other modes kept alive
-EXTRA_RUNS: dict[str, tuple[tuple[str, ...], ...]] = {"bench_motion": (("--hard", "1"),)}
+#: bench_sdar in a cell named on the command line (the shipped one, as a file)
+IN_CELL = ("--scene", str(ROOT / "domains/dual_arm_rearrangement/cells/ur5e_facing.yaml"))
+EXTRA_RUNS: dict[str, tuple[tuple[str, ...], ...]] = {
+    "bench_motion": (("--hard", "1"),),
+    "bench_sdar": (IN_CELL,),
+}
 #: The runs that may skip: what they need is not in the repository
 MAY_SKIP = {("bench_pddlstream_compat", ()), ("bench_motion", ("--hard", "1"))}
 
@@ -87,6 +92,11 @@ def _sdar(out: Summary) -> None:
     assert out["instances"] == 1 and out["success"] == 1 and out["steps"] > 0
 
 
+def _sdar_in_cell(out: Summary) -> None:
+    _sdar(out)
+    assert out["scene"] == IN_CELL[1]
+
+
 def _solve(out: Summary) -> None:
     assert out["runs"] == 1 and out["this"]["all_valid"] is True
 
@@ -119,6 +129,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_parser", ()): _parser,
     ("bench_pddlstream_compat", ()): _pddlstream,
     ("bench_sdar", ()): _sdar,
+    ("bench_sdar", IN_CELL): _sdar_in_cell,
     ("bench_solve", ()): _solve,
     ("bench_spheres", ()): _spheres,
     ("bench_streams", ()): _streams,

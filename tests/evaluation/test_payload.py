@@ -28,8 +28,9 @@ def _custom_suite(tmp_path: Path) -> Path:
     """An instance in suite/ whose scene (and robot) sit in scenes/."""
     scenes = tmp_path / "scenes"
     scenes.mkdir(parents=True)
-    shipped = domain_file("dual_arm_rearrangement", "scene.yaml")
-    shutil.copy(shipped, scenes / "wide.yaml")
+    shipped = domain_file("dual_arm_rearrangement", "cells/ur5e_facing.yaml")
+    text = shipped.read_text(encoding="utf-8")
+    (scenes / "wide.yaml").write_text(text.replace("../robots/", ""), encoding="utf-8")
     shutil.copy(load_scene(shipped).robot_urdf, scenes / load_scene(shipped).robot_urdf.name)
     suite = tmp_path / "suite"
     suite.mkdir()

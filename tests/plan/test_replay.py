@@ -66,7 +66,7 @@ def planned(ctx: WorldContext, planner: MotionPlanner) -> Planned:
     goal = {"o1": _box(o1, o1.goal), "o2": start["o2"]}
     home = {a: ctx.home(a) for a in ctx.arm_names}
     world = ctx.new_world()
-    grasps = sample_grasps(o1.size, ctx.scene.gripper.max_graspable_width)
+    grasps = sample_grasps(o1.size, ctx.scene.grasp_limits)
     at_start = solve_ik_candidates(
         ctx, world, start, [IKRequest("left", "o1", start["o1"], grasps)], home
     )

@@ -100,7 +100,7 @@ def base(ctx: WorldContext, planner: MotionPlanner, optimisers: OptimiserCache) 
     world = ctx.new_world()
     pick, place, T_tcp_obj, held = {}, {}, {}, {}
     for arm, name in ARMS.items():
-        grasps = sample_grasps(objects[name].size, ctx.scene.gripper.max_graspable_width)
+        grasps = sample_grasps(objects[name].size, ctx.scene.grasp_limits)
         at_start = solve_ik_candidates(
             ctx, world, start, [IKRequest(arm, name, start[name], grasps)], home
         )

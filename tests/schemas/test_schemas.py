@@ -127,8 +127,11 @@ INSTANCE_CASES: dict[str, Edit] = {
 SCENE_CASES: dict[str, Edit] = {
     "three arms": lambda d: d["arms"].append(copy.deepcopy(d["arms"][0])),
     "no gripper": _drop(["gripper"]),
-    "short home": _set(["arms", 0, "home"], [0.0] * 5),
-    "joint key": _set(["arms", 0, "joint_limits", "wrist_4"], [-1.0, 1.0]),
+    "home of words": _set(["arms", 0, "home"], ["up"] * 6),
+    "joint limit": _set(["arms", 0, "joint_limits", "wrist_4"], [-1.0]),
+    "fingers and box": _set(
+        ["gripper", "finger_box"], {"depth": 0.01, "width": 0.01, "length": 0.01, "thickness": 0.01}
+    ),
     "zero velocity": _set(["arms", 1, "velocity_limit"], 0.0),
     "table": _set(["table", "size"], [1.4, 0.8]),
     "velocity safety": _set(["velocity_safety"], 1.2),

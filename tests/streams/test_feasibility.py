@@ -76,7 +76,7 @@ def test_a_dense_scene_freed_in_order_is_not_refused(ctx: WorldContext) -> None:
         o.name: ObjectBox(pose_xyz_yaw(o.start.x, o.start.y, SIZE[2] / 2, o.start.yaw), SIZE)
         for o in inst.objects
     }
-    width = ctx.scene.gripper.max_graspable_width
+    width = ctx.scene.grasp_limits
     removal = remove_graspable(ctx, boxes, {n: sample_grasps(SIZE, width) for n in boxes})
     assert removal.rounds == (("o1",), ("o0",)) and removal.stuck == ()
     assert prove_infeasible(ctx, inst) is None

@@ -8,6 +8,7 @@ import pytest
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.shipped_cell import SHIPPED_GRASP
 from streams.context import WorldContext
 from streams.grasps import DEFAULT_PAIR_TILTS, half_turn_twins, sample_grasps
 from streams.stream_map import RearrangementStreams, make_stream_map
@@ -17,7 +18,7 @@ HALF_TURN = np.diag([-1.0, -1.0, 1.0])  # about the object's vertical axis
 
 
 def test_twins_hold_the_cuboid_turned_by_half_a_turn() -> None:
-    grasps = sample_grasps((0.08, 0.04, 0.05), 0.05, pair_tilts=DEFAULT_PAIR_TILTS)
+    grasps = sample_grasps((0.08, 0.04, 0.05), SHIPPED_GRASP, pair_tilts=DEFAULT_PAIR_TILTS)
     twins = half_turn_twins(grasps)
     assert twins[:6] == (1, 0, 5, 4, 3, 2)  # top-down pair; +45/-45 of opposite flips
     for g, k in zip(grasps, twins, strict=True):
@@ -29,7 +30,7 @@ def test_twins_hold_the_cuboid_turned_by_half_a_turn() -> None:
 
 
 def test_without_the_flipped_variants_there_is_no_twin() -> None:
-    grasps = sample_grasps((0.08, 0.04, 0.05), 0.05, symmetric=False)
+    grasps = sample_grasps((0.08, 0.04, 0.05), SHIPPED_GRASP, symmetric=False)
     assert half_turn_twins(grasps) == (None, None, None)
 
 

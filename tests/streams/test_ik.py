@@ -18,7 +18,7 @@ from streams.ik import (
 def _requests(
     ctx: WorldContext, objects: dict[str, ObjectBox], names: list[str]
 ) -> list[IKRequest]:
-    grasps = sample_grasps(objects[names[0]].size, ctx.scene.gripper.max_graspable_width)
+    grasps = sample_grasps(objects[names[0]].size, ctx.scene.grasp_limits)
     return [IKRequest(a, o, objects[o], grasps) for a in ctx.arm_names for o in names]
 
 
@@ -65,7 +65,7 @@ def test_compatible_pairs_are_jointly_collision_free(
     world = ctx.new_world()
     names = list(objects)
     home = {a: ctx.home(a) for a in ctx.arm_names}
-    grasps = sample_grasps(objects[names[0]].size, ctx.scene.gripper.max_graspable_width)
+    grasps = sample_grasps(objects[names[0]].size, ctx.scene.grasp_limits)
     left = solve_ik_candidates(
         ctx, world, objects, [IKRequest("left", names[0], objects[names[0]], grasps)], home
     )
@@ -109,7 +109,7 @@ def test_one_grasp_ik_table_serves_every_arrangement(
     world = ctx.new_world()
     name = next(iter(objects))
     box = objects[name]
-    grasps = sample_grasps(box.size, ctx.scene.gripper.max_graspable_width)
+    grasps = sample_grasps(box.size, ctx.scene.grasp_limits)
     home = {a: ctx.home(a) for a in ctx.arm_names}
     table = GraspIK(ctx, "left", name, box, grasps)
     fresh = solve_ik_candidates(ctx, world, objects, [IKRequest("left", name, box, grasps)], home)

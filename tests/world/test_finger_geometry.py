@@ -10,12 +10,16 @@ import pytest
 from sdar_tamp.world._pin import PinRobot
 from sdar_tamp.world.errors import KinematicsError
 from sdar_tamp.world.finger_geometry import finger_geometry
-from sdar_tamp.world.graspability import FINGER_DEPTH, FINGER_WIDTH
 from sdar_tamp.world.scene import domain_path, load_scene
-from streams.motion.shape import FINGER_ENVELOPE
 
-URDF = domain_path("ur5e_2f85.urdf")
+URDF = domain_path("robots/ur5e_2f85.urdf")
 FINGERS = ("gripper_left_finger", "gripper_right_finger")
+#: The constants the planner used before the cell described its gripper: fingertips 0.017 m
+#: beyond the TCP, 0.022 m wide; pads 0.036 m either side of the TCP, 0.065 m long.
+FINGER_DEPTH, FINGER_WIDTH = 0.017, 0.022
+FINGER_ENVELOPE = np.array(
+    [[x, y, z] for x in (-0.011, 0.011) for y in (-0.042, 0.042) for z in (-0.048, 0.017)]
+)
 
 
 def test_the_shipped_gripper_reads_back_exactly() -> None:
@@ -23,6 +27,13 @@ def test_the_shipped_gripper_reads_back_exactly() -> None:
     assert g.depth == FINGER_DEPTH and g.width == FINGER_WIDTH
     assert g.opening == load_scene().gripper.max_opening
     np.testing.assert_array_equal(g.envelope, FINGER_ENVELOPE)
+    # measured from the flange with the cell's TCP offset: the same
+    flange = finger_geometry(PinRobot.load(URDF), FINGERS, "tool0", tcp_offset=0.178)
+    assert (flange.depth, flange.width, flange.opening) == (g.depth, g.width, g.opening)
+    np.testing.assert_array_equal(flange.envelope, FINGER_ENVELOPE)
+    gripper = load_scene().arm("right").gripper
+    assert (gripper.finger_depth, gripper.finger_width) == (FINGER_DEPTH, FINGER_WIDTH)
+    np.testing.assert_array_equal(gripper.envelope, FINGER_ENVELOPE)
 
 
 def _variant(tmp_path: Path, old: str, new: str) -> PinRobot:

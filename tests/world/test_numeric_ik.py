@@ -64,7 +64,7 @@ def test_rotation_log_matches_pinocchio() -> None:
 
 
 def test_chain_fk_and_jacobian_match_pinocchio_and_differences() -> None:
-    robot = PinRobot.load(domain_path("ur5e_2f85.urdf"))
+    robot = PinRobot.load(domain_path("robots/ur5e_2f85.urdf"))
     chain = chain_to(robot, "tcp")
     rng = np.random.default_rng(1)
     q = rng.uniform(-np.pi, np.pi, (20, 6))
@@ -96,7 +96,7 @@ def _solve_reachable(chain: Chain, lo: np.ndarray, hi: np.ndarray) -> float:
 
 
 def test_reachable_poses_are_solved_six_dof() -> None:
-    robot = PinRobot.load(domain_path("ur5e_2f85.urdf"))
+    robot = PinRobot.load(domain_path("robots/ur5e_2f85.urdf"))
     spec = load_scene().arms[0]
     rate = _solve_reachable(chain_to(robot, "tcp"), spec.lower_array, spec.upper_array)
     assert rate >= 0.97

@@ -12,7 +12,7 @@ from sdar_tamp.world.scene import domain_path
 from sdar_tamp.world.ur_identify import ur_parameters
 from sdar_tamp.world.ur_ik import UR5E, URParameters, ur_fk, ur_ik
 
-UR5E_URDF = domain_path("ur5e_2f85.urdf")
+UR5E_URDF = domain_path("robots/ur5e_2f85.urdf")
 
 
 def test_the_shipped_ur5e_reads_back_exactly() -> None:
@@ -82,7 +82,7 @@ def test_a_scene_whose_arm_is_not_ur_gets_the_numeric_ik(tmp_path: Path) -> None
     scene = (
         default_scene_path()
         .read_text(encoding="utf-8")
-        .replace("robot: ur5e_2f85.urdf", "robot: bent.urdf")
+        .replace("robot: ../robots/ur5e_2f85.urdf", "robot: bent.urdf")
     )
     (tmp_path / "scene.yaml").write_text(scene, encoding="utf-8")
     bent = ArmKinematics.from_scene(load_scene(tmp_path / "scene.yaml"), "left")

@@ -192,13 +192,13 @@ def _ur5e_with_mesh_wrist(root: Path, size: float) -> Path:
     """The shipped scene with the wrist_3 link's collision shape a tetrahedron mesh of side
     ``size`` [m] given by a ``package://`` URI; returns the scene file."""
     write_stl(root / "cellmeshes" / "meshes" / "tet.stl", TET * size, TET_FACES)
-    text = domain_path("ur5e_2f85.urdf").read_text(encoding="utf-8")
+    text = domain_path("robots/ur5e_2f85.urdf").read_text(encoding="utf-8")
     old = '<geometry><cylinder radius="0.038" length="0.05"/></geometry>'
     assert text.count(old) == 1
     new = '<geometry><mesh filename="package://cellmeshes/meshes/tet.stl"/></geometry>'
     (root / "robot.urdf").write_text(text.replace(old, new), encoding="utf-8")
     scene = default_scene_path().read_text(encoding="utf-8")
-    scene = scene.replace("robot: ur5e_2f85.urdf", "packages: [.]\nrobot: robot.urdf")
+    scene = scene.replace("robot: ../robots/ur5e_2f85.urdf", "packages: [.]\nrobot: robot.urdf")
     path = root / "scene.yaml"
     path.write_text(scene, encoding="utf-8")
     return path

@@ -107,10 +107,9 @@ def test_an_object_too_short_to_hold_is_refused_with_its_place_and_reason() -> N
 def test_a_cube_as_wide_as_the_gripper_allows_and_a_short_bar_load(scene: Scene) -> None:
     """The loader and the grasp sampler share one width tolerance: the scene's graspable
     width (0.06 - 0.01, a hair under 0.05 m) accepts a 0.05 m cube."""
-    width = scene.gripper.max_graspable_width
     text = HEAD + _obj("cube", "[0, 0, 0]", "[0, 0.2, 0]", size="[0.05, 0.05, 0.05]")
     text += _obj("bar", "[0.15, 0, 0]", "[0.15, 0.2, 0]", size="[0.08, 0.04, 0.03]")
-    assert parse_instance(text, "inst.yaml", max_grasp_width=width).names == ("cube", "bar")
+    assert parse_instance(text, "inst.yaml", grasp=scene.grasp_limits).names == ("cube", "bar")
 
 
 def test_duplicate_names() -> None:

@@ -67,7 +67,7 @@ def _check_against_pinocchio(robot: PinRobot, frame: str, samples: int = 50) -> 
 
 
 def test_ur5e_chain_matches_pinocchio() -> None:
-    robot = PinRobot.load(domain_path("ur5e_2f85.urdf"))
+    robot = PinRobot.load(domain_path("robots/ur5e_2f85.urdf"))
     assert chain_to(robot, "tcp").dof == 6
     assert _check_against_pinocchio(robot, "tcp") < 1e-9
     assert _check_against_pinocchio(robot, "tool0") < 1e-9

@@ -37,7 +37,7 @@ BLOCKED_GOAL = np.array([0.04376532233356345, -0.9655976891109983, 1.52886364362
 def _pick_goal(ctx: WorldContext, objects: dict[str, ObjectBox], a: str, b: str) -> np.ndarray:
     world = ctx.new_world()
     home = {x: ctx.home(x) for x in ctx.arm_names}
-    g = sample_grasps(objects[a].size, ctx.scene.gripper.max_graspable_width)
+    g = sample_grasps(objects[a].size, ctx.scene.grasp_limits)
     left = solve_ik_candidates(ctx, world, objects, [IKRequest("left", a, objects[a], g)], home)
     right = solve_ik_candidates(ctx, world, objects, [IKRequest("right", b, objects[b], g)], home)
     pairs = compatible_pairs(ctx, world, objects, left, right)

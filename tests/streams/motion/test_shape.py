@@ -13,7 +13,6 @@ from sdar_tamp.world.transforms import pose_xyz_yaw
 from streams.context import WorldContext
 from streams.motion.cartesian import straight_tool_move
 from streams.motion.shape import (
-    FINGER_ENVELOPE,
     ShapeOptions,
     clearance_lift,
     footprint_distance,
@@ -23,6 +22,11 @@ from streams.motion.shape import (
 )
 
 OPTS = ShapeOptions()
+#: The shipped gripper's finger envelope (the cell's ``gripper.envelope``; the test of
+#: ``tests/world/test_gripper.py`` reads it back from the URDF).
+ENVELOPE = np.array(
+    [[x, y, z] for x in (-0.011, 0.011) for y in (-0.042, 0.042) for z in (-0.048, 0.017)]
+)
 SIZE = (0.08, 0.04, 0.05)
 
 
@@ -39,30 +43,32 @@ def _box(x: float, y: float, height: float = 0.05) -> ObjectBox:
 def test_lone_object_gets_the_least_lift() -> None:
     # the grasped object itself: fingertips 17 mm below the TCP at its centre must clear its top
     T = _top_down(0.0, 0.0, 0.025)
-    lift = clearance_lift(T, {"o": _box(0.0, 0.0)}, None, OPTS)
-    tip = float(FINGER_ENVELOPE[:, 2].max())
+    lift = clearance_lift(T, ENVELOPE, {"o": _box(0.0, 0.0)}, None, OPTS)
+    tip = float(ENVELOPE[:, 2].max())
     assert lift == pytest.approx(max(OPTS.min_lift, 0.05 + OPTS.lift_margin - (0.025 - tip)))
 
 
 def test_lift_follows_the_tallest_neighbour() -> None:
     T = _top_down(0.0, 0.0, 0.025)
     held = _box(0.0, 0.0)  # held: its bottom rests on the table
-    low = clearance_lift(T, {"n": _box(0.0, 0.1, 0.05)}, held, OPTS)
-    tall = clearance_lift(T, {"n": _box(0.0, 0.1, 0.09)}, held, OPTS)
+    low = clearance_lift(T, ENVELOPE, {"n": _box(0.0, 0.1, 0.05)}, held, OPTS)
+    tall = clearance_lift(T, ENVELOPE, {"n": _box(0.0, 0.1, 0.09)}, held, OPTS)
     assert low == pytest.approx(0.05 + OPTS.lift_margin)
     assert tall == pytest.approx(0.09 + OPTS.lift_margin)
-    far = clearance_lift(T, {"n": _box(0.0, 0.4, 0.09)}, held, OPTS)
+    far = clearance_lift(T, ENVELOPE, {"n": _box(0.0, 0.4, 0.09)}, held, OPTS)
     assert far == pytest.approx(OPTS.min_lift)  # not a neighbour ...
-    toward = clearance_lift(T, {"n": _box(0.0, 0.4, 0.09)}, held, OPTS, np.array([0.0, 0.6]))
+    toward = clearance_lift(
+        T, ENVELOPE, {"n": _box(0.0, 0.4, 0.09)}, held, OPTS, np.array([0.0, 0.6])
+    )
     assert toward == pytest.approx(tall)  # ... unless the motion passes it
-    huge = clearance_lift(T, {"n": _box(0.0, 0.1, 0.5)}, held, OPTS)
+    huge = clearance_lift(T, ENVELOPE, {"n": _box(0.0, 0.1, 0.5)}, held, OPTS)
     assert huge == OPTS.max_lift
 
 
 def test_side_grasp_keeps_the_fixed_lift() -> None:
     T = pose_xyz_yaw(0.0, 0.0, 0.025, 0.0)
     T[:3, :3] = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # tool z along x
-    assert clearance_lift(T, {}, None, OPTS) is None
+    assert clearance_lift(T, ENVELOPE, {}, None, OPTS) is None
 
 
 def test_footprint_distance() -> None:
