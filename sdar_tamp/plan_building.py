@@ -20,7 +20,6 @@ from sdar_tamp.plan_file import (
     plan_joint_names,
 )
 from sdar_tamp.plan_metrics import MetricValue, PlanMetrics
-from sdar_tamp.world.arm_access import arm_joint_names
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
 
@@ -166,7 +165,7 @@ def build_plan_file(
     arms = tuple(
         ArmInfo(
             a.name,
-            plan_joint_names(a.name, arm_joint_names(a)),
+            plan_joint_names(a.name, a.joint_names),
             a.T_world_base,
             kins[a.name].T_tool0_tcp,
             np.array(a.home),

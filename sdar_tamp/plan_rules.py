@@ -25,7 +25,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from sdar_tamp.plan_file import EVENT_TYPES, GRIPPER_DWELL, MAX_DT, PlanFile, plan_joint_names
-from sdar_tamp.world.arm_access import arm_joint_names, arm_tcp_offset
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
@@ -111,7 +110,7 @@ def check_format(plan: PlanFile) -> Violation | None:
 
 def check_scene(plan: PlanFile, scene: Scene) -> Violation | None:
     """Arm names and order, joint names (each arm's robot joints, in order, as
-    :func:`~sdar_tamp.world.arm_access.arm_joint_names` reads them), base poses, tool frames and
+    ``ArmSpec.joint_names``), base poses, tool frames and
     home configurations equal the scene's."""
     if plan.arm_names != scene.arm_names:
         return Violation(
@@ -121,7 +120,7 @@ def check_scene(plan: PlanFile, scene: Scene) -> Violation | None:
             f"scene's {list(scene.arm_names)} (names and order)",
         )
     for i, (info, spec) in enumerate(zip(plan.arms, scene.arms, strict=True)):
-        expected = plan_joint_names(spec.name, arm_joint_names(spec))
+        expected = plan_joint_names(spec.name, spec.joint_names)
         if info.joints != expected:
             if len(info.joints) != len(expected):
                 return Violation(
@@ -139,7 +138,7 @@ def check_scene(plan: PlanFile, scene: Scene) -> Violation | None:
                 f"arms[{i}].joints[{k}]: expected {expected[k]!r}, got {info.joints[k]!r} (the "
                 f"joints of the scene's robot, in order: {list(expected)})",
             )
-        tcp = translation(0.0, 0.0, arm_tcp_offset(scene, spec))
+        tcp = translation(0.0, 0.0, spec.gripper.tcp_offset)
         for label, T, ref in (
             ("T_world_base", info.T_world_base, spec.T_world_base),
             ("T_tool0_tcp", info.T_tool0_tcp, tcp),
@@ -197,7 +196,7 @@ def joint_label(name: str) -> str:
 def _joint(scene: Scene, j: int) -> str:
     """``arm joint`` of entry ``j`` of the scene's configuration vector."""
     arm, k = scene.layout.locate(j)
-    return f"{arm} {joint_label(arm_joint_names(scene.arm(arm))[k])}"
+    return f"{arm} {joint_label(scene.arm(arm).joint_names[k])}"
 
 
 def _joint_limits(plan: PlanFile, scene: Scene) -> Violation | None:

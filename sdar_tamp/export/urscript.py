@@ -40,8 +40,8 @@ from sdar_tamp.export.timeline import (
     positions_at,
 )
 from sdar_tamp.plan_file import PlanFile, plan_joint_names
-from sdar_tamp.world.arm_access import arm_robot_file, ur_joint_names
 from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.shipped_cell import UR_JOINT_NAMES
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
 
@@ -144,7 +144,7 @@ def check_ur_arms(plan: PlanFile, scene: Scene | None = None) -> None:
     checked: dict[Path, bool] = {}
     for info in plan.arms:
         if scene is not None and info.name in scene.arm_names:
-            path = arm_robot_file(scene, scene.arm(info.name))
+            path = scene.arm(info.name).urdf
             if path not in checked:
                 checked[path] = ur_parameters(PinRobot.load(path, scene.package_dirs)) is not None
             if not checked[path]:
@@ -155,7 +155,7 @@ def check_ur_arms(plan: PlanFile, scene: Scene | None = None) -> None:
                     "joint-trajectory or csv for this arm"
                 )
             continue
-        ur = plan_joint_names(info.name, ur_joint_names())
+        ur = plan_joint_names(info.name, UR_JOINT_NAMES)
         if info.joints != ur:
             raise ParameterError(
                 f"urscript: arm {info.name!r} is not a Universal Robots arm: its "

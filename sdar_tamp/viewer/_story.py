@@ -15,7 +15,6 @@ import numpy as np
 from sdar_tamp.plan_file import GRIPPER_DWELL
 from sdar_tamp.viewer._geometry import FINGER_FRAMES, ArmDrawing
 from sdar_tamp.viewer._timeline import Timeline
-from sdar_tamp.world.arm_access import arm_joint_names
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 
@@ -190,5 +189,5 @@ def joint_curves(timeline: Timeline, scene: Scene, rate: float = JOINT_RATE) -> 
         vmax = np.asarray(spec.velocity_limit, dtype=np.float64)
         positions.append((timeline.arm_q(q_s, a) - lower) / span)
         velocities.append(timeline.arm_q(qd_s, a) / np.where(vmax > 0, vmax, 1.0))
-        joints.append(arm_joint_names(spec))
+        joints.append(spec.joint_names)
     return JointCurves(times, tuple(positions), tuple(velocities), tuple(joints))

@@ -19,7 +19,6 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.viewer._geometry import ArmDrawing
 from sdar_tamp.viewer._plan import PlanLike, StepLike
 from sdar_tamp.world._pin import PinRobot
-from sdar_tamp.world.arm_access import arm_joint_names, arm_robot_file, arm_tcp_offset
 from sdar_tamp.world.errors import ArmLayoutError
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.layout import ArmLayout
@@ -242,14 +241,14 @@ def _drawing(
 ) -> ArmDrawing:
     """Arm ``name`` drawn from ``spec``'s robot description (loaded into ``robots`` once) and
     joints; ``T_tool0_tcp`` default: the arm's gripper's."""
-    path = arm_robot_file(scene, spec)
+    path = spec.urdf
     robot = robots.get(path)
     if robot is None:
         robot = robots[path] = PinRobot.load(path, scene.package_dirs)
     if T_tool0_tcp is None:
         T_tool0_tcp = np.eye(4)
-        T_tool0_tcp[2, 3] = arm_tcp_offset(scene, spec)
-    return ArmDrawing.build(name, robot, T_world_base, T_tool0_tcp, joints=arm_joint_names(spec))
+        T_tool0_tcp[2, 3] = spec.gripper.tcp_offset
+    return ArmDrawing.build(name, robot, T_world_base, T_tool0_tcp, joints=spec.joint_names)
 
 
 def yaw_of(T: FloatArray) -> FloatArray:

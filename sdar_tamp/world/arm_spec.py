@@ -16,7 +16,7 @@ import numpy as np
 
 from sdar_tamp.world._pin import PinRobot, chain_to
 from sdar_tamp.world._yaml import Node
-from sdar_tamp.world.errors import KinematicsError
+from sdar_tamp.world.errors import KinematicsError, SceneError
 from sdar_tamp.world.gripper import Gripper, read_gripper
 from sdar_tamp.world.shipped_cell import LEGACY_FINGERS, LEGACY_JOINT_SUFFIX
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
@@ -49,6 +49,17 @@ class ArmSpec:
     #: The description's other one-axis joints (a gripper's slides, joints before the base
     #: frame) and the value each is held at [rad or m]: default 0, or the nearest limit.
     locked_joints: tuple[tuple[str, float], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.joint_names:
+            raise SceneError(f"arm {self.name!r}: no joints; name them (arms[].joints)")
+        for field_name in ("lower", "upper", "velocity_limit", "acceleration_limit", "home"):
+            values = getattr(self, field_name)
+            if len(values) != len(self.joint_names):
+                raise SceneError(
+                    f"arm {self.name!r}: {field_name} has {len(values)} values for "
+                    f"{len(self.joint_names)} joints {list(self.joint_names)}"
+                )
 
     @property
     def dof(self) -> int:

@@ -105,6 +105,15 @@ def build_dual_arm(scene: Scene) -> CellCollisionModel:
     tool: dict[str, int] = {}
     T_wrist_tool: dict[str, FloatArray] = {}
     for spec in scene.arms:
+        for name, kind, exists in (
+            *((j, "joint", model.existJointName(f"{spec.name}_{j}")) for j in spec.joint_names),
+            (spec.tool_frame, "frame", model.existFrame(f"{spec.name}_{spec.tool_frame}")),
+        ):
+            if not exists:
+                raise SceneError(
+                    f"{scene.file}: arm {spec.name!r}: its robot description "
+                    f"{spec.urdf.name} has no {kind} {name!r}"
+                )
         joints = [int(model.getJointId(f"{spec.name}_{j}")) for j in spec.joint_names]
         wrist[spec.name] = joints[-1]
         tool[spec.name] = int(model.getFrameId(f"{spec.name}_{spec.tool_frame}"))

@@ -11,6 +11,7 @@ descriptions); any other serial chain the batched numeric IK of :mod:`.numeric_i
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -37,31 +38,6 @@ CLOSED_FORM_BRANCHES = 8
 NUMERIC_BRANCHES = 4
 #: The numeric IK's effort in the planner (seeds per pose, rounds of fresh seeds).
 NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=4)
-
-
-@dataclass(frozen=True)
-class ArmDescription:
-    """Where an arm of the scene comes from: its robot description, the tool frame its chain
-    ends at, its joints (None: the chain's) and the TCP offset along the tool frame's z [m]."""
-
-    urdf: Path
-    tool_frame: str
-    joint_names: tuple[str, ...] | None
-    tcp_offset: float
-
-
-def arm_description(scene: Scene, arm: str) -> ArmDescription:
-    """The description of the scene's arm ``arm``: the arm's own fields where the scene gives
-    them per arm, else the scene's robot, ``tool0`` and the scene's gripper (the one place that
-    reads them)."""
-    spec = scene.arm(arm)
-    gripper = getattr(spec, "gripper", scene.gripper)
-    return ArmDescription(
-        urdf=getattr(spec, "urdf", scene.robot_urdf),
-        tool_frame=getattr(spec, "tool_frame", "tool0"),
-        joint_names=getattr(spec, "joint_names", None),
-        tcp_offset=float(gripper.tcp_offset),
-    )
 
 
 @dataclass(frozen=True)
@@ -97,6 +73,9 @@ class ArmKinematics:
     params: URParameters | None  # read from the URDF (UR family), else None: numeric IK
     T_base_dh: FloatArray = field(default_factory=lambda: T_BASE_DH.copy(), compare=False)
     numeric: NumericIKOptions = NUMERIC_OPTIONS
+    #: The arm's base frame (``spec.base_frame``) in the description's root frame: the scene
+    #: places the base frame, the chain starts at the root.
+    T_root_base: FloatArray = field(default_factory=lambda: np.eye(4), compare=False)
 
     @staticmethod
     def from_model(
@@ -132,23 +111,29 @@ class ArmKinematics:
                 f"{urdf.name}: the chain to {tool_frame!r} has {chain.dof} joints; arm "
                 f"{spec.name!r} has {len(spec.home)}"
             )
+        T_root_base = _root_to_base(robot, spec.base_frame)
         found = ur_parameters(robot, tool_frame)
         if found is None:
-            return ArmKinematics(spec, robot, tcp_offset, chain, None, np.eye(4), numeric)
+            return ArmKinematics(
+                spec, robot, tcp_offset, chain, None, np.eye(4), numeric, T_root_base
+            )
         params, T_base_dh = found
-        return ArmKinematics(spec, robot, tcp_offset, chain, params, T_base_dh, numeric)
+        return ArmKinematics(
+            spec, robot, tcp_offset, chain, params, T_base_dh, numeric, T_root_base
+        )
 
     @staticmethod
     def from_scene(scene: Scene, arm: str) -> ArmKinematics:
-        """The kinematics of the scene's arm ``arm`` (see :meth:`from_model`)."""
-        d = arm_description(scene, arm)
+        """The kinematics of the scene's arm ``arm`` (see :meth:`from_model`): its robot
+        description, tool frame, joints and gripper's TCP offset."""
+        spec = scene.arm(arm)
         return ArmKinematics.from_model(
-            scene.arm(arm),
-            d.urdf,
-            tcp_offset=d.tcp_offset,
+            spec,
+            spec.urdf,
+            tcp_offset=spec.gripper.tcp_offset,
             package_dirs=scene.package_dirs,
-            tool_frame=d.tool_frame,
-            joint_names=d.joint_names,
+            tool_frame=spec.tool_frame,
+            joint_names=spec.joint_names,
         )
 
     @property
@@ -171,7 +156,9 @@ class ArmKinematics:
 
     @property
     def T_world_base(self) -> FloatArray:
-        return self.spec.T_world_base
+        """The description's root frame in the world (the chain's start): the scene's base
+        pose of the arm's base frame, less the base frame's place on the root."""
+        return self.spec.T_world_base @ inverse(self.T_root_base)
 
     @property
     def T_tool0_tcp(self) -> FloatArray:
@@ -189,10 +176,7 @@ class ArmKinematics:
         return self.fk(q)
 
     def fk_tcp(self, q: FloatArray) -> FloatArray:
-        """The TCP pose: the URDF's ``tcp`` frame if it has one, else ``tcp_offset`` along
-        the tool frame's z."""
-        if self.robot.model.existFrame("tcp"):
-            return self.fk(q, "tcp")
+        """The TCP pose: ``tcp_offset`` (the arm's gripper's) along the tool frame's z."""
         return self.fk(q) @ self.T_tool0_tcp
 
     # -- batched -------------------------------------------------------------------------
@@ -301,11 +285,22 @@ class ArmKinematics:
 
     def _full(self, q: FloatArray) -> FloatArray:
         """The robot's configuration vector ``(nq,)`` with the arm's joints at ``q``, any other
-        joint (fingers) at 0."""
+        joint (fingers) where the arm's ``locked_joints`` hold it (default 0)."""
         if self.robot.nq == self.dof:
             return q
-        full = np.zeros(self.robot.nq)
+        full = self._locked.copy()
         full[[j.q_index for j in self.chain.joints]] = q
+        return full
+
+    @cached_property
+    def _locked(self) -> FloatArray:
+        full = np.zeros(self.robot.nq)
+        model = self.robot.model
+        for name, value in self.spec.locked_joints:
+            if model.existJointName(name):
+                joint = model.joints[int(model.getJointId(name))]
+                if int(joint.nq) == 1:
+                    full[int(joint.idx_q)] = value
         return full
 
     def _check_q(self, q: FloatArray) -> FloatArray:
@@ -315,3 +310,18 @@ class ArmKinematics:
                 f"expected a configuration of shape ({self.dof},), got {qa.shape}"
             )
         return qa
+
+
+def _root_to_base(robot: PinRobot, base_frame: str) -> FloatArray:
+    """``T_root_base`` ``(4, 4)`` of the frame ``base_frame``, which no joint may move.
+
+    Raises:
+        KinematicsError: the frame is missing or a joint moves it.
+    """
+    fid = robot.frame_id(base_frame)
+    if int(robot.model.frames[fid].parentJoint) != 0:
+        raise KinematicsError(
+            f"{robot.urdf_path.name}: the base frame {base_frame!r} is moved by a joint; the "
+            "base frame is fixed to the description's root"
+        )
+    return robot.frame_pose(robot.neutral(), fid)

@@ -23,3 +23,6 @@ LEGACY_FINGERS = ("gripper_left_finger", "gripper_right_finger")
 #: Opening 0.06 m minus margin 0.01 m; fingertips 0.017 m beyond the TCP, 0.022 m wide (the
 #: Robotiq 2F-85 mould of ``robots/ur5e_2f85.urdf``).
 SHIPPED_GRASP = GraspLimits(max_width=0.05, finger_depth=0.017, finger_width=0.022)
+#: The joints of a Universal Robots arm as its ROS descriptions name them, base to wrist: a
+#: plan without a cell is a UR plan (URScript export) when its arms carry these names.
+UR_JOINT_NAMES = tuple(key + LEGACY_JOINT_SUFFIX for key in LEGACY_JOINT_KEYS)

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sdar_tamp.world.scene import ArmSpec, Gripper, Scene, load_scene
+from sdar_tamp.world.scene import ArmSpec, Scene, load_scene
 from streams.context import WorldContext
 
 ARM7_URDF = Path(__file__).resolve().parents[1] / "data" / "arm7.urdf"
@@ -23,24 +23,28 @@ HOME = (0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785)
 
 def seven_dof_scene() -> Scene:
     base = load_scene()
+    gripper = replace(base.arms[0].gripper, max_opening=0.07, tcp_offset=0.1034)
 
     def arm(name: str, x: float, yaw: float) -> ArmSpec:
         return ArmSpec(
             name=name,
+            urdf=ARM7_URDF,
             base_xyz=(x, 0.0, 0.0),
             base_yaw=yaw,
-            lower=LOWER,  # type: ignore[arg-type]
-            upper=UPPER,  # type: ignore[arg-type]
-            velocity_limit=VELOCITY,  # type: ignore[arg-type]
-            acceleration_limit=(5.0,) * 7,  # type: ignore[arg-type]
-            home=HOME,  # type: ignore[arg-type]
+            base_frame="base_link",
+            tool_frame="tool0",
+            joint_names=tuple(f"joint{i}" for i in range(1, 8)),
+            lower=LOWER,
+            upper=UPPER,
+            velocity_limit=VELOCITY,
+            acceleration_limit=(5.0,) * 7,
+            home=HOME,
+            gripper=gripper,
         )
 
     return replace(
         base,
         file="seven-dof test cell",
-        robot_urdf=ARM7_URDF,
-        gripper=Gripper(max_opening=0.07, tcp_offset=0.1034, grasp_margin=0.01),
         arms=(arm("left", -0.5, 0.0), arm("right", 0.5, float(np.pi))),
     )
 

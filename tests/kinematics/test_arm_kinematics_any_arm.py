@@ -130,7 +130,11 @@ def test_bad_arms_and_shapes_raise(scene7: Scene, kin7: ArmKinematics, tmp_path:
     spec = scene7.arm("left")
     with pytest.raises(KinematicsError, match="not \\['a'"):
         ArmKinematics.from_model(spec, ARM7_URDF, tcp_offset=0.1, joint_names=("a",) * 7)
-    six = replace(spec, home=spec.home[:6])
+    six = replace(
+        spec, joint_names=spec.joint_names[:6], lower=spec.lower[:6], upper=spec.upper[:6],
+        velocity_limit=spec.velocity_limit[:6], acceleration_limit=spec.acceleration_limit[:6],
+        home=spec.home[:6],
+    )  # fmt: skip
     with pytest.raises(KinematicsError, match="has 7 joints; arm 'left' has 6"):
         ArmKinematics.from_model(six, ARM7_URDF, tcp_offset=0.1)
     with pytest.raises(KinematicsError, match="unknown frame 'nose'"):

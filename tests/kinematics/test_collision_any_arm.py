@@ -53,13 +53,21 @@ def test_missing_or_unmoved_tool_frames_are_refused(scene7: Scene, tmp_path: Pat
     text = ARM7_URDF.read_text(encoding="utf-8")
     renamed = tmp_path / "renamed.urdf"
     renamed.write_text(text.replace('"tool0"', '"hand0"'), encoding="utf-8")
-    with pytest.raises(SceneError, match="no frame 'left_tool0'"):
-        build_dual_arm(replace(scene7, robot_urdf=renamed))
+    with pytest.raises(
+        SceneError, match="arm 'left': its robot description renamed.urdf has no frame 'tool0'"
+    ):
+        build_dual_arm(_with_urdf(scene7, renamed))
     fixed = tmp_path / "fixed.urdf"
     fixed.write_text(
         text.replace('<parent link="flange"/>\n    <child link="tool0"/>',
                      '<parent link="base_link"/>\n    <child link="tool0"/>'),
         encoding="utf-8",
     )  # fmt: skip
-    with pytest.raises(SceneError, match="no joint moves the frame 'left_tool0'"):
-        build_dual_arm(replace(scene7, robot_urdf=fixed))
+    with pytest.raises(
+        SceneError, match="the tool frame 'tool0' is not fixed to the arm's last joint"
+    ):
+        build_dual_arm(_with_urdf(scene7, fixed))
+
+
+def _with_urdf(scene: Scene, urdf: Path) -> Scene:
+    return replace(scene, arms=tuple(replace(a, urdf=urdf) for a in scene.arms))

@@ -27,7 +27,7 @@ def _objects() -> dict[str, ObjectBox]:
 
 def test_ik_stream_yields_grasp_candidates(ctx7: WorldContext) -> None:
     objects = _objects()
-    grasps = sample_grasps(SIZE, ctx7.scene.gripper.max_graspable_width)
+    grasps = sample_grasps(SIZE, ctx7.scene.grasp_limits)
     requests = [IKRequest(a, o, objects[o], grasps) for a in ctx7.arm_names for o in objects]
     home = {a: ctx7.home(a) for a in ctx7.arm_names}
     cands = solve_ik_candidates(ctx7, ctx7.new_world(), objects, requests, home)

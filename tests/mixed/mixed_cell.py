@@ -10,14 +10,12 @@ robot; :func:`seven_joint_arm` is the one place that builds it.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from sdar_tamp.plan_file import ArmInfo, PlanEvent, PlanFile, StepRecord, plan_joint_names
 from sdar_tamp.plan_metrics import PlanMetrics
-from sdar_tamp.world.arm_access import arm_joint_names, arm_tcp_offset
 from sdar_tamp.world.instance import ObjectSpec, Pose2D
 from sdar_tamp.world.scene import ArmSpec, Scene, load_scene
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw, translation
@@ -38,27 +36,20 @@ T_TCP_OBJ = pose_xyz_yaw(0.0, 0.0, 0.01, 0.0)
 DT = 0.02
 
 
-@dataclass(frozen=True)
-class NamedArmSpec(ArmSpec):
-    """An arm that names its joints and its robot description."""
-
-    joint_names: tuple[str, ...] = ()
-    urdf: Path | None = None
-
-
 def seven_joint_arm(like: ArmSpec) -> ArmSpec:
-    """A 7-joint arm at ``like``'s base pose."""
-    return NamedArmSpec(
-        like.name,
-        like.base_xyz,
-        like.base_yaw,
-        PANDA_LOWER,  # type: ignore[arg-type]
-        PANDA_UPPER,  # type: ignore[arg-type]
-        PANDA_VELOCITY,  # type: ignore[arg-type]
-        PANDA_ACCELERATION,  # type: ignore[arg-type]
-        PANDA_HOME,  # type: ignore[arg-type]
-        joint_names=PANDA_JOINTS,
+    """A 7-joint arm at ``like``'s base pose, with ``like``'s gripper."""
+    return dataclasses.replace(
+        like,
         urdf=PANDA_URDF,
+        base_frame="panda_link0",
+        tool_frame="tool0",
+        joint_names=PANDA_JOINTS,
+        lower=PANDA_LOWER,
+        upper=PANDA_UPPER,
+        velocity_limit=PANDA_VELOCITY,
+        acceleration_limit=PANDA_ACCELERATION,
+        home=PANDA_HOME,
+        locked_joints=(),
     )
 
 
@@ -93,9 +84,9 @@ def mixed_plan(scene: Scene) -> PlanFile:
     arms = tuple(
         ArmInfo(
             a.name,
-            plan_joint_names(a.name, arm_joint_names(a)),
+            plan_joint_names(a.name, a.joint_names),
             a.T_world_base,
-            translation(0.0, 0.0, arm_tcp_offset(scene, a)),
+            translation(0.0, 0.0, a.gripper.tcp_offset),
             np.array(a.home),
         )
         for a in scene.arms

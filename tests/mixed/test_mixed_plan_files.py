@@ -16,9 +16,9 @@ from sdar_tamp.plan_file import PlanFile, PlanFileError
 from sdar_tamp.plan_reading import load_plan
 from sdar_tamp.plan_rules import check_format, check_scene, check_timeline
 from sdar_tamp.plan_writing import plan_to_dict, save_plan
-from sdar_tamp.world.arm_access import arm_joint_names, ur_joint_names
 from sdar_tamp.world.errors import SceneError
 from sdar_tamp.world.scene import Scene, load_scene
+from sdar_tamp.world.shipped_cell import UR_JOINT_NAMES
 
 SOLVED = Path(__file__).parents[1] / "plan" / "solved"
 
@@ -115,14 +115,12 @@ def test_an_arm_without_joints_is_an_error(plan: PlanFile, tmp_path: Path) -> No
 
 # -- joint names ---------------------------------------------------------------------------------
 def test_joint_names_per_arm(cell: Scene) -> None:
-    assert arm_joint_names(cell.arms[0]) == ur_joint_names()
-    assert arm_joint_names(cell.arms[1]) == PANDA_JOINTS
-    unnamed = dataclasses.replace(cell.arms[1], joint_names=())
-    with pytest.raises(SceneError, match="arm 'right': 7 joints and no joint names"):
-        arm_joint_names(unnamed)
-    wrong = dataclasses.replace(cell.arms[1], joint_names=PANDA_JOINTS[:6])
-    with pytest.raises(SceneError, match="6 joint names for 7 joints"):
-        arm_joint_names(wrong)
+    assert cell.arms[0].joint_names == UR_JOINT_NAMES
+    assert cell.arms[1].joint_names == PANDA_JOINTS
+    with pytest.raises(SceneError, match="arm 'right': no joints"):
+        dataclasses.replace(cell.arms[1], joint_names=())
+    with pytest.raises(SceneError, match="lower has 7 values for 6 joints"):
+        dataclasses.replace(cell.arms[1], joint_names=PANDA_JOINTS[:6])
 
 
 # -- the validator's rules that need no replay ---------------------------------------------------
