@@ -54,7 +54,7 @@ def test_missing_or_unmoved_tool_frames_are_refused(scene7: Scene, tmp_path: Pat
     renamed = tmp_path / "renamed.urdf"
     renamed.write_text(text.replace('"tool0"', '"hand0"'), encoding="utf-8")
     with pytest.raises(
-        SceneError, match="arm 'left': its robot description renamed.urdf has no frame 'tool0'"
+        SceneError, match=r"arm 'left': its robot description renamed\.urdf has no frame 'tool0'"
     ):
         build_dual_arm(_with_urdf(scene7, renamed))
     fixed = tmp_path / "fixed.urdf"
