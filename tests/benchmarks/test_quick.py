@@ -43,6 +43,10 @@ def _async(out: Summary) -> None:
     assert out["median_ratio"] <= 1.0  # the scheduler never returns a longer plan
 
 
+def _cells(out: Summary) -> None:
+    assert out["cells"] and all(c["reached_by_all"] == 1.0 for c in out["cells"].values())
+
+
 def _classical(out: Summary) -> None:
     assert out["problems"] >= 1 and out["solved"]["ours"] == out["problems"]
     assert not any(out["invalid"].values())
@@ -97,6 +101,7 @@ def _world(out: Summary) -> None:
 #: What a run's summary must show (runs not named here: only the common checks)
 CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_async", ()): _async,
+    ("bench_cells", ()): _cells,
     ("bench_classical", ()): _classical,
     ("bench_feasibility", ()): _feasibility,
     ("bench_motion", ()): _motion,
