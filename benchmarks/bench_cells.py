@@ -9,15 +9,16 @@ above it too, every joint within the cell's limits, no contact of the arm with i
 table. Printed per cell and arm: the share of workspace points reached, the first points
 missed; then the share reached by all arms.
 
-``--layout``: the computation the cells' layouts were chosen by. For each robot a reach map
+``--layout panda|ur``: the computation the cells' layouts were chosen by. For each robot a reach map
 in its own base frame (4 cm grid, its URDF limits, home as in the cell); then, for candidate
-base layouts on the table (two Pandas side by side on one edge at several spacings, or facing
-each other at several distances; a UR5e facing a UR10e at several distances), the largest
-axis-aligned rectangle every arm reaches, and its area. ``--limits CELL``: the joint ranges
+base layouts on the table (two Pandas side by side on one edge at several spacings and
+inward turns, the rectangle in front of the bases, or facing each other at several distances;
+a UR5e facing a UR10e at several distances), the largest axis-aligned rectangle every arm
+reaches, and its area. ``--limits CELL``: the joint ranges
 the cell's workspace needs with the URDF's limits, and the narrowed limits they suggest.
 
     python benchmarks/bench_cells.py             # the shipped cells' workspaces, 2 cm grid
-    python benchmarks/bench_cells.py --layout    # the layout search (minutes)
+    python benchmarks/bench_cells.py --layout panda   # the layout search (minutes; or ur)
     python benchmarks/bench_cells.py --limits panda_facing   # joint ranges used
     python benchmarks/bench_cells.py --quick     # 10 cm grid, two yaws: seconds
 """
@@ -119,8 +120,10 @@ def _lookup(reach: Any, T_world_base: Any, world: Any) -> Any:
     return ok[near] & (d[np.arange(len(world)), near] <= 0.03)
 
 
-def _best(maps: list[Any], bases: list[Any]) -> tuple[float, Any]:
-    xs, ys = np.arange(-1.0, 1.0001, 0.04), np.arange(-1.0, 1.0001, 0.04)
+def _best(maps: list[Any], bases: list[Any], y_min: float = -1.0) -> tuple[float, Any]:
+    """The largest rectangle (4 cm grid, ``y >= y_min`` [m]) every arm reaches: area [m^2]
+    and ``[[x0, x1], [y0, y1]]``."""
+    xs, ys = np.arange(-1.0, 1.0001, 0.04), np.arange(y_min, 1.0001, 0.04)
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     world = np.stack([X.ravel(), Y.ravel()], axis=1)
     ok = np.ones(len(world), dtype=bool)
@@ -130,26 +133,36 @@ def _best(maps: list[Any], bases: list[Any]) -> tuple[float, Any]:
     if rect is None:
         return 0.0, None
     (x0, x1), (y0, y1) = rect
-    return (x1 - x0) * (y1 - y0), [[round(x0, 2), round(x1, 2)], [round(y0, 2), round(y1, 2)]]
+    area = round((x1 - x0) * (y1 - y0), 3)
+    return area, [[round(x0, 2), round(x1, 2)], [round(y0, 2), round(y1, 2)]]
 
 
-def layout_search() -> dict[str, Any]:
-    panda = _reach_map("robots/panda_hand.urdf", 0.1034, None, PANDA_READY, 0.9)
-    ur5e = _reach_map("ur5e_2f85.urdf", 0.178, (UR_LOWER, UR_UPPER), UR_HOME, 1.0)
-    ur10e = _reach_map("robots/ur10e_2f85.urdf", 0.178, (UR_LOWER, UR_UPPER), UR_HOME, 1.4)
+def layout_search(robots: str) -> dict[str, Any]:
+    """Candidate layouts of two Pandas (``robots == "panda"``) or of a UR5e and a UR10e
+    (``"ur"``) and the largest rectangle each gives."""
     rows: list[dict[str, Any]] = []
-    for spacing in (0.5, 0.6, 0.7, 0.8, 0.9, 1.0):  # side by side on the edge y = -0.4
-        bases = [pose_xyz_yaw(s * spacing / 2, -0.4, 0.0, np.pi / 2) for s in (-1, 1)]
-        area, rect = _best([panda, panda], bases)
-        rows.append({"cell": "panda side by side", "spacing": spacing, "area": area, "rect": rect})
-    for distance in (0.8, 0.9, 1.0, 1.1, 1.2):  # facing each other across the table
-        bases = [pose_xyz_yaw(s * distance / 2, 0.0, 0.0, np.pi * (s > 0)) for s in (-1, 1)]
-        area, rect = _best([panda, panda], bases)
-        rows.append({"cell": "panda facing", "distance": distance, "area": area, "rect": rect})
-    for x10 in (0.55, 0.65, 0.75, 0.85, 0.95):  # UR5e at x = -0.55 facing a UR10e at x10
-        bases = [pose_xyz_yaw(-0.55, 0.0, 0.0, 0.0), pose_xyz_yaw(x10, 0.0, 0.0, np.pi)]
-        area, rect = _best([ur5e, ur10e], bases)
-        rows.append({"cell": "ur5e-ur10e facing", "ur10e_x": x10, "area": area, "rect": rect})
+    if robots == "panda":
+        panda = _reach_map("robots/panda_hand.urdf", 0.1034, None, PANDA_READY, 0.9)
+        # side by side on the edge y = -0.4, facing +y, turned by `toe` [rad] toward the
+        # other arm; the rectangle in front of the bases (y >= -0.3)
+        for toe in (0.0, 0.25, 0.5):
+            for spacing in (0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0):
+                bases = [pose_xyz_yaw(s * spacing / 2, -0.4, 0.0, np.pi / 2 + s * toe)
+                         for s in (-1, 1)]  # fmt: skip
+                area, rect = _best([panda, panda], bases, y_min=-0.3)
+                rows.append({"cell": "panda side by side", "spacing": spacing, "toe": toe,
+                             "area": area, "rect": rect})  # fmt: skip
+        for distance in (0.8, 0.9, 1.0, 1.1, 1.2):  # facing each other across the table
+            bases = [pose_xyz_yaw(s * distance / 2, 0.0, 0.0, np.pi * (s > 0)) for s in (-1, 1)]
+            area, rect = _best([panda, panda], bases)
+            rows.append({"cell": "panda facing", "distance": distance, "area": area, "rect": rect})
+    else:
+        ur5e = _reach_map("ur5e_2f85.urdf", 0.178, (UR_LOWER, UR_UPPER), UR_HOME, 1.0)
+        ur10e = _reach_map("robots/ur10e_2f85.urdf", 0.178, (UR_LOWER, UR_UPPER), UR_HOME, 1.4)
+        for x10 in (0.55, 0.65, 0.75, 0.85, 0.95):  # UR5e at x = -0.55 facing a UR10e at x10
+            bases = [pose_xyz_yaw(-0.55, 0.0, 0.0, 0.0), pose_xyz_yaw(x10, 0.0, 0.0, np.pi)]
+            area, rect = _best([ur5e, ur10e], bases)
+            rows.append({"cell": "ur5e-ur10e facing", "ur10e_x": x10, "area": area, "rect": rect})
     return {"layouts": rows}
 
 
@@ -194,7 +207,7 @@ def joint_ranges(path: Path, step: float) -> dict[str, Any]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="10 cm grid, two yaws: seconds")
-    ap.add_argument("--layout", action="store_true", help="the layout search (minutes)")
+    ap.add_argument("--layout", choices=("panda", "ur"), help="the layout search (minutes)")
     ap.add_argument("--limits", metavar="CELL", help="joint ranges the cell's workspace uses")
     args = ap.parse_args()
     t0 = time.perf_counter()
@@ -204,7 +217,7 @@ def main() -> None:
         for arm, row in out.items():
             print(arm, json.dumps(row))
     elif args.layout:
-        out = layout_search()
+        out = layout_search(args.layout)
         for row in out["layouts"]:
             print(json.dumps(row))
     else:
