@@ -159,3 +159,15 @@ def test_primitives_only_and_the_gripper_is_named_so(urdf: Path) -> None:
         if str(robot.model.frames[o.parentFrame].name) in hand_frames
     }
     assert on_hand == gripper
+
+
+@pytest.mark.parametrize(("urdf", "dof"), [(PANDA, 7), (UR10E, 6)], ids=["panda", "ur10e"])
+def test_the_sphere_model_reads_them(urdf: Path, dof: int) -> None:
+    """Every moving joint carries spheres, and the coarse model puts the whole gripper in one
+    box on the last joint (fewer spheres there than the fine model)."""
+    from streams.motion.spheres import arm_spheres
+
+    fine, coarse = arm_spheres(urdf), arm_spheres(urdf, coarse=True)
+    for model in (fine, coarse):
+        assert sorted(set(model.joint.tolist())) == list(range(1, dof + 1))
+    assert (coarse.joint == dof).sum() < (fine.joint == dof).sum()
