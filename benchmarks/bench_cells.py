@@ -46,7 +46,7 @@ from sdar_tamp.world.cell_reach import (
 from sdar_tamp.world.scene import domain_path
 from sdar_tamp.world.transforms import inverse, pose_xyz_yaw
 
-CELLS = ("panda_facing", "mixed_ur5e_ur10e")
+CELLS = ("panda_facing", "panda_side_by_side", "mixed_ur5e_ur10e")
 
 
 def cell_arms(path: Path) -> tuple[dict[str, Any], list[tuple[str, ReachArm]]]:

@@ -1,5 +1,5 @@
-"""The shipped cells written in the per-arm form (scene v2): two Franka Pandas side by side,
-and a UR5e with a UR10e.
+"""The shipped cells written in the per-arm form (scene v2): two Franka Pandas facing each
+other, two side by side, and a UR5e with a UR10e.
 
 Their workspaces are checked reachable top-down by every arm within the cell's limits (a
 coarse grid here; ``benchmarks/bench_cells.py`` checks the 2 cm grid). Loading them with
@@ -23,7 +23,7 @@ from sdar_tamp.world.graspability import grasp_problem
 from sdar_tamp.world.scene import domain_path, load_scene
 
 CELLS = domain_path("cells")
-NAMES = ("panda_facing", "mixed_ur5e_ur10e")
+NAMES = ("panda_facing", "panda_side_by_side", "mixed_ur5e_ur10e")
 
 
 def _bench() -> object:
