@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sdar_tamp.world._pin import PinRobot, chain_to
+from sdar_tamp.world._pin import PinRobot, chain_to, se3_to_array
 from sdar_tamp.world.finger_geometry import finger_geometry
 from sdar_tamp.world.scene import domain_path
 from sdar_tamp.world.ur_identify import ur_parameters
@@ -171,3 +171,39 @@ def test_the_sphere_model_reads_them(urdf: Path, dof: int) -> None:
     for model in (fine, coarse):
         assert sorted(set(model.joint.tolist())) == list(range(1, dof + 1))
     assert (coarse.joint == dof).sum() < (fine.joint == dof).sum()
+
+
+def test_panda_shapes_envelope_the_makers_meshes() -> None:
+    """Every collision-mesh vertex of links 0 to 7 of Franka's own description (as packaged in
+    ``example-robot-data``, whose link frames are the same DH frames) lies within 3 mm of our
+    shapes. Skipped when that package is not installed."""
+    from tests.world.test_maker_urdfs import SHARE
+
+    if SHARE is None:
+        pytest.skip("example-robot-data is not installed")
+    robots = SHARE / "example-robot-data" / "robots"
+    theirs = PinRobot.load(robots / "panda_description" / "urdf" / "panda.urdf", (robots, SHARE))
+    ours = PinRobot.load(PANDA)
+    for i in range(8):
+        link = f"panda_link{i}"
+        points = []
+        for obj in theirs.geometry.geometryObjects:
+            if str(theirs.model.frames[obj.parentFrame].name) != link:
+                continue
+            T = se3_to_array(obj.placement)  # in the joint frame, as ours are
+            v = np.asarray(obj.geometry.vertices(), dtype=np.float64).reshape(-1, 3)
+            points.append(v @ T[:3, :3].T + T[:3, 3])
+        p = np.concatenate(points)
+        covered = np.zeros(len(p), dtype=bool)
+        for obj in ours.geometry.geometryObjects:
+            if str(ours.model.frames[obj.parentFrame].name) != link:
+                continue
+            T = se3_to_array(obj.placement)
+            local = (p - T[:3, 3]) @ T[:3, :3]
+            g = obj.geometry
+            if type(g).__name__ == "Box":
+                covered |= np.all(np.abs(local) <= np.asarray(g.halfSide) + 0.003, axis=1)
+            else:
+                radial = np.hypot(local[:, 0], local[:, 1]) <= g.radius + 0.003
+                covered |= radial & (np.abs(local[:, 2]) <= g.halfLength + 0.003)
+        assert covered.all(), (link, p[~covered][:3])
