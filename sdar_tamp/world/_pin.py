@@ -14,8 +14,9 @@ import numpy as np
 import pinocchio as pin
 
 from sdar_tamp.errors import SourceLocation
+from sdar_tamp.world import _coal
 from sdar_tamp.world.errors import KinematicsError, SceneError
-from sdar_tamp.world.transforms import FloatArray
+from sdar_tamp.world.transforms import BoolArray, FloatArray
 from sdar_tamp.world.urdf import read_urdf
 
 
@@ -184,3 +185,37 @@ def chain_to(robot: PinRobot, frame: str) -> Chain:
             )
         )
     return Chain(tuple(joints), se3_to_array(f.placement), frame)
+
+
+def colliding_configurations(robot: PinRobot, q: FloatArray, table_top: float) -> BoolArray:
+    """``(n,)``: which configurations ``q`` ``(n, nq)`` put two collision shapes of the robot
+    at least two joints apart in contact, or a shape of a link past the first moving one
+    below the plane ``z = table_top`` [m] of the robot's base frame (a table top)."""
+    geometry = robot.geometry.copy()
+    model = robot.model
+    table = pin.GeometryObject(
+        "table", 0, pin.SE3(np.eye(3), np.array([0.0, 0.0, table_top - 0.5])), _coal.box((4, 4, 1))
+    )
+    table_id = geometry.addGeometryObject(table)
+
+    def depth(joint: int) -> int:
+        n = 0
+        while joint != 0:
+            joint, n = int(model.parents[joint]), n + 1
+        return n
+
+    objects = list(geometry.geometryObjects)
+    for a in range(len(objects)):
+        ja = int(objects[a].parentJoint)
+        if a != table_id and depth(ja) >= 2:
+            geometry.addCollisionPair(pin.CollisionPair(a, table_id))
+        for b in range(a + 1, len(objects)):
+            jb = int(objects[b].parentJoint)
+            if table_id not in (a, b) and abs(depth(ja) - depth(jb)) >= 2:
+                geometry.addCollisionPair(pin.CollisionPair(a, b))
+    gdata = geometry.createData()
+    data = model.createData()
+    out = np.zeros(len(q), dtype=np.bool_)
+    for i, row in enumerate(np.asarray(q, dtype=np.float64)):
+        out[i] = bool(pin.computeCollisions(model, data, geometry, gdata, row, True))
+    return out

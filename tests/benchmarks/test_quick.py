@@ -55,6 +55,10 @@ def _async(out: Summary) -> None:
     assert out["median_ratio"] <= 1.0  # the scheduler never returns a longer plan
 
 
+def _cells(out: Summary) -> None:
+    assert out["cells"] and all(c["reached_by_all"] == 1.0 for c in out["cells"].values())
+
+
 def _classical(out: Summary) -> None:
     assert out["problems"] >= 1 and out["solved"]["ours"] == out["problems"]
     assert not any(out["invalid"].values())
@@ -121,6 +125,7 @@ def _world(out: Summary) -> None:
 CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_arm_ik", ()): _arm_ik,
     ("bench_async", ()): _async,
+    ("bench_cells", ()): _cells,
     ("bench_classical", ()): _classical,
     ("bench_feasibility", ()): _feasibility,
     ("bench_motion", ()): _motion,
