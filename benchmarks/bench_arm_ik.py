@@ -2,7 +2,7 @@
 
 The planner's IK call (``ik_tcp``: every branch of a batch of TCP poses) for the shipped UR5e
 (the closed form, eight branches) and for a 7-DoF arm with the Franka Panda's kinematics
-(``tests/data/arm7.urdf``, Franka's datasheet limits; the numeric IK, up to four distinct
+(the shipped Panda cell's left arm; the numeric IK, up to four distinct
 solutions from eight seeds). Targets are the forward kinematics of configurations drawn
 uniformly inside the limits, so every one is reachable. Measured per arm: the share of poses
 with at least one valid branch, the largest pose error of a valid branch (position [m] or
@@ -18,37 +18,23 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from sdar_tamp.world.cells import cell_path
 from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.numeric_ik import pose_error
-from sdar_tamp.world.scene import ArmSpec, load_scene
-
-ARM7_URDF = Path(__file__).resolve().parents[1] / "tests" / "data" / "arm7.urdf"
-#: Franka's datasheet limits [rad], [rad/s]; the home is Franka's "ready" pose.
-LOWER = (-2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973)
-UPPER = (2.8973, 1.7628, 2.8973, -0.0698, 2.8973, 3.7525, 2.8973)
-HOME = (0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785)
+from sdar_tamp.world.scene import load_scene
 
 
 def _arms() -> dict[str, ArmKinematics]:
-    scene = load_scene()
-    spec = ArmSpec(
-        name="arm7",
-        base_xyz=(0.0, 0.0, 0.0),
-        base_yaw=0.0,
-        lower=LOWER,  # type: ignore[arg-type]
-        upper=UPPER,  # type: ignore[arg-type]
-        velocity_limit=(2.175,) * 4 + (2.61,) * 3,  # type: ignore[arg-type]
-        acceleration_limit=(5.0,) * 7,  # type: ignore[arg-type]
-        home=HOME,  # type: ignore[arg-type]
-    )
+    """The left arm of the shipped UR5e cell (closed form) and of the Panda cell (numeric)."""
+    ur5e = load_scene()
+    panda = load_scene(cell_path("panda_facing"))
     return {
-        "ur5e": ArmKinematics.from_scene(scene, scene.arm_names[0]),
-        "arm7": ArmKinematics.from_model(spec, ARM7_URDF, tcp_offset=0.1034),
+        "ur5e": ArmKinematics.from_scene(ur5e, ur5e.arm_names[0]),
+        "panda": ArmKinematics.from_scene(panda, panda.arm_names[0]),
     }
 
 
@@ -93,7 +79,7 @@ def main() -> None:
             f"{row['mean_valid_branches']:>8.2f} {row['max_error'] or 0.0:>9.1e} "
             f"{row['ms_per_pose']:>8.3f}"
         )
-    ratio = out["arms"]["arm7"]["ms_per_pose"] / out["arms"]["ur5e"]["ms_per_pose"]
+    ratio = out["arms"]["panda"]["ms_per_pose"] / out["arms"]["ur5e"]["ms_per_pose"]
     out["numeric_over_closed_form"] = ratio
     print(f"numeric IK (7-DoF) / closed form (UR5e), time per pose: {ratio:.0f}x")
     if args.quick:

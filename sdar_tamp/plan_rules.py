@@ -189,7 +189,7 @@ def check_timeline(
 
 
 def joint_label(name: str) -> str:
-    """A robot joint's name as messages show it (``shoulder_pan_joint`` -> ``shoulder_pan``)."""
+    """A robot joint's name as messages show it (a trailing ``_joint`` dropped)."""
     return name[: -len("_joint")] if name.endswith("_joint") and name != "_joint" else name
 
 

@@ -176,7 +176,10 @@ class ArmKinematics:
         return self.fk(q)
 
     def fk_tcp(self, q: FloatArray) -> FloatArray:
-        """The TCP pose: ``tcp_offset`` (the arm's gripper's) along the tool frame's z."""
+        """The TCP pose: the URDF's ``tcp`` frame if it has one, else ``tcp_offset`` (the arm's
+        gripper's) along the tool frame's z."""
+        if self.robot.model.existFrame("tcp"):
+            return self.fk(q, "tcp")
         return self.fk(q) @ self.T_tool0_tcp
 
     # -- batched -------------------------------------------------------------------------
