@@ -157,7 +157,7 @@ def layout_search(robots: str) -> dict[str, Any]:
             area, rect = _best([panda, panda], bases)
             rows.append({"cell": "panda facing", "distance": distance, "area": area, "rect": rect})
     else:
-        ur5e = _reach_map("ur5e_2f85.urdf", 0.178, (UR_LOWER, UR_UPPER), UR_HOME, 1.0)
+        ur5e = _reach_map("robots/ur5e_2f85.urdf", 0.178, (UR_LOWER, UR_UPPER), UR_HOME, 1.0)
         ur10e = _reach_map("robots/ur10e_2f85.urdf", 0.178, (UR_LOWER, UR_UPPER), UR_HOME, 1.4)
         for x10 in (0.55, 0.65, 0.75, 0.85, 0.95):  # UR5e at x = -0.55 facing a UR10e at x10
             bases = [pose_xyz_yaw(-0.55, 0.0, 0.0, 0.0), pose_xyz_yaw(x10, 0.0, 0.0, np.pi)]

@@ -44,7 +44,7 @@ Summary = dict[str, Any]
 
 
 def _arm_ik(out: Summary) -> None:
-    ur, arm7 = out["arms"]["ur5e"], out["arms"]["arm7"]
+    ur, arm7 = out["arms"]["ur5e"], out["arms"]["panda"]
     assert ur["solver"] == "closed form" and ur["branches"] == 8 and ur["success_rate"] == 1.0
     assert arm7["solver"] == "numeric" and arm7["dof"] == 7 and arm7["poses"] == 100
     assert arm7["success_rate"] >= 0.95 and arm7["max_error"] < 1e-5

@@ -17,7 +17,6 @@ import yaml
 
 from sdar_tamp.world._pin import PinRobot, chain_to
 from sdar_tamp.world.cell_reach import grid, reached
-from sdar_tamp.world.errors import SceneError
 from sdar_tamp.world.finger_geometry import finger_geometry
 from sdar_tamp.world.graspability import grasp_problem
 from sdar_tamp.world.scene import domain_path, load_scene
@@ -65,8 +64,8 @@ def test_cell_arms_match_their_robots(name: str) -> None:
         np.testing.assert_allclose(T_tool_tcp, expected, atol=1e-12)
         fingers = finger_geometry(robot, gripper["fingers"])
         assert fingers.opening == gripper["max_opening"] <= gripper["stroke"]
-        width = gripper["max_opening"] - gripper["grasp_margin"]
-        assert grasp_problem(tuple(cell["object_size"]), width) is None
+    scene = load_scene(path)
+    assert grasp_problem(tuple(cell["object_size"]), scene.grasp_limits) is None
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -83,10 +82,5 @@ def test_cell_workspace_is_reached_by_every_arm(name: str) -> None:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_cell_loads_as_a_scene(name: str) -> None:
-    try:
-        scene = load_scene(CELLS / f"{name}.yaml")
-    except SceneError as error:
-        if "unknown key" in str(error) or "required keys" in str(error):
-            pytest.skip(f"the scene reader does not take per-arm robots yet: {error}")
-        raise
+    scene = load_scene(CELLS / f"{name}.yaml")
     assert len(scene.arms) == 2

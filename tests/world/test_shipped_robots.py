@@ -126,7 +126,7 @@ def test_ur10e_is_identified_with_its_published_parameters() -> None:
 
 def test_the_ur10e_has_the_ur5e_structure() -> None:
     """Same joint and frame names as the shipped UR5e, the same gripper and TCP."""
-    ur5e, ur10e = PinRobot.load(domain_path("ur5e_2f85.urdf")), PinRobot.load(UR10E)
+    ur5e, ur10e = PinRobot.load(domain_path("robots/ur5e_2f85.urdf")), PinRobot.load(UR10E)
     assert ur10e.joint_names == ur5e.joint_names
     names = {str(f.name) for f in ur10e.model.frames}
     assert names == {str(f.name) for f in ur5e.model.frames}
