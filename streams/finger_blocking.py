@@ -23,7 +23,10 @@ import numpy as np
 
 from sdar_tamp.world._pin import PinRobot, se3_to_array
 from sdar_tamp.world.collision import ObjectBox
-from sdar_tamp.world.transforms import BoolArray, FloatArray, inverse
+from sdar_tamp.world.errors import SceneError
+from sdar_tamp.world.gripper import Gripper
+from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import BoolArray, FloatArray, inverse, translation
 from streams._pin_geometry import arm_primitives
 from streams.grasps import Grasp
 
@@ -49,6 +52,44 @@ def gripper_boxes(
         for p in arm_primitives(urdf, package_dirs)
         if p.joint == joint and p.kind == "box"
     )
+
+
+def declared_finger_boxes(gripper: Gripper) -> tuple[GripperBox, GripperBox]:
+    """The two finger boxes of a gripper known by its measures (a cell's ``finger_box``, or a
+    description without a ``tcp`` frame): either side of the closing axis (y) from the
+    pre-grasp opening out to the envelope, over the envelope's extent along x and z."""
+    env = gripper.envelope
+    lo, hi = env.min(axis=0), env.max(axis=0)
+    inner = gripper.max_opening / 2.0
+    boxes = []
+    for y0, y1 in ((float(lo[1]), -inner), (inner, float(hi[1]))):
+        if y1 <= y0:
+            raise SceneError(
+                f"gripper: the fingers' envelope ({lo[1]:.4f} .. {hi[1]:.4f} m across the "
+                f"closing axis) does not reach beyond the opening {gripper.max_opening} m"
+            )
+        T = translation((lo[0] + hi[0]) / 2.0, (y0 + y1) / 2.0, (lo[2] + hi[2]) / 2.0)
+        half = ((hi[0] - lo[0]) / 2.0, (y1 - y0) / 2.0, (hi[2] - lo[2]) / 2.0)
+        boxes.append(GripperBox(T, (float(half[0]), float(half[1]), float(half[2]))))
+    return boxes[0], boxes[1]
+
+
+def cell_gripper_boxes(scene: Scene) -> tuple[GripperBox, ...]:
+    """The gripper boxes of every arm of the cell (an arm's robot description's boxes on its
+    ``tcp`` frame's link where it has that frame and boxes there, else its gripper's declared
+    finger boxes); arms of one description and gripper count once."""
+    out: list[GripperBox] = []
+    seen: set[tuple[Path, Gripper]] = set()
+    for arm in scene.arms:
+        if (arm.urdf, arm.gripper) in seen:
+            continue
+        seen.add((arm.urdf, arm.gripper))
+        robot = PinRobot.load(arm.urdf, scene.package_dirs)
+        found: tuple[GripperBox, ...] = ()
+        if robot.model.existFrame("tcp"):
+            found = gripper_boxes(arm.urdf, "tcp", scene.package_dirs)
+        out.extend(found or declared_finger_boxes(arm.gripper))
+    return tuple(out)
 
 
 def boxes_overlap(

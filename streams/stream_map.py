@@ -31,7 +31,7 @@ from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
 from streams.buffers import GRASP_CORRIDOR, BufferPool
 from streams.context import WorldContext
-from streams.finger_blocking import GraspBlocking, gripper_boxes
+from streams.finger_blocking import GraspBlocking, cell_gripper_boxes
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, half_turn_twins, sample_grasps
 from streams.ik import GraspIK, SceneCache, collision_free_candidates
 from streams.motion.planner import MotionPlanner
@@ -124,7 +124,7 @@ class RearrangementStreams:
         """The grasp-blocking tests of the scene's gripper (built on first use)."""
         if self._blocking is None:
             self._blocking = GraspBlocking(
-                gripper_boxes(self.ctx.scene.robot_urdf, package_dirs=self.ctx.scene.package_dirs),
+                cell_gripper_boxes(self.ctx.scene),
                 IK_MARGIN,
             )
         return self._blocking

@@ -4,13 +4,25 @@ far apart)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+from sdar_tamp.world.errors import SceneError
 from sdar_tamp.world.instance import Pose2D
+from sdar_tamp.world.scene import load_scene
 from sdar_tamp.world.transforms import pose_xyz_yaw
 from streams.context import WorldContext
-from streams.finger_blocking import GraspBlocking, GripperBox, boxes_overlap, gripper_boxes
+from streams.finger_blocking import (
+    GraspBlocking,
+    GripperBox,
+    boxes_overlap,
+    cell_gripper_boxes,
+    declared_finger_boxes,
+    gripper_boxes,
+)
 from streams.stream_map import RearrangementStreams
 
 BAR = (0.08, 0.04, 0.05)  # graspable across y only
@@ -106,3 +118,47 @@ def test_grasp_cfree_tells_grasps_apart(streams: RearrangementStreams) -> None:
     assert not any(streams.test_grasp_cfree("c", here, g, "d", neighbour) for g in across_x)
     assert all(streams.test_grasp_cfree("c", here, g, "d", neighbour) for g in across_y)
     assert not streams.test_grasp_cfree("c", here, across_y[0], "c", here)
+
+
+# -- the cell's gripper boxes --------------------------------------------------------------------
+def test_the_shipped_cell_keeps_its_descriptions_boxes() -> None:
+    scene = load_scene()
+    boxes = cell_gripper_boxes(scene)  # both arms: one description, one gripper
+    own = gripper_boxes(scene.arms[0].urdf, package_dirs=scene.package_dirs)
+    assert len(boxes) == len(own) > 0
+    for a, b in zip(boxes, own, strict=True):
+        np.testing.assert_array_equal(a.T_tcp_box, b.T_tcp_box)
+        assert a.half == b.half
+
+
+def test_declared_finger_boxes_fill_the_envelope_beside_the_opening() -> None:
+    gripper = load_scene().arms[0].gripper
+    left, right = declared_finger_boxes(gripper)
+    lo, hi = gripper.envelope.min(axis=0), gripper.envelope.max(axis=0)
+    for box, sign in ((left, -1.0), (right, 1.0)):
+        centre, half = box.T_tcp_box[:3, 3], np.array(box.half)
+        assert sign * (centre[1] - sign * half[1]) == pytest.approx(gripper.max_opening / 2)
+        np.testing.assert_allclose(centre[[0, 2]] - half[[0, 2]], lo[[0, 2]])
+        np.testing.assert_allclose(centre[[0, 2]] + half[[0, 2]], hi[[0, 2]])
+    assert right.T_tcp_box[1, 3] + right.half[1] == pytest.approx(hi[1])
+    assert left.T_tcp_box[1, 3] - left.half[1] == pytest.approx(lo[1])
+
+
+def test_a_description_without_a_tcp_frame_uses_the_declared_fingers(tmp_path: Path) -> None:
+    scene = load_scene()
+    text = scene.arms[0].urdf.read_text(encoding="utf-8")
+    renamed = tmp_path / "no_tcp.urdf"
+    renamed.write_text(text.replace('"tcp"', '"tool_centre"'), encoding="utf-8")
+    arms = tuple(replace(a, urdf=renamed) for a in scene.arms)
+    boxes = cell_gripper_boxes(replace(scene, arms=arms))
+    expected = declared_finger_boxes(scene.arms[0].gripper)
+    assert len(boxes) == 2
+    for a, b in zip(boxes, expected, strict=True):
+        np.testing.assert_array_equal(a.T_tcp_box, b.T_tcp_box)
+
+
+def test_fingers_inside_the_opening_are_an_error() -> None:
+    gripper = load_scene().arms[0].gripper
+    narrow = replace(gripper, max_opening=0.2, stroke=0.2)
+    with pytest.raises(SceneError, match=r"does not reach beyond the opening 0\.2 m"):
+        declared_finger_boxes(narrow)

@@ -112,3 +112,26 @@ def test_the_panda_is_not_ur() -> None:
     robots = SHARE / "example-robot-data" / "robots"
     urdf = robots / "panda_description/urdf/panda.urdf"
     assert ur_parameters(PinRobot.load(urdf, (robots, SHARE)), flange="panda_hand_tcp") is None
+
+
+def test_a_cell_of_maker_arms_without_gripper_or_tcp_frame() -> None:
+    """A maker's description as it ships (meshes, no gripper, no ``tcp`` frame): the cell
+    declares the finger box; the closed form is found from the URDF, the grasp-blocking boxes
+    come from the declared fingers."""
+    from sdar_tamp.world.kinematics import ArmKinematics
+    from sdar_tamp.world.scene import load_scene
+    from streams.finger_blocking import cell_gripper_boxes, declared_finger_boxes
+
+    assert SHARE is not None
+    path = Path(__file__).with_name("data") / "maker_ur10_pair.yaml"
+    scene = load_scene(path, environ={"ROS_PACKAGE_PATH": str(SHARE)})
+    assert scene.arms[0].urdf.name == "ur10_robot.urdf" and scene.arms[0].dof == 6
+    kin = ArmKinematics.from_scene(scene, "left")
+    assert kin.closed_form and kin.params is not None
+    assert kin.params.a2 == pytest.approx(-0.612)
+    q = np.array(scene.arms[0].home)
+    reached = kin.ik_tcp(kin.fk_tcp(q)[None])
+    assert reached.valid.any()
+    boxes = cell_gripper_boxes(scene)
+    expected = declared_finger_boxes(scene.arms[0].gripper)
+    assert len(boxes) == 2 and boxes[0].half == expected[0].half
