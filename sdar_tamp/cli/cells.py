@@ -28,7 +28,36 @@ def cmd_cells(args: argparse.Namespace) -> int:
             f"{arm.tool_frame} ({', '.join(arm.joint_names)}); gripper opening "
             f"{g.max_opening:g} m, fingers {g.finger_depth:g} m deep, {g.finger_width:g} m wide"
         )
+    if args.reach is not None:
+        check_reach(scene, Path(args.scene), args.reach)
     return 0
+
+
+def check_reach(scene: Any, path: Path, step: float) -> None:
+    """Raise a located error at the file's ``workspace`` naming the first point (and how many
+    more) an arm does not grasp top-down on a ``step`` [m] grid; print the count checked."""
+    from sdar_tamp.world._yaml import read_yaml
+    from sdar_tamp.world.cell_reach import grid, unreached_points
+    from sdar_tamp.world.errors import SceneError
+
+    if not step > 0.0:
+        raise SceneError(f"--reach: expected a grid step > 0 [m], got {step}")
+    missed = unreached_points(scene, step)
+    for arm, points in missed.items():
+        if len(points):
+            root = read_yaml(path, SceneError)
+            node = root.mapping([], list(root.value))["workspace"]  # type: ignore[call-overload]
+            x, y = points[0]
+            more = f" and {len(points) - 1} more point(s)" if len(points) > 1 else ""
+            raise SceneError(
+                f"workspace: arm {arm!r} does not grasp ({x:.3f}, {y:.3f}) m top-down at every "
+                f"yaw within its limits{more} (grid {step:g} m); narrow the workspace or move "
+                "the arm",
+                node.location,
+            )
+    n = len(grid(scene.workspace.x, scene.workspace.y, step))
+    print(f"  reach: every arm grasps all {n} workspace points top-down (grid {step:g} m)")
+
 
 
 def add_cells_parser(sub: argparse._SubParsersAction[Any]) -> None:
@@ -40,5 +69,13 @@ def add_cells_parser(sub: argparse._SubParsersAction[Any]) -> None:
     )
     cells.add_argument(
         "scene", type=Path, nargs="?", default=None, help="a scene file to check (optional)"
+    )
+    cells.add_argument(
+        "--reach",
+        type=float,
+        default=None,
+        metavar="STEP",
+        help="also check that every arm grasps every workspace point of a STEP [m] grid "
+        "top-down at every yaw (numeric IK, limits, self and table collisions)",
     )
     cells.set_defaults(func=cmd_cells)

@@ -19,7 +19,9 @@ import numpy as np
 
 from sdar_tamp.world._pin import PinRobot, chain_to, colliding_configurations
 from sdar_tamp.world.errors import KinematicsError
+from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.numeric_ik import NumericIKOptions, numeric_ik
+from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import (
     BoolArray,
     FloatArray,
@@ -164,3 +166,29 @@ def largest_rectangle(
         return None
     i0, i1, j, k = best[1]
     return (float(xs[i0]), float(xs[i1])), (float(ys[j]), float(ys[k]))
+
+
+def scene_reach_arms(scene: Scene) -> dict[str, ReachArm]:
+    """Every arm of a loaded cell, for the reach check (its description, base pose, tool frame,
+    gripper's TCP offset, limits and home)."""
+    out: dict[str, ReachArm] = {}
+    for spec in scene.arms:
+        kin = ArmKinematics.from_scene(scene, spec.name)
+        out[spec.name] = ReachArm(
+            kin.robot, kin.T_world_base, spec.tool_frame, spec.gripper.tcp_offset,
+            spec.lower_array, spec.upper_array, np.array(spec.home),
+        )  # fmt: skip
+    return out
+
+
+def unreached_points(scene: Scene, step: float) -> dict[str, FloatArray]:
+    """Per arm, the points ``(k, 2)`` [m] of the cell's workspace (a grid of ``step`` [m],
+    edges included) it does not grasp top-down at the default object's mid-height at every
+    yaw of :data:`DEFAULT_YAWS` (:func:`reached`); empty arrays when it reaches them all."""
+    if not step > 0.0:
+        raise KinematicsError(f"step must be > 0 [m]; got {step}")
+    points = grid(scene.workspace.x, scene.workspace.y, step)
+    z = scene.object_size[2] / 2.0
+    return {
+        name: points[~reached(arm, points, z)] for name, arm in scene_reach_arms(scene).items()
+    }

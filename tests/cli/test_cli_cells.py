@@ -72,3 +72,44 @@ def test_the_sampled_reach_covers_the_workspace() -> None:
         np.testing.assert_allclose(chain[0, :2], arm.base_xyz[:2], atol=1e-9)
         gaps = np.linalg.norm(near[None, :, :2] - corners[:, None], axis=2).min(axis=1)
         assert gaps.max() < 0.1, (arm.name, gaps)
+
+
+def _cell_copy(tmp_path: Path, workspace: str) -> Path:
+    """The shipped cell with its robot path made absolute and another workspace line."""
+    text = default_scene_path().read_text(encoding="utf-8")
+    robots = default_scene_path().parent.parent / "robots"
+    text = text.replace("../robots/", f"{robots}/")
+    lines = [workspace if ln.startswith("workspace:") else ln for ln in text.splitlines()]
+    path = tmp_path / "cell.yaml"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def test_sdar_cells_reach_checks_every_arm(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    assert main(["cells", str(default_scene_path()), "--reach", "0.25"]) == 0
+    assert "every arm grasps all 12 workspace points" in capsys.readouterr().out
+    far = _cell_copy(tmp_path, "workspace: {x: [-0.25, 0.25], y: [-0.30, 0.70]}")
+    line = (
+        far.read_text(encoding="utf-8")
+        .splitlines()
+        .index("workspace: {x: [-0.25, 0.25], y: [-0.30, 0.70]}")
+        + 1
+    )
+    assert main(["cells", str(far), "--reach", "0.25"]) == 2
+    err = capsys.readouterr().err
+    assert f"cell.yaml:{line}:12: workspace: arm 'left' does not grasp (" in err
+    assert ") m top-down at every yaw within its limits" in err
+    assert main(["cells", str(default_scene_path()), "--reach", "0"]) == 2
+    assert "--reach: expected a grid step > 0 [m], got 0.0" in capsys.readouterr().err
+
+
+def test_unreached_points_per_arm() -> None:
+    from sdar_tamp.world.cell_reach import unreached_points
+    from sdar_tamp.world.errors import KinematicsError
+
+    missed = unreached_points(load_scene(), 0.25)
+    assert set(missed) == {"left", "right"} and all(len(p) == 0 for p in missed.values())
+    with pytest.raises(KinematicsError, match="step must be > 0"):
+        unreached_points(load_scene(), -1.0)
