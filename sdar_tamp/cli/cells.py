@@ -59,7 +59,6 @@ def check_reach(scene: Any, path: Path, step: float) -> None:
     print(f"  reach: every arm grasps all {n} workspace points top-down (grid {step:g} m)")
 
 
-
 def add_cells_parser(sub: argparse._SubParsersAction[Any]) -> None:
     """Register ``sdar cells``."""
     cells = sub.add_parser(

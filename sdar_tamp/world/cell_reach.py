@@ -189,6 +189,4 @@ def unreached_points(scene: Scene, step: float) -> dict[str, FloatArray]:
         raise KinematicsError(f"step must be > 0 [m]; got {step}")
     points = grid(scene.workspace.x, scene.workspace.y, step)
     z = scene.object_size[2] / 2.0
-    return {
-        name: points[~reached(arm, points, z)] for name, arm in scene_reach_arms(scene).items()
-    }
+    return {name: points[~reached(arm, points, z)] for name, arm in scene_reach_arms(scene).items()}
