@@ -75,7 +75,15 @@ def straight_tool_moves(
 def tool_pose_ik(
     kin: ArmKinematics, T_world_tcp: FloatArray, q_near: FloatArray
 ) -> FloatArray | None:
-    """The valid IK branch ``(dof,)`` for a TCP pose nearest to ``q_near``, or None."""
+    """The valid IK branch ``(dof,)`` for a TCP pose nearest to ``q_near``, or None. For an
+    arm without a closed form, the numeric IK from ``q_near`` first (warm start: the solution
+    of ``q_near``'s branch, its redundancy pulled toward ``q_near``), every branch only when
+    that fails."""
+    if not kin.closed_form:
+        q0 = np.asarray(q_near, dtype=np.float64)
+        warm = kin.ik_tcp_from(T_world_tcp[None], q0[None, None])
+        if warm.valid[0, 0]:
+            return np.asarray(warm.q[0, 0], dtype=np.float64)
     sol = kin.ik_tcp(T_world_tcp[None])
     if not sol.valid[0].any():
         return None

@@ -80,6 +80,23 @@ def test_straight_moves_in_one_batch_are_the_moves_one_by_one(
     assert straight_tool_moves(ctx7.kinematics["left"], ctx7.home("left")[None], 2.0) == [None]
 
 
+def test_tool_pose_ik_of_a_numeric_arm_starts_from_the_near_configuration(
+    ctx7: WorldContext,
+) -> None:
+    kin = ctx7.kinematics["left"]
+    home = ctx7.home("left")
+    T = kin.fk_tcp(home)
+    T[:3, 3] += [0.05, 0.03, 0.1]
+    q = tool_pose_ik(kin, T, home)
+    assert q is not None
+    np.testing.assert_allclose(kin.fk_tcp(q), T, atol=1e-5)
+    every = kin.ik_tcp(T[None])  # no branch of the cold solve is nearer the start
+    d = np.linalg.norm(every.q[0][every.valid[0]] - home, axis=1)
+    assert np.linalg.norm(q - home) <= d.min() + 1e-6
+    lo, hi = kin.spec.lower_array, kin.spec.upper_array
+    assert np.all(q >= lo) and np.all(q <= hi)
+
+
 def test_optimiser_solves_a_free_space_transfer(ctx7: WorldContext) -> None:
     """The left arm's TCP crosses from y = 0.25 to y = -0.25 past an obstacle sphere on the
     straight line: IPOPT bends the path round it."""
