@@ -196,7 +196,7 @@ class BufferPool:
             raise ValueError(f"k must be >= 0, got {k}")
         if not 0.0 <= margin <= GRASP_CORRIDOR:
             raise ValueError(f"margin must be in [0, {GRASP_CORRIDOR}] [m], got {margin}")
-        lazy = not self._known[arm].all()
+        lazy = not self._ctx.kinematics[arm].closed_form
         free = np.flatnonzero((clear > margin) & (self.reach[arm] | lazy))
         grown = np.array([self.size[0] + 2 * margin, self.size[1] + 2 * margin])
         out: list[Pose2D] = []
