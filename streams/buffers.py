@@ -3,8 +3,9 @@
 A buffer is a planar pose ``(x, y, yaw)`` of the object such that its footprint (grown by
 ``margin``) lies inside the workspace, overlaps no footprint in ``occupied`` (current object
 footprints and goal footprints still to be filled) nor another returned buffer, and the arm
-reaches it with a top-down grasp (closed-form IK, any branch within the joint limits, for the
-grasp and its pre-grasp). Randomness comes from ``numpy.random.default_rng(seed)`` only.
+reaches it with a top-down grasp (its IK, closed form or numeric: any branch within the joint
+limits, for the grasp and its pre-grasp). Randomness comes from
+``numpy.random.default_rng(seed)`` only.
 """
 
 from __future__ import annotations
@@ -102,13 +103,23 @@ def sample_buffers(
 GRASP_CORRIDOR = 0.025
 
 
+#: Poses whose reach a numeric-IK arm checks in one batch when :meth:`BufferPool.take` meets
+#: one it does not know yet.
+REACH_CHUNK = 32
+
+
 class BufferPool:
     """Candidate buffer poses of one object size, inside the workspace, with the arms that
     reach each top-down (:func:`reachable_top_down`): that depends on neither the other
     objects nor the call, so ``count`` poses are sampled once and each call only measures
     their clearance from its footprints (:meth:`clearance`) and takes some of the clear ones
     (:meth:`take`). Randomness: ``numpy.random.default_rng(seed)`` for the pool, the call's
-    seed for the order in which poses are taken."""
+    seed for the order in which poses are taken.
+
+    A closed-form arm's reach is computed for the whole pool at once and ``take`` draws from
+    the clear poses it reaches. A numeric-IK arm's costs milliseconds a pose (thousands of
+    poses: tens of seconds), so ``take`` draws from the clear poses and checks the reach of
+    those it meets, :data:`REACH_CHUNK` at a time, keeping what it learnt."""
 
     def __init__(
         self,
@@ -132,9 +143,34 @@ class BufferPool:
         self.poses: FloatArray = cand[inside]  # (n, 3)
         self.rect: FloatArray = rect[inside]  # (n, 4, 2)
         self._near: dict[Hashable, tuple[IntArray, FloatArray]] = {}
-        self.reach: dict[str, BoolArray] = {
-            arm: reachable_top_down(ctx, arm, self.poses, size) for arm in ctx.arm_names
-        }
+        self._ctx = ctx
+        #: Per arm, which poses it reaches: computed for every pose at once for a closed-form
+        #: arm (microseconds a pose), else filled in by :meth:`take` as it meets them.
+        self.reach: dict[str, BoolArray] = {}
+        self._known: dict[str, BoolArray] = {}
+        for arm in ctx.arm_names:
+            eager = ctx.kinematics[arm].closed_form
+            self.reach[arm] = (
+                reachable_top_down(ctx, arm, self.poses, size)
+                if eager
+                else np.zeros(len(self.poses), dtype=np.bool_)
+            )
+            self._known[arm] = np.full(len(self.poses), eager, dtype=np.bool_)
+
+    def known(self, arm: str) -> BoolArray:
+        """``(n,)``: the poses whose reach by ``arm`` is known (in :attr:`reach`)."""
+        return self._known[arm]
+
+    def _reaches(self, arm: str, i: int, order: IntArray, at: int) -> bool:
+        """Whether ``arm`` reaches pose ``i`` (``order[at]``); an unknown pose is checked with
+        the next :data:`REACH_CHUNK` unknown poses of ``order`` in one batch."""
+        known, reach = self._known[arm], self.reach[arm]
+        if not known[i]:
+            ahead = order[at:]
+            batch = ahead[~known[ahead]][:REACH_CHUNK]
+            reach[batch] = reachable_top_down(self._ctx, arm, self.poses[batch], self.size)
+            known[batch] = True
+        return bool(reach[i])
 
     def clearance(self, occupied: Mapping[Hashable, FloatArray]) -> FloatArray:
         """``(n,)`` [m]: how far each pose's footprint may grow and stay clear of the
@@ -160,13 +196,17 @@ class BufferPool:
             raise ValueError(f"k must be >= 0, got {k}")
         if not 0.0 <= margin <= GRASP_CORRIDOR:
             raise ValueError(f"margin must be in [0, {GRASP_CORRIDOR}] [m], got {margin}")
-        free = np.flatnonzero((clear > margin) & self.reach[arm])
+        lazy = not self._ctx.kinematics[arm].closed_form
+        free = np.flatnonzero((clear > margin) & (self.reach[arm] | lazy))
         grown = np.array([self.size[0] + 2 * margin, self.size[1] + 2 * margin])
         out: list[Pose2D] = []
         chosen: list[FloatArray] = []
-        for i in np.random.default_rng(seed).permutation(free):
+        order = np.random.default_rng(seed).permutation(free)
+        for at, i in enumerate(order):
             if len(out) >= k:
                 break
+            if lazy and not self._reaches(arm, int(i), order, at):
+                continue
             rect = corners(self.poses[i : i + 1], grown[None])
             if chosen and overlap_matrix(rect, np.concatenate(chosen)).any():
                 continue

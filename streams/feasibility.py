@@ -122,20 +122,29 @@ class _Checker:
         self.boxes = dict(boxes)
         self.world = CollisionWorld(ctx.scene, tolerance=-margin)
         self.home = {a: ctx.home(a) for a in ctx.arm_names}
-        self.candidates = {o: self._candidates(o, grasps[o], lift) for o in boxes}
+        self.candidates = self._candidates(grasps, lift)
 
-    def _candidates(self, obj: str, grasps: tuple[Grasp, ...], lift: float) -> list[_Candidate]:
-        if not grasps:
-            return []
-        T_tcp = self.boxes[obj].T_world_obj @ np.stack([g.T_object_tcp for g in grasps])
-        out: list[_Candidate] = []
+    def _candidates(
+        self, grasps: Mapping[str, tuple[Grasp, ...]], lift: float
+    ) -> dict[str, list[_Candidate]]:
+        """Per object, its grasp configurations: the IK of every object's grasps in one batch
+        per arm (the numeric IK's cost is mostly per call, not per pose)."""
+        out: dict[str, list[_Candidate]] = {o: [] for o in self.boxes}
+        named = [(o, g) for o in self.boxes for g in grasps[o]]
+        if not named:
+            return out
+        T_tcp = np.concatenate(
+            [
+                self.boxes[o].T_world_obj @ np.stack([g.T_object_tcp for g in grasps[o]])
+                for o in self.boxes
+                if grasps[o]
+            ]
+        )
         for arm in self.ctx.arm_names:
             grasp, pre = self.ctx.kinematics[arm].ik_tcp_pair(T_tcp, pregrasp_offset(T_tcp, lift))
             rows, branches = np.nonzero(grasp.valid & pre.valid)
-            out.extend(
-                _Candidate(arm, grasp.q[gi, b], pre.q[gi, b])
-                for gi, b in zip(rows, branches, strict=True)
-            )
+            for gi, b in zip(rows, branches, strict=True):
+                out[named[gi][0]].append(_Candidate(arm, grasp.q[gi, b], pre.q[gi, b]))
         return out
 
     def rest(self, names: Iterable[str]) -> None:

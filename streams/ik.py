@@ -32,7 +32,7 @@ from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
 from streams.grasps import Grasp, pregrasp_offset
-from streams.motion.cartesian import straight_tool_move
+from streams.motion.cartesian import straight_tool_move, straight_tool_moves
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,6 +96,14 @@ class GraspIK:
         """Configurations ``(k, dof)`` of the straight approach of grasp ``gi`` on branch ``b``,
         from the grasp back to the pre-grasp (None: unreachable)."""
         key = (gi, b)
+        if key not in self._sweeps and not self._kin.closed_form:
+            # the numeric IK: every branch's approach in one batch (its cost is per call)
+            todo = [(int(g), int(c)) for g, c in zip(*np.nonzero(self.ok), strict=True)]
+            todo = [k for k in todo if k not in self._sweeps] or [key]
+            moves = straight_tool_moves(
+                self._kin, np.stack([self.q[k] for k in todo]), -self.lift, step=SWEEP_STEP
+            )
+            self._sweeps.update(zip(todo, moves, strict=True))
         if key not in self._sweeps:
             self._sweeps[key] = straight_tool_move(
                 self._kin, self.q[gi, b], -self.lift, step=SWEEP_STEP

@@ -38,6 +38,8 @@ CLOSED_FORM_BRANCHES = 8
 NUMERIC_BRANCHES = 4
 #: The numeric IK's effort in the planner (seeds per pose, rounds of fresh seeds).
 NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=4)
+#: Pose pairs an arm keeps solved by the numeric IK (grasp and pre-grasp; some 500 bytes each).
+PAIR_CACHE = 50_000
 
 
 @dataclass(frozen=True)
@@ -76,6 +78,10 @@ class ArmKinematics:
     #: The arm's base frame (``spec.base_frame``) in the description's root frame: the scene
     #: places the base frame, the chain starts at the root.
     T_root_base: FloatArray = field(default_factory=lambda: np.eye(4), compare=False)
+    #: The numeric IK's pose pairs solved so far (see :meth:`ik_tcp_pair`), by the pair's bytes.
+    _pairs: dict[bytes, tuple[FloatArray, BoolArray, FloatArray, BoolArray]] = field(
+        default_factory=dict, compare=False, repr=False
+    )
 
     @staticmethod
     def from_model(
@@ -250,9 +256,36 @@ class ArmKinematics:
             both = self.ik_tcp(np.concatenate([T1, T2]))
             n = len(T1)
             return IKSolutions(both.q[:n], both.valid[:n]), IKSolutions(both.q[n:], both.valid[n:])
-        first = self.ik_tcp(T1)
-        second = self.ik_tcp_from(T2, first.q)
-        return first, IKSolutions(second.q, second.valid & first.valid)
+        return self._numeric_pair(T1, T2)
+
+    def _numeric_pair(self, T1: FloatArray, T2: FloatArray) -> tuple[IKSolutions, IKSolutions]:
+        """:meth:`ik_tcp_pair` by the numeric IK, each pair solved once: the pairs met before
+        are read from the arm's table (up to :data:`PAIR_CACHE` pairs, then it starts over),
+        the others solved in one batch."""
+        keys = [T1[i].tobytes() + T2[i].tobytes() for i in range(len(T1))]
+        if not keys:
+            empty = IKSolutions(
+                np.zeros((0, self.branches, self.dof)), np.zeros((0, self.branches), np.bool_)
+            )
+            return empty, empty
+        todo: dict[bytes, int] = {}
+        for i, k in enumerate(keys):
+            if k not in self._pairs and k not in todo:
+                todo[k] = i
+        if todo:
+            rows = list(todo.values())
+            first = self.ik_tcp(T1[rows])
+            second = self.ik_tcp_from(T2[rows], first.q)
+            if len(self._pairs) + len(rows) > PAIR_CACHE:
+                self._pairs.clear()
+            for j, k in enumerate(todo):
+                valid = second.valid[j] & first.valid[j]
+                self._pairs[k] = (first.q[j], first.valid[j], second.q[j], valid)
+        got = [self._pairs[k] for k in keys]
+        return (
+            IKSolutions(np.stack([g[0] for g in got]), np.stack([g[1] for g in got])),
+            IKSolutions(np.stack([g[2] for g in got]), np.stack([g[3] for g in got])),
+        )
 
     # -- numerical IK (pinocchio) ----------------------------------------------------------
     def ik_dls(

@@ -129,11 +129,14 @@ def _step(
     redundant chain, clipped to ``max_step``."""
     Jt = np.transpose(J, (0, 2, 1))
     JJt = J @ Jt + (damping**2)[:, None, None] * np.eye(6)
-    J_pinv = Jt @ np.linalg.inv(JJt)  # (m, dof, 6)
-    step = (J_pinv @ err[:, :, None])[:, :, 0]
-    if J.shape[2] > 6:
-        null = np.eye(J.shape[2]) - J_pinv @ J
-        step += opts.null_space_gain * (null @ to_ref[:, :, None])[:, :, 0]
+    if J.shape[2] <= 6:
+        step = (Jt @ np.linalg.solve(JJt, err[:, :, None]))[:, :, 0]
+    else:  # one solve for the step and the null-space projection: (JJt)^-1 [err, J]
+        rhs = np.concatenate([err[:, :, None], J], axis=2)
+        sol = Jt @ np.linalg.solve(JJt, rhs)  # (m, dof, 1 + dof): J^+ err, J^+ J
+        step = sol[:, :, 0] + opts.null_space_gain * (
+            to_ref - (sol[:, :, 1:] @ to_ref[:, :, None])[:, :, 0]
+        )
     out: FloatArray = np.clip(step, -opts.max_step, opts.max_step)
     return out
 

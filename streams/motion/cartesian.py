@@ -44,10 +44,46 @@ def straight_tool_move(
     return np.stack(out)
 
 
+def straight_tool_moves(
+    kin: ArmKinematics,
+    qs: FloatArray,
+    distance: float,
+    step: float = 0.01,
+    max_joint_step: float = 0.3,
+) -> list[FloatArray | None]:
+    """:func:`straight_tool_move` from each configuration of ``qs`` ``(m, dof)``; for an arm
+    without a closed form every step of every move is solved in one batch of the numeric IK
+    (whose cost is mostly per call), each from its own start."""
+    q_all = np.asarray(qs, dtype=np.float64).reshape(-1, kin.dof)
+    if kin.closed_form or len(q_all) == 0:
+        return [straight_tool_move(kin, q, distance, step, max_joint_step) for q in q_all]
+    n = max(1, int(np.ceil(abs(distance) / step)))
+    T0 = np.stack([kin.fk_tcp(q) for q in q_all])  # (m, 4, 4)
+    T = np.repeat(T0[:, None], n, axis=1)  # (m, n, 4, 4)
+    T[:, :, :3, 3] += (distance * np.arange(1, n + 1) / n)[None, :, None] * T0[:, None, :3, 2]
+    starts = np.repeat(q_all[:, None, None], n, axis=1).reshape(-1, 1, kin.dof)
+    near = kin.ik_tcp_from(T.reshape(-1, 4, 4), starts)
+    steps, valid = near.q[:, 0].reshape(len(q_all), n, kin.dof), near.valid[:, 0].reshape(-1, n)
+    out: list[FloatArray | None] = []
+    for k, q in enumerate(q_all):
+        path = np.concatenate([q[None], steps[k]])
+        ok = valid[k].all() and np.abs(np.diff(path, axis=0)).max() <= max_joint_step
+        out.append(path if ok else None)
+    return out
+
+
 def tool_pose_ik(
     kin: ArmKinematics, T_world_tcp: FloatArray, q_near: FloatArray
 ) -> FloatArray | None:
-    """The valid IK branch ``(dof,)`` for a TCP pose nearest to ``q_near``, or None."""
+    """The valid IK branch ``(dof,)`` for a TCP pose nearest to ``q_near``, or None. For an
+    arm without a closed form, the numeric IK from ``q_near`` first (warm start: the solution
+    of ``q_near``'s branch, its redundancy pulled toward ``q_near``), every branch only when
+    that fails."""
+    if not kin.closed_form:
+        q0 = np.asarray(q_near, dtype=np.float64)
+        warm = kin.ik_tcp_from(T_world_tcp[None], q0[None, None])
+        if warm.valid[0, 0]:
+            return np.asarray(warm.q[0, 0], dtype=np.float64)
     sol = kin.ik_tcp(T_world_tcp[None])
     if not sol.valid[0].any():
         return None

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from sdar_tamp.world.errors import KinematicsError
-from sdar_tamp.world.kinematics import NUMERIC_BRANCHES, ArmKinematics
+from sdar_tamp.world.kinematics import NUMERIC_BRANCHES, ArmKinematics, IKSolutions
 from sdar_tamp.world.numeric_ik import numeric_ik_branches, pose_error
 from sdar_tamp.world.scene import Scene, load_scene
 from tests.kinematics.conftest import ARM7_URDF
@@ -90,6 +90,33 @@ def test_continued_solutions_stay_on_their_branch(kin7: ArmKinematics) -> None:
         kin7.ik_tcp_from(T_tcp, np.zeros((40, 7)))
     with pytest.raises(KinematicsError, match="as many first as second"):
         kin7.ik_tcp_pair(T_tcp, lifted[:3])
+
+
+def test_numeric_pairs_are_solved_once(scene7: Scene, monkeypatch: pytest.MonkeyPatch) -> None:
+    kin = ArmKinematics.from_scene(scene7, "left")  # its own table of solved pairs
+    q = np.array(kin.spec.home) + np.linspace(-0.2, 0.2, 7)
+    T = kin.fk_batch(np.stack([q, q + 0.05])) @ kin.T_tool0_tcp
+    lifted = T.copy()
+    lifted[:, :3, 3] -= 0.05 * T[:, :3, 2]
+    first, second = kin.ik_tcp_pair(T, lifted)
+    assert first.valid.any(axis=1).all() and second.valid.any(axis=1).all()
+    calls: list[int] = []
+    solve = ArmKinematics.ik_tcp
+
+    def counted(self: ArmKinematics, T_world_tcp: np.ndarray) -> IKSolutions:
+        calls.append(len(T_world_tcp))
+        return solve(self, T_world_tcp)
+
+    monkeypatch.setattr(ArmKinematics, "ik_tcp", counted)
+    again = kin.ik_tcp_pair(T[::-1], lifted[::-1])  # met before: read, not solved
+    assert calls == []
+    np.testing.assert_array_equal(again[0].q, first.q[::-1])
+    np.testing.assert_array_equal(again[1].valid, second.valid[::-1])
+    one_new = np.concatenate([T[:1], T[:1] @ kin.T_tool0_tcp])
+    kin.ik_tcp_pair(one_new, np.concatenate([lifted[:1], lifted[:1]]))
+    assert calls == [1]  # only the pair not met before, once
+    empty = kin.ik_tcp_pair(np.zeros((0, 4, 4)), np.zeros((0, 4, 4)))
+    assert empty[0].q.shape == (0, NUMERIC_BRANCHES, 7) and empty[1].valid.shape == (0, 4)
 
 
 def test_closed_form_continued_solutions_pick_the_nearest_branch(ctx_ur: ArmKinematics) -> None:

@@ -10,7 +10,7 @@ from sdar_tamp.world.transforms import pose_xyz_yaw
 from streams.context import WorldContext
 from streams.grasps import pregrasp_offset, sample_grasps
 from streams.ik import GraspIK, IKRequest, solve_ik_candidates
-from streams.motion.cartesian import straight_tool_move, tool_pose_ik
+from streams.motion.cartesian import straight_tool_move, straight_tool_moves, tool_pose_ik
 from streams.motion.optimiser import TrajectoryOptimiser
 from streams.motion.optimiser_records import TrajOptOptions, TransferQuery
 from streams.motion.sphere_pairs import HeldSpheres
@@ -59,6 +59,42 @@ def test_straight_approach_by_the_numeric_ik(ctx7: WorldContext) -> None:
     far[:3, 3] = [1.5, 0.0, 0.3]
     assert tool_pose_ik(kin, far, home) is None
     assert straight_tool_move(kin, home, 2.0, step=0.5) is None  # leaves the reach
+
+
+def test_straight_moves_in_one_batch_are_the_moves_one_by_one(
+    ctx7: WorldContext, ctx: WorldContext
+) -> None:
+    for c, arm in ((ctx7, "left"), (ctx, "right")):  # numeric IK, then the closed form
+        kin = c.kinematics[arm]
+        home = c.home(arm)
+        starts = np.stack([home, home + 0.1, home - 0.1])
+        for distance in (-0.06, 2.0):  # the second leaves the reach
+            batch = straight_tool_moves(kin, starts, distance, step=0.015)
+            single = [straight_tool_move(kin, q, distance, step=0.015) for q in starts]
+            assert len(batch) == 3
+            for b, s in zip(batch, single, strict=True):
+                assert (b is None) == (s is None)
+                if b is not None and s is not None:
+                    np.testing.assert_allclose(b, s, atol=1e-12)
+        assert straight_tool_moves(kin, np.zeros((0, kin.dof)), -0.06) == []
+    assert straight_tool_moves(ctx7.kinematics["left"], ctx7.home("left")[None], 2.0) == [None]
+
+
+def test_tool_pose_ik_of_a_numeric_arm_starts_from_the_near_configuration(
+    ctx7: WorldContext,
+) -> None:
+    kin = ctx7.kinematics["left"]
+    home = ctx7.home("left")
+    T = kin.fk_tcp(home)
+    T[:3, 3] += [0.05, 0.03, 0.1]
+    q = tool_pose_ik(kin, T, home)
+    assert q is not None
+    np.testing.assert_allclose(kin.fk_tcp(q), T, atol=1e-5)
+    every = kin.ik_tcp(T[None])  # no branch of the cold solve is nearer the start
+    d = np.linalg.norm(every.q[0][every.valid[0]] - home, axis=1)
+    assert np.linalg.norm(q - home) <= d.min() + 1e-6
+    lo, hi = kin.spec.lower_array, kin.spec.upper_array
+    assert np.all(q >= lo) and np.all(q <= hi)
 
 
 def test_optimiser_solves_a_free_space_transfer(ctx7: WorldContext) -> None:
