@@ -106,6 +106,7 @@ def read_gripper(
     k = node.mapping(GRIPPER_KEYS, GRIPPER_OPTIONAL)
     opening = k["max_opening"].as_float(positive=True)
     tcp_offset = k["tcp_offset"].as_float(positive=True)
+    _check_tcp_frame(k["tcp_offset"], robot, tool_frame, tcp_offset, q)
     margin = k["grasp_margin"].as_float()
     if not 0.0 <= margin < opening:
         raise k["grasp_margin"].error(f"a margin in [0, max_opening = {opening}) [m]")
@@ -148,3 +149,34 @@ def read_gripper(
     return Gripper(
         opening, stroke, tcp_offset, margin, dwell, measured.depth, measured.width, corners, links
     )
+
+
+#: How far [m] a description's ``tcp`` frame may lie from ``tcp_offset`` along the tool frame.
+TCP_TOLERANCE = 1e-6
+
+
+def _check_tcp_frame(
+    node: Node,
+    robot: PinRobot,
+    tool_frame: str,
+    tcp_offset: float,
+    q: FloatArray | None,
+) -> None:
+    """A description with a ``tcp`` frame must put it ``tcp_offset`` along the tool frame's z
+    (the planner's forward kinematics takes that frame where it exists, the rest the offset)."""
+    model = robot.model
+    if not model.existFrame("tcp") or not model.existFrame(tool_frame):
+        return
+    config = robot.neutral() if q is None else q
+    T_tool = robot.frame_pose(config, robot.frame_id(tool_frame))
+    T_tcp = robot.frame_pose(config, robot.frame_id("tcp"))
+    offset = np.linalg.inv(T_tool) @ T_tcp
+    expected = np.eye(4)
+    expected[2, 3] = tcp_offset
+    gap = float(np.abs(offset - expected).max())
+    if gap > TCP_TOLERANCE:
+        x, y, z = (float(v) for v in offset[:3, 3])
+        raise node.error(
+            f"the offset of the description's 'tcp' frame from {tool_frame!r} "
+            f"({x:.4f}, {y:.4f}, {z:.4f}) m, unturned (it differs by {gap:.2g})"
+        )

@@ -93,6 +93,11 @@ def test_a_per_arm_gripper_and_the_shared_grasp_limits(tmp_path: Path) -> None:
         ),
         (lambda g: g.update(fingers="pads"), "gripper.fingers: expected a list"),
         (
+            lambda g: g.update(tcp_offset=0.17),
+            "gripper.tcp_offset: expected the offset of the description's 'tcp' frame from "
+            "'tool0' (0.0000, 0.0000, 0.1780) m, unturned (it differs by 0.008), got 0.17",
+        ),
+        (
             lambda g: g.update(max_opening=0.04, stroke=0.085),
             "gripper: expected a gripper that holds the default object [0.08, 0.04, 0.05]: "
             "both horizontal sides",
