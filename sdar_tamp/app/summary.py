@@ -113,3 +113,10 @@ class ProgressBar:
         self._stop.set()
         self._ticker.join()
         self._bar.close()
+
+
+def terminal_progress(label: str, stream: TextIO = sys.stderr) -> ProgressBar | None:
+    """A :class:`ProgressBar` on ``stream`` when it is a terminal, else ``None``: a log file
+    or a pipe gets the summary lines only, not the bar's redraws."""
+    isatty = getattr(stream, "isatty", None)
+    return ProgressBar(label, stream) if callable(isatty) and isatty() else None

@@ -20,7 +20,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     import tempfile
 
     from sdar_tamp.app.pipeline import solve_instance
-    from sdar_tamp.app.summary import ProgressBar, format_summary
+    from sdar_tamp.app.summary import format_summary, terminal_progress
     from sdar_tamp.plan_writing import save_plan
     from sdar_tamp.resources import domain_file
     from sdar_tamp.viewer import write_html, write_storyboard
@@ -32,17 +32,18 @@ def cmd_demo(args: argparse.Namespace) -> int:
         out = output_folder(args.output, name="--output")
         out.mkdir(parents=True, exist_ok=True)
     print(f"Solving the shipped mixed instance {DEMO_INSTANCE} (12 objects) with SDAR:")
-    bar = ProgressBar(instance.stem)
+    bar = terminal_progress(instance.stem)
     try:
         outcome = solve_instance(
             instance,
             time_limit=args.time_limit,
             execution="async",  # `sdar solve`'s default
             progress=bar,
-            stage=bar.stage,
+            stage=bar.stage if bar is not None else None,
         )
     finally:
-        bar.close()
+        if bar is not None:
+            bar.close()
     print(format_summary(outcome))
     if outcome.plan is None:
         return 1

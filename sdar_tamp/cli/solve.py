@@ -18,12 +18,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
     from sdar_tamp.app.config import PlannerConfig
     from sdar_tamp.app.pipeline import solve_instance
-    from sdar_tamp.app.summary import ProgressBar, format_summary
+    from sdar_tamp.app.summary import format_summary, terminal_progress
     from sdar_tamp.plan_writing import save_plan
 
     if args.output is not None:
         output_file(args.output, suffixes=(".json",), force=args.force)
-    bar = ProgressBar(f"{args.instance.stem}") if not (args.quiet or args.json) else None
+    bar = terminal_progress(f"{args.instance.stem}") if not (args.quiet or args.json) else None
     try:
         config = PlannerConfig(
             task_planner=args.task_planner,

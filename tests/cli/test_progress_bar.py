@@ -33,3 +33,22 @@ def test_the_stage_after_planning_is_named() -> None:
         assert out.getvalue().rstrip().endswith("validating]")
     finally:
         bar.close()
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_the_bar_is_drawn_on_a_terminal_only() -> None:
+    from sdar_tamp.app.summary import terminal_progress
+
+    assert terminal_progress("M1", io.StringIO()) is None  # a pipe or a log file
+    out = _Terminal()
+    bar = terminal_progress("M1", out)
+    assert bar is not None
+    try:
+        bar(1, 4)
+    finally:
+        bar.close()
+    assert out.getvalue().startswith("\rM1:") and "1/4" in out.getvalue()
