@@ -12,7 +12,7 @@ from test_classical_relaxed_engines import _gripper, _states, needs_numba
 
 from sdar_tamp.errors import ParameterError
 from solvers.classical import bitset_task as compiled_module
-from solvers.classical import ground, heuristics, plan
+from solvers.classical import ground, heuristics, jit_relaxed, plan
 from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.heuristics import RelaxedHeuristic
 from solvers.classical.open_lists import TypeBuckets
@@ -62,6 +62,9 @@ def test_large_tasks_switch_to_the_compiled_heuristic_after_its_time(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     monkeypatch.setattr(heuristics, "JIT_AFTER_SECONDS", 0.0)
+    # a process that has not loaded the compiled code yet (an earlier test of this worker may
+    # have: a later task then uses it at once, tested in test_classical_relaxed_engines.py)
+    monkeypatch.setattr(jit_relaxed, "kernel_loaded", lambda: False)
     compiled = CompiledTask(ground(_gripper(100)))
     auto = RelaxedHeuristic(compiled, "ff", compiled.costs)
     python = RelaxedHeuristic(compiled, "ff", compiled.costs, engine="python")
