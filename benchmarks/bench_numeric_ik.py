@@ -17,11 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import site
-import sys
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -29,14 +25,7 @@ import numpy as np
 from sdar_tamp.world._pin import PinRobot, chain_to
 from sdar_tamp.world.numeric_ik import chain_fk, numeric_ik, pose_error
 from sdar_tamp.world.scene import load_scene
-
-
-def _share() -> Path | None:
-    given = os.environ.get("EXAMPLE_ROBOT_DATA_SHARE")
-    roots = [Path(given)] if given else []
-    for prefix in [*site.getsitepackages(), sys.prefix]:
-        roots += [Path(prefix) / "cmeel.prefix" / "share", Path(prefix) / "share"]
-    return next((r for r in roots if (r / "example-robot-data" / "robots").is_dir()), None)
+from sdar_tamp.world.urdf import example_robot_data_share
 
 
 def _arms() -> list[tuple[str, PinRobot, str, np.ndarray | None, np.ndarray | None]]:
@@ -44,7 +33,7 @@ def _arms() -> list[tuple[str, PinRobot, str, np.ndarray | None, np.ndarray | No
     spec = scene.arms[0]
     ur = PinRobot.load(scene.robot_urdf, scene.package_dirs)
     arms = [("ur5e", ur, "tcp", spec.lower_array, spec.upper_array)]
-    share = _share()
+    share = example_robot_data_share()
     if share is not None:
         robots = share / "example-robot-data" / "robots"
         for name, rel, frame in (

@@ -21,8 +21,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import site
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -32,6 +30,7 @@ import numpy as np
 
 from sdar_tamp.world._coal import hull_volume
 from sdar_tamp.world.scene import load_scene
+from sdar_tamp.world.urdf import example_robot_data_share
 from streams._pin_geometry import arm_primitives
 from streams.motion import sphere_cache, spheres
 from streams.motion.sphere_fit import FitOptions, fit_spheres, surface_points, union_volume
@@ -40,21 +39,13 @@ ROOT = Path(__file__).resolve().parent.parent
 MESHES = ROOT / "tests" / "streams" / "motion" / "meshes"
 
 
-def _share() -> Path | None:
-    given = os.environ.get("EXAMPLE_ROBOT_DATA_SHARE")
-    roots = [Path(given)] if given else []
-    for prefix in [*site.getsitepackages(), sys.prefix]:
-        roots += [Path(prefix) / "cmeel.prefix" / "share", Path(prefix) / "share"]
-    return next((r for r in roots if (r / "example-robot-data" / "robots").is_dir()), None)
-
-
 def _models(quick: bool) -> list[tuple[str, Path, tuple[Path, ...], str]]:
     scene = load_scene()
     models = [
         ("mesh_arm", MESHES / "mesharm" / "urdf" / "mesh_arm.urdf", (MESHES,), "meshes"),
         ("ur5e_all", scene.robot_urdf, scene.package_dirs, "all"),
     ]
-    share = _share()
+    share = example_robot_data_share()
     if share is not None:
         robots = share / "example-robot-data" / "robots"
         makers = [("panda", "panda_description/urdf/panda.urdf")]

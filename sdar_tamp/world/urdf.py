@@ -44,6 +44,22 @@ def package_dirs_from_env(environ: Mapping[str, str] | None = None) -> tuple[Pat
     return tuple(Path(p) for p in value.split(os.pathsep) if p.strip())
 
 
+def example_robot_data_share(environ: Mapping[str, str] | None = None) -> Path | None:
+    """The ``share`` folder holding ``example-robot-data/robots`` (the optional extra
+    ``robots``): ``EXAMPLE_ROBOT_DATA_SHARE`` of ``environ`` (default ``os.environ``) if it
+    names one, else the installed package's (a pip install puts it under ``cmeel.prefix``);
+    ``None`` when it is not installed."""
+    import site
+    import sys
+
+    env = os.environ if environ is None else environ
+    given = env.get("EXAMPLE_ROBOT_DATA_SHARE")
+    roots = [Path(given)] if given else []
+    for prefix in [*site.getsitepackages(), sys.prefix]:
+        roots += [Path(prefix) / "cmeel.prefix" / "share", Path(prefix) / "share"]
+    return next((r for r in roots if (r / "example-robot-data" / "robots").is_dir()), None)
+
+
 def resolve_package_uri(uri: str, package_dirs: tuple[Path, ...]) -> Path | None:
     """The file a ``package://<package>/<path>`` URI names, or ``None`` when no directory of
     ``package_dirs`` (in order) holds it."""

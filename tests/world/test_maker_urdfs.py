@@ -4,9 +4,6 @@ environment variable ``EXAMPLE_ROBOT_DATA_SHARE`` may name its ``share`` directo
 
 from __future__ import annotations
 
-import os
-import site
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,18 +11,10 @@ import pytest
 
 from sdar_tamp.world._pin import PinRobot
 from sdar_tamp.world.errors import SceneError
+from sdar_tamp.world.urdf import example_robot_data_share
 from streams._pin_geometry import arm_primitives
 
-
-def _share() -> Path | None:
-    given = os.environ.get("EXAMPLE_ROBOT_DATA_SHARE")
-    roots = [Path(given)] if given else []
-    for prefix in [*site.getsitepackages(), sys.prefix]:
-        roots += [Path(prefix) / "cmeel.prefix" / "share", Path(prefix) / "share"]
-    return next((r for r in roots if (r / "example-robot-data" / "robots").is_dir()), None)
-
-
-SHARE = _share()
+SHARE = example_robot_data_share()
 pytestmark = pytest.mark.skipif(SHARE is None, reason="example-robot-data is not installed")
 
 ARMS = {

@@ -255,3 +255,13 @@ def test_missing_package_directory_is_located(tmp_path: Path) -> None:
     path.write_text(path.read_text("utf-8").replace("packages: [.]", "packages: [nope]"), "utf-8")
     with pytest.raises(SceneError, match=r"scene\.yaml:4:\d+: packages\[0\]: expected a package"):
         load_scene(path)
+
+
+def test_the_example_robot_data_share_may_be_named_by_the_environment(tmp_path: Path) -> None:
+    from sdar_tamp.world.urdf import example_robot_data_share
+
+    (tmp_path / "example-robot-data" / "robots").mkdir(parents=True)
+    assert example_robot_data_share({"EXAMPLE_ROBOT_DATA_SHARE": str(tmp_path)}) == tmp_path
+    # a named folder without the package: the installed one, or None where it is not
+    missing = {"EXAMPLE_ROBOT_DATA_SHARE": str(tmp_path / "x")}
+    assert example_robot_data_share(missing) == example_robot_data_share({})

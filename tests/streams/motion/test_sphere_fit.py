@@ -6,9 +6,6 @@ are checked the same way when that package is installed (``pip install sdar-tamp
 
 from __future__ import annotations
 
-import os
-import site
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +14,7 @@ import pytest
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.world._coal import hull_volume
 from sdar_tamp.world.scene import load_scene
+from sdar_tamp.world.urdf import example_robot_data_share
 from streams._pin_geometry import Primitive, arm_primitives
 from streams.motion import sphere_cache, sphere_fit
 from streams.motion import spheres as spheres_module
@@ -385,15 +383,7 @@ def test_a_single_point_mesh_gets_one_sphere() -> None:
     assert len(fit.radius) == 1 and fit.radius[0] == 0.0 and fit.hull_volume == 0.0
 
 
-def _share() -> Path | None:
-    given = os.environ.get("EXAMPLE_ROBOT_DATA_SHARE")
-    roots = [Path(given)] if given else []
-    for prefix in [*site.getsitepackages(), sys.prefix]:
-        roots += [Path(prefix) / "cmeel.prefix" / "share", Path(prefix) / "share"]
-    return next((r for r in roots if (r / "example-robot-data" / "robots").is_dir()), None)
-
-
-SHARE = _share()
+SHARE = example_robot_data_share()
 NO_MAKERS = pytest.mark.skipif(SHARE is None, reason="example-robot-data is not installed")
 
 LINKS = {
