@@ -1,4 +1,4 @@
-"""The cell: table, workspace, default object and the arms (two, for now), each with its
+"""The cell: table, workspace, default object and the arms (one or more), each with its
 robot description, chain, limits and gripper.
 
 Loaded from a scene file (the shipped cells live in ``domains/dual_arm_rearrangement/cells``,
@@ -136,8 +136,6 @@ class Scene:
 
 
 _JOINT_FIELDS = ("lower", "upper", "velocity_limit", "acceleration_limit", "home")
-#: How many arms a cell has (the planner's count, checked in this one place).
-ARM_COUNT = 2
 
 
 def _packages(path: Path, keys: dict[str, Node]) -> tuple[Path, ...]:
@@ -176,8 +174,8 @@ def load_scene(path: Path | None = None, environ: Mapping[str, str] | None = Non
     sx, sy, sz = keys["object_size"].as_floats(3, "[lx, ly, lz]", positive=True)
     size = (sx, sy, sz)
     arm_nodes = keys["arms"].items()
-    if len(arm_nodes) != ARM_COUNT:
-        raise keys["arms"].error(f"a list of exactly {ARM_COUNT} arms", show_value=False)
+    if not arm_nodes:
+        raise keys["arms"].error("a non-empty list of arms", show_value=False)
     robots: dict[Path, PinRobot] = {}
     arms: list[ArmSpec] = []
     for node in arm_nodes:

@@ -135,10 +135,20 @@ def test_home_outside_limits(tmp_path: Path) -> None:
     assert "arms[0].home[2]: expected elbow_joint within [0.0," in _error(tmp_path, data)
 
 
-def test_number_of_arms(tmp_path: Path) -> None:
+def test_no_arms(tmp_path: Path) -> None:
     data = _data()
-    data["arms"] = data["arms"][:1]
-    assert "arms: expected a list of exactly 2 arms" in _error(tmp_path, data)
+    data["arms"] = []
+    assert "arms: expected a non-empty list of arms" in _error(tmp_path, data)
+
+
+def test_any_number_of_arms(tmp_path: Path) -> None:
+    for count in (1, 3):
+        data = _data()
+        arms = [dict(data["arms"][k % 2], name=f"arm{k}") for k in range(count)]
+        data["arms"] = arms
+        scene = load_scene(_write(tmp_path, data))
+        assert scene.arm_names == tuple(f"arm{k}" for k in range(count))
+        assert scene.layout.dof == 6 * count
 
 
 def test_duplicate_arm_names(tmp_path: Path) -> None:
