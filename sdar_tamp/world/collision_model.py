@@ -1,4 +1,5 @@
-"""Typed adapter building the pinocchio model of both arms and the scene geometry.
+"""Typed adapter building the pinocchio model of a cell's arms (one or more) and the scene
+geometry.
 
 The arms are one pinocchio model whose joints follow the scene's :class:`ArmLayout`, each arm
 built from its own robot description with its link and joint names prefixed by the arm's
@@ -88,9 +89,10 @@ def _arm_model(spec: ArmSpec, text: str) -> tuple[Any, Any, FloatArray]:
 
 
 def build_dual_arm(scene: Scene) -> CellCollisionModel:
-    """The arms of ``scene`` in one pinocchio model, each from its own robot description and
-    joints (any other joint of the description locked, see ``ArmSpec.locked_joints``), bases
-    at their world poses."""
+    """The arms of ``scene`` (any number) in one pinocchio model, each from its own robot
+    description and joints (any other joint of the description locked, see
+    ``ArmSpec.locked_joints``), bases at their world poses. (The name is historical: the
+    model holds every arm of the cell.)"""
     texts = {u: read_urdf(u, scene.package_dirs) for u in dict.fromkeys(a.urdf for a in scene.arms)}
     model = pin.Model()
     geometry = pin.GeometryModel()
@@ -168,7 +170,8 @@ def build_scene_geometry(
 ) -> SceneGeometry:
     """Add table, resting objects ``name -> (T_world_obj, size)`` and held objects
     ``arm -> (name, T_tool0_obj, size)`` to the arm shapes; activate the named ``pairs``.
-    Pairs of two arms' shapes count as colliding closer than ``arm_margin`` [m]."""
+    Pairs of two different arms' shapes (every pair of arms) count as colliding closer than
+    ``arm_margin`` [m]."""
     geometry = arms.arm_geometry.copy()
     sx, sy, sz = table_size
     table = pin.GeometryObject(
