@@ -140,10 +140,10 @@ def instance_of(
 def crossing(k: int, gap: float = 0.16) -> dict[str, tuple[str, Pose2D, Pose2D]]:
     half = math.pi / 2
     moves = {
-        "south": ("os", Pose2D(-0.2, -0.2, 0.0), Pose2D(0.0, -gap / 2, 0.0)),
-        "north": ("on", Pose2D(0.2, 0.2, 0.0), Pose2D(0.0, gap / 2, 0.0)),
-        "west": ("ow", Pose2D(-0.26, 0.15, half), Pose2D(-0.12, 0.0, half)),
-        "east": ("oe", Pose2D(0.26, -0.15, half), Pose2D(0.12, 0.0, half)),
+        "south": ("s1", Pose2D(-0.2, -0.2, 0.0), Pose2D(0.0, -gap / 2, 0.0)),
+        "north": ("n1", Pose2D(0.2, 0.2, 0.0), Pose2D(0.0, gap / 2, 0.0)),
+        "west": ("w1", Pose2D(-0.26, 0.15, half), Pose2D(-0.12, 0.0, half)),
+        "east": ("e1", Pose2D(0.26, -0.15, half), Pose2D(0.12, 0.0, half)),
     }
     return dict(list(moves.items())[:k])
 

@@ -80,10 +80,10 @@ def test_gripper_events_of_any_subset_of_arms_and_objects_held_per_arm(
     # the south gripper opens on the object the north one holds
     events = list(plan.events)
     south = next(i for i in releases if events[i].arm == "south")
-    events[south] = dataclasses.replace(events[south], object="on")
+    events[south] = dataclasses.replace(events[south], object="n1")
     v = validate_plan(instance, dataclasses.replace(plan, events=tuple(events)), scene).violation
     assert v is not None and v.kind == "release"
-    assert v.message == "south releases on but holds os"
+    assert v.message == "south releases n1 but holds s1"
     # three of the four open at once; the south arm lifts; then the west one opens: valid
     phases = pick_place(scene, crossing(4))
     release = phases[6]
@@ -107,7 +107,7 @@ def test_gripper_events_of_any_subset_of_arms_and_objects_held_per_arm(
     )
     v = validate_plan(instance, dataclasses.replace(staggered, events=late), scene).violation
     assert v is not None and v.kind == "dwell" and v.t == pytest.approx(opened["west"] + 0.3)
-    assert "after the west release of ow" in v.message and "; west shoulder_" in v.message
+    assert "after the west release of w1" in v.message and "; west shoulder_" in v.message
 
 
 @pytest.fixture(scope="module")
