@@ -150,3 +150,18 @@ def test_a_mutated_asynchronous_plan_one_arm_shifted_into_another_is_rejected(
     # the scheduler started the east arm as early as contact allows: two ticks sooner collide
     v = validate_plan(instance, shifted(fast, "east", 2), scene).violation
     assert v is not None and v.message.startswith("arms west and east in contact: ")
+
+
+def test_arms_named_by_prefixes_of_each_other_keep_their_shapes(cells: dict[int, Scene]) -> None:
+    """An arm named ``s`` beside one named ``s_e``: every shape belongs to its own arm (the
+    names of the second's shapes start with ``s_`` too)."""
+    scene = cells[4]
+    names = {"south": "s", "north": "n", "west": "w", "east": "s_e"}
+    renamed = dataclasses.replace(
+        scene, arms=tuple(dataclasses.replace(a, name=names[a.name]) for a in scene.arms)
+    )
+    world = CollisionWorld(renamed, arm_margin=0.01)
+    assert world.owner("s_e_wrist_3_link_0") == "s_e" and world.owner("s_wrist_3_link_0") == "s"
+    pairs = world.arm_clearances(renamed.home)
+    assert len(pairs) == 6 and all(c.distance > 0.1 for c in pairs.values())
+    assert not world.in_collision(renamed.home)
