@@ -50,8 +50,8 @@ from sdar_tamp.world.transforms import FloatArray
 
 FORMAT = "sdar-plan"
 VERSION = 2  #: the version :func:`~sdar_tamp.plan_writing.save_plan` writes
-#: Versions the reader accepts, each with the arm counts it allows (min, max; None: no max):
-#: version 1 holds exactly two arms, version 2 any number >= 1.
+#: Versions the reader accepts, each with the arm counts it allows (``(n, n)``: exactly n;
+#: ``(n, None)``: n or more): version 1 holds exactly two arms, version 2 any number >= 1.
 READ_VERSIONS: Mapping[int, tuple[int, int | None]] = MappingProxyType({1: (2, 2), 2: (1, None)})
 UNITS = {"length": "m", "angle": "rad", "time": "s"}
 MAX_DT = 0.02  #: largest spacing of trajectory samples [s]

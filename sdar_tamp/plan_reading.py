@@ -216,15 +216,14 @@ def plan_from_dict(data: Any, source: str = "<plan>", layout: ArmLayout | None =
 
 
 def _arm_items(r: _Reader, v: Any, version: int) -> list[Any]:
-    """The ``arms`` list, as many as ``version`` allows (version 1: two; 2: one or more)."""
+    """The ``arms`` list, as many as ``version`` allows (version 1: exactly two; 2: one or
+    more; :data:`~sdar_tamp.plan_file.READ_VERSIONS`)."""
     low, high = READ_VERSIONS[version]
     items = r.items(v, "arms", what="arms")
-    if low == high and len(items) != low:
-        raise r.fail("arms", f"expected {low} arms (a version-{version} file), got {len(items)}")
-    if len(items) < low or (high is not None and len(items) > high):
-        raise r.fail(
-            "arms", f"expected at least {low} arm (a version-{version} file), got {len(items)}"
-        )
+    exact = high is not None  # a version allows an exact count, or a minimum
+    if len(items) < low or (exact and len(items) != high):
+        count = f"{low} arms" if exact else f"at least {low} arm{'s' if low > 1 else ''}"
+        raise r.fail("arms", f"expected {count} (a version-{version} file), got {len(items)}")
     return items
 
 
