@@ -16,10 +16,12 @@ from karm_cells import build, cell, crossing, instance_of, pick_place, relay, sh
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_rules import check_timeline
 from sdar_tamp.replay import validate_plan
+from sdar_tamp.replay_walk import describe_contacts
 from sdar_tamp.schedule import schedule_async
-from sdar_tamp.world.collision import CollisionWorld
+from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import pose_xyz_yaw
 
 
 def _closest(plan: PlanFile, scene: Scene, stride: int = 5) -> dict[tuple[str, str], float]:
@@ -165,3 +167,21 @@ def test_arms_named_by_prefixes_of_each_other_keep_their_shapes(cells: dict[int,
     pairs = world.arm_clearances(renamed.home)
     assert len(pairs) == 6 and all(c.distance > 0.1 for c in pairs.values())
     assert not world.in_collision(renamed.home)
+
+
+def test_contact_messages_name_the_arms_of_held_objects_too(cells: dict[int, Scene]) -> None:
+    world = CollisionWorld(cells[4])
+    world.set_objects({"o1": ObjectBox(pose_xyz_yaw(0.0, 0.0, 0.025, 0.0), (0.08, 0.04, 0.05))})
+    world.attach("west", "o1")
+    assert world.owner("held:o1") == "west" and world.owner("object:o1") is None
+    pairs = [
+        CollisionPair("south_wrist_3_link_0", "object:o2"),
+        CollisionPair("held:o1", "east_gripper_base_link_1"),
+        CollisionPair("north_wrist_3_link_0", "south_forearm_link_0"),
+        CollisionPair("east_wrist_1_link_0", "west_wrist_1_link_0"),
+    ]
+    assert describe_contacts(pairs, world) == (
+        "arms west and east; south and north in contact: south_wrist_3_link_0 with object:o2, "
+        "held:o1 with east_gripper_base_link_1, north_wrist_3_link_0 with south_forearm_link_0 ..."
+    )
+    assert describe_contacts(pairs[:1], world) == "south_wrist_3_link_0 with object:o2"
