@@ -13,7 +13,7 @@ from sdar_tamp.errors import SdarError
 #: The generator's families and the named suites, spelt out so that the command line starts
 #: without NumPy (tests/cli checks they match sdar_tamp.world.generators and .suites).
 CLI_FAMILIES = ("R", "S", "D", "M", "N")
-CLI_SUITES = ("paper", "stress", "dense")
+CLI_SUITES = ("paper", "stress", "dense", "families")
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
