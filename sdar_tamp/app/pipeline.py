@@ -12,7 +12,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from sdar_tamp.app.bound import instance_bound
+from sdar_tamp.app.bound import run_bound
 from sdar_tamp.app.cache import PlannerCache
 from sdar_tamp.app.config import (
     EXECUTIONS,
@@ -104,7 +104,7 @@ def solve_instance(
         task_selection_time=float(stats.get("task_selection_time", 0.0)),
         tasks=int(stats.get("tasks", 0)),
     )
-    bound = instance_bound(rearrangement.ctx.scene, instance, config)
+    bound = run_bound(rearrangement.ctx, instance, config)
     if solution.plan is None:
         return SolveOutcome(
             instance, solution.status.value, None, False, "no plan", figures,

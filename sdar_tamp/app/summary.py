@@ -86,8 +86,10 @@ def bound_record(outcome: SolveOutcome) -> dict[str, Any] | None:
 def _bound_line(outcome: SolveOutcome) -> list[str]:
     """``execution 23.1 s, bound 14.2 s (1.63x)``: the plan against the lower bound."""
     b, m = outcome.bound, outcome.plan
-    if b is None or m is None or m.metrics.execution_time is None:
+    if m is None or m.metrics.execution_time is None:
         return []
+    if b is None:
+        return ["  bound not computed (an arm without the closed-form IK: not provable)"]
     ratio = outcome.execution_over_bound
     times = "" if ratio is None else f" ({ratio:.2f}x)"
     caveat = "" if b.proven else "; IK branches sampled, not proven"

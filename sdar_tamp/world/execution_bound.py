@@ -196,16 +196,18 @@ def execution_bound(
     instance: Instance,
     grasps: Mapping[str, Sequence[FloatArray]],
     dwell: float,
+    kinematics: Mapping[str, ArmKinematics] | None = None,
 ) -> ExecutionBound:
     """The lower bound of the module docstring for ``instance`` in ``scene``: ``grasps`` per
     object name, its grasp set as ``T_object_tcp`` ``(4, 4)`` poses; ``dwell`` [s] the
-    plans' gripper dwell."""
+    plans' gripper dwell; ``kinematics``: the arms' (default: loaded from the scene)."""
     if not dwell >= 0.0:
         raise ParameterError(f"dwell: expected >= 0 [s], got {dwell}")
     missing = [o.name for o in instance.objects if o.name not in grasps]
     if missing:
         raise ParameterError(f"grasps: no grasp set for the objects {missing}")
-    kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+    given = kinematics or {}
+    kins = {a: given.get(a) or ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
     share = scene.velocity_safety
     limits = {
         a: (

@@ -141,3 +141,17 @@ def test_bad_input_is_refused() -> None:
         execution_bound(scene, inst, {"o1": []}, dwell=-1.0)
     with pytest.raises(ParameterError, match=r"grasps: no grasp set for the objects \['o1'\]"):
         execution_bound(scene, inst, {}, dwell=0.5)
+
+
+def test_the_pipeline_bounds_only_cells_with_the_closed_form_ik() -> None:
+    from sdar_tamp.app.bound import run_bound
+    from sdar_tamp.app.config import PlannerConfig
+    from streams.context import WorldContext
+
+    inst = load_instance(shipped_suite_dir("paper") / "R4.yaml")
+    ur = WorldContext.load()
+    bound = run_bound(ur, inst, PlannerConfig())
+    assert bound is not None and bound.proven
+    assert bound.seconds == pytest.approx(instance_bound(ur.scene, inst).seconds)
+    panda = WorldContext.load(cell_path("panda_facing"))
+    assert run_bound(panda, inst, PlannerConfig()) is None
