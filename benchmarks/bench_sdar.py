@@ -17,7 +17,8 @@ instances' own; ``--folder`` takes the instances of a folder (e.g. a suite gener
 cell by ``sdar generate --suite paper --scene CELL.yaml``) instead of a shipped suite.
 
 ``--suite table_1arm`` ... ``table_4arm``: the ``families`` suite shipped for the cells of the
-shared table (each instance names its cell).
+shared table (each instance names its cell). ``--bound-only`` solves nothing: it prints each
+instance's lower bound (with ``--min-objects 24``, say).
 
 Every row shows the execution time against its lower bound
 (:mod:`sdar_tamp.world.execution_bound`: ``bound`` [s] and ``x``, execution over bound); the
@@ -75,6 +76,7 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--suite", default="paper", choices=(*SUITES, *CELL_SUITES))
     ap.add_argument("--max-objects", type=int, default=None)
+    ap.add_argument("--min-objects", type=int, default=None)
     ap.add_argument("--time-limit", type=float, default=60.0)
     ap.add_argument("--task-planner", default="sdar", choices=("sdar", "baseline"))
     ap.add_argument("--motion-planner", default="sdar", choices=("sdar", "plain", "sequential"))
@@ -87,6 +89,11 @@ def main(argv: list[str] | None = None) -> None:
         action="store_true",
         help="instead: the generic adaptive algorithm against sdar on a one-object instance",
     )
+    ap.add_argument(
+        "--bound-only",
+        action="store_true",
+        help="instead: the execution-time bound of every instance, nothing solved",
+    )
     ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
     args = ap.parse_args(argv)
     if args.quick:  # explicit options still win
@@ -95,21 +102,21 @@ def main(argv: list[str] | None = None) -> None:
     if args.compare_adaptive:
         compare_adaptive(args.time_limit, args.quick)
         return
+    files = _suite_files(args.suite) if args.folder is None else _folder_files(args.folder)
+    files = [p for p in files if _wanted(p, args)]
+    if args.bound_only:
+        bounds_only(files, args)
+        return
 
     cache = PlannerCache()
     rows = []
     step_times: list[float] = []
     step_selection: list[float] = []
     step_motion: list[float] = []
-    wanted = {s for s in args.only.split(",") if s}
     start = time.perf_counter()
     print(f"{'instance':>9} {'n':>3} {'ok':>3} {'actions':>7} {'steps':>5} {'exec s':>7} "
           f"{'bound s':>7} {'x':>5} {'plan s':>7} {'step med':>8} {'levels'}")  # fmt: skip
-    for path in _suite_files(args.suite) if args.folder is None else _folder_files(args.folder):
-        if wanted and path.stem not in wanted:
-            continue
-        if args.max_objects is not None and len(load_instance(path).objects) > args.max_objects:
-            continue
+    for path in files:
         outcome = solve_instance(
             path,
             time_limit=args.time_limit,
@@ -206,6 +213,52 @@ def main(argv: list[str] | None = None) -> None:
         f"time median {_fmt(summary['execution_time_median'])} s, execution over bound median "
         f"{_fmt(summary['execution_over_bound_median'])}"
     )
+    print(json.dumps(summary))
+
+
+def _wanted(path: Path, args: argparse.Namespace) -> bool:
+    """Whether ``--only``, ``--max-objects`` and ``--min-objects`` keep the instance file."""
+    wanted = {s for s in args.only.split(",") if s}
+    if wanted and path.stem not in wanted:
+        return False
+    n = len(load_instance(path).objects)
+    too_many = args.max_objects is not None and n > args.max_objects
+    return not too_many and (args.min_objects is None or n >= args.min_objects)
+
+
+def bounds_only(files: list[Path], args: argparse.Namespace) -> None:
+    """The lower bound of every instance in its cell (or ``--scene``), nothing solved: one
+    row per instance, then the medians as one JSON object."""
+    from sdar_tamp.app.bound import instance_bound
+    from sdar_tamp.world.scene import load_scene
+
+    start = time.perf_counter()
+    rows = {}
+    print(f"{'instance':>9} {'n':>3} {'arms':>4} {'bound s':>7} {'sum/k s':>7} {'max c s':>7}")
+    for path in files:
+        instance = load_instance(path)
+        scene = load_scene(args.scene or instance.scene_path(path))
+        b = instance_bound(scene, instance)
+        rows[instance.name] = {
+            "bound": b.seconds, "sum_over_arms": b.total / b.arms, "longest_object": b.longest,
+            "arms": b.arms, "relays": sum(o.relay for o in b.objects),
+        }  # fmt: skip
+        print(
+            f"{instance.name:>9} {len(instance.objects):>3} {b.arms:>4} {b.seconds:>7.2f} "
+            f"{b.total / b.arms:>7.2f} {b.longest:>7.2f}",
+            flush=True,
+        )
+    values = [r["bound"] for r in rows.values()]
+    summary = {
+        "benchmark": "sdar-bound",
+        "suite": args.suite if args.folder is None else str(args.folder),
+        "scene": None if args.scene is None else str(args.scene),
+        "instances": len(rows),
+        "bound_median": statistics.median(values) if values else None,
+        "per_instance": rows,
+        "wall_time": time.perf_counter() - start,
+        "quick": args.quick,
+    }
     print(json.dumps(summary))
 
 
