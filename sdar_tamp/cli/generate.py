@@ -30,6 +30,11 @@ def cmd_generate(args: argparse.Namespace) -> int:
     if args.suite is not None:
         if args.family is not None or args.objects is not None:
             raise SdarError("sdar generate: --suite cannot be combined with --family/--objects")
+        if args.suite == "families" and args.scene is None:
+            raise SdarError(
+                "sdar generate --suite families: expected --scene CELL (the suite is made for "
+                "a given cell's workspace and arms; the shipped cells: `sdar cells`)"
+            )
         output_folder(args.output)
         taken = [p for p in suite_files(args.suite, args.output) if p.exists()]
         if taken and not args.force:

@@ -91,3 +91,12 @@ def test_sdar_generate_families_in_a_cell(tmp_path: Path) -> None:
     inst = load_instance(out)
     assert inst.workspace == load_scene(cell_path("ur5e_table_3arm")).workspace
     assert inst.scene is not None and inst.scene.endswith("ur5e_table_3arm.yaml")
+
+
+def test_sdar_generate_families_needs_a_cell(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["generate", "--suite", "families", "-o", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert "sdar generate --suite families: expected --scene CELL" in err
+    assert not (tmp_path / "s").exists() or not any((tmp_path / "s").iterdir())
