@@ -128,6 +128,11 @@ def shipped_suite_dir(suite: str) -> Path:
 
 def load_suite(suite: str, directory: Path | None = None) -> tuple[Instance, ...]:
     """Load a suite: from ``directory`` if given, else the shipped copy, in suite order."""
+    if directory is None and suite == "families":
+        raise SuiteError(
+            "suite 'families' is made for a given cell and has no shipped copy of its own; "
+            f"the shipped ones are {list(CELL_SUITES)} (or pass the folder it was written to)"
+        )
     folder = Path(directory) if directory is not None else shipped_suite_dir(suite)
     members = suite_members(suite)
     missing = [m.name for m in members if not (folder / f"{m.name}.yaml").is_file()]

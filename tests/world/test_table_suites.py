@@ -36,6 +36,8 @@ def test_the_families_suite_has_four_families_at_four_sizes_twice() -> None:
         assert suite_members(name) == members
     with pytest.raises(SuiteError, match=r"unknown suite 'tables'; expected one of .*table_4arm"):
         suite_members("tables")
+    with pytest.raises(SuiteError, match=r"no shipped copy of its own; the shipped ones are \["):
+        load_suite("families")
 
 
 @pytest.mark.parametrize("suite", sorted(CELL_SUITES))
