@@ -36,8 +36,8 @@ at most ``k E`` of them, hence ``E >= sum_i c_i / k``.
 Scope: the minimum over IK branches is exact for arms with the closed-form IK (every branch
 of a UR-family arm is enumerated, each joint value also a turn away where the limits allow).
 A UR arm has a continuum of solutions only at singular poses: the wrist one (joints 4 and 6
-parallel) needs the tool's approach horizontal, and every grasp of the planner's set is at
-most 45 degrees from vertical; the shoulder one needs the wrist above the base's axis, far
+parallel) needs the tool's approach horizontal, which no grasp of the planner's set has
+(its tilts are below 90 degrees); the shoulder one needs the wrist above the base's axis, far
 from any workspace. For other arms (numeric IK) the minimum runs over the branches the
 numeric IK finds, and :attr:`ExecutionBound.proven` is false. Goals are taken as given: the
 validator's 1 mm / 1 degree tolerance on a goal is not subtracted. No approach term is added:
