@@ -3,6 +3,7 @@ reference plan the tests hold above it."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -77,6 +78,10 @@ def test_a_hand_computed_case_equals_the_formula() -> None:
     assert bound.arms == 1 and bound.proven
     # the planner's whole grasp set can only lower it, never raise it
     assert instance_bound(scene, inst).seconds <= bound.seconds + 1e-12
+    # the scene's velocity_safety scales both limits, as the planner's timing does
+    slow = dataclasses.replace(scene, velocity_safety=0.5)
+    half = execution_bound(slow, inst, {"o0": [top_down[0].T_object_tcp]}, dwell=0.5)
+    assert half.objects[0].motion == pytest.approx(2.0 * math.sqrt(theta / 2.5), abs=1e-9)
 
 
 def test_the_bound_scales_with_the_arms() -> None:
