@@ -16,6 +16,15 @@ planner's one-off set-up (building the optimiser) is excluded and printed separa
 instances' own; ``--folder`` takes the instances of a folder (e.g. a suite generated for the
 cell by ``sdar generate --suite paper --scene CELL.yaml``) instead of a shipped suite.
 
+``--suite table_1arm`` ... ``table_4arm``: the ``families`` suite shipped for the cells of the
+shared table (each instance names its cell). ``--bound-only`` solves nothing: it prints each
+instance's lower bound (with ``--min-objects 24``, say).
+
+Every row shows the execution time against its lower bound
+(:mod:`sdar_tamp.world.execution_bound`: ``bound`` [s] and ``x``, execution over bound); the
+JSON holds their medians (``execution_time_median``, ``bound_median``,
+``execution_over_bound_median``) and per instance (``per_instance``).
+
 Prints one row per instance, a summary, then one JSON object on the last line.
 
 ``--quick`` changes only the defaults: ``--only R4`` (4 objects, in the ``paper`` suite)
@@ -36,7 +45,7 @@ from sdar_tamp.app.pipeline import solve_instance
 from sdar_tamp.app.records import SolveOutcome
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import load_instance
-from sdar_tamp.world.suites import SUITES
+from sdar_tamp.world.suites import CELL_SUITES, SUITES
 
 
 def _order(p: Path) -> tuple[str, int]:
@@ -46,6 +55,11 @@ def _order(p: Path) -> tuple[str, int]:
 
 def _suite_files(suite: str) -> list[Path]:
     folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
+    if not folder.is_dir():
+        raise SystemExit(
+            f"--suite {suite}: not shipped; generate it in a cell (sdar generate --scene CELL "
+            f"--suite {suite} -o DIR) and pass --folder DIR"
+        )
     return sorted(folder.glob("*.yaml"), key=_order)
 
 
@@ -60,8 +74,9 @@ QUICK = {"only": "R4", "time_limit": 30.0}
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--suite", default="paper", choices=SUITES)
+    ap.add_argument("--suite", default="paper", choices=(*SUITES, *CELL_SUITES))
     ap.add_argument("--max-objects", type=int, default=None)
+    ap.add_argument("--min-objects", type=int, default=None)
     ap.add_argument("--time-limit", type=float, default=60.0)
     ap.add_argument("--task-planner", default="sdar", choices=("sdar", "baseline"))
     ap.add_argument("--motion-planner", default="sdar", choices=("sdar", "plain", "sequential"))
@@ -74,6 +89,11 @@ def main(argv: list[str] | None = None) -> None:
         action="store_true",
         help="instead: the generic adaptive algorithm against sdar on a one-object instance",
     )
+    ap.add_argument(
+        "--bound-only",
+        action="store_true",
+        help="instead: the execution-time bound of every instance, nothing solved",
+    )
     ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
     args = ap.parse_args(argv)
     if args.quick:  # explicit options still win
@@ -82,21 +102,21 @@ def main(argv: list[str] | None = None) -> None:
     if args.compare_adaptive:
         compare_adaptive(args.time_limit, args.quick)
         return
+    files = _suite_files(args.suite) if args.folder is None else _folder_files(args.folder)
+    files = [p for p in files if _wanted(p, args)]
+    if args.bound_only:
+        bounds_only(files, args)
+        return
 
     cache = PlannerCache()
     rows = []
     step_times: list[float] = []
     step_selection: list[float] = []
     step_motion: list[float] = []
-    wanted = {s for s in args.only.split(",") if s}
     start = time.perf_counter()
     print(f"{'instance':>9} {'n':>3} {'ok':>3} {'actions':>7} {'steps':>5} {'exec s':>7} "
-          f"{'plan s':>7} {'step med':>8} {'levels'}")  # fmt: skip
-    for path in _suite_files(args.suite) if args.folder is None else _folder_files(args.folder):
-        if wanted and path.stem not in wanted:
-            continue
-        if args.max_objects is not None and len(load_instance(path).objects) > args.max_objects:
-            continue
+          f"{'bound s':>7} {'x':>5} {'plan s':>7} {'step med':>8} {'levels'}")  # fmt: skip
+    for path in files:
         outcome = solve_instance(
             path,
             time_limit=args.time_limit,
@@ -117,6 +137,8 @@ def main(argv: list[str] | None = None) -> None:
             "planning_time": f.planning_time,
             "selection_time": f.selection_time,
             "motion_time": f.motion_time,
+            "bound": None if outcome.bound is None else outcome.bound.seconds,
+            "execution_over_bound": outcome.execution_over_bound,
         }
         if outcome.plan is not None:
             m = outcome.plan.metrics
@@ -133,7 +155,8 @@ def main(argv: list[str] | None = None) -> None:
         print(
             f"{row['instance']:>9} {n:>3} {'yes' if row['success'] else 'NO':>3} "
             f"{row.get('actions', '-'):>7} {row.get('steps', '-'):>5} "
-            f"{float(row.get('execution_time', 0.0)):>7.1f} {row['planning_time']:>7.2f} "
+            f"{float(row.get('execution_time', 0.0)):>7.1f} {_num(row['bound'], 7, 1)} "
+            f"{_num(row['execution_over_bound'], 5, 2)} {row['planning_time']:>7.2f} "
             f"{float(row.get('step_time_median', 0.0)):>8.3f} {row.get('levels', '')}"
             + ("" if row["success"] else f"  {outcome.violation or outcome.diagnosis}"),
             flush=True,
@@ -145,6 +168,9 @@ def main(argv: list[str] | None = None) -> None:
     solved = [r for r in rows if r["success"]]
     # the paper's "per step" figure: an instance's whole planning time over its steps
     per_instance = [float(r["planning_time"]) / int(r["steps"]) for r in solved if r["steps"]]
+    executions = [float(r["execution_time"]) for r in solved]
+    bounds = [float(r["bound"]) for r in rows if r["bound"] is not None]
+    ratios = [float(r["execution_over_bound"]) for r in solved if r["execution_over_bound"]]
     summary = {
         "benchmark": "sdar",
         "suite": args.suite if args.folder is None else str(args.folder),
@@ -161,6 +187,18 @@ def main(argv: list[str] | None = None) -> None:
         "step_selection_median": statistics.median(step_selection) if step_selection else None,
         "step_motion_median": statistics.median(step_motion) if step_motion else None,
         "instance_step_time_median": statistics.median(per_instance) if per_instance else None,
+        "execution_time_median": statistics.median(executions) if executions else None,
+        "bound_median": statistics.median(bounds) if bounds else None,
+        "execution_over_bound_median": statistics.median(ratios) if ratios else None,
+        "execution_over_bound_min": min(ratios) if ratios else None,
+        "per_instance": {
+            r["instance"]: {
+                "execution_time": r.get("execution_time"),
+                "bound": r["bound"],
+                "execution_over_bound": r["execution_over_bound"],
+            }
+            for r in rows
+        },
         "planning_time_total": sum(r["planning_time"] for r in rows),
         "wall_time": time.perf_counter() - start,
         "failures": [r["instance"] for r in rows if not r["success"]],
@@ -171,8 +209,56 @@ def main(argv: list[str] | None = None) -> None:
         f"{_fmt(summary['step_time_median'])} s (selection {_fmt(summary['step_selection_median'])}"
         f" s, motion {_fmt(summary['step_motion_median'])} s), p90 "
         f"{_fmt(summary['step_time_p90'])} s over {summary['steps']} steps; planning time over "
-        f"steps per instance, median {_fmt(summary['instance_step_time_median'])} s"
+        f"steps per instance, median {_fmt(summary['instance_step_time_median'])} s; execution "
+        f"time median {_fmt(summary['execution_time_median'])} s, execution over bound median "
+        f"{_fmt(summary['execution_over_bound_median'])}"
     )
+    print(json.dumps(summary))
+
+
+def _wanted(path: Path, args: argparse.Namespace) -> bool:
+    """Whether ``--only``, ``--max-objects`` and ``--min-objects`` keep the instance file."""
+    wanted = {s for s in args.only.split(",") if s}
+    if wanted and path.stem not in wanted:
+        return False
+    n = len(load_instance(path).objects)
+    too_many = args.max_objects is not None and n > args.max_objects
+    return not too_many and (args.min_objects is None or n >= args.min_objects)
+
+
+def bounds_only(files: list[Path], args: argparse.Namespace) -> None:
+    """The lower bound of every instance in its cell (or ``--scene``), nothing solved: one
+    row per instance, then the medians as one JSON object."""
+    from sdar_tamp.app.bound import instance_bound
+    from sdar_tamp.world.scene import load_scene
+
+    start = time.perf_counter()
+    rows = {}
+    print(f"{'instance':>9} {'n':>3} {'arms':>4} {'bound s':>7} {'sum/k s':>7} {'max c s':>7}")
+    for path in files:
+        instance = load_instance(path)
+        scene = load_scene(args.scene or instance.scene_path(path))
+        b = instance_bound(scene, instance)
+        rows[instance.name] = {
+            "bound": b.seconds, "sum_over_arms": b.total / b.arms, "longest_object": b.longest,
+            "arms": b.arms, "relays": sum(o.relay for o in b.objects),
+        }  # fmt: skip
+        print(
+            f"{instance.name:>9} {len(instance.objects):>3} {b.arms:>4} {b.seconds:>7.2f} "
+            f"{b.total / b.arms:>7.2f} {b.longest:>7.2f}",
+            flush=True,
+        )
+    values = [r["bound"] for r in rows.values()]
+    summary = {
+        "benchmark": "sdar-bound",
+        "suite": args.suite if args.folder is None else str(args.folder),
+        "scene": None if args.scene is None else str(args.scene),
+        "instances": len(rows),
+        "bound_median": statistics.median(values) if values else None,
+        "per_instance": rows,
+        "wall_time": time.perf_counter() - start,
+        "quick": args.quick,
+    }
     print(json.dumps(summary))
 
 
@@ -214,6 +300,10 @@ def _quantile(values: list[float], q: float) -> float | None:
         return None
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+
+
+def _num(value: float | None, width: int, digits: int) -> str:
+    return f"{'-':>{width}}" if value is None else f"{value:>{width}.{digits}f}"
 
 
 def _fmt(value: object) -> str:

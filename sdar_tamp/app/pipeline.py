@@ -12,6 +12,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from sdar_tamp.app.bound import run_bound
 from sdar_tamp.app.cache import PlannerCache
 from sdar_tamp.app.config import (
     EXECUTIONS,
@@ -103,10 +104,11 @@ def solve_instance(
         task_selection_time=float(stats.get("task_selection_time", 0.0)),
         tasks=int(stats.get("tasks", 0)),
     )
+    bound = run_bound(rearrangement.ctx, instance, config)
     if solution.plan is None:
         return SolveOutcome(
             instance, solution.status.value, None, False, "no plan", figures,
-            tuple(solution.diagnosis),
+            tuple(solution.diagnosis), bound,
         )  # fmt: skip
     tasks = task_records(solution)
     figures = dataclasses.replace(
@@ -137,7 +139,7 @@ def solve_instance(
             stage("validating")
         report = validate_plan(instance, plan, rearrangement.ctx.scene)
     violation = "" if report.ok or report.violation is None else describe(report.violation)
-    return SolveOutcome(instance, "solved", plan, report.ok, violation, figures)
+    return SolveOutcome(instance, "solved", plan, report.ok, violation, figures, (), bound)
 
 
 def describe(violation: Violation) -> str:

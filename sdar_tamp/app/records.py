@@ -5,8 +5,8 @@
 - :class:`StepTime`: planning time of one synchronous step, split into selection and motion;
 - :class:`RunFigures`: the figures of one ``sdar solve`` (planners, seed, set-up, planning
   times, per-step times, motion levels, buffer moves);
-- :class:`SolveOutcome`: the instance, the status, the plan file, the replay's verdict and
-  the figures.
+- :class:`SolveOutcome`: the instance, the status, the plan file, the replay's verdict, the
+  figures and the lower bound on the execution time.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import NamedTuple
 
 from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.world.execution_bound import ExecutionBound
 from sdar_tamp.world.instance import Instance
 from solvers.solution import Solution, TaskTrace
 
@@ -138,7 +139,16 @@ class SolveOutcome:
     violation: str
     figures: RunFigures
     diagnosis: tuple[str, ...] = ()
+    #: The lower bound on the execution time of any plan (``sdar_tamp.world.execution_bound``).
+    bound: ExecutionBound | None = None
 
     @property
     def success(self) -> bool:
         return self.status == "solved" and self.valid
+
+    @property
+    def execution_over_bound(self) -> float | None:
+        """The plan's execution time over the bound (``None`` without a plan or a bound)."""
+        if self.plan is None or self.bound is None or self.plan.metrics.execution_time is None:
+            return None
+        return self.bound.ratio(float(self.plan.metrics.execution_time))

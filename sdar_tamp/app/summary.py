@@ -15,7 +15,10 @@ def format_summary(outcome: SolveOutcome) -> str:
     f = outcome.figures
     head = f"{outcome.instance.name}: {outcome.status}"
     if outcome.plan is None:
-        return "\n".join([head, *(f"  {d}" for d in outcome.diagnosis)])
+        lines = [head, *(f"  {d}" for d in outcome.diagnosis)]
+        if outcome.bound is not None:
+            lines.append(f"  execution-time bound {outcome.bound.seconds:.1f} s")
+        return "\n".join(lines)
     m = outcome.plan.metrics
     lines = [
         head + (", plan valid" if outcome.valid else f", plan INVALID ({outcome.violation})"),
@@ -23,6 +26,7 @@ def format_summary(outcome: SolveOutcome) -> str:
         f"{m.steps} ({m.dual_arm_steps} with both arms moving at once)",
         f"  execution time {float(_given(m.execution_time)):.2f} s"
         + _async_note(m, f.schedule_time),
+        *_bound_line(outcome),
         f"  planning time {f.planning_time:.2f} s: selection/IK {f.selection_time:.2f} s, "
         f"motion {f.motion_time:.2f} s (setup {f.setup_time:.2f} s not counted; "
         f"optimiser built in the background, waited for {f.optimiser_wait:.2f} s)",
@@ -57,8 +61,43 @@ def summary_record(outcome: SolveOutcome, plan_file: Path | None = None) -> dict
             "levels": dict(f.levels),
         },
         "diagnosis": list(outcome.diagnosis),
+        "bound": bound_record(outcome),
     }
     return record
+
+
+def bound_record(outcome: SolveOutcome) -> dict[str, Any] | None:
+    """The execution-time bound of ``outcome`` as a JSON-ready object (``None`` without one):
+    the bound, its two terms, the arms, whether it is proven, the plan's ratio to it."""
+    b = outcome.bound
+    if b is None:
+        return None
+    return {
+        "seconds": b.seconds,
+        "sum_over_arms": b.total / b.arms,
+        "longest_object": b.longest,
+        "arms": b.arms,
+        "objects": len(b.objects),
+        "proven": b.proven,
+        "execution_over_bound": outcome.execution_over_bound,
+    }
+
+
+def _bound_line(outcome: SolveOutcome) -> list[str]:
+    """``execution 23.1 s, bound 14.2 s (1.63x)``: the plan against the lower bound."""
+    b, m = outcome.bound, outcome.plan
+    if m is None or m.metrics.execution_time is None:
+        return []
+    if b is None:
+        return ["  bound not computed (an arm without the closed-form IK: not provable)"]
+    ratio = outcome.execution_over_bound
+    times = "" if ratio is None else f" ({ratio:.2f}x)"
+    caveat = "" if b.proven else "; IK branches sampled, not proven"
+    return [
+        f"  execution {float(m.metrics.execution_time):.1f} s, bound {b.seconds:.1f} s{times}: "
+        f"sum c_i / {b.arms} arm(s) {b.total / b.arms:.1f} s, longest object {b.longest:.1f} s"
+        f"{caveat}"
+    ]
 
 
 def _given(value: float | None) -> float:

@@ -13,7 +13,7 @@ from sdar_tamp.errors import SdarError
 #: The generator's families and the named suites, spelt out so that the command line starts
 #: without NumPy (tests/cli checks they match sdar_tamp.world.generators and .suites).
 CLI_FAMILIES = ("R", "S", "D", "M", "N")
-CLI_SUITES = ("paper", "stress", "dense")
+CLI_SUITES = ("paper", "stress", "dense", "families")
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
@@ -30,6 +30,11 @@ def cmd_generate(args: argparse.Namespace) -> int:
     if args.suite is not None:
         if args.family is not None or args.objects is not None:
             raise SdarError("sdar generate: --suite cannot be combined with --family/--objects")
+        if args.suite == "families" and args.scene is None:
+            raise SdarError(
+                "sdar generate --suite families: expected --scene CELL (the suite is made for "
+                "a given cell's workspace and arms; the shipped cells: `sdar cells`)"
+            )
         output_folder(args.output)
         taken = [p for p in suite_files(args.suite, args.output) if p.exists()]
         if taken and not args.force:

@@ -99,6 +99,7 @@ def run_task(task: BenchTask) -> RunAnswer:
         motion_time_s=f.motion_time, setup_time_s=f.setup_time,
         wall_time_s=time.perf_counter() - start, abstract_actions=abstract.actions,
         abstract_buffer_moves=abstract.buffer_moves, abstract_steps=abstract.steps,
+        bound_s=None if outcome.bound is None else outcome.bound.seconds,
     )  # fmt: skip
     if outcome.plan is None:
         return RunAnswer(row)
@@ -106,6 +107,6 @@ def run_task(task: BenchTask) -> RunAnswer:
     row = dataclasses.replace(
         row, actions=m.actions, steps=m.steps, dual_arm_steps=m.dual_arm_steps,
         execution_time_s=m.execution_time, buffer_moves=f.buffer_moves,
-        step_time_median_s=f.step_time_median,
+        step_time_median_s=f.step_time_median, execution_over_bound=outcome.execution_over_bound,
     )  # fmt: skip
     return RunAnswer(row, tuple(f.step_times), outcome.plan)

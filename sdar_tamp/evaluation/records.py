@@ -39,6 +39,10 @@ class BenchRow:
     dual_arm_steps: int | None = None
     buffer_moves: int | None = None
     execution_time_s: float | None = None
+    #: the lower bound on the execution time (``sdar_tamp.world.execution_bound``) and the
+    #: plan's execution time over it
+    bound_s: float | None = None
+    execution_over_bound: float | None = None
     planning_time_s: float | None = None
     selection_time_s: float | None = None
     motion_time_s: float | None = None

@@ -26,9 +26,9 @@ PLANS = "plans"
 COLUMNS = (
     "instance", "family", "objects", "combination", "task_planner", "motion_planner", "seed",
     "time_limit_s", "success", "status", "valid", "actions", "steps", "dual_arm_steps",
-    "buffer_moves", "execution_time_s", "planning_time_s", "selection_time_s", "motion_time_s",
-    "step_time_median_s", "setup_time_s", "wall_time_s", "abstract_actions",
-    "abstract_buffer_moves", "abstract_steps", "violation", "diagnosis",
+    "buffer_moves", "execution_time_s", "bound_s", "execution_over_bound", "planning_time_s",
+    "selection_time_s", "motion_time_s", "step_time_median_s", "setup_time_s", "wall_time_s",
+    "abstract_actions", "abstract_buffer_moves", "abstract_steps", "violation", "diagnosis",
 )  # fmt: skip
 STEP_COLUMNS = ("instance", "combination", "step", "selection_s", "motion_s")
 FAMILY_ORDER = "RSDMN"

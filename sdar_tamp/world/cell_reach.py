@@ -190,3 +190,11 @@ def unreached_points(scene: Scene, step: float) -> dict[str, FloatArray]:
     points = grid(scene.workspace.x, scene.workspace.y, step)
     z = scene.object_size[2] / 2.0
     return {name: points[~reached(arm, points, z)] for name, arm in scene_reach_arms(scene).items()}
+
+
+def uncovered_points(missed: dict[str, FloatArray]) -> FloatArray:
+    """The points ``(k, 2)`` [m] no arm reaches, from :func:`unreached_points`' answer: a
+    cell whose arms share the workspace needs each point reached by at least one arm."""
+    sets = [{(float(x), float(y)) for x, y in points} for points in missed.values()]
+    common = set.intersection(*sets) if sets else set()
+    return np.array(sorted(common), dtype=np.float64).reshape(-1, 2)

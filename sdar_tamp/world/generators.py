@@ -17,6 +17,15 @@ objects without successor get a goal overlapping no other object's start. Each i
 verified with :mod:`sdar_tamp.world.dependency`; failures are retried with the same generator,
 bounded.
 Every random choice comes from ``numpy.random.default_rng(seed)``: same seed, same instance.
+
+Reach. The generators place objects anywhere in the workspace; a cell's workspace is chosen
+so that each of its points is grasped top-down by at least one of the cell's arms (``sdar
+cells CELL --reach STEP``, :mod:`sdar_tamp.world.cell_reach`), whatever their number: an
+object pose must be graspable by at least one arm, not by every arm (on the paper cell both
+arms happen to reach all of it; on the cells of the shared table the side arms reach their
+third only). The command line's acceptance test asks the same of every start and goal with
+the cell's own arms (:class:`streams.feasibility.ProofCheck`: an object no arm can pick or
+place is refused).
 An optional acceptance test (``accept``: instance -> the reason it is refused, or ``None``)
 rejects further samples, e.g. those the infeasibility proofs of :mod:`streams.feasibility`
 show unsolvable (the command line passes them); a refused sample is retried like any other.
@@ -142,7 +151,7 @@ def generate_instance(
                 )
             continue
         crowded = 0
-        if inst is not None and _verified(family, inst):
+        if inst is not None and has_family_structure(family, inst):
             validate_instance(inst, SHIPPED_GRASP if opts.grasp is None else opts.grasp)
             why = accept(inst) if accept is not None else None
             if why is None:
@@ -183,7 +192,9 @@ def _table_area(opts: GeneratorOptions) -> float:
     return (ws.x[1] - ws.x[0] + opts.gap) * (ws.y[1] - ws.y[0] + opts.gap)
 
 
-def _verified(family: str, inst: Instance) -> bool:
+def has_family_structure(family: str, inst: Instance) -> bool:
+    """Whether the dependency graph of ``inst`` has the structure ``family`` promises (see
+    the module docstring; ``R`` promises none)."""
     g = instance_dependency_graph(inst)
     cycles = g.cycle_components()
     if family == "S":

@@ -6,6 +6,14 @@
   are named ``Mn16``, ``Mn20``, ``Mn24`` since ``M#`` is an index in the paper): 12 instances.
 * ``dense``: the dense family ``N`` with 16, 20 and 24 objects at the paper's clearance
   (``N16``, ``N20``, ``N24``): mixed sizes, neighbours trading places, turned goals.
+* ``families``: the paper's four families M, R, D and S with 12, 16, 20 and 24 objects, two
+  seeded instances each (``M12-1``, ``M12-2`` ... ``S24-2``: 32 instances) at the generator's
+  default clearance, meant for a cell given with ``--scene`` (its workspace, object and
+  arms). Its seeds do not depend on the cell, so cells with one workspace get the same
+  instances unless a cell's acceptance test refuses a sample the others accept.
+
+The shipped copies of the ``families`` suite on the cells of the shared 1.2 m x 1.0 m table
+are the suites ``table_1arm`` ... ``table_4arm`` (:data:`CELL_SUITES`: suite name -> cell).
 
 Seeds are fixed per instance (:func:`suite_members`), so a suite regenerates identically. The
 shipped copies live in ``domains/dual_arm_rearrangement/suites/<suite>/``.
@@ -22,9 +30,14 @@ from sdar_tamp.world.errors import SuiteError
 from sdar_tamp.world.generators import Acceptance, GeneratorOptions, generate_instance
 from sdar_tamp.world.instance import Instance, load_instance, save_instance
 
-SUITES = ("paper", "stress", "dense")
+SUITES = ("paper", "stress", "dense", "families")
 _FAMILY_SEED = {"R": 1000, "S": 2000, "D": 3000, "M": 4000, "N": 5000}
 STRESS_GAP = 0.01  # [m]
+#: The shipped ``families`` suites: suite name -> the shipped cell they were generated in.
+CELL_SUITES = {f"table_{k}arm": f"ur5e_table_{k}arm" for k in (1, 2, 3, 4)}
+#: Object counts and instances per family and count of the ``families`` suite.
+FAMILY_SIZES = (12, 16, 20, 24)
+FAMILY_COPIES = 2
 
 
 @dataclass(frozen=True)
@@ -61,7 +74,15 @@ def suite_members(suite: str) -> tuple[SuiteMember, ...]:
         return tuple(members)
     if suite == "dense":
         return tuple(SuiteMember(f"N{n}", "N", n, _FAMILY_SEED["N"] + n) for n in (16, 20, 24))
-    raise SuiteError(f"unknown suite {suite!r}; expected one of {list(SUITES)}")
+    if suite == "families" or suite in CELL_SUITES:
+        return tuple(
+            SuiteMember(f"{f}{n}-{j}", f, n, _FAMILY_SEED[f] + 300 + 10 * n + j)
+            for f in "MRDS"
+            for n in FAMILY_SIZES
+            for j in range(1, FAMILY_COPIES + 1)
+        )
+    known = [*SUITES, *CELL_SUITES]
+    raise SuiteError(f"unknown suite {suite!r}; expected one of {known}")
 
 
 def build_suite(
@@ -107,6 +128,11 @@ def shipped_suite_dir(suite: str) -> Path:
 
 def load_suite(suite: str, directory: Path | None = None) -> tuple[Instance, ...]:
     """Load a suite: from ``directory`` if given, else the shipped copy, in suite order."""
+    if directory is None and suite == "families":
+        raise SuiteError(
+            "suite 'families' is made for a given cell and has no shipped copy of its own; "
+            f"the shipped ones are {list(CELL_SUITES)} (or pass the folder it was written to)"
+        )
     folder = Path(directory) if directory is not None else shipped_suite_dir(suite)
     members = suite_members(suite)
     missing = [m.name for m in members if not (folder / f"{m.name}.yaml").is_file()]

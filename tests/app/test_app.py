@@ -344,6 +344,11 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(
     assert replays == [outcome.plan]  # the plan kept is replayed once
     assert outcome.figures.schedule_time > 0.0
     metrics = outcome.plan.metrics
+    assert outcome.bound is not None and outcome.bound.arms == 2
+    assert 0.0 < outcome.bound.seconds < float(metrics.execution_time)  # async or not
+    ratio = float(metrics.execution_time) / outcome.bound.seconds
+    assert outcome.execution_over_bound == pytest.approx(ratio)
+    assert f"bound {outcome.bound.seconds:.1f} s ({ratio:.2f}x)" in format_summary(outcome)
     if metrics.execution == "async":
         assert float(metrics.execution_time) < float(metrics.execution_time_sync)
         assert "asynchronous (synchronous" in format_summary(outcome)

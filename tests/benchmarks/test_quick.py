@@ -33,9 +33,11 @@ HANG_GUARD = 900.0  # [s]
 #: Runs besides ``--quick`` alone (their arguments after ``--quick``): other modes kept alive
 #: bench_sdar in a cell named on the command line (the shipped one, as a file)
 IN_CELL = ("--scene", str(ROOT / "domains/dual_arm_rearrangement/cells/ur5e_facing.yaml"))
+#: bench_sdar's bounds alone, on a 24-object instance of the 4-arm table's suite
+BOUNDS = ("--bound-only", "--suite", "table_4arm", "--only", "S24-1")
 EXTRA_RUNS: dict[str, tuple[tuple[str, ...], ...]] = {
     "bench_motion": (("--hard", "1"),),
-    "bench_sdar": (IN_CELL,),
+    "bench_sdar": (IN_CELL, BOUNDS),
 }
 #: The runs that may skip: what they need is not in the repository
 MAY_SKIP = {("bench_pddlstream_compat", ()), ("bench_motion", ("--hard", "1"))}
@@ -94,6 +96,15 @@ def _pddlstream(out: Summary) -> None:
 
 def _sdar(out: Summary) -> None:
     assert out["instances"] == 1 and out["success"] == 1 and out["steps"] > 0
+    r4 = out["per_instance"]["R4"]
+    assert 0.0 < r4["bound"] < r4["execution_time"] == out["execution_time_median"]
+    assert out["execution_over_bound_median"] == r4["execution_over_bound"] > 1.0
+
+
+def _bounds(out: Summary) -> None:
+    assert out["benchmark"] == "sdar-bound" and out["instances"] == 1
+    s24 = out["per_instance"]["S24-1"]
+    assert s24["arms"] == 4 and s24["bound"] == max(s24["sum_over_arms"], s24["longest_object"])
 
 
 def _sdar_in_cell(out: Summary) -> None:
@@ -135,6 +146,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_pddlstream_compat", ()): _pddlstream,
     ("bench_sdar", ()): _sdar,
     ("bench_sdar", IN_CELL): _sdar_in_cell,
+    ("bench_sdar", BOUNDS): _bounds,
     ("bench_solve", ()): _solve,
     ("bench_spheres", ()): _spheres,
     ("bench_streams", ()): _streams,

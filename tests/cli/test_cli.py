@@ -69,6 +69,11 @@ def test_solve_writes_a_plan_that_validates(
     assert (record["instance"], record["status"], record["valid"]) == ("R4", "solved", True)
     assert record["plan_file"] == str(plan) and record["metrics"]["actions"] >= 4
     assert record["figures"]["planning_time"] > 0 and record["violation"] is None
+    bound, execution = record["bound"], record["metrics"]["execution_time"]
+    assert bound["arms"] == 2 and bound["objects"] == 4 and bound["proven"]
+    assert 0.0 < bound["seconds"] < execution
+    assert bound["seconds"] == max(bound["sum_over_arms"], bound["longest_object"])
+    assert bound["execution_over_bound"] == pytest.approx(execution / bound["seconds"])
     assert main(["validate", str(instance), str(plan)]) == 0
     data = json.loads(plan.read_text())
     assert data["format"] == "sdar-plan" and data["metrics"]["task_planner"] == "sdar"
@@ -80,7 +85,8 @@ def test_solve_reports_failure_with_exit_status_1(
 ) -> None:
     instance = domain_file("dual_arm_rearrangement", "suites/paper/M2.yaml")
     assert main(["solve", str(instance), "-q", "--time-limit", "0.01"]) == 1
-    assert "M2: timeout" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "M2: timeout" in out and "execution-time bound " in out
 
 
 def test_solve_rejects_a_bad_time_limit(capsys: pytest.CaptureFixture[str]) -> None:

@@ -90,17 +90,20 @@ def test_sdar_cells_reach_checks_every_arm(
 ) -> None:
     assert main(["cells", str(default_scene_path()), "--reach", "0.25"]) == 0
     assert "every arm grasps all 12 workspace points" in capsys.readouterr().out
-    far = _cell_copy(tmp_path, "workspace: {x: [-0.25, 0.25], y: [-0.30, 0.70]}")
+    far = _cell_copy(tmp_path, "workspace: {x: [-0.25, 0.25], y: [-0.30, 1.20]}")
     line = (
         far.read_text(encoding="utf-8")
         .splitlines()
-        .index("workspace: {x: [-0.25, 0.25], y: [-0.30, 0.70]}")
+        .index("workspace: {x: [-0.25, 0.25], y: [-0.30, 1.20]}")
         + 1
     )
     assert main(["cells", str(far), "--reach", "0.25"]) == 2
     err = capsys.readouterr().err
-    assert f"cell.yaml:{line}:12: workspace: arm 'left' does not grasp (" in err
+    assert f"cell.yaml:{line}:12: workspace: no arm grasps (" in err
     assert ") m top-down at every yaw within its limits" in err
+    assert main(["cells", str(far), "--reach", "0.25", "--every-arm"]) == 2
+    err = capsys.readouterr().err
+    assert f"cell.yaml:{line}:12: workspace: arm 'left' does not grasp (" in err
     assert main(["cells", str(default_scene_path()), "--reach", "0"]) == 2
     assert "--reach: expected a grid step > 0 [m], got 0.0" in capsys.readouterr().err
 

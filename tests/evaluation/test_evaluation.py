@@ -200,6 +200,10 @@ def test_bench_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
         assert r["success"] == "1" and r["valid"] == "1" and r["status"] == "solved"
         assert int(r["actions"]) >= 4 and float(r["execution_time_s"]) > 0
         assert r["abstract_actions"] == "4"
+        execution, bound = float(r["execution_time_s"]), float(r["bound_s"])
+        assert 0.0 < bound < execution  # the same bound for both combinations
+        assert float(r["execution_over_bound"]) == pytest.approx(execution / bound, rel=1e-5)
+    assert len({r["bound_s"] for r in rows}) == 1
     steps = load_steps(tmp_path)
     assert {s["combination"] for s in steps} == {"sdar", "sdar-t+plain"}
     assert len(steps) == sum(int(r["steps"]) for r in rows)
