@@ -85,6 +85,14 @@ def test_the_shipped_scene_validates(tmp_path: Path) -> None:
     assert load_scene(tmp_path / "scene.yaml").arm_names == ("left", "right")
 
 
+def test_every_shipped_cell_validates() -> None:
+    cells = sorted(SCENE.parent.glob("*.yaml"))
+    assert {path.name for path in cells} >= {f"ur5e_table_{k}arm.yaml" for k in (1, 2, 3, 4)}
+    for path in cells:
+        document = yaml.safe_load(path.read_text(encoding="utf-8"))
+        assert _errors("scene", document) == [], path
+
+
 def test_a_plan_file_validates(plan_document: dict[str, Any]) -> None:
     assert _errors("plan", plan_document) == []
     assert plan_from_dict(plan_document).instance == "P1"
