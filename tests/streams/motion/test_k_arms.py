@@ -30,7 +30,7 @@ from streams.motion.planner import MotionPlanner
 from streams.motion.records import MotionRequest, MotionResult, MotionTally, TransferProblem
 from streams.motion.slots import select_pairs
 from streams.motion.sphere_pairs import HeldSpheres, arm_pairs, path_spheres
-from streams.motion.strategies import SequentialStrategy
+from streams.motion.strategies import SequentialStrategy, UntangleStrategy
 from streams.motion.transfers import Transfers
 from streams.motion.waypoints import straight_line
 
@@ -250,6 +250,42 @@ def test_sequential_moves_the_deepest_arm_home_first(
         np.testing.assert_allclose(a[-1], b[0])
 
 
+class _RefusingFirstStages(Transfers):
+    """Transfers that record the first stage of every untangling attempt and refuse it."""
+
+    def __init__(self, planner: MotionPlanner) -> None:
+        super().__init__(planner.ctx, planner.build, planner.margin_world, MotionTally())
+        self.tried: list[np.ndarray] = []
+
+    def optimise_or_lift(
+        self, problem: TransferProblem, q_a: np.ndarray, q_b: np.ndarray,
+        fixed: tuple[bool, ...] = (),
+    ) -> np.ndarray | None:  # fmt: skip
+        self.tried.append(q_b)
+        return None
+
+
+def test_untangle_tries_the_deepest_arm_first(
+    cells: dict[int, WorldContext], k_optimisers: OptimiserCache
+) -> None:
+    ctx = cells[3]
+    planner = MotionPlanner(ctx, optimisers=k_optimisers)
+    transfers = _RefusingFirstStages(planner)
+    q_from = ctx.scene.home.copy()
+    q_from[ctx.layout.slice("west")] += np.array([0.0, 0.5, -0.6, 0.0, 0.0, 0.0])  # reach out
+    q_to = ctx.scene.home + 0.05
+    problem = TransferProblem(q_from, q_to, tuple(HeldSpheres.empty() for _ in range(3)),
+                              NO_OBSTACLES)  # fmt: skip
+    assert UntangleStrategy()(transfers, problem) is None
+    depth = transfers.depth(q_from)
+    order = [ctx.arm_names[int(i)] for i in np.argsort(-depth)]
+    assert order[0] == "west"
+    parked = [next(a for a in ctx.arm_names if not np.allclose(ctx.layout.part(q, a),
+                                                               ctx.layout.part(q_to, a)))
+              for q in transfers.tried]  # fmt: skip
+    assert parked == order  # one attempt per arm, deepest first
+
+
 def test_others(ctx: WorldContext, cells: dict[int, WorldContext]) -> None:
     assert ctx.others("left") == ("right",)
     assert cells[4].others("north") == ("south", "west", "east")
@@ -354,3 +390,23 @@ def test_benchmark_refuses_more_arms_than_the_cell_has(
     with pytest.raises(SystemExit):
         bench.main(["--arms", "2,5", "--calls", "1"])
     assert "--arms: expected counts in 1..4 (the cell's arms), got [5]" in capsys.readouterr().err
+
+
+def test_the_exact_check_sees_every_pair_of_arms(cells: dict[int, WorldContext]) -> None:
+    """Two arms meeting at the table centre collide whichever two of the four they are."""
+    ctx = cells[4]
+    world = ctx.new_world()
+    reach: dict[str, np.ndarray] = {}
+    for arm in ctx.arm_names:
+        T = ctx.kinematics[arm].fk_tcp(ctx.home(arm))
+        T[:3, 3] = (0.0, 0.0, 0.15)
+        q = tool_pose_ik(ctx.kinematics[arm], T, ctx.home(arm))
+        assert q is not None, arm
+        reach[arm] = q
+    for a, b in itertools.combinations(ctx.arm_names, 2):
+        q = ctx.layout.join({**{x: ctx.home(x) for x in ctx.arm_names}, a: reach[a]})
+        assert not world.in_collision(q)  # one arm alone at the centre
+        q = ctx.layout.replace(q, b, reach[b])
+        owners = {{p.first.split("_")[0], p.second.split("_")[0]} == {a, b}
+                  for p in world.report(q)}  # fmt: skip
+        assert world.in_collision(q) and True in owners, (a, b)
