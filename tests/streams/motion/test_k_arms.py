@@ -15,8 +15,11 @@ import pytest
 
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.errors import ArmLayoutError
+from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
+from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.transforms import inverse, pose_xyz_yaw
 from streams.context import WorldContext
+from streams.feasibility import prove_infeasible
 from streams.grasps import sample_grasps
 from streams.ik import IKCandidate, IKRequest, solve_ik_candidates
 from streams.motion.cartesian import tool_pose_ik
@@ -410,3 +413,26 @@ def test_the_exact_check_sees_every_pair_of_arms(cells: dict[int, WorldContext])
         owners = {{p.first.split("_")[0], p.second.split("_")[0]} == {a, b}
                   for p in world.report(q)}  # fmt: skip
         assert world.in_collision(q) and True in owners, (a, b)
+
+
+def test_feasibility_proofs_with_one_and_three_arms(cells: dict[int, WorldContext]) -> None:
+    """An object beyond the one arm's reach is proven stuck in the one-arm cell and not in the
+    three-arm cell (the north arm reaches it); a trio boxed in is stuck with any arm count."""
+    ws = Workspace((-0.30, 0.30), (-0.25, 0.25))
+
+    def instance(starts: list[Pose2D], goals: list[Pose2D]) -> Instance:
+        pairs = enumerate(zip(starts, goals, strict=True))
+        return Instance("k", ws, tuple(ObjectSpec(f"o{i}", SIZE, s, g) for i, (s, g) in pairs))
+
+    far = instance([Pose2D(0.0, 0.35, 0.0)], [Pose2D(0.0, -0.1, 0.0)])
+    proof = prove_infeasible(cells[1], far)
+    assert proof is not None and proof.phase == "start"
+    assert proof.lines()[1] == "o0: no grasp within reach of any arm"
+    assert prove_infeasible(cells[3], far) is None
+    trio = [Pose2D(0.0, -0.045, 0.0), Pose2D(0.0, 0.0, 0.0), Pose2D(0.0, 0.045, 0.0)]
+    spread = [Pose2D(-0.15, -0.15, 0.0), Pose2D(0.0, -0.15, 0.0), Pose2D(0.15, -0.15, 0.0)]
+    for k in (1, 3):
+        boxed = prove_infeasible(cells[k], instance(trio, spread))
+        assert boxed is not None and set(boxed.objects) == {"o0", "o1", "o2"}
+        assert prove_infeasible(cells[k], instance(spread, trio[::-1])) is not None
+        assert prove_infeasible(cells[k], instance(spread, spread[::-1])) is None
