@@ -20,6 +20,7 @@ from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.transforms import inverse, pose_xyz_yaw
 from streams.context import WorldContext
 from streams.feasibility import prove_infeasible
+from streams.finger_blocking import cell_gripper_boxes
 from streams.grasps import sample_grasps
 from streams.ik import IKCandidate, IKRequest, solve_ik_candidates
 from streams.motion.cartesian import tool_pose_ik
@@ -471,3 +472,15 @@ def test_waiting_arms_are_obstacles_of_the_moving_one(
     # two arms are always optimised together (the two-arm planner)
     two = planner.transfers()
     assert two.subsets is not None and not two._by_subset(q_a[:12], q_b[:12], (0,))
+
+
+def test_grasp_blocking_boxes_of_arms_of_one_description(
+    ctx: WorldContext, cells: dict[int, WorldContext]
+) -> None:
+    """Arms of one description and gripper count once, however many the cell has."""
+    shipped = cell_gripper_boxes(ctx.scene)
+    for k in (1, 3, 4):
+        boxes = cell_gripper_boxes(cells[k].scene)
+        assert len(boxes) == len(shipped) > 0
+        for a, b in zip(boxes, shipped, strict=True):
+            np.testing.assert_allclose(a.T_tcp_box, b.T_tcp_box)
