@@ -1,6 +1,7 @@
 """The building blocks of a transfer that the strategies share: one optimised transfer (after
 the straight or lightly bent direct path where that is clear), the warm starts (a lifted
-via-point, a curve's knots), and the untangling geometry (park pose, reach depth).
+via-point, a curve's knots), and the untangling geometry (park pose, reach depth), for arms
+placed anywhere around the table (each by its base pose and the direction it faces).
 
 A :class:`Transfers` serves one motion call: the planner makes it with that call's
 :class:`~streams.motion.records.MotionTally`, and every optimisation, direct path and
@@ -22,6 +23,7 @@ from streams.motion.optimiser import TrajectoryOptimiser
 from streams.motion.optimiser_build import OptimiserBuild
 from streams.motion.optimiser_records import TransferQuery
 from streams.motion.records import MotionTally, TransferProblem, flag
+from streams.motion.subsets import MIN_ARMS, SubsetOptimisers, joint_columns, waiting_spheres
 from streams.motion.timing import spline_curve, time_parameterize
 from streams.motion.waypoints import straight_line
 
@@ -37,6 +39,8 @@ DIRECT_VIA_SPREAD = 1.0
 #: on the ``paper`` suite execution 805.0 -> 794.3 s in all (no instance longer), the same
 #: actions; on the hard transfers of ``bench_motion.py --hard`` one arm 1.73 -> 1.40 s.
 REFINE_BENT = True
+#: Distance [m] of an untangling park pose's TCP in front of its arm's base.
+PARK_REACH = 0.40
 
 
 class Transfers:
@@ -48,7 +52,10 @@ class Transfers:
     paths tried after the straight line (empty: the straight line only); ``direct=False``
     always optimises (the sphere model's own straight-line test still applies);
     ``refine_bent``: a bent path is handed to the optimiser as its warm start and the result
-    kept when it executes faster and passes the same check."""
+    kept when it executes faster and passes the same check. ``subsets``: with
+    :data:`~streams.motion.subsets.MIN_ARMS` arms or more, a transfer in which some arms wait
+    is optimised over the moving arms alone (:mod:`streams.motion.subsets`); None: always over
+    every arm."""
 
     def __init__(
         self,
@@ -60,8 +67,10 @@ class Transfers:
         direct: bool = True,
         direct_lifts: Sequence[float] = DIRECT_LIFTS,
         refine_bent: bool = REFINE_BENT,
+        subsets: SubsetOptimisers | None = None,
     ) -> None:
         self.ctx = ctx
+        self.subsets = subsets
         self.build = build
         self.margin_world = margin_world
         self.tally = tally
@@ -109,6 +118,9 @@ class Transfers:
             if direct is not None:
                 self.tally.direct_paths += 1
                 return self.refine_direct(problem, direct, fixed)
+        moving = tuple(i for i, waits in enumerate(fixed) if not waits)
+        if self._by_subset(q_a, q_b, moving):
+            return self._optimise_moving(problem, q_a, q_b, warm_start, moving)
         query = TransferQuery(
             q_a, q_b, problem.held, problem.obstacles, self.nominal_duration(q_a, q_b), fixed
         )
@@ -116,6 +128,46 @@ class Transfers:
         self.tally.optimisation_time += result.solve_time
         self.tally.ipopt_solves += int(result.rounds > 0)
         return result.path if result.success else None
+
+    def _by_subset(self, q_a: FloatArray, q_b: FloatArray, moving: tuple[int, ...]) -> bool:
+        """Whether the transfer is optimised over the ``moving`` arms alone: a cell of
+        :data:`~streams.motion.subsets.MIN_ARMS` arms or more, some arms waiting, and those
+        at the same joints at both ends."""
+        n = len(self.ctx.layout)
+        if self.subsets is None or n < MIN_ARMS or not 0 < len(moving) < n:
+            return False
+        waiting = [sl for i, sl in enumerate(self.ctx.layout.slices) if i not in moving]
+        return all(np.allclose(q_a[sl], q_b[sl]) for sl in waiting)
+
+    def _optimise_moving(
+        self,
+        problem: TransferProblem,
+        q_a: FloatArray,
+        q_b: FloatArray,
+        warm_start: FloatArray | None,
+        moving: tuple[int, ...],
+    ) -> FloatArray | None:
+        """The optimised transfer of the ``moving`` arms among the waiting ones (their spheres
+        as obstacles), every arm's joints in the path ``(K, dof)``."""
+        assert self.subsets is not None
+        _, build = self.subsets.get(moving)
+        cols = joint_columns(self.ctx, moving)
+        waiting = tuple(i for i in range(len(self.ctx.layout)) if i not in moving)
+        wc, wr = waiting_spheres(self.ctx, q_a, problem.held, waiting)
+        oc, orad = problem.obstacles
+        query = TransferQuery(
+            q_a[cols], q_b[cols], tuple(problem.held[i] for i in moving),
+            (np.concatenate([oc, wc]), np.concatenate([orad, wr])),
+            self.nominal_duration(q_a, q_b),
+        )  # fmt: skip
+        result = build.get().solve(query, None if warm_start is None else warm_start[:, cols])
+        self.tally.optimisation_time += result.solve_time
+        self.tally.ipopt_solves += int(result.rounds > 0)
+        if not result.success:
+            return None
+        path = np.tile(np.asarray(q_a, dtype=np.float64), (len(result.path), 1))
+        path[:, cols] = result.path
+        return path
 
     def refine_direct(
         self, problem: TransferProblem, direct: FloatArray, fixed: tuple[bool, ...] = ()
@@ -212,23 +264,42 @@ class Transfers:
         )
 
     def park(self, arm: str, q_goal_arm: FloatArray, height: float = 0.30) -> FloatArray | None:
-        """The untangling park pose of ``arm``: TCP above its own half of the table at the
-        goal's ``y``, ``height`` [m] up, with the goal's orientation."""
+        """The untangling park pose of ``arm``: its TCP :data:`PARK_REACH` [m] in front of its
+        base along the direction it faces (on its own side of the table), across that
+        direction at its goal's offset from the base (the point clipped to the workspace),
+        ``height`` [m] up, with the goal's orientation; the IK branch nearest the goal's
+        joints. For two arms facing each other across x this is ``x = base_x +- 0.40``,
+        ``y`` the goal's (clipped)."""
         kin = self.ctx.kinematics[arm]
-        spec = self.ctx.scene.arm(arm)
         T = kin.fk_tcp(q_goal_arm)
+        base, facing = self._base_xy(arm), self._facing(arm)
+        across = np.array([-facing[1], facing[0]])
+        offset = float((T[:2, 3] - base) @ across)
+        xy = base + PARK_REACH * facing + offset * across
         ws = self.ctx.scene.workspace
-        base_x = spec.base_xyz[0]
-        T[0, 3] = base_x + np.sign(-base_x) * 0.40
-        T[1, 3] = float(np.clip(T[1, 3], *ws.y))
+        T[0, 3] = float(np.clip(xy[0], *ws.x))
+        T[1, 3] = float(np.clip(xy[1], *ws.y))
         T[2, 3] = height
         return tool_pose_ik(kin, T, q_goal_arm)
 
     def depth(self, q: FloatArray) -> FloatArray:
-        """``(arms,)``: how far [m] each arm's TCP reaches past the table centre line, away
-        from its own base."""
+        """``(arms,)``: how far [m] each arm's TCP reaches past the table centre, along the
+        direction its base faces (away from its own base; for two arms facing each other
+        across x: past the centre line ``x = 0`` into the other arm's half)."""
         out = np.zeros(len(self.ctx.layout))
         for i, arm in enumerate(self.ctx.arm_names):
             p = self.ctx.kinematics[arm].fk_tcp(self.ctx.layout.part(q, arm))[:3, 3]
-            out[i] = p[0] * np.sign(-self.ctx.scene.arm(arm).base_xyz[0])
+            out[i] = float(p[:2] @ self._facing(arm))
+        return out
+
+    def _base_xy(self, arm: str) -> FloatArray:
+        return np.array(self.ctx.scene.arm(arm).base_xyz[:2], dtype=np.float64)
+
+    def _facing(self, arm: str) -> FloatArray:
+        """The unit direction ``(2,)`` the base of ``arm`` faces on the table (its x axis,
+        by its yaw), rounded to the axes where it is within 1e-9 of one."""
+        yaw = self.ctx.scene.arm(arm).base_yaw
+        f = np.array([np.cos(yaw), np.sin(yaw)])
+        f[np.abs(f) < 1e-9] = 0.0
+        out: FloatArray = f / np.linalg.norm(f)
         return out
