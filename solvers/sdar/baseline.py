@@ -30,9 +30,9 @@ from solvers.sdar.tasks import Move, Step, TaskView, step_is_valid
 
 __all__ = [
     "BaselineTaskPlanner",
+    "group_consecutive",
     "minimum_feedback_vertex_set",
     "optimal_single_arm_plan",
-    "group_consecutive",
     "pair_consecutive",
 ]
 

@@ -47,9 +47,7 @@ class TaskScene:
         (members in object order)."""
         rest = [x for x in self.names if x not in lifted]
         index = {x: k for k, x in enumerate(rest)}
-        edges = tuple(
-            (index[x], index[y]) for x in rest for y in self.blockers[x] if y in index
-        )
+        edges = tuple((index[x], index[y]) for x in rest for y in self.blockers[x] if y in index)
         comps = strongly_connected_components(len(rest), edges)
         return [tuple(sorted((rest[k] for k in c), key=self.order.__getitem__)) for c in comps]
 
@@ -89,15 +87,16 @@ def extend(scene: TaskScene, step: Step, arms: int) -> Step:
         ]
         if not fits:
             break
-
-        def worth(u: tuple[str, ...]) -> tuple[int, int, int, int]:
-            freed, removed = scene.frees(lifted | frozenset(u))
-            return (-freed, -removed, -len(u), scene.order[u[0]])
-
-        best = min(fits, key=worth)
+        best = min(fits, key=lambda u, now=lifted: _worth(scene, now, u))
         added.extend(best)
         lifted = lifted | frozenset(best)
         units.remove(best)
     if not added:
         return step
     return Step((*step.moves, *(Move(x) for x in added)), step.kind, step.rank, step.tie)
+
+
+def _worth(scene: TaskScene, lifted: frozenset[str], unit: tuple[str, ...]) -> tuple[int, ...]:
+    """Order of the units that fit a step: more freed, more edges removed, larger, first."""
+    freed, removed = scene.frees(lifted | frozenset(unit))
+    return (-freed, -removed, -len(unit), scene.order[unit[0]])

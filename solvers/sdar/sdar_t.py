@@ -53,8 +53,9 @@ buffer), 7 (another object of a cycle to a buffer), 8 and 9 as above; a first-ca
 takes ``n + |minimum FVS|`` actions, the single-arm optimum. With ``k > 2`` arms the buffer sets
 leave components of up to ``k`` objects (:mod:`solvers.sdar.buffer_sets`, ``arms=k``), and the
 candidates are bounded so (:mod:`solvers.sdar.k_steps`): the first ``max_candidates`` two-move
-steps of the ranked list and its one-move steps (class 6 included) are each extended greedily with goal moves of
-units whose goals are free once the step's objects are lifted, up to ``k`` moves; the extended
+steps of the ranked list and its one-move steps (class 6 included) are each extended greedily
+with goal moves of units whose goals are free once the step's objects are lifted, up to ``k``
+moves; the extended
 step and its base are both kept (the base is the fallback when the larger step cannot be
 grounded); closed components of ``3..k`` objects are proposed as ``rotate`` steps of class 1 (an
 ``m``-cycle rotated by ``m`` arms without a buffer; a component of ``3..k`` objects can still be
