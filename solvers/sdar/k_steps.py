@@ -87,7 +87,8 @@ def extend(scene: TaskScene, step: Step, arms: int) -> Step:
         ]
         if not fits:
             break
-        best = min(fits, key=lambda u, now=lifted: _worth(scene, now, u))
+        worth = {u: _worth(scene, lifted, u) for u in fits}
+        best = min(fits, key=worth.__getitem__)
         added.extend(best)
         lifted = lifted | frozenset(best)
         units.remove(best)
