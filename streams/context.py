@@ -44,10 +44,14 @@ class WorldContext:
     def arm_names(self) -> tuple[str, ...]:
         return self.layout.names
 
-    def other(self, arm: str) -> str:
-        """The other arm of a two-arm world."""
+    def others(self, arm: str) -> tuple[str, ...]:
+        """Every arm but ``arm``, in layout order (none in a one-arm world)."""
         self.layout.index(arm)  # an arm of the layout
-        others = [a for a in self.layout if a != arm]
+        return tuple(a for a in self.layout if a != arm)
+
+    def other(self, arm: str) -> str:
+        """The other arm of a two-arm world (:meth:`others` for any number of arms)."""
+        others = self.others(arm)
         if len(others) != 1:
             raise ParameterError(f"other: defined for two arms, the scene has {len(self.layout)}")
         return others[0]
@@ -57,8 +61,8 @@ class WorldContext:
 
     def new_world(self, margin: float = -1e-3, arm_margin: float = 0.0) -> CollisionWorld:
         """A fresh collision world (mutable: each stream keeps its own). Resting and held
-        objects are grown by ``margin`` [m] per face (the default shrinks them 1 mm); the two
-        arms' shapes must keep ``arm_margin`` [m] apart."""
+        objects are grown by ``margin`` [m] per face (the default shrinks them 1 mm); the
+        shapes of any two arms must keep ``arm_margin`` [m] apart."""
         return CollisionWorld(self.scene, tolerance=-margin, arm_margin=arm_margin)
 
     def split(self, q: FloatArray) -> dict[str, FloatArray]:

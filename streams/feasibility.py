@@ -3,8 +3,10 @@
 Picking an object needs a grasp of the grasp set whose configuration, and the pre-grasp
 backed off along the approach, puts the arm clear of the table, of itself and of every other
 resting object, within the joint limits (the gripper may touch the object it grasps; the other
-arm is left out, so nothing it could do makes an object pickable). Releasing an object at its
-goal and retreating needs the same of its goal pose.
+arms, however many the cell has, are left out, so nothing they could do makes an object
+pickable). Each arm of the cell is tried for every grasp: an object is pickable when any arm
+has such a grasp. Releasing an object at its goal and retreating needs the same of its goal
+pose.
 
 *First picks.* With every object at its start, repeatedly take away every object that has
 such a grasp; taking objects away only frees grasps. Call the rest ``S``. In a plan, the first
@@ -151,7 +153,8 @@ class _Checker:
         self.world.set_objects({n: self.boxes[n] for n in names})
 
     def hits(self, obj: str, c: _Candidate, q: FloatArray) -> set[str]:
-        """What the arm hits at ``q`` (object names, ``table``, ``self``); empty when clear."""
+        """What the arm hits at ``q`` (object names, ``table``, ``self``); empty when clear
+        (the other arms wait at home; what they touch is not counted)."""
         full = self.ctx.layout.join({**self.home, c.arm: q})
         if not self.world.in_collision(full):
             return set()
@@ -160,7 +163,7 @@ class _Checker:
         for p in self.world.report():
             a, b = (p.first, p.second) if p.first.startswith(arm_prefix) else (p.second, p.first)
             if not a.startswith(arm_prefix):
-                continue  # pairs of the other arm: left out
+                continue  # pairs of the other arms only: left out
             if b.startswith(arm_prefix):
                 found.add("self")
             elif b == "table":

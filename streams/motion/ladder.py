@@ -1,10 +1,11 @@
-"""SDAR-M synchronous dual-arm motion with fallbacks (the paper's Alg. 2): the ladder.
+"""SDAR-M synchronous motion of k arms with fallbacks (the paper's Alg. 2): the ladder.
 
-A synchronous segment takes the arms from ``q_start`` to ``q_goal`` (``(dof,)`` [rad]) with
-the held objects fixed for the whole segment (gripper actions happen between segments):
+A synchronous segment takes the arms (one to any number, placed anywhere around the table)
+from ``q_start`` to ``q_goal`` (``(dof,)`` [rad]) with the held objects fixed for the whole
+segment (gripper actions happen between segments):
 
 1. retreat: arms flagged ``retreat`` first move their tool straight back along the tool axis
-   (IK interpolation), both arms at once, by a lift [m] chosen per grasp from the clearance
+   (IK interpolation), every such arm at once, by a lift [m] chosen per grasp from the clearance
    of its neighbours (:func:`streams.motion.shape.clearance_lift`; or the request's fixed
    ``lift``), see :mod:`streams.motion.phases`;
 2. transfer: between the two lifted (pre-grasp) configurations, produced by a *strategy*
@@ -24,8 +25,12 @@ passes is returned as a success. Strategies are tried in order until one passes:
 ``plan_dual_motion(..., fallbacks=False)`` is the paper's "plain" planner (no fallbacks);
 ``sequential_only=True`` is the baseline motion planner
 (:class:`~streams.motion.strategies.OneArmStrategy`: the arms move one after the other;
-SDAR-M then also keeps the idle arm at home, so that one arm works while the other waits at
-its retract pose).
+SDAR-M then also keeps the idle arms at home, so that one arm works while the others wait at
+their retract poses).
+
+The name says "dual" for history: a request of k arms (``q_start``/``q_goal`` over the scene's
+:class:`~sdar_tamp.world.layout.ArmLayout`, ``held`` per arm, ``retreat``/``approach`` per-arm
+tuples) is planned the same way, the optimiser keeping every pair of arms apart.
 """
 
 from __future__ import annotations

@@ -5,8 +5,11 @@ joints); ``q_0`` and ``q_{K-1}`` are parameters. Cost: squared second difference
 (smoothness) plus a small weight on squared first differences (length). Constraints at every
 interior knot: the sphere clearances of the slots (arm-arm, arm-obstacle and arm-table, see
 :mod:`streams.motion.slots`), then the per-step joint velocity and acceleration rows on the
-nominal time grid. A slot names one sphere of an arm by parameters (its joint frame, as a
-one-hot row, and its centre and radius in that frame), so the NLP is built once per
+nominal time grid. The arm-arm rows come in one block of ``arm_arm_slots`` rows per pair of
+arms (:func:`~streams.motion.sphere_pairs.arm_pairs`: ``k (k - 1) / 2`` blocks for ``k``
+arms, none for one arm), then one arm-obstacle block and one arm-table block per arm. A slot
+names one sphere of an arm by parameters (its joint frame, as a one-hot row, and its centre
+and radius in that frame), so the NLP is built once per
 :class:`~streams.motion.optimiser_records.TrajOptOptions` and each call chooses the pairs.
 
 The collision rows of one knot are one small CasADi function of that knot's joints and the
@@ -26,15 +29,26 @@ from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
 from streams.motion._casadi import ca, sx_sym
 from streams.motion.optimiser_records import TrajOptOptions
+from streams.motion.sphere_pairs import arm_pairs
 
 #: Joint frames of a UR arm a sphere may hang on (frame ``j`` carries link ``j + 1``; tool0 is
 #: the last); another arm has its own count (:attr:`streams.motion.fk_casadi.ArmFK.n_frames`).
 FRAMES = 6
 
 
-def slot_kinds(o: TrajOptOptions) -> tuple[tuple[str, int], ...]:
-    """Slot blocks per arm, in the order of the rows: arm-arm, arm-obstacle, arm-table."""
-    return (("aa", o.arm_arm_slots), ("ao", o.obstacle_slots), ("t", o.table_slots))
+def pair_kind(pair: int) -> str:
+    """The slot kind of the arm-arm block of pair ``pair`` (its index in
+    :func:`~streams.motion.sphere_pairs.arm_pairs`)."""
+    return f"aa{pair}"
+
+
+def slot_kinds(o: TrajOptOptions, arm: int = 0, arms: int = 2) -> tuple[tuple[str, int], ...]:
+    """Slot blocks of arm ``arm`` of ``arms``, in the order of its parameter blocks: the
+    arm-arm block of every pair it belongs to, then arm-obstacle, then arm-table."""
+    pairs = tuple(
+        (pair_kind(p), o.arm_arm_slots) for p, ij in enumerate(arm_pairs(arms)) if arm in ij
+    )
+    return (*pairs, ("ao", o.obstacle_slots), ("t", o.table_slots))
 
 
 class ParameterLayout:
@@ -61,15 +75,16 @@ def parameter_layout(
     arms: ArmLayout, o: TrajOptOptions, frames: tuple[int, ...] | None = None
 ) -> ParameterLayout:
     """The blocks of the NLP's parameter vector: the end knots, every arm's slots (frame,
-    centre, radius per kind; the obstacle spheres of its arm-obstacle slots) and the margin.
-    ``frames``: per arm, the frames its spheres may hang on (default :data:`FRAMES` each)."""
+    centre, radius per kind, :func:`slot_kinds`; the obstacle spheres of its arm-obstacle
+    slots) and the margin. ``frames``: per arm, the frames its spheres may hang on (default
+    :data:`FRAMES` each)."""
     dof = arms.dof
     per_arm = (FRAMES,) * len(arms) if frames is None else frames
     lay = ParameterLayout()
     lay.add("q0", 1, dof)
     lay.add("q1", 1, dof)
     for i in range(len(arms)):
-        for kind, slots in slot_kinds(o):
+        for kind, slots in slot_kinds(o, i, len(arms)):
             lay.add(f"{kind}_frame{i}", slots, per_arm[i])
             lay.add(f"{kind}_centre{i}", slots, 3)
             lay.add(f"{kind}_radius{i}", slots, 1)
@@ -109,13 +124,16 @@ def _slot_centres(lay: ParameterLayout, frames: list[Any], p: Any, kind: str, i:
 
 
 def _knot_rows(ctx: WorldContext, lay: ParameterLayout, q: Any, p: Any) -> Any:
-    """The collision rows of one knot ``q`` ``(dof,)``: arm-arm slots, then arm-obstacle
-    and arm-table slots per arm."""
+    """The collision rows of one knot ``q`` ``(dof,)``: the arm-arm slots of every pair of
+    arms, then arm-obstacle slots per arm, then arm-table slots per arm."""
     arms = ctx.layout
     m = lay.sym(p, "margin")
     frames = [ctx.fk[arm].frames(q[sl]) for arm, sl in zip(ctx.arm_names, arms.slices, strict=True)]
-    (cl, rl), (cr, rr) = (_slot_centres(lay, frames[i], p, "aa", i) for i in (0, 1))
-    g = [ca.sum2((cl - cr) ** 2) - (rl + rr + m) ** 2]
+    g: list[Any] = []
+    for pair, ij in enumerate(arm_pairs(len(arms))):
+        kind = pair_kind(pair)
+        (cl, rl), (cr, rr) = (_slot_centres(lay, frames[i], p, kind, i) for i in ij)
+        g.append(ca.sum2((cl - cr) ** 2) - (rl + rr + m) ** 2)
     for i in range(len(arms)):
         c, r = _slot_centres(lay, frames[i], p, "ao", i)
         obs = lay.sym(p, f"ao_obs{i}")

@@ -1,14 +1,15 @@
-"""Synchronous dual-arm trajectory optimisation (CasADi + IPOPT), built once per shape.
+"""Synchronous trajectory optimisation of k arms (CasADi + IPOPT), built once per shape.
 
 The NLP (:mod:`streams.motion.nlp`): the interior knots of a path over every arm, a
 smoothness and length cost, joint limits, per-step joint velocity
 ``|q_{k+1} - q_k| <= v_max dt`` and acceleration ``|q_{k+1} - 2 q_k + q_{k-1}| <= a_max dt^2``
 on the nominal time grid ``dt = T / (K - 1)`` (``T`` per call; the exact timing is
 :mod:`streams.motion.timing`'s job), and sphere clearances in *slots*: arm-arm (coarse
-spheres, held objects included, so the two held objects are checked against each other),
-arm-obstacle per arm, arm-table per arm. Each call chooses the pairs that matter
-(:mod:`streams.motion.slots`): the ones closest along the warm start, refreshed by an
-active-set round when the solution comes near a pair without a slot.
+spheres, held objects included, so two held objects are checked against each other; one
+block per pair of arms, none for one arm), arm-obstacle per arm, arm-table per arm. Each
+call chooses the pairs that matter (:mod:`streams.motion.slots`): the ones closest along the
+warm start, refreshed by an active-set round when the solution comes near a pair without a
+slot.
 
 The evenly spaced straight line is the unconstrained minimiser of the cost; when it satisfies
 every constraint (and no pair without a slot comes too close) it is returned without calling
@@ -28,7 +29,7 @@ from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
 from streams.motion import codegen
 from streams.motion._casadi import ca, to_array
-from streams.motion.nlp import build_nlp, slot_kinds
+from streams.motion.nlp import build_nlp, pair_kind, slot_kinds
 from streams.motion.optimiser_records import TrajOptOptions, TrajOptResult, TransferQuery
 from streams.motion.slots import (
     Selection,
@@ -37,7 +38,7 @@ from streams.motion.slots import (
     slot_lower_bounds,
     violations,
 )
-from streams.motion.sphere_pairs import path_spheres
+from streams.motion.sphere_pairs import arm_pairs, path_spheres
 from streams.motion.waypoints import densify, straight_line
 
 _log = get_logger(__name__)
@@ -188,11 +189,13 @@ class TrajectoryOptimiser:
         lay.put(p, "q0", query.q_start)
         lay.put(p, "q1", query.q_goal)
         lay.put(p, "margin", np.array([o.margin]))
-        for i in range(len(self._arms)):
+        n = len(self._arms)
+        for i in range(n):
             fine, coarse = self._spheres[i].with_held(query.held[i])
-            chosen = (("aa", coarse, s.aa[:, i]), ("ao", fine, s.ao[i][:, 0]),
-                      ("t", fine, s.table[i]))  # fmt: skip
-            for (kind, slots), (_, table, idx) in zip(slot_kinds(o), chosen, strict=True):
+            chosen = [(pair_kind(p), coarse, s.aa[p][:, ij.index(i)])
+                      for p, ij in enumerate(arm_pairs(n)) if i in ij]  # fmt: skip
+            chosen += [("ao", fine, s.ao[i][:, 0]), ("t", fine, s.table[i])]
+            for (kind, slots), (_, table, idx) in zip(slot_kinds(o, i, n), chosen, strict=True):
                 frame, centre, radius = table.slots(idx, slots)
                 lay.put(p, f"{kind}_frame{i}", frame)
                 lay.put(p, f"{kind}_centre{i}", centre)
@@ -203,7 +206,7 @@ class TrajectoryOptimiser:
             obs[: len(idx), 3] = query.obstacles[1][idx]
             lay.put(p, f"ao_obs{i}", obs)
         per_knot = np.concatenate(
-            [slot_lower_bounds(s.aa_lb, o.arm_arm_slots)]
+            [slot_lower_bounds(lb, o.arm_arm_slots) for lb in s.aa_lb]
             + [slot_lower_bounds(lb, o.obstacle_slots) for lb in s.ao_lb]
             + [slot_lower_bounds(lb, o.table_slots) for lb in s.table_lb]
         )

@@ -15,7 +15,7 @@ class TrajOptOptions:
 
     knots: int = 10
     held_slots: int = 4  # spheres per held object
-    arm_arm_slots: int = 24
+    arm_arm_slots: int = 24  # per pair of arms
     obstacle_slots: int = 12  # per arm
     table_slots: int = 6  # per arm
     margin: float = 0.015  # [m] clearance asked of the spheres

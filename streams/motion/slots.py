@@ -2,6 +2,9 @@
 the choice of the closest pairs along a warm start, and the pairs without a slot that a
 solution brings too close (the next active-set round's forced pairs).
 
+Arm-arm pairs are chosen per pair of arms (:func:`~streams.motion.sphere_pairs.arm_pairs`),
+each pair of arms with its own ``arm_arm_slots``; arm-obstacle and arm-table pairs per arm.
+
 Each slot constraint is ``|c_i - c_j|^2 - (r_i + r_j + margin)^2 >= lb`` (table:
 ``z - r - margin >= lb``) with ``lb = 0`` unless an end point itself is closer (the fixed
 end points may touch, e.g. a held object on the table at a place), then ``lb`` is that value.
@@ -21,6 +24,7 @@ from streams.motion.sphere_pairs import (
     HeldSpheres,
     PathSpheres,
     arm_arm_clearance,
+    arm_pairs,
     obstacle_clearance,
     table_clearance,
 )
@@ -94,28 +98,29 @@ def slot_lower_bounds(lb: FloatArray, slots: int) -> FloatArray:
 
 @dataclass(frozen=True)
 class Selection:
-    """Chosen pairs: ``aa`` ``(n, 2)`` sphere indices; ``ao[i]`` ``(n, 2)`` (arm sphere,
-    obstacle sphere); ``table[i]`` ``(n,)``; and each slot's constraint lower bound."""
+    """Chosen pairs: ``aa[p]`` ``(n, 2)`` sphere indices (of the first and second arm of
+    pair ``p`` of :func:`~streams.motion.sphere_pairs.arm_pairs`); ``ao[i]`` ``(n, 2)`` (arm
+    sphere, obstacle sphere); ``table[i]`` ``(n,)``; and each slot's constraint lower bound."""
 
-    aa: Any
+    aa: tuple[Any, ...]  # per pair of arms
     ao: tuple[Any, ...]  # per arm
     table: tuple[Any, ...]  # per arm
-    aa_lb: FloatArray
+    aa_lb: tuple[FloatArray, ...]  # per pair of arms
     ao_lb: tuple[FloatArray, ...]  # per arm
     table_lb: tuple[FloatArray, ...]  # per arm
 
 
 @dataclass(frozen=True)
 class Violators:
-    """Pairs without a slot that a solution brings too close, per kind (arm-arm; per arm
-    arm-obstacle and arm-table)."""
+    """Pairs without a slot that a solution brings too close, per kind (per pair of arms
+    arm-arm; per arm arm-obstacle and arm-table)."""
 
-    aa: set[tuple[int, int]]
+    aa: tuple[set[tuple[int, int]], ...]  # per pair of arms
     ao: tuple[set[tuple[int, int]], ...]  # per arm
     table: tuple[set[int], ...]  # per arm
 
     def any_left(self) -> bool:
-        return bool(self.aa or any(self.ao) or any(self.table))
+        return bool(any(self.aa) or any(self.ao) or any(self.table))
 
     def merged(self, other: Selection | None) -> Selection:
         def pairs(base: Any, extra: set[tuple[int, int]]) -> Any:
@@ -128,12 +133,14 @@ class Violators:
         empty2 = np.zeros((0, 2), dtype=np.int64)
         empty1 = np.zeros(0, dtype=np.int64)
         nolb = np.zeros(0)
-        aa = pairs(other.aa if other else empty2, self.aa)
+        aa = tuple(
+            pairs(other.aa[p] if other else empty2, extra) for p, extra in enumerate(self.aa)
+        )
         arms = range(len(self.ao))
         ao = tuple(pairs(other.ao[i] if other else empty2, self.ao[i]) for i in arms)
         tb = tuple(singles(other.table[i] if other else empty1, self.table[i]) for i in arms)
         nolbs = tuple(nolb for _ in arms)
-        return Selection(aa, ao, tb, nolb, nolbs, nolbs)
+        return Selection(aa, ao, tb, tuple(nolb for _ in aa), nolbs, nolbs)
 
 
 def _pick(clear: FloatArray, slots: int, limit: float, forced: Any) -> Any:
@@ -160,11 +167,14 @@ def select_pairs(
     """The pairs that get slots: per kind the closest along ``dense`` (the warm start's
     spheres) below ``select_distance``, ``forced`` ones first, each with its lower bound from
     the end points ``ends``."""
-    aa_c = arm_arm_clearance(dense).min(axis=0)
-    aa = _pick(aa_c, o.arm_arm_slots, o.select_distance, forced.aa if forced else None)
-    aa_end = arm_arm_clearance(ends)[:, aa[:, 0], aa[:, 1]]
-    rl, rr = ends.coarse_radii[0][aa[:, 0]], ends.coarse_radii[1][aa[:, 1]]
-    aa_lb = _lb_sq(aa_end, rl + rr, o.margin)
+    aa, aa_lb = [], []
+    for p, (i, j) in enumerate(arm_pairs(dense.arms)):
+        aa_c = arm_arm_clearance(dense, i, j).min(axis=0)
+        sel = _pick(aa_c, o.arm_arm_slots, o.select_distance, forced.aa[p] if forced else None)
+        aa_end = arm_arm_clearance(ends, i, j)[:, sel[:, 0], sel[:, 1]]
+        rl, rr = ends.coarse_radii[i][sel[:, 0]], ends.coarse_radii[j][sel[:, 1]]
+        aa.append(sel)
+        aa_lb.append(_lb_sq(aa_end, rl + rr, o.margin))
     ao, ao_lb, tb, tb_lb = [], [], [], []
     oc, orad = query.obstacles
     for i in range(len(query.held)):
@@ -184,7 +194,7 @@ def select_pairs(
         tend = table_clearance(ends, i)[:, tsel].min(axis=0)
         tb.append(tsel)
         tb_lb.append(np.minimum(0.0, tend - o.margin) - 1e-6)
-    return Selection(aa, tuple(ao), tuple(tb), aa_lb, tuple(ao_lb), tuple(tb_lb))
+    return Selection(tuple(aa), tuple(ao), tuple(tb), tuple(aa_lb), tuple(ao_lb), tuple(tb_lb))
 
 
 def _lb_sq(end_clearance: FloatArray, rsum: FloatArray, margin: float) -> FloatArray:
@@ -200,11 +210,14 @@ def violations(
     """Pairs without a slot that come closer than zero clearance on the dense path (and
     closer than at both end points). Pairs with a slot are the NLP's business."""
     tol = -1e-3
-    aa = arm_arm_clearance(dense).min(axis=0)
-    aa_end = arm_arm_clearance(ends).min(axis=0)
-    bad_aa = {(int(a), int(b)) for a, b in np.argwhere(aa < np.minimum(0.0, aa_end) + tol)}
-    bad_aa -= {(int(a), int(b)) for a, b in selection.aa}
-    worst = float(aa.min())
+    worst = float("inf")
+    bad_aa: list[set[tuple[int, int]]] = []
+    for p, (i, j) in enumerate(arm_pairs(dense.arms)):
+        aa = arm_arm_clearance(dense, i, j).min(axis=0)
+        aa_end = arm_arm_clearance(ends, i, j).min(axis=0)
+        bad = {(int(a), int(b)) for a, b in np.argwhere(aa < np.minimum(0.0, aa_end) + tol)}
+        bad_aa.append(bad - {(int(a), int(b)) for a, b in selection.aa[p]})
+        worst = min(worst, float(aa.min()))
     ao: list[set[tuple[int, int]]] = []
     tb: list[set[int]] = []
     oc, orad = query.obstacles
@@ -222,4 +235,4 @@ def violations(
         bad_t = {int(a) for a in np.flatnonzero(t < np.minimum(0.0, te) + tol)}
         tb.append(bad_t - {int(a) for a in selection.table[i]})
         worst = min(worst, float(t.min()))
-    return worst, Violators(bad_aa, tuple(ao), tuple(tb))
+    return worst, Violators(tuple(bad_aa), tuple(ao), tuple(tb))

@@ -1,12 +1,14 @@
-"""Numeric sphere clearances along a dual-arm path, for choosing the optimiser's pair slots.
+"""Numeric sphere clearances along a path of k arms, for choosing the optimiser's pair slots.
 
-Arm spheres are those of :class:`streams.motion.spheres.ArmSpheres` followed by the held-object
-spheres of that arm (given in the tool0 frame). Clearance of a sphere pair is
-``|c_i - c_j| - r_i - r_j`` [m]; of a sphere and the table, ``z - r``.
+Arm-arm clearances are taken for every pair of arms (:func:`arm_pairs`: ``k (k - 1) / 2``
+pairs, none for one arm). Arm spheres are those of :class:`streams.motion.spheres.ArmSpheres`
+followed by the held-object spheres of that arm (given in the tool0 frame). Clearance of a
+sphere pair is ``|c_i - c_j| - r_i - r_j`` [m]; of a sphere and the table, ``z - r``.
 """
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,15 +29,26 @@ class HeldSpheres:
         return HeldSpheres(np.zeros((0, 3)), np.zeros(0))
 
 
+def arm_pairs(arms: int) -> tuple[tuple[int, int], ...]:
+    """The pairs of arm positions ``(i, j)``, ``i < j``, in lexicographic order: ``(0, 1)``
+    for two arms, ``(0, 1), (0, 2), (1, 2)`` for three, none for one."""
+    return tuple(itertools.combinations(range(arms), 2))
+
+
 @dataclass(frozen=True)
 class PathSpheres:
-    """Sphere centres of both arms along a path: ``(s, n_arm, 3)`` each, and radii."""
+    """Sphere centres of every arm along a path (layout order): ``(s, n_arm, 3)`` each, and
+    radii ``(n_arm,)`` each."""
 
-    centres: tuple[FloatArray, FloatArray]
-    radii: tuple[FloatArray, FloatArray]
-    moving_link: tuple[FloatArray, FloatArray]  # (n_arm,) bool: sphere may touch the table check
-    coarse_centres: tuple[FloatArray, FloatArray]  # the coarse arm spheres + held spheres
-    coarse_radii: tuple[FloatArray, FloatArray]
+    centres: tuple[FloatArray, ...]
+    radii: tuple[FloatArray, ...]
+    moving_link: tuple[FloatArray, ...]  # (n_arm,) bool: sphere may touch the table check
+    coarse_centres: tuple[FloatArray, ...]  # the coarse arm spheres + held spheres
+    coarse_radii: tuple[FloatArray, ...]
+
+    @property
+    def arms(self) -> int:
+        return len(self.centres)
 
 
 def path_spheres(ctx: WorldContext, path: FloatArray, held: tuple[HeldSpheres, ...]) -> PathSpheres:
@@ -61,16 +74,15 @@ def path_spheres(ctx: WorldContext, path: FloatArray, held: tuple[HeldSpheres, .
         rs.append(np.concatenate([fk.spheres.radius, h.radius]))
         crs.append(np.concatenate([fk.coarse.radius, h.radius]))
         ms.append(np.concatenate([fk.spheres.joint >= 2, np.ones(len(h.radius), dtype=bool)]))
-    return PathSpheres(
-        (cs[0], cs[1]), (rs[0], rs[1]), (ms[0], ms[1]), (ccs[0], ccs[1]), (crs[0], crs[1])
-    )
+    return PathSpheres(tuple(cs), tuple(rs), tuple(ms), tuple(ccs), tuple(crs))
 
 
-def arm_arm_clearance(ps: PathSpheres) -> FloatArray:
-    """``(s, n_left, n_right)`` clearances between the two arms' coarse spheres [m]."""
+def arm_arm_clearance(ps: PathSpheres, i: int = 0, j: int = 1) -> FloatArray:
+    """``(s, n_i, n_j)`` clearances between the coarse spheres of arms ``i`` and ``j``
+    (layout positions) [m]."""
     c, r = ps.coarse_centres, ps.coarse_radii
-    d = np.linalg.norm(c[0][:, :, None] - c[1][:, None], axis=-1)
-    out: FloatArray = d - r[0][:, None] - r[1][None]
+    d = np.linalg.norm(c[i][:, :, None] - c[j][:, None], axis=-1)
+    out: FloatArray = d - r[i][:, None] - r[j][None]
     return out
 
 

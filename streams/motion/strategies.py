@@ -6,12 +6,18 @@ transfer between the lifted configurations as a list of stages:
   tries a sampled collision-free path's warm start in between:
   :func:`streams.motion.sampling.warm_started_strategies`);
 * ``untangle`` (:class:`UntangleStrategy`, rules in ``docs/arm_untangling.md``): the arm that
-  reaches deeper into the other arm's half yields: it moves to a lifted park pose above its
-  own half while the other arm goes straight to its goal; then it moves to its own goal while
-  the other waits. If that fails, the roles swap;
-* ``sequential`` (:class:`SequentialStrategy`): one arm at a time; the first arm retracts to
-  its home pose, the second moves to its goal, then the first moves to its goal;
+  reaches deepest into the shared middle of the table yields: it moves to a lifted park pose
+  above its own side while every other arm goes straight to its goal; then it moves to its
+  own goal while the others wait. If that fails, the next deepest arm yields, and so on;
+* ``sequential`` (:class:`SequentialStrategy`): the deepest arm retracts to its home pose,
+  the other arms move to their goals (together, else one at a time, deepest first), then the
+  first arm moves to its goal; if that fails, the next deepest arm retracts first;
 * ``one-arm`` (:class:`OneArmStrategy`): the baseline motion planner's transfer.
+
+Every strategy works for any number of arms placed anywhere around the table: "deep" is
+:meth:`~streams.motion.transfers.Transfers.depth`, how far an arm's TCP reaches past the
+table centre along the direction its base faces. With two arms the orders above are those of
+the two-arm planner (the arm reaching deeper into the other's half first).
 
 A strategy gets the call's :class:`~streams.motion.transfers.Transfers` (optimised and direct
 transfers, warm starts, park poses) and the :class:`~streams.motion.records.TransferProblem`.
@@ -76,7 +82,9 @@ class PlainStrategy:
 
 @dataclass(frozen=True)
 class UntangleStrategy:
-    """Arm untangling (see the module docstring and ``docs/arm_untangling.md``)."""
+    """Arm untangling (see the module docstring and ``docs/arm_untangling.md``): one arm
+    yields (parks) while the others go to their goals, then it goes to its goal; the
+    yielding arm is tried in order of depth, deepest first (ties: layout order)."""
 
     name: str = "untangle"
     park_height: float = 0.30  # [m]
@@ -104,7 +112,10 @@ class UntangleStrategy:
 
 @dataclass(frozen=True)
 class SequentialStrategy:
-    """One arm at a time: retract the first to home, move the others, move the first."""
+    """Retract the first arm to home, move the others, move the first. The first arm is
+    tried in order of depth, deepest first (ties: layout order). The others move together
+    in one stage; with three arms or more, if that stage fails, one at a time, in the same
+    order of depth (with two arms the one stage is the other arm's alone)."""
 
     name: str = "sequential"
 
@@ -112,28 +123,52 @@ class SequentialStrategy:
         ctx = transfers.ctx
         layout = ctx.layout
         n = len(layout)
-        order = np.argsort(-transfers.depth(problem.q_from))
-        for f in (int(k) for k in order):
+        order = [int(k) for k in np.argsort(-transfers.depth(problem.q_from))]
+        for f in order:
             first, others = _only(f, n), tuple(k == f for k in range(n))
             q1 = layout.replace(problem.q_from, f, ctx.home(ctx.arm_names[f]))
             q2 = layout.replace(problem.q_to, f, q1[layout.slice(f)])
-            stages = []
-            for qa, qb, fixed in ((problem.q_from, q1, first), (q1, q2, others),
-                                  (q2, problem.q_to, first)):  # fmt: skip
-                path = transfers.optimise_or_lift(problem, qa, qb, fixed)
-                if path is None:
-                    break
-                stages.append(path)
-            else:
-                return stages
+            head = transfers.optimise_or_lift(problem, problem.q_from, q1, first)
+            if head is None:
+                continue
+            middle = transfers.optimise_or_lift(problem, q1, q2, others)
+            middle_stages = [middle] if middle is not None else None
+            if middle_stages is None and n > 2:
+                middle_stages = _one_at_a_time(transfers, problem, q1, q2, [k for k in order
+                                                                           if k != f])  # fmt: skip
+            if middle_stages is None:
+                continue
+            tail = transfers.optimise_or_lift(problem, q2, problem.q_to, first)
+            if tail is not None:
+                return [head, *middle_stages, tail]
         return None
+
+
+def _one_at_a_time(
+    transfers: Transfers, problem: TransferProblem, q_a: FloatArray, q_b: FloatArray,
+    arms: list[int],
+) -> list[FloatArray] | None:  # fmt: skip
+    """Stages taking the arms ``arms`` (layout positions) from ``q_a`` to ``q_b`` one after
+    the other in that order (the others waiting), or None when one fails."""
+    layout = transfers.ctx.layout
+    n = len(layout)
+    stages: list[FloatArray] = []
+    q = q_a.copy()
+    for i in arms:
+        q_next = layout.replace(q, i, layout.part(q_b, i))
+        path = transfers.optimise_or_lift(problem, q, q_next, _only(i, n))
+        if path is None:
+            return None
+        stages.append(path)
+        q = q_next
+    return stages
 
 
 @dataclass(frozen=True)
 class OneArmStrategy:
     """The baseline motion planner's transfer: the arms move one after the other, each
-    straight to its goal while the other waits; an arm bound for its home pose moves first,
-    otherwise the arm reaching deeper into the other's half."""
+    straight to its goal while the others wait; arms bound for their home poses move first,
+    then the others, each group in order of depth, deepest first (ties: layout order)."""
 
     name: str = "one-arm"
 

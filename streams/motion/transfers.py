@@ -1,6 +1,7 @@
 """The building blocks of a transfer that the strategies share: one optimised transfer (after
 the straight or lightly bent direct path where that is clear), the warm starts (a lifted
-via-point, a curve's knots), and the untangling geometry (park pose, reach depth).
+via-point, a curve's knots), and the untangling geometry (park pose, reach depth), for arms
+placed anywhere around the table (each by its base pose and the direction it faces).
 
 A :class:`Transfers` serves one motion call: the planner makes it with that call's
 :class:`~streams.motion.records.MotionTally`, and every optimisation, direct path and
@@ -37,6 +38,8 @@ DIRECT_VIA_SPREAD = 1.0
 #: on the ``paper`` suite execution 805.0 -> 794.3 s in all (no instance longer), the same
 #: actions; on the hard transfers of ``bench_motion.py --hard`` one arm 1.73 -> 1.40 s.
 REFINE_BENT = True
+#: Distance [m] of an untangling park pose's TCP in front of its arm's base.
+PARK_REACH = 0.40
 
 
 class Transfers:
@@ -212,23 +215,42 @@ class Transfers:
         )
 
     def park(self, arm: str, q_goal_arm: FloatArray, height: float = 0.30) -> FloatArray | None:
-        """The untangling park pose of ``arm``: TCP above its own half of the table at the
-        goal's ``y``, ``height`` [m] up, with the goal's orientation."""
+        """The untangling park pose of ``arm``: its TCP :data:`PARK_REACH` [m] in front of its
+        base along the direction it faces (on its own side of the table), across that
+        direction at its goal's offset from the base (the point clipped to the workspace),
+        ``height`` [m] up, with the goal's orientation; the IK branch nearest the goal's
+        joints. For two arms facing each other across x this is ``x = base_x +- 0.40``,
+        ``y`` the goal's (clipped)."""
         kin = self.ctx.kinematics[arm]
-        spec = self.ctx.scene.arm(arm)
         T = kin.fk_tcp(q_goal_arm)
+        base, facing = self._base_xy(arm), self._facing(arm)
+        across = np.array([-facing[1], facing[0]])
+        offset = float((T[:2, 3] - base) @ across)
+        xy = base + PARK_REACH * facing + offset * across
         ws = self.ctx.scene.workspace
-        base_x = spec.base_xyz[0]
-        T[0, 3] = base_x + np.sign(-base_x) * 0.40
-        T[1, 3] = float(np.clip(T[1, 3], *ws.y))
+        T[0, 3] = float(np.clip(xy[0], *ws.x))
+        T[1, 3] = float(np.clip(xy[1], *ws.y))
         T[2, 3] = height
         return tool_pose_ik(kin, T, q_goal_arm)
 
     def depth(self, q: FloatArray) -> FloatArray:
-        """``(arms,)``: how far [m] each arm's TCP reaches past the table centre line, away
-        from its own base."""
+        """``(arms,)``: how far [m] each arm's TCP reaches past the table centre, along the
+        direction its base faces (away from its own base; for two arms facing each other
+        across x: past the centre line ``x = 0`` into the other arm's half)."""
         out = np.zeros(len(self.ctx.layout))
         for i, arm in enumerate(self.ctx.arm_names):
             p = self.ctx.kinematics[arm].fk_tcp(self.ctx.layout.part(q, arm))[:3, 3]
-            out[i] = p[0] * np.sign(-self.ctx.scene.arm(arm).base_xyz[0])
+            out[i] = float(p[:2] @ self._facing(arm))
+        return out
+
+    def _base_xy(self, arm: str) -> FloatArray:
+        return np.array(self.ctx.scene.arm(arm).base_xyz[:2], dtype=np.float64)
+
+    def _facing(self, arm: str) -> FloatArray:
+        """The unit direction ``(2,)`` the base of ``arm`` faces on the table (its x axis,
+        by its yaw), rounded to the axes where it is within 1e-9 of one."""
+        yaw = self.ctx.scene.arm(arm).base_yaw
+        f = np.array([np.cos(yaw), np.sin(yaw)])
+        f[np.abs(f) < 1e-9] = 0.0
+        out: FloatArray = f / np.linalg.norm(f)
         return out
