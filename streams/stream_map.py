@@ -237,7 +237,7 @@ class RearrangementStreams:
         with_goals = np.minimum(clear, pool.clearance(self._corners(goals)))
         for avoid in (with_goals, clear):  # goals too if possible
             for margin in (GRASP_CORRIDOR, BUFFER_MARGIN):
-                found = dict.fromkeys(  # both arms may reach one pose: once
+                found = dict.fromkeys(  # several arms may reach one pose: once
                     p
                     for arm in self.ctx.arm_names
                     for p in pool.take(arm, avoid, BUFFERS_PER_ARM, seed, margin)
