@@ -146,7 +146,19 @@ class Grounder:
             [a for _, a in sorted((cost[a, i], a) for a in arms if (a, i) in cost)][: m + 1]
             for i in range(m)
         ]
+        alone = [step.moves[i] for i, reach in enumerate(per_move) if not reach]
+        if alone:
+            show = self.cache.show
+            self.failures.unassigned(step, "no arm has a grasp with IK at " + ", ".join(
+                f"{show(mv.obj)} and at {'a buffer' if mv.to_buffer else 'its goal'}"
+                for mv in alone
+            ))  # fmt: skip
+            return []
         tuples = [t for t in itertools.product(*per_move) if len(set(t)) == m]
+        if not tuples:
+            self.failures.unassigned(
+                step, "no assignment gives its moves distinct arms that reach them"
+            )
         tuples.sort(key=lambda t: (sum(cost[a, i] for i, a in enumerate(t)), t))
         return tuples[: self.options.assignments]
 

@@ -207,3 +207,22 @@ def test_a_step_of_more_moves_than_arms_is_an_error_of_the_task_planner() -> Non
     assert solver.view().arms == 1
     with pytest.raises(ParameterError, match=r"step of 3 moves .* for a cell of 1 arm"):
         solver.solve()
+
+
+def test_a_move_no_arm_reaches_is_a_reason_of_the_dead_end(monkeypatch: pytest.MonkeyPatch) -> None:
+    r = _rearrangement("three_arm_cycle.yaml")
+    solver = SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions())
+    rotate = solver.planner.candidates(solver.view())[0]
+    monkeypatch.setattr(solver.grounder, "_move_options", lambda *args, **kwargs: [])
+    assert solver.grounder.select([rotate], MotionMode.FULL) == []
+    (reason,) = solver.failures.reasons
+    assert reason.startswith("rotate (") and "no arm has a grasp with IK at o" in reason
+
+
+def test_assignments_with_more_than_two_arms_are_bounded_and_distinct() -> None:
+    r = _rearrangement("four_arm_cycle.yaml")
+    solver = SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions(assignments=3))
+    rotate = solver.planner.candidates(solver.view())[0]
+    found = solver.grounder._assignments(rotate)
+    assert 1 <= len(found) <= 3
+    assert all(len(set(arms)) == len(rotate.moves) == 4 for arms in found)
