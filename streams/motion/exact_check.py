@@ -1,8 +1,8 @@
-"""Exact validation of a dual-arm trajectory with the world's coal collision checker.
+"""Exact validation of a trajectory of k arms with the world's coal collision checker.
 
 Between consecutive samples the configuration is interpolated linearly in joint space so that
-neither tool centre point moves more than ``max_tcp_step`` [m] (default 5 mm) between two
-checks; every check is a full :meth:`CollisionWorld.in_collision` query (arm-arm, self,
+no tool centre point moves more than ``max_tcp_step`` [m] (default 5 mm) between two
+checks; every check is a full :meth:`CollisionWorld.in_collision` query (every pair of arms, self,
 table, resting objects, held objects). Joint limits are checked on every sample, and, when
 times are given, the finite-difference velocity and acceleration limits (with a relative
 tolerance).

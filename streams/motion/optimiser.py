@@ -82,6 +82,12 @@ class TrajectoryOptimiser:
         functions = [self._jac_g, self._hess_lag]
         self._library = codegen.request(functions, "sdar_trajopt", self.recipe(), flags)
 
+    @property
+    def library(self) -> Path | None:
+        """Where the compiled derivatives are (or will be once compiled) after
+        :meth:`request_compiled`; None when they are not asked for or not to be had."""
+        return self._library
+
     def recipe(self) -> str:
         """What the derivatives' code is made from: the options, the arms' layout and base
         poses, the kinematic parameters and the code that builds the expressions (the key of

@@ -31,7 +31,7 @@ from streams.motion.transfers import DIRECT_LIFTS, REFINE_BENT, Transfers
 #: Clearance [m] a transfer taken without optimisation keeps from resting and held objects
 #: on the exact check (the optimiser's sphere model asks 15 mm of its spheres).
 DIRECT_MARGIN = 0.005
-#: [m] where the two arms' shapes come closer than this at a checked sample of a planned
+#: [m] where the shapes of two arms come closer than this at a checked sample of a planned
 #: motion, the chords to the neighbouring samples are checked finely (see
 #: :func:`streams.motion.exact_check.validate_trajectory`): between samples at most 5 mm of
 #: tool travel apart, two wrists passing a millimetre apart at the samples can touch.

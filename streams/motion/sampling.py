@@ -1,6 +1,6 @@
-"""Sampling-based synchronous dual-arm transfers: OMPL's RRTConnect in the joint space of every arm.
+"""Sampling-based synchronous transfers of k arms: OMPL's RRTConnect in their joint space.
 
-An optional extra (``pip install sdar-tamp[ompl]``). The planner samples both arms' joints
+An optional extra (``pip install sdar-tamp[ompl]``). The planner samples every arm's joints
 within their limits; a state is valid when the planner's ``margin_world`` (resting and held
 objects grown by the direct-path margin, see :class:`streams.motion.planner.MotionPlanner`)
 reports no collision, and OMPL checks edges every ``resolution`` [rad] of joint-space

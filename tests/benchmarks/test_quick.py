@@ -74,6 +74,15 @@ def _motion(out: Summary) -> None:
     assert out["validation_failures_returned_as_success"] == 0
 
 
+def _motion_arms(out: Summary) -> None:
+    rows = out["by_arms"]
+    assert sorted(rows) == ["1", "2", "3", "4"]
+    for k, row in rows.items():
+        n = int(k)
+        assert row["calls"] == 2 and row["arm_arm_blocks"] == n * (n - 1) // 2
+        assert row["exact_check_passed"] <= row["calls"] and row["median_cpu_s"] > 0
+
+
 def _motion_hard(out: Summary) -> None:
     for kind in ("one_arm", "both_arms"):
         assert {"optimiser", "ompl", "ladder", "sdar-m"} <= out[kind].keys()
@@ -130,6 +139,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_feasibility", ()): _feasibility,
     ("bench_motion", ()): _motion,
     ("bench_motion", ("--hard", "1")): _motion_hard,
+    ("bench_motion_arms", ()): _motion_arms,
     ("bench_numeric_ik", ()): _numeric_ik,
     ("bench_parser", ()): _parser,
     ("bench_pddlstream_compat", ()): _pddlstream,
