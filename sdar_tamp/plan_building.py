@@ -47,7 +47,10 @@ class GripperEvent:
     T_tcp_object: FloatArray
 
 
-#: Metrics computed by :func:`build_plan_file` (they replace values passed under these keys).
+#: Metrics computed by :func:`build_plan_file` (they replace values passed under these keys):
+#: gripper actions completed (a grasp and its release), motion segments, the segments in which
+#: two arms or more move at once (``dual_arm_steps``: for two arms, both; the key keeps its
+#: name so that two-arm plans read as before), and the duration [s].
 COMPUTED_METRICS = ("actions", "steps", "dual_arm_steps", "execution_time")
 Pose3 = tuple[float, float, float]
 
@@ -63,15 +66,16 @@ def build_plan_file(
     dt: float = MAX_DT,
     q_start: FloatArray | None = None,
 ) -> PlanFile:
-    """Concatenate ``items`` into one timeline (arms in scene order).
+    """Concatenate ``items`` into one timeline (the scene's arms, one or more, in scene order).
 
     Each segment must start where the timeline stands. Consecutive gripper events (no motion
     between them) of different arms happen at the same instant, followed by one dwell of
-    ``gripper_time`` [s] with the robot still; a second event of one arm waits for the dwell
-    of its first. The timeline is resampled linearly wherever the spacing exceeds
-    ``dt`` [s]. ``final_poses``: start poses ``(x, y, yaw)`` [m, m, rad] of the objects in
-    ``start_poses`` (``sizes`` must name the same objects), updated at every release from the
-    tool pose (``T_world_tcp @ T_tcp_object`` projected on the table). Metrics: see
+    ``gripper_time`` [s] with the robot still: any subset of the arms may act at once (a
+    two-gripper action, or several one-gripper actions at one configuration); a second event
+    of one arm waits for the dwell of its first. The timeline is resampled linearly wherever
+    the spacing exceeds ``dt`` [s]. ``final_poses``: start poses ``(x, y, yaw)`` [m, m, rad]
+    of the objects in ``start_poses`` (``sizes`` must name the same objects), updated at every
+    release from the tool pose (``T_world_tcp @ T_tcp_object`` projected on the table). Metrics: see
     :data:`COMPUTED_METRICS`; other entries of ``metrics`` are passed through. The timeline
     starts at ``q_start`` ``(dof,)``, else at the first segment's start, else at home.
     """

@@ -1,18 +1,26 @@
-"""The plan file: one timed dual-arm trajectory with gripper events, as self-describing JSON.
+"""The plan file: one timed trajectory of a cell's arms with gripper events, as
+self-describing JSON.
 
-Layout (``version`` 1; every length in m, angle in rad, time in s)::
+Layout (``version`` 2; every length in m, angle in rad, time in s)::
 
-    {"format": "sdar-plan", "version": 1, "units": {"length": "m", "angle": "rad", "time": "s"},
+    {"format": "sdar-plan", "version": 2, "units": {"length": "m", "angle": "rad", "time": "s"},
      "instance": "M1",
-     "arms": [{"name", "joints" (the arm's k URDF joint names), "T_world_base" (4x4, the URDF
-               base_link), "T_tool0_tcp" (4x4), "home" (k)}, ...two arms, scene order],
+     "arms": [{"name", "joints" (the arm's d URDF joint names), "T_world_base" (4x4, the URDF
+               base_link), "T_tool0_tcp" (4x4), "home" (d)}, ...one or more arms, scene order],
      "trajectory": {"t": [n times from 0, spacing <= 0.02],
-                    "q": [n rows of k1 + k2 joints: arm 1's, then arm 2's]},
+                    "q": [n rows of d1 + ... + dk joints: arm 1's, then arm 2's, ... arm k's]},
      "events": [{"t", "arm", "type": "grasp" | "release", "object", "T_tcp_object" (4x4)}],
+                # events of several arms may share a time (simultaneous gripper actions);
                 # after its gripper event an arm stands still GRIPPER_DWELL (0.5 s)
      "final_poses": {"o1": [x, y, yaw]},
      "metrics": {"actions", "steps", "dual_arm_steps", "execution_time", "planning_time", ...},
      "steps": [{"t_start", "t_end", "level", "objects", "kind"}]}   # optional
+
+``arms`` is a list of any length >= 1 (a cell of one to four arms, or more: nothing caps it),
+with distinct names; ``dual_arm_steps`` counts the motions in which two arms or more move at
+once (for a two-arm cell: both arms, its meaning in version 1). Version 1 is the same layout
+with exactly two arms; :func:`~sdar_tamp.plan_reading.load_plan` reads both versions
+(:data:`READ_VERSIONS`), :func:`~sdar_tamp.plan_writing.save_plan` writes :data:`VERSION`.
 
 :func:`~sdar_tamp.plan_reading.load_plan` checks the shape of everything and raises
 :class:`PlanFileError` naming the file, the line and column, and the key path
@@ -28,8 +36,9 @@ by identity (their arrays are read-only copies); compare
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -40,18 +49,18 @@ from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.transforms import FloatArray
 
 FORMAT = "sdar-plan"
-VERSION = 1
+VERSION = 2  #: the version :func:`~sdar_tamp.plan_writing.save_plan` writes
+#: Versions the reader accepts, each with the arm counts it allows (``(n, n)``: exactly n;
+#: ``(n, None)``: n or more): version 1 holds exactly two arms, version 2 any number >= 1.
+READ_VERSIONS: Mapping[int, tuple[int, int | None]] = MappingProxyType({1: (2, 2), 2: (1, None)})
 UNITS = {"length": "m", "angle": "rad", "time": "s"}
 MAX_DT = 0.02  #: largest spacing of trajectory samples [s]
 EVENT_TYPES = ("grasp", "release")
 MAX_DEPTH = 64  #: deepest nesting of JSON lists and objects a plan file may have
 #: After its gripper event an arm stands still this long [s] (the gripper closes or opens; a
 #: parallel gripper takes about half a second). :func:`~sdar_tamp.plan_building.build_plan_file`
-#: keeps both arms still.
+#: keeps every arm still.
 GRIPPER_DWELL = 0.5
-#: Arms of a version-1 plan file (each with its own joint count; the in-memory plan goes by
-#: its layout).
-FILE_ARMS = 2
 
 
 def plan_joint_names(arm: str, robot_joints: Sequence[str]) -> tuple[str, ...]:

@@ -22,7 +22,8 @@ class PlanMetrics:
     Planning figures [s] (``planning_time`` and its ``_selection`` and ``_motion`` parts,
     ``step_time_median``), the run that made it (``task_planner``, ``motion_planner``,
     ``seed``, ``buffer_moves``), the counts and duration [s] of the timeline
-    (``actions``, ``steps``, ``dual_arm_steps``, ``execution_time``; see
+    (``actions``, ``steps``, ``dual_arm_steps``: motions with two arms or more moving,
+    ``execution_time``; see
     :data:`~sdar_tamp.plan_building.COMPUTED_METRICS`), and for an asynchronous schedule
     ``execution`` (``"async"``) and the synchronous duration ``execution_time_sync`` [s].
     ``extra``: any other metrics, by name."""

@@ -8,6 +8,11 @@ refused at its first bracket too deep. Each arm has as many joints as its ``join
 :class:`~sdar_tamp.world.layout.ArmLayout`, each arm must have the joint count of the cell's arm
 in its place (``plan.json:31:17: arms[1].joints: the cell's arm 'right' has 7 joints, the plan's
 arm 'right' 6 (...)``); names and frames are the validator's scene rule.
+
+Both versions of the format are read (:data:`~sdar_tamp.plan_file.READ_VERSIONS`): a version-1
+file holds exactly two arms (``plan.json:10:11: arms: expected 2 arms (a version-1 file), got
+3``), a version-2 file one or more; the rest of the layout is the same, so a version-1 file
+reads into the same :class:`~sdar_tamp.plan_file.PlanFile` as its version-2 copy.
 """
 
 from __future__ import annotations
@@ -23,12 +28,11 @@ import numpy as np
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.plan_file import (
     EVENT_TYPES,
-    FILE_ARMS,
     FORMAT,
     MAX_DEPTH,
     MAX_DT,
+    READ_VERSIONS,
     UNITS,
-    VERSION,
     ArmInfo,
     PlanEvent,
     PlanFile,
@@ -178,11 +182,15 @@ def plan_from_dict(data: Any, source: str = "<plan>", layout: ArmLayout | None =
     top = r.obj(data, "", _TOP, ("steps",))
     if top["format"] != FORMAT:
         raise r.fail("format", f"expected {FORMAT!r}, got {_show(top['format'])}")
-    if top["version"] != VERSION or isinstance(top["version"], bool):
-        raise r.fail("version", f"expected {VERSION} (this reader), got {_show(top['version'])}")
+    version = top["version"]
+    if isinstance(version, bool) or not isinstance(version, int) or version not in READ_VERSIONS:
+        raise r.fail(
+            "version",
+            f"expected one of {sorted(READ_VERSIONS)} (this reader), got {_show(version)}",
+        )
     if top["units"] != UNITS:
         raise r.fail("units", f"expected {json.dumps(UNITS)}, got {_show(top['units'])}")
-    items = r.items(top["arms"], "arms", FILE_ARMS)
+    items = _arm_items(r, top["arms"], version)
     arms = tuple(_arm(r, a, f"arms[{i}]") for i, a in enumerate(items))
     for i, arm in enumerate(arms):
         if arm.name in (a.name for a in arms[:i]):
@@ -205,6 +213,18 @@ def plan_from_dict(data: Any, source: str = "<plan>", layout: ArmLayout | None =
     )
     instance = r.text(top["instance"], "instance")
     return PlanFile(instance, arms, t, q, events, final, PlanMetrics.from_mapping(metrics), steps)
+
+
+def _arm_items(r: _Reader, v: Any, version: int) -> list[Any]:
+    """The ``arms`` list, as many as ``version`` allows (version 1: exactly two; 2: one or
+    more; :data:`~sdar_tamp.plan_file.READ_VERSIONS`)."""
+    low, high = READ_VERSIONS[version]
+    items = r.items(v, "arms", what="arms")
+    exact = high is not None  # a version allows an exact count, or a minimum
+    if len(items) < low or (exact and len(items) != high):
+        count = f"{low} arms" if exact else f"at least {low} arm{'s' if low > 1 else ''}"
+        raise r.fail("arms", f"expected {count} (a version-{version} file), got {len(items)}")
+    return items
 
 
 def _arm(r: _Reader, v: Any, key: str) -> ArmInfo:

@@ -264,7 +264,9 @@ def _at(plan: PlanFile, t: float) -> FloatArray:
 
 def _dwell(plan: PlanFile, scene: Scene, dwell: float) -> Violation | None:
     """After its gripper event an arm stands still for ``dwell`` [s] (the gripper closes or
-    opens; the other arm may move); an arm's gripper acts at most once per dwell."""
+    opens; the other arms may move); an arm's gripper acts at most once per dwell, and the
+    events of several arms at one instant (any subset of the arms) are one group whose arms
+    all stand still."""
     last: dict[str, tuple[float, str]] = {}
     for e in plan.events:
         prev = last.get(e.arm)

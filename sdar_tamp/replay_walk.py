@@ -54,6 +54,22 @@ def contact_allowed(pair: CollisionPair, exempt: Mapping[str, tuple[str, FloatAr
     return False
 
 
+def describe_contacts(pairs: list[CollisionPair], world: CollisionWorld, limit: int = 3) -> str:
+    """The colliding ``pairs`` as a message: the first ``limit`` pairs of shapes, led by the
+    arms in contact when a pair joins two arms (``arms south and north in contact: ...``;
+    a held object counts as its arm's)."""
+    arms: list[str] = []
+    for p in pairs:
+        a, b = world.owner(p.first), world.owner(p.second)
+        if a is not None and b is not None and a != b:
+            both = " and ".join(sorted((a, b), key=world.layout.names.index))
+            if both not in arms:
+                arms.append(both)
+    text = ", ".join(f"{p.first} with {p.second}" for p in pairs[:limit])
+    text += " ..." if len(pairs) > limit else ""
+    return f"arms {'; '.join(arms)} in contact: {text}" if arms else text
+
+
 class ReplayWalk:
     """The state of the world along the timeline (resting and held objects), walked once in
     time order by :meth:`walk`, which returns the first violation of the replay rules."""
@@ -103,8 +119,7 @@ class ReplayWalk:
         pairs = [p for p in self.world.report(q) if not self.allowed(p)]
         if not pairs:
             return None
-        text = ", ".join(f"{p.first} with {p.second}" for p in pairs[:3])
-        return Violation(t, "collision", text + (" ..." if len(pairs) > 3 else ""))
+        return Violation(t, "collision", describe_contacts(pairs, self.world))
 
     def allowed(self, p: CollisionPair) -> bool:
         return contact_allowed(p, self.exempt)

@@ -2,9 +2,17 @@
 
 Actions are read through the domain and :class:`~solvers.sdar.vocabulary.SdarVocabulary`,
 not by argument position: a gripper action's events are its ``holding`` effects (added by a
-pick, deleted by a place: arm, object and grasp by parameter name); a move's trajectory is the
-output of the vocabulary's motion stream, found through the fact that stream certifies and
-the move requires.
+pick, deleted by a place: arm, object and grasp by parameter name, one event per effect, so an
+action may work any number of grippers); a move's trajectory is the output of the
+vocabulary's motion stream, found through the fact that stream certifies and the move
+requires. The domain must have the vocabulary's move, pick and place; its two-gripper
+actions (``pick-both``, ``place-both``) are read when it has them.
+
+Simultaneous gripper actions: the events of one action, and those of consecutive gripper
+actions with no move between them (several ``pick`` or ``place`` actions at one
+configuration, as a task planner for k arms may emit them), are consecutive items of the
+timeline, which :func:`~sdar_tamp.plan_building.build_plan_file` puts at one instant with one
+dwell (a second action of the same arm waits for the first's dwell).
 """
 
 from __future__ import annotations
@@ -40,8 +48,9 @@ class ActionDecoder:
     """Reads the plan actions of a rearrangement domain by the names of its vocabulary.
 
     Raises:
-        ParameterError: the domain lacks an action of the vocabulary, a gripper action has no
-            ``holding`` effect, or no move precondition is certified by the motion stream.
+        ParameterError: the domain lacks the vocabulary's move, pick or place, a gripper
+            action has no ``holding`` effect, or no move precondition is certified by the
+            motion stream.
     """
 
     def __init__(
@@ -49,11 +58,7 @@ class ActionDecoder:
     ) -> None:
         self.vocabulary = voc = vocabulary or SdarVocabulary()
         actions = {a.name: a for a in domain.actions}
-        missing = [
-            n
-            for n in (voc.move, voc.pick, voc.place, voc.pick_both, voc.place_both)
-            if n not in actions
-        ]
+        missing = [n for n in (voc.move, voc.pick, voc.place) if n not in actions]
         if missing:
             raise ParameterError(f"the domain has no action(s) {', '.join(missing)}")
         self._grippers: dict[str, tuple[bool, tuple[tuple[int, int, int], ...]]] = {}
@@ -63,6 +68,8 @@ class ActionDecoder:
             (voc.pick_both, True),
             (voc.place_both, False),
         ):
+            if name not in actions:  # a domain without two-gripper actions (say, for k arms)
+                continue
             action = actions[name]
             index = {p.name: i for i, p in enumerate(action.parameters)}
             parts = tuple(
@@ -120,7 +127,8 @@ def decoder_of(rearrangement: Rearrangement) -> ActionDecoder:
 def timeline(
     plan: Sequence[Action], tasks: Sequence[TaskRecord], decoder: ActionDecoder
 ) -> list[MotionSegment | GripperEvent]:
-    """The plan's motions and gripper events in order (both events of a two-gripper action).
+    """The plan's motions and gripper events in order (every event of an action of several
+    grippers; consecutive gripper actions stay consecutive, hence simultaneous).
     ``tasks`` label the motions (kind and objects of the task each belongs to)."""
     labels = [(t.kind, t.objects) for t in tasks for _ in range(t.motions)]
     items: list[MotionSegment | GripperEvent] = []

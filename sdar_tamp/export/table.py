@@ -1,9 +1,9 @@
 """A plan as one CSV table at a fixed rate (50 Hz by default).
 
-Columns: ``time`` [s], every arm's joint positions [rad] under the plan's joint names (first
-arm, then second; each arm with its own joint count), then per arm ``<arm>_gripper`` (1
-closed, 0 open: the commanded state, from the event's time on) and ``<arm>_held`` (the object
-in that gripper, empty when open). Rows at
+Columns: ``time`` [s], every arm's joint positions [rad] under the plan's joint names (the
+arms in plan order, one to four or more; each arm with its own joint count), then per arm
+``<arm>_gripper`` (1 closed, 0 open: the commanded state, from the event's time on) and
+``<arm>_held`` (the object in that gripper, empty when open). Rows at
 ``k / rate`` for ``k = 0 .. ceil(duration * rate)``; positions are linear between the plan's
 samples and hold the final configuration after the end (the last row may pass the end by less
 than one period).

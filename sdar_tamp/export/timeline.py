@@ -96,6 +96,12 @@ def gripper_states(plan: PlanFile, times: FloatArray) -> GripperState:
     return GripperState(closed, tuple(held))
 
 
-def base_to_base(plan: PlanFile) -> FloatArray:
-    """``T_base0_base1`` ``(4, 4)``: the second arm's ``base_link`` in the first arm's."""
-    return inverse(plan.arms[0].T_world_base) @ plan.arms[1].T_world_base
+def base_to_base(plan: PlanFile, i: int = 0, j: int = 1) -> FloatArray:
+    """``T_base_i_base_j`` ``(4, 4)``: arm ``j``'s ``base_link`` in arm ``i``'s (plan order;
+    by default the second arm's in the first's)."""
+    for name, k in (("i", i), ("j", j)):
+        if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < len(plan.arms):
+            raise ParameterError(
+                f"{name}: expected an arm index in [0, {len(plan.arms)}), got {k!r}"
+            )
+    return inverse(plan.arms[i].T_world_base) @ plan.arms[j].T_world_base

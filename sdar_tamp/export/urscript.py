@@ -1,8 +1,9 @@
-"""A plan as one URScript program per arm: a ``servoj`` stream and gripper calls.
+"""A plan as one URScript program per arm (one to four arms, or more): a ``servoj`` stream and
+gripper calls.
 
 Each program (``def sdar_<arm>(): ... end``) first moves the arm to the plan's first
 configuration with ``movej``, calls ``sdar_wait_for_start()`` (a placeholder: bind it to the
-signal that starts both arms together, such as a shared digital input), then streams
+signal that starts every arm together, such as a shared digital input), then streams
 ``servoj(q, 0, 0, servo_t, servo_lookahead, servo_gain)`` with the plan's configuration at
 ``t = k * period`` for ``k = 1 .. ceil(duration / period)`` (``servoj`` blocks for ``servo_t``
 = ``period`` [s]; its ``a`` and ``v`` arguments are unused by the controller). A gripper event
@@ -12,8 +13,9 @@ the stream keeps streaming that configuration while the gripper acts. The two gr
 functions are placeholders that only log: replace their bodies with your gripper's
 non-blocking commands (for a Robotiq URCap, for example, ``rq_close()`` and ``rq_open()``).
 
-The header comment states the units, the parameters and the base-to-base transform; the
-``Base`` frame of the UR controller is the URDF ``base_link`` rotated by pi about z.
+The header comment states the units, the parameters and the base-to-base transform to every
+other arm of the plan (``# T_<arm>_<other>``); the ``Base`` frame of the UR controller is the
+URDF ``base_link`` rotated by pi about z.
 
 URScript runs on Universal Robots controllers only: every arm must be a UR-family arm. Given
 the cell (``scene``), each arm's robot description is checked (its chain to ``tool0`` has the
@@ -170,9 +172,15 @@ T_BASE_LINK_CONTROLLER = pose_xyz_yaw(0.0, 0.0, 0.0, math.pi)
 
 
 def _header(plan: PlanFile, index: int, settings: ServoSettings, count: int) -> list[str]:
-    info, other = plan.arms[index], plan.arms[1 - index]
-    T = base_to_base(plan) if index == 0 else inverse(base_to_base(plan))
-    Tc = inverse(T_BASE_LINK_CONTROLLER) @ T @ T_BASE_LINK_CONTROLLER
+    info = plan.arms[index]
+    others = [k for k in range(len(plan.arms)) if k != index]
+    start = (
+        "# Start this program alone (bind sdar_wait_for_start() to your start signal)."
+        if not others
+        else "# Start this program and the other arm's together (bind sdar_wait_for_start())."
+        if len(others) == 1
+        else "# Start this program and the other arms' together (bind sdar_wait_for_start())."
+    )
     lines = [
         f"# sdar-tamp plan of instance {plan.instance}: arm {info.name!r}, {plan.duration:.3f} s.",
         "# Units: m, rad, s. Joint order: " + ", ".join(info.joints) + ".",
@@ -181,14 +189,21 @@ def _header(plan: PlanFile, index: int, settings: ServoSettings, count: int) -> 
         "# Gripper calls: sdar_gripper_close(object), sdar_gripper_open(object) at the plan's",
         "# event times (placeholders below: bind them to your gripper, non-blocking; the plan",
         "# holds the arm still 0.5 s after every event).",
-        "# Start this program and the other arm's together (bind sdar_wait_for_start()).",
+        start,
         f"# T_world_base of {info.name} (URDF base_link; world: table centre, z up):",
         *_matrix(info.T_world_base),
-        f"# T_{info.name}_{other.name}: the {other.name} arm's base_link in this arm's base_link:",
-        *_matrix(T),
-        "# The same between the controllers' Base frames (base_link rotated by pi about z):",
-        *_matrix(Tc),
     ]
+    for k in others:  # every other arm's base, in plan order
+        other = plan.arms[k]
+        T = base_to_base(plan, index, k)
+        Tc = inverse(T_BASE_LINK_CONTROLLER) @ T @ T_BASE_LINK_CONTROLLER
+        lines += [
+            f"# T_{info.name}_{other.name}: the {other.name} arm's base_link in this arm's "
+            "base_link:",
+            *_matrix(T),
+            "# The same between the controllers' Base frames (base_link rotated by pi about z):",
+            *_matrix(Tc),
+        ]
     return lines
 
 
@@ -208,7 +223,7 @@ def _definitions(settings: ServoSettings) -> list[str]:
         '    textmsg("sdar: open the gripper from ", object_name)',
         "  end",
         "  def sdar_wait_for_start():",
-        "    # Replace with the signal that starts both arms at once, e.g.",
+        "    # Replace with the signal that starts every arm at once, e.g.",
         "    # while not get_standard_digital_in(0): sync() end",
         "    sync()",
         "  end",

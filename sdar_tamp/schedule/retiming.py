@@ -1,7 +1,7 @@
 """One arm's motion re-timed for that arm alone, on the scheduler's grid.
 
-A synchronous motion is timed for both arms together: its profile is as fast as the arm with
-the harder path allows, so the other arm moves slower than its own limits permit. Alone, an
+A synchronous motion is timed for every arm together: its profile is as fast as the arm with
+the hardest path allows, so the other arms move slower than their own limits permit. Alone, an
 arm's share of the motion can be timed again along the same geometric path:
 
 * with a :data:`PathTimer` (a time-optimal parameterisation under the arm's velocity and

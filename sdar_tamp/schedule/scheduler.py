@@ -1,7 +1,7 @@
-"""Asynchronous dual-arm execution: a synchronous plan re-scheduled so each arm runs on its own.
+"""Asynchronous execution: a synchronous plan of k arms re-scheduled so each arm runs on its own.
 
-In a synchronous plan a step lasts as long as the slower arm's motion and one arm's gripper
-dwell stops the other arm too. :func:`schedule_async` cuts each arm's timeline into blocks
+In a synchronous plan a step lasts as long as the slowest arm's motion and one arm's gripper
+dwell stops the other arms too. :func:`schedule_async` cuts each arm's timeline into blocks
 (:mod:`sdar_tamp.schedule.pieces`: rest-to-rest motions, each re-timed for its arm alone by
 :mod:`sdar_tamp.schedule.retiming` and optionally ending in a gripper event and the arm's own
 dwell) and places them on a new common timeline of ``tick`` [s], group by group (the blocks
@@ -11,18 +11,19 @@ earliest tick that
 * follows the arm's previous block (and its dwell),
 * keeps the cross-arm order of gripper events (``order="objects"``: the events on one object,
   the later one at least a dwell after the earlier; ``order="events"``: every event keeps its
-  place relative to the other arm's events),
+  place relative to the other arms' events),
 * lets the block end no later than it ended in the synchronous plan,
 * and passes the replay (:mod:`sdar_tamp.schedule.sweep`) of everything from the arm's last
-  block to the end of both timelines: no collision between the arms, their held objects, the
-  table and the resting objects where they rest at that time; released objects land on free
-  spots. An arm whose next block is not placed yet stands where its last block left it.
+  block to the end of every arm's timeline: no collision between any two arms, their held
+  objects, the table and the resting objects where they rest at that time; released objects
+  land on free spots. An arm whose next block is not placed yet stands where its last block left it.
 
-When a block finds no start, the group is taken back and tried with the other arm first; when
-that fails too, the group goes as in the synchronous plan (both arms at their synchronous pace
-and offsets), shifted as early as both arms allow: in the same configurations and world as
-there, so it passes. Every stretch of the result is replayed once both arms are fixed there,
-so the schedule is collision-free at the validator's points. Blocks start and end at rest and
+When a block finds no start, the group is taken back and tried with each other arm leading in
+turn (:meth:`_Placement.reorderings`; for two arms: the other arm first); when that fails too,
+the group goes as in the synchronous plan (every arm at its synchronous pace and offsets),
+shifted as early as its arms allow: in the same configurations and world as there, so it
+passes. Every stretch of the result is replayed once every arm is fixed there, so the
+schedule is collision-free at the validator's points. Blocks start and end at rest and
 are sampled on the common grid, so the limits hold. The result is kept only when shorter than
 the synchronous plan (else the next ordering is tried, and at last the synchronous plan kept).
 """
@@ -180,7 +181,7 @@ def retimer(scene: Scene, arm: int, options: ScheduleOptions) -> ArmRetimer:
 
 
 def groups(blocks: list[list[Block]]) -> list[list[Block]]:
-    """Both arms' blocks in groups that overlapped (or touched) in the synchronous plan, in
+    """Every arm's blocks in groups that overlapped (or touched) in the synchronous plan, in
     time order; a group's blocks in the order they ended there."""
     ordered = sorted((b for arm in blocks for b in arm), key=lambda b: (b.sync_start, b.arm))
     out: list[list[Block]] = []
@@ -196,7 +197,7 @@ def groups(blocks: list[list[Block]]) -> list[list[Block]]:
 
 
 class _Placement:
-    """The greedy placement of both arms' blocks for one event ordering."""
+    """The greedy placement of every arm's blocks for one event ordering."""
 
     def __init__(
         self,
@@ -231,9 +232,7 @@ class _Placement:
         for group in groups(self.blocks):
             mark = self.mark()
             searching = self.sweep.checks < self.max_checks
-            if searching and (
-                self.alone(group) or (len(group) > 1 and self.alone(self.flipped(group)))
-            ):
+            if searching and any(self.alone(order) for order in self.reorderings(group)):
                 continue
             self.undo(mark)
             first = min(b.sync_index for b in group)
@@ -254,15 +253,24 @@ class _Placement:
             return False
         return True
 
-    def flipped(self, group: list[Block]) -> list[Block]:
-        """``group`` with the other arm's blocks first (each arm's blocks in order), unless
-        that breaks the order of the events (then ``group`` itself)."""
-        first = group[0].arm
-        out = [b for b in group if b.arm != first] + [b for b in group if b.arm == first]
-        timed = [b.event for b in out if b.event is not None]
-        for i, e in enumerate(timed):
-            if any(self.must_follow(e, o) for o in timed[i + 1 :]):
-                return group
+    def reorderings(self, group: list[Block]) -> list[list[Block]]:
+        """The orders :meth:`run` tries ``group`` in: as it is, then (for a group of more than
+        one block) with each other arm leading in turn, the arms' order rotated (each arm's
+        blocks in order). A rotation that breaks the order of the events is replaced by
+        ``group`` itself (tried again: the searches and their collision checks are those of
+        the two-arm scheduler, where the one rotation puts the other arm first)."""
+        out = [group]
+        if len(group) < 2:
+            return out
+        arms = list(dict.fromkeys(b.arm for b in group))
+        for r in range(1, max(2, len(arms))):
+            k = r % len(arms)
+            moved = [b for arm in arms[k:] + arms[:k] for b in group if b.arm == arm]
+            timed = [b.event for b in moved if b.event is not None]
+            broken = any(
+                self.must_follow(e, o) for i, e in enumerate(timed) for o in timed[i + 1 :]
+            )
+            out.append(group if broken else moved)
         return out
 
     def mark(self) -> tuple[list[int], list[TimedEvent], dict[int, int], int]:
@@ -286,7 +294,7 @@ class _Placement:
         )
 
     def must_follow(self, e: PlanEvent, other: PlanEvent) -> bool:
-        """Whether event ``e`` must come after ``other`` of the other arm."""
+        """Whether event ``e`` must come after ``other`` of another arm."""
         if other.arm == e.arm or other.t >= e.t:
             return False
         return self.order == "events" or other.object == e.object
@@ -351,7 +359,7 @@ class _Placement:
             if conflict.tick < s:  # while an arm waits for its start: later is no better
                 break
             if all(s > self.horizon(a) for a in self.arms if a not in arms):
-                break  # the other arm stands still from now on: nothing changes
+                break  # the other arms stand still from now on: nothing changes
         block = entries[0].block
         detail = (
             f"no start for a block of {self.plan.arm_names[entries[0].arm]} "

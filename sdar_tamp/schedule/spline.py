@@ -12,7 +12,7 @@ Why this is safe to sample on any grid: the plan rules (:mod:`sdar_tamp.plan_rul
 velocity and acceleration by first and second divided differences of the samples, which are mean
 values of the derivatives of any smooth motion through them. The spline, at rest before its start
 and after its end, is such a motion (continuous velocity, bounded acceleration), so any sampling
-of it, merged with any sampling of the other arm, stays within the limits it respects.
+of it, merged with any sampling of the other arms, stays within the limits it respects.
 """
 
 from __future__ import annotations

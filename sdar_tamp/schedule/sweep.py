@@ -19,7 +19,7 @@ import numpy as np
 from sdar_tamp.plan_file import PlanEvent
 from sdar_tamp.plan_rules import STILL_TOL
 from sdar_tamp.replay_sampling import interval_subdivisions
-from sdar_tamp.replay_walk import POS_TOL, contact_allowed
+from sdar_tamp.replay_walk import POS_TOL, contact_allowed, describe_contacts
 from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Instance
@@ -151,7 +151,7 @@ class WorldSweep:
         pairs = [p for p in self.world.report(q) if not self.allowed(p)]
         if not pairs:
             return None
-        return Conflict(tick, "collision", ", ".join(f"{p.first} with {p.second}" for p in pairs))
+        return Conflict(tick, "collision", describe_contacts(pairs, self.world, len(pairs)))
 
     def _in_collision(self, q: FloatArray) -> bool:
         """``world.in_collision(q)``, remembered per arrangement and configuration."""

@@ -1,7 +1,7 @@
 """An interactive 3-D page that explains a plan: one self-contained HTML file (plotly, offline).
 
 The page shows the table with the workspace outline, each object's goal as a flat outline in the
-object's colour, the objects as boxes and both arms as meshes of their collision shapes; the
+object's colour, the objects as boxes and every arm as meshes of their collision shapes; the
 fingers close on a grasped object. Under the view, a time slider shows the plan's steps (bands
 named by kind, level and objects) and its grasp and release events; buttons play, pause and jump
 to the previous or next step, and a menu sets the playback speed. A heads-up line names the
@@ -43,8 +43,9 @@ OBJECT_COLOURS = (
     "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
     "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf",
 )  # fmt: skip
-#: Arm colours (first arm, second arm); grippers and bases are drawn dark grey.
-ARM_COLOURS = ("#5b8fd1", "#e08a4f")
+#: Arm colours (first arm, second arm, ...; repeated past the last); grippers and bases are
+#: drawn dark grey.
+ARM_COLOURS = ("#5b8fd1", "#e08a4f", "#5fb36a", "#a27ccf")
 _DARK = "#4d4d4d"
 _DIV = "sdar-viewer"
 #: Metrics named in the page title when the plan has them.
@@ -115,7 +116,7 @@ def page_data(
         for i, b in enumerate(bases)
     ]
     arms = [
-        _arm_trace(a, f"arm {a.name}", _posed(a, poses[i][0]), ARM_COLOURS[i % 2])
+        _arm_trace(a, f"arm {a.name}", _posed(a, poses[i][0]), ARM_COLOURS[i % len(ARM_COLOURS)])
         for i, a in enumerate(moving)
     ]
     obj_poses, _ = timeline.object_poses(times[:1])
@@ -159,7 +160,11 @@ def page_data(
         "t1": timeline.t_end,
         "times": [round(float(t), 4) for t in times],
         "figure": figure,
-        "traces": {"arms": [n, n + 1], "objects": n + 2, "labels": n + 3},
+        "traces": {
+            "arms": list(range(n, n + len(arms))),
+            "objects": n + len(arms),
+            "labels": n + len(arms) + 1,
+        },
         "arms": [_arm_data(a, poses[i], tcps[i], grip[i], i) for i, a in enumerate(moving)],
         "objects": [
             {
@@ -227,7 +232,7 @@ def _posed(arm: ArmDrawing, T: FloatArray) -> FloatArray:
 def _arm_data(arm: ArmDrawing, poses: FloatArray, tcp: FloatArray, grip: Grip, i: int) -> JSON:
     return {
         "name": arm.name,
-        "colour": ARM_COLOURS[i % 2],
+        "colour": ARM_COLOURS[i % len(ARM_COLOURS)],
         "links": list(arm.links),
         "local": typed_array(arm.vertices),
         "vlink": typed_array(arm.vertex_link, "i4"),
@@ -360,7 +365,13 @@ def _title(timeline: Timeline) -> str:
 
 def _layout(scene: Scene, z_top: float) -> JSON:
     sx, sy, _ = scene.table.size
-    xr, yr, zr = (-sx / 2 - 0.05, sx / 2 + 0.05), (-sy / 2 - 0.05, sy / 2 + 0.05), (-0.06, z_top)
+    bases = np.array([a.T_world_base[:2, 3] for a in scene.arms]).reshape(-1, 2)
+    # the table, and every arm's base with room around it (bases may stand past the table)
+    xr = (min(-sx / 2, float(bases[:, 0].min()) - 0.1) - 0.05,
+          max(sx / 2, float(bases[:, 0].max()) + 0.1) + 0.05)  # fmt: skip
+    yr = (min(-sy / 2, float(bases[:, 1].min()) - 0.1) - 0.05,
+          max(sy / 2, float(bases[:, 1].max()) + 0.1) + 0.05)  # fmt: skip
+    zr = (-0.06, z_top)
     span = xr[1] - xr[0]
 
     def axis(title: str, r: tuple[float, float]) -> JSON:

@@ -2,10 +2,10 @@
 (``.gif``).
 
 Each picture shows the workspace, every goal as a dashed outline, resting objects (green when at
-their goal, grey otherwise), held objects (in the colour of the arm holding them) and the two
-arms seen from above as thick lines through their link frames, with the gripper's jaw line. A
-storyboard panel shows the moment midway through carrying (or the middle of the step) and the
-path of each tool centre point during the step.
+their goal, grey otherwise), held objects (in the colour of the arm holding them) and every
+arm of the cell (one or more) seen from above as thick lines through their link frames, with
+the gripper's jaw line. A storyboard panel shows the moment midway through carrying (or the
+middle of the step) and the path of each tool centre point during the step.
 """
 
 from __future__ import annotations
@@ -29,11 +29,13 @@ from sdar_tamp.world.transforms import FloatArray
 #: Storyboard layout: panels per row, panel size [inch] and resolution [dots per inch].
 COLUMNS = 4
 PANEL_SIZE = (4.0, 2.6)
-#: How far past the table's edges the pictures reach [m] (arms lean out behind their bases).
+#: How far past the table's edges the pictures reach [m] (x, y); where an arm's base stands
+#: nearer than ``MARGIN[0]`` to the picture's edge, it reaches that far past the base (arms
+#: lean out behind their bases).
 MARGIN = (0.2, 0.08)
 DPI = 100
-#: Arm colours (first arm, second arm), as in the HTML viewer.
-ARM_COLOURS = ("#3a74c4", "#d9692a")
+#: Arm colours (first arm, second arm, ...; repeated past the last), as in the HTML viewer.
+ARM_COLOURS = ("#3a74c4", "#d9692a", "#3d9a4c", "#8a5bb8")
 SUFFIXES = (".png", ".gif")
 #: Tolerances for "at its goal": position [m] and yaw (modulo pi, the cuboid's symmetry) [rad].
 GOAL_TOL = (0.005, 0.02)
@@ -68,6 +70,11 @@ def write_storyboard(
     else:
         _animation(timeline, scene, out, fps)
     return out
+
+
+def arm_colour(index: int) -> str:
+    """The colour of the arm at ``index`` (plan order)."""
+    return ARM_COLOURS[index % len(ARM_COLOURS)]
 
 
 def panel_grid(n_panels: int) -> tuple[int, int]:
@@ -164,7 +171,8 @@ def _view(ax: Any, timeline: Timeline, scene: Scene) -> _Artists:
         for o in instance.objects
     ]
     arms, joints, jaws = [], [], []
-    for colour in ARM_COLOURS:
+    for a in range(len(timeline.arms)):
+        colour = arm_colour(a)
         (line,) = ax.plot([], [], "-", color=colour, lw=6, alpha=0.75, solid_capstyle="round",
                           zorder=5)  # fmt: skip
         (dots,) = ax.plot([], [], "o", color="white", mec=colour, ms=3.5, zorder=6)
@@ -173,8 +181,16 @@ def _view(ax: Any, timeline: Timeline, scene: Scene) -> _Artists:
         joints.append(dots)
         jaws.append(jaw)
     ax.set_aspect("equal")
-    ax.set_xlim(-sx / 2 - MARGIN[0], sx / 2 + MARGIN[0])
-    ax.set_ylim(-sy / 2 - MARGIN[1], sy / 2 + MARGIN[1])
+    bases = np.array([a.T_world_base[:2, 3] for a in scene.arms]).reshape(-1, 2)
+    reach = MARGIN[0]
+    ax.set_xlim(
+        min(-sx / 2 - MARGIN[0], float(bases[:, 0].min()) - reach),
+        max(sx / 2 + MARGIN[0], float(bases[:, 0].max()) + reach),
+    )
+    ax.set_ylim(
+        min(-sy / 2 - MARGIN[1], float(bases[:, 1].min()) - reach),
+        max(sy / 2 + MARGIN[1], float(bases[:, 1].max()) + reach),
+    )
     ax.tick_params(labelsize=6)
     return _Artists(ax, objects, labels, arms, joints, jaws)
 
@@ -188,7 +204,7 @@ def _update(view: _Artists, timeline: Timeline, t: float) -> None:
     at_goal = _at_goal(xy_yaw, instance.goal_poses())
     for i, rect in enumerate(corners(xy_yaw, instance.sizes()[:, :2])):
         arm = int(holder[0, i])
-        colour = ARM_COLOURS[arm] if arm >= 0 else ("#8fd18f" if at_goal[i] else "#c8c8c8")
+        colour = arm_colour(arm) if arm >= 0 else ("#8fd18f" if at_goal[i] else "#c8c8c8")
         view.objects[i].set_xy(rect)
         view.objects[i].set_facecolor(colour)
         view.objects[i].set_alpha(0.6 if arm >= 0 else 0.9)
@@ -209,7 +225,7 @@ def _tcp_paths(ax: Any, timeline: Timeline, seg: Segment) -> None:
     q = timeline.q_at(times)
     for a, arm in enumerate(timeline.arms):
         tcp = arm.tcp_poses(timeline.arm_q(q, a))[:, :2, 3]
-        ax.plot(tcp[:, 0], tcp[:, 1], ":", color=ARM_COLOURS[a], lw=1.2, zorder=4)
+        ax.plot(tcp[:, 0], tcp[:, 1], ":", color=arm_colour(a), lw=1.2, zorder=4)
 
 
 def _at_goal(xy_yaw: FloatArray, goals: FloatArray) -> Any:

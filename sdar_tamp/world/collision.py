@@ -1,14 +1,15 @@
-"""Collision checking of the dual-arm scene with coal (through pinocchio's broad phase).
+"""Collision checking of a cell's arms and scene with coal (through pinocchio's broad phase).
 
-Checked pairs:
+Checked pairs (for a cell of any number of arms):
 
-* arm against arm (every link and gripper shape of one arm against every one of the other);
+* arm against arm, for every pair of arms (every link and gripper shape of one arm against
+  every one of the other);
 * one arm against itself, links at least two joints apart (adjacent links are excluded);
 * arm against table (except the links fixed to the base and moved by the first joint, which
   stand on it);
 * arm against every resting object;
-* a held object against the other arm, its own arm's links but the last (never its last link
-  and gripper, which hold it), the table, every resting object and the other held object.
+* a held object against every other arm, its own arm's links but the last (never its last link
+  and gripper, which hold it), the table, every resting object and every other held object.
 
 Resting objects are not checked against each other or the table (that is the arrangement's
 job, see :mod:`sdar_tamp.world.instance`). Object boxes are shrunk by ``tolerance`` on every
@@ -70,7 +71,8 @@ class Clearance:
 
 
 class CollisionWorld:
-    """Both arms, the table, resting and held objects; answers collision queries.
+    """The cell's arms (one or more), the table, resting and held objects; answers collision
+    queries.
 
     Configurations ``q`` ``(layout.dof,)`` hold every arm's joints in the scene's
     :class:`~sdar_tamp.world.layout.ArmLayout` (``scene.layout``).
@@ -98,6 +100,7 @@ class CollisionWorld:
         self._scene = scene
         self._tolerance = tolerance
         self._arms = _dual_arm(scene)
+        self._owners = {shape.name: shape.arm for shape in self._arms.shapes}
         self._resting: dict[str, ObjectBox] = {}
         self._held: dict[str, tuple[str, FloatArray, ObjectBox]] = {}
         self.layout = scene.layout
@@ -199,6 +202,36 @@ class CollisionWorld:
             return Clearance(float("inf"), None)
         i = int(np.argmin(d))
         return Clearance(float(d[i]), CollisionPair(*geometry.pair_names[i]))
+
+    def owner(self, shape: str) -> str | None:
+        """The arm a shape belongs to: the arm of a link or gripper shape, the arm holding a
+        ``held:`` object; None for the table and resting objects."""
+        if shape.startswith("held:"):
+            name = shape[len("held:") :]
+            return next((arm for arm, held in self._held.items() if held[0] == name), None)
+        return self._owners.get(shape)
+
+    def arm_clearances(self, q: FloatArray | None = None) -> dict[tuple[str, str], Clearance]:
+        """For every pair of arms (scene order, each arm with what it holds), the smallest
+        signed distance between their shapes at ``q`` (default: current) [m] and the pair of
+        shapes realising it (an empty mapping for a cell of one arm)."""
+        geometry = self._scene_geometry()
+        self._set(q)
+        d = cm.pair_distances(self._arms, geometry, self._q)
+        names = self.layout.names
+        out = {
+            (a, b): Clearance(float("inf"), None)
+            for i, a in enumerate(names)
+            for b in names[i + 1 :]
+        }
+        for k, (first, second) in enumerate(geometry.pair_names):
+            a, b = self.owner(first), self.owner(second)
+            if a is None or b is None or a == b:
+                continue
+            key = (a, b) if names.index(a) < names.index(b) else (b, a)
+            if d[k] < out[key].distance:
+                out[key] = Clearance(float(d[k]), CollisionPair(first, second))
+        return out
 
     # -- internals ------------------------------------------------------------------------
     def _set(self, q: FloatArray | None) -> None:

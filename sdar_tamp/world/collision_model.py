@@ -1,4 +1,5 @@
-"""Typed adapter building the pinocchio model of both arms and the scene geometry.
+"""Typed adapter building the pinocchio model of a cell's arms (one or more) and the scene
+geometry.
 
 The arms are one pinocchio model whose joints follow the scene's :class:`ArmLayout`, each arm
 built from its own robot description with its link and joint names prefixed by the arm's
@@ -88,9 +89,10 @@ def _arm_model(spec: ArmSpec, text: str) -> tuple[Any, Any, FloatArray]:
 
 
 def build_dual_arm(scene: Scene) -> CellCollisionModel:
-    """The arms of ``scene`` in one pinocchio model, each from its own robot description and
-    joints (any other joint of the description locked, see ``ArmSpec.locked_joints``), bases
-    at their world poses."""
+    """The arms of ``scene`` (any number) in one pinocchio model, each from its own robot
+    description and joints (any other joint of the description locked, see
+    ``ArmSpec.locked_joints``), bases at their world poses. (The name is historical: the
+    model holds every arm of the cell.)"""
     texts = {u: read_urdf(u, scene.package_dirs) for u in dict.fromkeys(a.urdf for a in scene.arms)}
     model = pin.Model()
     geometry = pin.GeometryModel()
@@ -125,7 +127,7 @@ def build_dual_arm(scene: Scene) -> CellCollisionModel:
             )
         T_wrist_tool[spec.name] = se3_to_array(frame.placement)
         for gi, obj in enumerate(geometry.geometryObjects):
-            if not obj.name.startswith(f"{spec.name}_"):
+            if _owner(str(obj.name), scene.arm_names) != spec.name:
                 continue
             parent = int(obj.parentJoint)
             link = joints.index(parent) + 1 if parent in joints else 0
@@ -139,6 +141,13 @@ def build_dual_arm(scene: Scene) -> CellCollisionModel:
     return CellCollisionModel(
         model, model.createData(), geometry, tuple(shapes), layout, wrist, tool, T_wrist_tool
     )
+
+
+def _owner(shape: str, arms: tuple[str, ...]) -> str | None:
+    """The arm whose name, then ``_``, begins ``shape``: the longest such name (an arm ``s``
+    beside an arm ``s_e``: ``s_e_base_link_0`` is the second's)."""
+    found = [arm for arm in arms if shape.startswith(f"{arm}_")]
+    return max(found, key=len) if found else None
 
 
 def tool0_pose(arms: CellCollisionModel, q: FloatArray, arm: str) -> FloatArray:
@@ -168,7 +177,8 @@ def build_scene_geometry(
 ) -> SceneGeometry:
     """Add table, resting objects ``name -> (T_world_obj, size)`` and held objects
     ``arm -> (name, T_tool0_obj, size)`` to the arm shapes; activate the named ``pairs``.
-    Pairs of two arms' shapes count as colliding closer than ``arm_margin`` [m]."""
+    Pairs of two different arms' shapes (every pair of arms) count as colliding closer than
+    ``arm_margin`` [m]."""
     geometry = arms.arm_geometry.copy()
     sx, sy, sz = table_size
     table = pin.GeometryObject(
@@ -203,7 +213,8 @@ def build_scene_geometry(
     )
     data = geometry.createData()
     if arm_margin > 0.0:
-        owner = np.array([_arm_index(a, arms) for a in all_names])
+        index = {s.name: arms.layout.index(s.arm) for s in arms.shapes}
+        owner = np.array([index.get(name, -1) for name in all_names])  # -1: no arm's shape
         margins = np.where(
             active & (owner[:, None] >= 0) & (owner[None, :] >= 0)
             & (owner[:, None] != owner[None, :]),
@@ -212,11 +223,6 @@ def build_scene_geometry(
         data.setSecurityMargins(geometry, margins, True, False)
     manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(arms.model, geometry, data)
     return SceneGeometry(geometry, data, manager, names)
-
-
-def _arm_index(shape: str, arms: CellCollisionModel) -> int:
-    """The index of the arm a link or gripper shape belongs to (its name's prefix), else -1."""
-    return next((k for k, arm in enumerate(arms.wrist_joint) if shape.startswith(f"{arm}_")), -1)
 
 
 def any_collision(arms: CellCollisionModel, scene: SceneGeometry, q: FloatArray) -> bool:

@@ -220,10 +220,23 @@ def test_actions_are_read_by_name_through_the_vocabulary(
 
 def test_a_domain_without_the_vocabulary_cannot_be_decoded() -> None:
     text = domain_file("dual_arm_rearrangement").read_text(encoding="utf-8")
-    domain = parse_domain(text.replace("(:action place-both", "(:action put-both"))
+    domain = parse_domain(text.replace("(:action place\n", "(:action put\n"))
     problem_streams = rearrangement_streams()
-    with pytest.raises(ParameterError, match=r"the domain has no action.* place-both"):
+    with pytest.raises(ParameterError, match=r"the domain has no action\(s\) place$"):
         ActionDecoder(domain, problem_streams)
+
+
+def test_a_domain_without_two_gripper_actions_is_decoded() -> None:
+    """The two-gripper actions are optional: a domain (say, for k arms) that works several
+    grippers by consecutive one-gripper actions is read without them."""
+    text = domain_file("dual_arm_rearrangement").read_text(encoding="utf-8")
+    text = text.replace("(:action place-both", "(:action put-both")
+    decoder = ActionDecoder(parse_domain(text), rearrangement_streams())
+    g = object()
+    place, (one,) = decoder.gripper(Action("place", ("right", "o", "p", g, "q", "d")))
+    assert not place and one == GripperAction("right", "o", g)  # type: ignore[arg-type]
+    with pytest.raises(ParameterError, match="'place-both' is neither a move nor a gripper"):
+        decoder.gripper(Action("place-both", ()))
 
 
 def rearrangement_streams() -> Any:

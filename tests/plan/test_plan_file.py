@@ -73,7 +73,7 @@ def test_round_trip_is_exact(plan: PlanFile, tmp_path: Path) -> None:
     np.testing.assert_array_equal(loaded.q, plan.q)
     assert loaded.steps == plan.steps
     data = json.loads(path.read_text())
-    assert data["format"] == "sdar-plan" and data["version"] == 1
+    assert data["format"] == "sdar-plan" and data["version"] == 2
     assert data["units"] == {"length": "m", "angle": "rad", "time": "s"}
     assert data["arms"][0]["joints"][0] == "left_shoulder_pan_joint"
 
@@ -108,9 +108,15 @@ BAD: dict[str, tuple[Callable[[dict[str, Any]], object], str]] = {
     "not a list": (_set(["events"], {}), ": events: expected a list of events, got {}"),
     "unexpected key": (_set(["extra"], 1), ": extra: unexpected key"),
     "format": (_set(["format"], "other"), ": format: expected 'sdar-plan'"),
-    "version": (_set(["version"], 2), ": version: expected 1"),
+    "version": (_set(["version"], 3), ": version: expected one of [1, 2] (this reader), got 3"),
+    "version type": (_set(["version"], True), ": version: expected one of [1, 2]"),
     "units": (_set(["units", "length"], "mm"), ": units: expected"),
-    "arm count": (lambda d: d["arms"].pop(), ": arms: expected 2 items, got 1"),
+    "arm count": (
+        lambda d: (d.update(version=1), d["arms"].pop()),
+        ": arms: expected 2 arms (a version-1 file), got 1",
+    ),
+    "no arms": (_set(["arms"], []), ": arms: expected at least 1 arm (a version-2 file), got 0"),
+    "arms not a list": (_set(["arms"], {}), ": arms: expected a list of arms, got {}"),
     "arm names": (_set(["arms", 1, "name"], "left"), ": arms[1].name: expected a name"),
     "joints": (_set(["arms", 0, "joints"], []), ": arms[0].joints: expected the arm's joint"),
     "joints and home": (_set(["arms", 0, "joints"], ["a"]), ": arms[0].home: expected 1 numbers"),

@@ -861,7 +861,11 @@ def test_some_arm_offsets_make_the_arms_collide(base: Base) -> None:
     for m in _arm_offsets(base):
         v = _validate(base, m).violation
         assert v is not None
-        pairs = [p.split(" with ") for p in v.message.split(", ") if " with " in p]
+        text = v.message
+        if text.startswith("arms "):  # the arms in contact, then the shapes
+            assert text.startswith("arms left and right in contact: "), text
+            text = text.split(": ", 1)[1]
+        pairs = [p.split(" with ") for p in text.split(", ") if " with " in p]
         sides = [{a.split("_")[0], c.split("_")[0]} for a, c in pairs]
         if v.kind == "collision" and {"left", "right"} in sides:
             between.append(m.name)

@@ -125,7 +125,7 @@ INSTANCE_CASES: dict[str, Edit] = {
     "workspace": _set(["workspace"], {"x": [-0.2, 0.2]}),
 }
 SCENE_CASES: dict[str, Edit] = {
-    "three arms": lambda d: d["arms"].append(copy.deepcopy(d["arms"][0])),
+    "no arms": _set(["arms"], []),
     "no gripper": _drop(["gripper"]),
     "home of words": _set(["arms", 0, "home"], ["up"] * 6),
     "joint limit": _set(["arms", 0, "joint_limits", "wrist_4"], [-1.0]),
@@ -138,14 +138,19 @@ SCENE_CASES: dict[str, Edit] = {
 }
 PLAN_CASES: dict[str, Edit] = {
     "format": _set(["format"], "other-plan"),
-    "version": _set(["version"], 2),
+    "version": _set(["version"], 3),
+    "version 1 of three arms": lambda d: (
+        d.update(version=1),
+        d["arms"].append({**copy.deepcopy(d["arms"][0]), "name": "third"}),
+    ),
+    "no arms": _set(["arms"], []),
     "units": _set(["units", "length"], "mm"),
     "empty row": _set(["trajectory", "q", 3], []),
     "no joints": _set(["arms", 0, "joints"], []),
     "event type": _set(["events", 0, "type"], "grab"),
     "event key": _set(["events", 0, "force"], 10.0),
     "missing metrics": _drop(["metrics"]),
-    "one arm": lambda d: d["arms"].pop(),
+    "one arm in version 1": lambda d: (d.update(version=1), d["arms"].pop()),
     "transform": _set(["arms", 0, "T_world_base"], [[1, 0, 0, 0]] * 3),
     "metric value": _set(["metrics", "seed"], [0]),
     "step objects": _set(["steps", 0, "objects"], [""]),
