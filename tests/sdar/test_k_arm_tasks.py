@@ -226,3 +226,17 @@ def test_bad_arm_counts_are_refused() -> None:
         group_consecutive([Move("o0")], g, arms=0)
     with pytest.raises(ValueError, match="at least one move"):
         Step((), "pair")
+
+
+def test_abstract_figures_count_the_arms_of_the_instances_scene() -> None:
+    from sdar_tamp.app.abstract import abstract_figures
+
+    data = Path(__file__).parent / "data"
+    three = abstract_figures(data / "three_arm_cycle.yaml", "sdar")
+    assert (three.actions, three.buffer_moves, three.steps) == (3, 0, 1)
+    two = abstract_figures(data / "three_arm_cycle.yaml", "sdar", arms=2)
+    assert (two.actions, two.buffer_moves) == (4, 1)
+    one = abstract_figures(data / "one_arm_chain.yaml", "baseline")
+    assert (one.actions, one.steps) == (3, 3)
+    with pytest.raises(ParameterError, match="arms"):
+        abstract_figures(data / "one_arm_chain.yaml", "sdar", arms=0)
