@@ -13,7 +13,8 @@ use the symbolic kinematics without loading the planner):
   :mod:`~streams.motion.cartesian`, :mod:`~streams.motion.waypoints`;
 * the trajectory optimiser: :mod:`~streams.motion.optimiser` (:class:`TrajectoryOptimiser`),
   :mod:`~streams.motion.optimiser_records` (:class:`TrajOptOptions`), its NLP
-  (:mod:`~streams.motion.nlp`), sphere slots (:mod:`~streams.motion.slots`), background
+  (:mod:`~streams.motion.nlp`), sphere slots (:mod:`~streams.motion.slots`), the moving
+  arms' own problem when others wait (:mod:`~streams.motion.subsets`), background
   build and cache (:mod:`~streams.motion.optimiser_build`,
   :mod:`~streams.motion.optimiser_cache`), compiled derivatives
   (:mod:`~streams.motion.codegen`);

@@ -26,6 +26,7 @@ from streams.motion.optimiser_records import TrajOptOptions
 from streams.motion.phases import grasp_lifts, retreat_and_approach, transfer_problem
 from streams.motion.records import MotionRequest, MotionTally, TransferProblem
 from streams.motion.shape import ShapeOptions
+from streams.motion.subsets import SubsetOptimisers
 from streams.motion.transfers import DIRECT_LIFTS, REFINE_BENT, Transfers
 
 #: Clearance [m] a transfer taken without optimisation keeps from resting and held objects
@@ -71,6 +72,7 @@ class MotionPlanner:
         self.ctx = ctx
         cache = optimisers if optimisers is not None else OptimiserCache()
         self._build = cache.get(ctx, options)
+        self.subsets = SubsetOptimisers(ctx, self._build.options, cache)
         self.world = ctx.new_world()
         self.margin_world = ctx.new_world(margin=direct_margin)
         self.near_world = ctx.new_world(arm_margin=ARM_CLEARANCE)
@@ -103,6 +105,7 @@ class MotionPlanner:
             self.ctx, self._build, self.margin_world,
             tally if tally is not None else MotionTally(),
             direct=self.direct, direct_lifts=self.direct_lifts, refine_bent=self.refine_bent,
+            subsets=self.subsets,
         )  # fmt: skip
 
     def configure(self, request: MotionRequest) -> None:

@@ -23,6 +23,7 @@ from streams.motion.optimiser import TrajectoryOptimiser
 from streams.motion.optimiser_build import OptimiserBuild
 from streams.motion.optimiser_records import TransferQuery
 from streams.motion.records import MotionTally, TransferProblem, flag
+from streams.motion.subsets import MIN_ARMS, SubsetOptimisers, joint_columns, waiting_spheres
 from streams.motion.timing import spline_curve, time_parameterize
 from streams.motion.waypoints import straight_line
 
@@ -51,7 +52,10 @@ class Transfers:
     paths tried after the straight line (empty: the straight line only); ``direct=False``
     always optimises (the sphere model's own straight-line test still applies);
     ``refine_bent``: a bent path is handed to the optimiser as its warm start and the result
-    kept when it executes faster and passes the same check."""
+    kept when it executes faster and passes the same check. ``subsets``: with
+    :data:`~streams.motion.subsets.MIN_ARMS` arms or more, a transfer in which some arms wait
+    is optimised over the moving arms alone (:mod:`streams.motion.subsets`); None: always over
+    every arm."""
 
     def __init__(
         self,
@@ -63,8 +67,10 @@ class Transfers:
         direct: bool = True,
         direct_lifts: Sequence[float] = DIRECT_LIFTS,
         refine_bent: bool = REFINE_BENT,
+        subsets: SubsetOptimisers | None = None,
     ) -> None:
         self.ctx = ctx
+        self.subsets = subsets
         self.build = build
         self.margin_world = margin_world
         self.tally = tally
@@ -112,6 +118,9 @@ class Transfers:
             if direct is not None:
                 self.tally.direct_paths += 1
                 return self.refine_direct(problem, direct, fixed)
+        moving = tuple(i for i, waits in enumerate(fixed) if not waits)
+        if self._by_subset(q_a, q_b, moving):
+            return self._optimise_moving(problem, q_a, q_b, warm_start, moving)
         query = TransferQuery(
             q_a, q_b, problem.held, problem.obstacles, self.nominal_duration(q_a, q_b), fixed
         )
@@ -119,6 +128,46 @@ class Transfers:
         self.tally.optimisation_time += result.solve_time
         self.tally.ipopt_solves += int(result.rounds > 0)
         return result.path if result.success else None
+
+    def _by_subset(self, q_a: FloatArray, q_b: FloatArray, moving: tuple[int, ...]) -> bool:
+        """Whether the transfer is optimised over the ``moving`` arms alone: a cell of
+        :data:`~streams.motion.subsets.MIN_ARMS` arms or more, some arms waiting, and those
+        at the same joints at both ends."""
+        n = len(self.ctx.layout)
+        if self.subsets is None or n < MIN_ARMS or not 0 < len(moving) < n:
+            return False
+        waiting = [sl for i, sl in enumerate(self.ctx.layout.slices) if i not in moving]
+        return all(np.allclose(q_a[sl], q_b[sl]) for sl in waiting)
+
+    def _optimise_moving(
+        self,
+        problem: TransferProblem,
+        q_a: FloatArray,
+        q_b: FloatArray,
+        warm_start: FloatArray | None,
+        moving: tuple[int, ...],
+    ) -> FloatArray | None:
+        """The optimised transfer of the ``moving`` arms among the waiting ones (their spheres
+        as obstacles), every arm's joints in the path ``(K, dof)``."""
+        assert self.subsets is not None
+        _, build = self.subsets.get(moving)
+        cols = joint_columns(self.ctx, moving)
+        waiting = tuple(i for i in range(len(self.ctx.layout)) if i not in moving)
+        wc, wr = waiting_spheres(self.ctx, q_a, problem.held, waiting)
+        oc, orad = problem.obstacles
+        query = TransferQuery(
+            q_a[cols], q_b[cols], tuple(problem.held[i] for i in moving),
+            (np.concatenate([oc, wc]), np.concatenate([orad, wr])),
+            self.nominal_duration(q_a, q_b),
+        )  # fmt: skip
+        result = build.get().solve(query, None if warm_start is None else warm_start[:, cols])
+        self.tally.optimisation_time += result.solve_time
+        self.tally.ipopt_solves += int(result.rounds > 0)
+        if not result.success:
+            return None
+        path = np.tile(np.asarray(q_a, dtype=np.float64), (len(result.path), 1))
+        path[:, cols] = result.path
+        return path
 
     def refine_direct(
         self, problem: TransferProblem, direct: FloatArray, fixed: tuple[bool, ...] = ()

@@ -20,6 +20,7 @@ from sdar_tamp.world.scene import Workspace
 from sdar_tamp.world.transforms import inverse, pose_xyz_yaw
 from streams.context import WorldContext
 from streams.feasibility import prove_infeasible
+from streams.finger_blocking import cell_gripper_boxes
 from streams.grasps import sample_grasps
 from streams.ik import IKCandidate, IKRequest, solve_ik_candidates
 from streams.motion.cartesian import tool_pose_ik
@@ -436,3 +437,50 @@ def test_feasibility_proofs_with_one_and_three_arms(cells: dict[int, WorldContex
         assert boxed is not None and set(boxed.objects) == {"o0", "o1", "o2"}
         assert prove_infeasible(cells[k], instance(spread, trio[::-1])) is not None
         assert prove_infeasible(cells[k], instance(spread, spread[::-1])) is None
+
+
+def test_waiting_arms_are_obstacles_of_the_moving_one(
+    cells: dict[int, WorldContext], k_optimisers: OptimiserCache, planner: MotionPlanner
+) -> None:
+    """South moves past north, which waits in its way (west at home): the transfer is
+    optimised for south alone with north's spheres as obstacles, and checked with every arm."""
+    ctx = cells[3]
+    kin = ctx.kinematics["north"]
+    T = kin.fk_tcp(CROSS_START[6:12])
+    T[0, 3] = 0.05  # north above the middle of south's way
+    north = tool_pose_ik(kin, T, CROSS_START[6:12])
+    assert north is not None
+    q_a = ctx.layout.join({**{a: ctx.home(a) for a in ctx.arm_names}, "north": north,
+                           "south": CROSS_START[:6]})  # fmt: skip
+    q_b = ctx.layout.replace(q_a, "south", CROSS_GOAL[:6])
+    objects = _boxes({"a": (-0.2, -0.04, 0.0), "b": (0.2, -0.04, 0.0), "c": (0.2, 0.04, 0.0),
+                      "d": (-0.2, 0.04, 0.0)})  # fmt: skip
+    world = ctx.new_world()
+    configure_world(ctx, world, objects, {}, q_a)
+    straight = validate_trajectory(ctx, world, straight_line(q_a, q_b, 30))
+    assert not straight.ok and {straight.pairs[0].first[:5], straight.pairs[0].second[:5]} == {
+        "south", "north"}  # fmt: skip
+    moving = MotionPlanner(ctx, optimisers=k_optimisers, direct=False)
+    request = MotionRequest(q_a, q_b, objects)
+    result = plan_dual_motion(moving, request)
+    _independent_check(ctx, result, request)
+    assert result.ipopt_solves >= 1 and moving.subsets.sets == ((0,),)
+    assert result.trajectory is not None
+    for arm in ("north", "west"):
+        part = ctx.layout.part(result.trajectory.q, arm)
+        np.testing.assert_allclose(part, np.tile(ctx.layout.part(q_a, arm), (len(part), 1)))
+    # two arms are always optimised together (the two-arm planner)
+    two = planner.transfers()
+    assert two.subsets is not None and not two._by_subset(q_a[:12], q_b[:12], (0,))
+
+
+def test_grasp_blocking_boxes_of_arms_of_one_description(
+    ctx: WorldContext, cells: dict[int, WorldContext]
+) -> None:
+    """Arms of one description and gripper count once, however many the cell has."""
+    shipped = cell_gripper_boxes(ctx.scene)
+    for k in (1, 3, 4):
+        boxes = cell_gripper_boxes(cells[k].scene)
+        assert len(boxes) == len(shipped) > 0
+        for a, b in zip(boxes, shipped, strict=True):
+            np.testing.assert_allclose(a.T_tcp_box, b.T_tcp_box)
