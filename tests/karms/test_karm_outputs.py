@@ -122,6 +122,11 @@ def test_the_viewer_has_one_timeline_per_arm(
     assert {e["arm"] for e in data["events"]} == set(range(k))
     assert len(data["joints"]["data"]) == k * 2 * 6  # q and q-dot of six joints per arm
     assert data["validated"] is True and data["violation"] is None
+    view = data["figure"]["layout"]["scene"]
+    for axis, c in (("xaxis", 0), ("yaxis", 1)):  # every base in view, beyond the table too
+        low, high = view[axis]["range"]
+        bases = [a.T_world_base[c, 3] for a in scene.arms]
+        assert low < min(bases) - 0.1 and max(bases) + 0.1 < high
     board = write_storyboard(instance, plan, tmp_path / "k.png", scene)
     assert board.stat().st_size > 0 and len(ARM_COLOURS) >= 4
 
@@ -150,3 +155,24 @@ def test_the_commands_on_a_four_arm_plan(
     # the plan against the three-arm cell: a located error naming the arm counts
     assert main(["validate", str(instance), str(plan), "--scene", str(cells[3].file)]) != 0
     assert "arms: the cell has 3 arms, the plan 4" in capsys.readouterr().err
+
+
+def test_the_pictures_draw_every_arm_and_reach_past_every_base(
+    plans: dict[int, PlanFile], cells: dict[int, Scene], instances: dict[int, Instance]
+) -> None:
+    pytest.importorskip("matplotlib")
+    from sdar_tamp.viewer.storyboard import MARGIN, _figure, _update, _view, arm_colour
+
+    scene = cells[4]
+    timeline = Timeline.build(instances[4], plans[4], scene)
+    ax = _figure(4.0, 4.0).add_subplot()
+    view = _view(ax, timeline, scene)
+    _update(view, timeline, plans[4].duration / 2)
+    assert len(view.arms) == len(view.jaws) == 4
+    assert [line.get_color() for line in view.arms] == [arm_colour(a) for a in range(4)]
+    assert all(len(line.get_xdata()) > 2 for line in view.arms)  # each arm drawn
+    for limits, c in ((ax.get_xlim(), 0), (ax.get_ylim(), 1)):
+        bases = [a.T_world_base[c, 3] for a in scene.arms]
+        assert limits[0] <= min(bases) - MARGIN[0] + 1e-9
+        assert limits[1] >= max(bases) + MARGIN[0] - 1e-9
+    assert arm_colour(4) == arm_colour(0) != arm_colour(1)
