@@ -9,8 +9,9 @@ between them (checked every 1.5 cm), collides with the table, the other resting 
 itself or the other arm (held at ``other_q``, default its home pose).
 The gripper may touch the object being grasped (the fingers close on it); every other
 contact counts. Survivors are ranked by the joint distance of their pre-grasp from the arm's
-current configuration. :func:`compatible_pairs` then pairs candidates of the two arms whose
-configurations are collision-free together (the sub-task instantiation of SDAR-M).
+current configuration. :func:`compatible_tuples` then combines candidates of several arms (one
+per arm) whose configurations are collision-free together, cheapest total first
+(:func:`compatible_pairs` for two arms: the sub-task instantiation of SDAR-M).
 
 The closed-form part does not depend on the other objects: :class:`GraspIK` computes it once
 for every grasp of an object at a pose, and :func:`collision_free_candidates` filters it for
@@ -21,6 +22,7 @@ Values holding arrays (:class:`IKRequest`, :class:`IKCandidate`) compare by iden
 
 from __future__ import annotations
 
+import heapq
 from collections import OrderedDict
 from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass
@@ -259,31 +261,79 @@ def compatible_pairs(
     limit: int = 1,
 ) -> list[tuple[IKCandidate, IKCandidate]]:
     """Up to ``limit`` pairs (one candidate per arm, different objects), cheapest total cost
-    first, whose grasp and pre-grasp configurations are collision-free *together*.
+    first, whose grasp and pre-grasp configurations are collision-free *together*:
+    :func:`compatible_tuples` of two arms.
 
     ``first`` must hold candidates of the scene's first arm and ``second`` of the other.
     """
+    found = compatible_tuples(ctx, world, objects, (first, second), limit)
+    return [(a, b) for a, b in found]
+
+
+def compatible_tuples(
+    ctx: WorldContext,
+    world: CollisionWorld,
+    objects: Mapping[str, ObjectBox],
+    per_arm: Sequence[Sequence[IKCandidate]],
+    limit: int = 1,
+    max_checks: int = 10_000,
+) -> list[tuple[IKCandidate, ...]]:
+    """Up to ``limit`` tuples (one candidate of each list, each list one arm's, different
+    arms and objects), cheapest total cost first (ties by list positions), whose grasp and
+    pre-grasp configurations are collision-free *together*.
+
+    Tuples are enumerated best first from the lists sorted by cost (a heap over index
+    vectors: a tuple's successors raise one index), so no product of the lists is built;
+    at most ``max_checks`` tuples are examined.
+    """
+    if limit < 1 or max_checks < 1:
+        raise ParameterError(f"limit and max_checks must be >= 1, got {limit}, {max_checks}")
+    lists = [sorted(c, key=lambda x: x.cost) for c in per_arm]
+    if not lists or any(not c for c in lists):
+        return []
     ensure_objects(world, objects)
-    pairs = sorted(
-        ((a, b) for a in first for b in second if a.obj != b.obj),
-        key=lambda p: p[0].cost + p[1].cost,
-    )
-    out: list[tuple[IKCandidate, IKCandidate]] = []
-    for a, b in pairs:
-        if len(out) >= limit:
-            break
-        if _pair_collides(world, a, b, a.q, b.q) or _pair_collides(world, a, b, a.q_pre, b.q_pre):
+
+    def total(index: tuple[int, ...]) -> float:
+        return sum(lists[k][i].cost for k, i in enumerate(index))
+
+    start = (0,) * len(lists)
+    heap: list[tuple[float, tuple[int, ...]]] = [(total(start), start)]
+    seen = {start}
+    out: list[tuple[IKCandidate, ...]] = []
+    checks = 0
+    while heap and len(out) < limit and checks < max_checks:
+        _, index = heapq.heappop(heap)
+        for k in range(len(lists)):
+            if index[k] + 1 < len(lists[k]):
+                nxt = (*index[:k], index[k] + 1, *index[k + 1 :])
+                if nxt not in seen:
+                    seen.add(nxt)
+                    heapq.heappush(heap, (total(nxt), nxt))
+        combo = tuple(lists[k][i] for k, i in enumerate(index))
+        if len({c.arm for c in combo}) < len(combo) or len({c.obj for c in combo}) < len(combo):
             continue
-        out.append((a, b))
+        checks += 1
+        if _tuple_collides(ctx, world, combo, [c.q for c in combo]) or _tuple_collides(
+            ctx, world, combo, [c.q_pre for c in combo]
+        ):
+            continue
+        out.append(combo)
     return out
 
 
-def _pair_collides(
-    world: CollisionWorld, a: IKCandidate, b: IKCandidate, qa: FloatArray, qb: FloatArray
+def _tuple_collides(
+    ctx: WorldContext,
+    world: CollisionWorld,
+    combo: Sequence[IKCandidate],
+    qs: Sequence[FloatArray],
 ) -> bool:
-    if not world.in_collision(world.layout.join({a.arm: qa, b.arm: qb})):
+    """The arms at ``qs`` collide, except each gripper touching the object it grasps (the
+    arms not in ``combo`` at home)."""
+    parts = {a: ctx.home(a) for a in ctx.arm_names}
+    parts.update({c.arm: q for c, q in zip(combo, qs, strict=True)})
+    if not world.in_collision(world.layout.join(parts)):
         return False
-    allowed = {(a.arm, f"object:{a.obj}"), (b.arm, f"object:{b.obj}")}
+    allowed = {(c.arm, f"object:{c.obj}") for c in combo}
     return any(
         not any(_is_gripper_contact(p.first, p.second, arm, t) for arm, t in allowed)
         for p in world.report()

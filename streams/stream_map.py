@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
 from sdar_tamp.world.collision import ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
@@ -236,7 +237,7 @@ class RearrangementStreams:
         with_goals = np.minimum(clear, pool.clearance(self._corners(goals)))
         for avoid in (with_goals, clear):  # goals too if possible
             for margin in (GRASP_CORRIDOR, BUFFER_MARGIN):
-                found = dict.fromkeys(  # both arms may reach one pose: once
+                found = dict.fromkeys(  # several arms may reach one pose: once
                     p
                     for arm in self.ctx.arm_names
                     for p in pool.take(arm, avoid, BUFFERS_PER_ARM, seed, margin)
@@ -258,12 +259,29 @@ class RearrangementStreams:
             np.array([self.size(o)[:2] for o, _ in poses]),
         )
 
-    def combine_confs(
-        self, a1: str, q1: ArmConf, a2: str, q2: ArmConf
-    ) -> Iterator[tuple[CellConf]]:
-        if a1 == a2:
+    def combine_confs(self, *pairs: str | ArmConf) -> Iterator[tuple[CellConf]]:
+        """The cell configuration of one (arm, configuration) pair per arm of the cell
+        (``a1, q1, a2, q2, ...``: ``combine-confs`` is declared for the cell's arms), when
+        the arms are clear of each other; nothing when an arm is named twice or missing.
+
+        Raises:
+            ParameterError: an odd number of values, or a configuration of another arm.
+        """
+        if len(pairs) % 2:
+            raise ParameterError(
+                f"combine-confs: expected (arm, configuration) pairs, got {len(pairs)} values"
+            )
+        by_arm: dict[str, ArmConf] = {}
+        for arm, q in zip(pairs[::2], pairs[1::2], strict=True):
+            if not isinstance(arm, str) or not isinstance(q, ArmConf) or q.arm != arm:
+                raise ParameterError(
+                    f"combine-confs: expected an arm and its configuration, got {arm!r}, {q!r}"
+                )
+            if arm in by_arm:
+                return
+            by_arm[arm] = q
+        if set(by_arm) != set(self.ctx.arm_names):
             return
-        by_arm = {a1: q1, a2: q2}
         conf = CellConf(*(by_arm[a] for a in self.ctx.arm_names))
         if not self._arms_only.in_collision(conf.q):
             yield (conf,)

@@ -1,18 +1,27 @@
-; Synchronous dual-arm tabletop rearrangement.
+; Synchronous multi-arm tabletop rearrangement (k arms; the shipped paper cell has two).
 ;
-; The two arms always move together: a (move ?d1 ?t ?d2) takes both arms from one dual-arm
+; The arms always move together: a (move ?d1 ?t ?d2) takes every arm from one cell
 ; configuration to another along one synchronous trajectory (an arm that has nothing to do
-; waits in place). Between motions the grippers act: one arm alone (pick / place, while the
-; other arm holds an object or waits) or both at the same instant (pick-both / place-both,
-; e.g. the two halves of a dual-arm swap). Objects go to their goals or to buffers (free
-; temporary poses) with the same actions.
+; waits in place). A cell configuration (type dualconf, named for the two-arm cell it began
+; with) holds one (confin ?d ?a ?q) fact per arm, so nothing here counts the arms. Between
+; motions the grippers act: one arm alone (pick / place, while the other arms hold objects or
+; wait), two at the same instant (pick-both / place-both, e.g. the two halves of a dual-arm
+; swap), or three or more at the same instant, written as consecutive pick / place actions at
+; one configuration with no move between them (e.g. an m-cycle rotated by m arms: every object
+; lifted, then every object placed). A PDDL action has a fixed arity, so a gripper action for
+; every number of arms would need one action per count; consecutive actions need none, each
+; placement's precondition then sees the objects placed before it at that instant (their
+; clearance is certified pairwise), and the plan's timeline makes them one instant with one
+; dwell. Objects go to their goals or to buffers (free temporary poses) with the same actions.
 ;
 ; A placement needs a free pose: (unsafe ?o ?p) holds when some other resting object is not
 ; certified collision-free with ?o at ?p (closed world: an untested pair counts as unsafe).
 ;
 ; Costs are execution time [s]: a motion costs its duration, a gripper action the problem's
-; (gripper-time), whether one gripper or both act. (distance ?d1 ?d2) estimates a motion's
-; duration before it is planned (used to rank candidates).
+; (gripper-time), whether one gripper or both act; consecutive pick / place actions at one
+; instant each count one (gripper-time), so for three or more grippers at once the total cost
+; exceeds the plan's execution time, which counts one dwell per instant. (distance ?d1 ?d2)
+; estimates a motion's duration before it is planned (used to rank candidates).
 (define (domain dual-arm-rearrangement)
   (:requirements :strips :typing :equality :negative-preconditions :existential-preconditions
                  :derived-predicates :action-costs)

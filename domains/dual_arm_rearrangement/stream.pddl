@@ -1,7 +1,8 @@
-; Streams of synchronous dual-arm rearrangement (bound in streams/stream_map.py).
+; Streams of synchronous multi-arm rearrangement (bound in streams/stream_map.py).
 ; Poses are planar object poses (x, y, yaw); arm configurations are per arm, combined into
-; dual-arm configurations between which synchronous motions are planned. Type names used as
-; unary facts type the outputs (grasp, armconf, pose, dualconf, traj).
+; cell configurations (every arm; type dualconf) between which synchronous motions are
+; planned. Type names used as unary facts type the outputs (grasp, armconf, pose, dualconf,
+; traj).
 (define (stream dual-arm-rearrangement)
   ; grasps of an object: top-down first, then growing tilt angles
   (:stream sample-grasp
@@ -18,7 +19,9 @@
     :inputs (?o) :domain (obj ?o)
     :fluents (atpose)
     :outputs (?p) :certified (and (pose ?p) (objpose ?o ?p) (buffer ?p)))
-  ; a dual-arm configuration from one configuration per arm (the two arms clear of each other)
+  ; a cell configuration from one configuration per arm (the arms clear of each other).
+  ; Declared here for the two-arm cell; for a cell of k arms the problem declares it with k
+  ; pairs, ?a1 ?q1 ... ?ak ?qk, each arm's facts as the first's (sdar_tamp/app/cell_streams.py)
   (:stream combine-confs
     :inputs (?a1 ?q1 ?a2 ?q2) :domain (and (confof ?a1 ?q1) (confof ?a2 ?q2))
     :outputs (?d) :certified (and (dualconf ?d) (confin ?d ?a1 ?q1) (confin ?d ?a2 ?q2)))

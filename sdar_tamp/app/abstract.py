@@ -8,9 +8,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sdar_tamp.app.config import TASK_PLANNERS, check_choice
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
 from sdar_tamp.world.dependency import instance_dependency_graph
 from sdar_tamp.world.instance import load_instance
+from sdar_tamp.world.scene import load_scene
 from solvers.sdar.abstract import AbstractRunError, run_abstract
 from solvers.sdar.planners import make_task_planner
 
@@ -26,12 +28,21 @@ class AbstractFigures:
     steps: int | None
 
 
-def abstract_figures(instance_path: Path, task_planner: str) -> AbstractFigures:
-    """The geometry-free run of ``task_planner`` on the instance in ``instance_path``."""
+def abstract_figures(
+    instance_path: Path, task_planner: str, arms: int | None = None
+) -> AbstractFigures:
+    """The geometry-free run of ``task_planner`` on the instance in ``instance_path`` for a
+    cell of ``arms`` arms (default: the arms of the instance's scene, or of the default
+    scene)."""
     check_choice("task_planner", task_planner, TASK_PLANNERS)
-    graph = instance_dependency_graph(load_instance(instance_path))
+    instance = load_instance(instance_path)
+    graph = instance_dependency_graph(instance)
+    if arms is None:
+        arms = len(load_scene(instance.scene_path(instance_path)).arms)
+    if arms < 1:
+        raise ParameterError(f"arms must be None or >= 1, got {arms}")
     try:
-        run = run_abstract(make_task_planner(task_planner), graph)
+        run = run_abstract(make_task_planner(task_planner), graph, arms=arms)
     except AbstractRunError as error:
         LOG.warning("%s: abstract %s run failed: %s", instance_path.stem, task_planner, error)
         return AbstractFigures(None, None, None)

@@ -1,9 +1,11 @@
-"""How an instance becomes a problem: the dual-arm domain, its init facts and its streams.
+"""How an instance becomes a problem: the rearrangement domain, its init facts and its streams.
 
 :func:`rearrangement_problem` turns an :class:`~sdar_tamp.world.instance.Instance` into a
 :class:`~sdar_tamp.language.problem.PDDLProblem` of ``domains/dual_arm_rearrangement`` (init
 facts over Python values, the goal, the stream map of :mod:`streams.stream_map`), configured
-by a :class:`~sdar_tamp.app.config.PlannerConfig`.
+by a :class:`~sdar_tamp.app.config.PlannerConfig`. The cell may have any number of arms: the
+initial cell configuration holds one ``confin`` fact per arm, and ``combine-confs`` is
+declared for the cell's arms (:func:`~sdar_tamp.app.cell_streams.streams_for_arms`).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from sdar_tamp.app.cell_streams import streams_for_arms
 from sdar_tamp.app.config import MOTION_PLANNERS, PlannerConfig, check_choice
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.generators import from_gen_fn, from_test
@@ -96,7 +99,7 @@ def rearrangement_problem(
     wrapped = {name: _wrap(STREAM_KINDS[name], fn) for name, fn in stream_map.items()}
     arms = ctx.arm_names
     confs = {a: ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in arms}
-    home = CellConf(confs[arms[0]], confs[arms[1]])
+    home = CellConf(*(confs[a] for a in arms))
     init: list[tuple[Any, ...]] = [("dualconf", home), ("atdualconf", home)]
     init.append(("=", ("gripper-time",), float(config.gripper_time)))
     for a in arms:
@@ -110,7 +113,7 @@ def rearrangement_problem(
     problem = PDDLProblem(
         domain_file(DOMAIN).read_text(encoding="utf-8"),
         {},
-        domain_file(DOMAIN, "stream.pddl").read_text(encoding="utf-8"),
+        streams_for_arms(domain_file(DOMAIN, "stream.pddl").read_text(encoding="utf-8"), len(arms)),
         wrapped,
         init,
         goal,

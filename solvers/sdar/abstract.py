@@ -39,8 +39,11 @@ class AbstractRun:
     buffer_moves: int
 
 
-def view_of(graph: DependencyGraph, at_goal: frozenset[str], in_buffer: frozenset[str]) -> TaskView:
-    """The view of ``graph`` (edges over start poses) once some objects have moved."""
+def view_of(
+    graph: DependencyGraph, at_goal: frozenset[str], in_buffer: frozenset[str], arms: int = 2
+) -> TaskView:
+    """The view of ``graph`` (edges over start poses) once some objects have moved, for a cell
+    of ``arms`` arms."""
     keep = [i for i, name in enumerate(graph.names) if name not in at_goal]
     index = {old: new for new, old in enumerate(keep)}
     moved = at_goal | in_buffer
@@ -50,7 +53,7 @@ def view_of(graph: DependencyGraph, at_goal: frozenset[str], in_buffer: frozense
         if i in index and j in index and graph.names[j] not in moved
     )
     names = tuple(graph.names[i] for i in keep)
-    return TaskView(DependencyGraph(names, edges), at_goal, in_buffer - at_goal)
+    return TaskView(DependencyGraph(names, edges), at_goal, in_buffer - at_goal, arms=arms)
 
 
 def first_candidate(candidates: Sequence[Step], view: TaskView) -> Step:
@@ -63,11 +66,14 @@ def run_abstract(
     graph: DependencyGraph,
     choose: Chooser = first_candidate,
     max_steps: int | None = None,
+    arms: int = 2,
 ) -> AbstractRun:
-    """Run ``planner`` until every object of ``graph`` is at its goal.
+    """Run ``planner`` for a cell of ``arms`` arms until every object of ``graph`` is at its
+    goal.
 
-    Raises :class:`AbstractRunError` if a chosen step is invalid, the planner proposes nothing
-    while objects remain, or more than ``max_steps`` (default ``4 n + 4``) steps are taken.
+    Raises :class:`AbstractRunError` if a chosen step is invalid (more moves than arms
+    included), the planner proposes nothing while objects remain, or more than ``max_steps``
+    (default ``4 n + 4``) steps are taken.
     """
     limit = 4 * graph.n + 4 if max_steps is None else max_steps
     at_goal: frozenset[str] = frozenset()
@@ -76,7 +82,7 @@ def run_abstract(
     while len(at_goal) < graph.n:
         if len(steps) >= limit:
             raise AbstractRunError(f"{planner.name}: not finished after {limit} steps")
-        view = view_of(graph, at_goal, in_buffer)
+        view = view_of(graph, at_goal, in_buffer, arms)
         candidates = planner.candidates(view)
         if not candidates:
             raise AbstractRunError(f"{planner.name}: no candidate for {view.remaining}")
@@ -92,6 +98,8 @@ def run_abstract(
     return AbstractRun(tuple(steps), sum(len(s.moves) for s in steps), buffers)
 
 
-def count_actions(planner_factory: Callable[[], TaskPlanner], graph: DependencyGraph) -> int:
+def count_actions(
+    planner_factory: Callable[[], TaskPlanner], graph: DependencyGraph, arms: int = 2
+) -> int:
     """Pick-and-places a fresh planner needs on ``graph`` when its first choice always works."""
-    return run_abstract(planner_factory(), graph).actions
+    return run_abstract(planner_factory(), graph, arms=arms).actions

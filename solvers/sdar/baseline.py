@@ -1,7 +1,7 @@
 """The baseline task planner: our reconstruction of Gao & Yu (IROS 2022), "GaoYu22IROS".
 
 The original code is not public; this follows the paper's description of it (section IV-A:
-"first searches for an optimal plan for a single robot arm", then splits it over two arms):
+"first searches for an optimal plan for a single robot arm", then splits it over the arms):
 
 1. :func:`optimal_single_arm_plan`: with free buffer space, the fewest pick-and-places of one
    arm are ``n + |minimum feedback vertex set|`` (objects outside the set go start -> goal
@@ -10,8 +10,9 @@ The original code is not public; this follows the paper's description of it (sec
    The sequence repeats: an object on a buffer goes to its goal as soon as the goal is free;
    else an object on its start with a free goal goes there (so ``j`` before ``i`` when
    ``i -> j``); else a member of the set goes to a buffer (the one blocking most goals).
-2. :func:`pair_consecutive`: consecutive actions of two different objects that form a valid
-   synchronous step (both picked, then both placed) share a step; otherwise one arm moves alone.
+2. :func:`group_consecutive`: up to ``k`` consecutive actions of different objects that form a
+   valid synchronous step (all picked, then all placed) share a step, greedily from the front
+   (:func:`pair_consecutive` for two arms); otherwise one arm moves alone.
 
 :class:`BaselineTaskPlanner` proposes the next planned step first, then valid one-move
 fallbacks. When SDAR-M executes only part of a pair, :meth:`~BaselineTaskPlanner.commit` drops
@@ -29,6 +30,7 @@ from solvers.sdar.tasks import Move, Step, TaskView, step_is_valid
 
 __all__ = [
     "BaselineTaskPlanner",
+    "group_consecutive",
     "minimum_feedback_vertex_set",
     "optimal_single_arm_plan",
     "pair_consecutive",
@@ -70,22 +72,41 @@ def optimal_single_arm_plan(
 def pair_consecutive(
     moves: list[Move], graph: DependencyGraph, in_buffer: frozenset[str] = frozenset()
 ) -> list[Step]:
-    """Split a valid single-arm sequence into synchronous steps of one or two moves (``plan``).
+    """Split a valid single-arm sequence into synchronous steps of one or two moves (``plan``):
+    :func:`group_consecutive` for two arms."""
+    return group_consecutive(moves, graph, in_buffer, arms=2)
 
-    Moves ``k`` and ``k + 1`` share a step when they move different objects and the pair is
-    valid from the arrangement before move ``k``; pairing is greedy from the front.
+
+def group_consecutive(
+    moves: list[Move],
+    graph: DependencyGraph,
+    in_buffer: frozenset[str] = frozenset(),
+    arms: int = 2,
+) -> list[Step]:
+    """Split a valid single-arm sequence into synchronous steps of up to ``arms`` moves
+    (``plan``).
+
+    Move ``k + 1`` joins the step of moves ``k...`` when it moves an object the step does not
+    and the longer step is valid from the arrangement before the step; grouping is greedy from
+    the front.
     """
+    if arms < 1:
+        raise ParameterError(f"arms must be >= 1, got {arms}")
     at_goal: frozenset[str] = frozenset()
     buffered = in_buffer
     steps: list[Step] = []
     k = 0
     while k < len(moves):
-        view = view_of(graph, at_goal, buffered)
+        view = view_of(graph, at_goal, buffered, arms)
         step = Step((moves[k],), "plan")
-        if k + 1 < len(moves) and moves[k].obj != moves[k + 1].obj:
-            pair = Step((moves[k], moves[k + 1]), "plan")
-            if step_is_valid(pair, view):
-                step = pair
+        while k + len(step.moves) < len(moves) and len(step.moves) < arms:
+            following = moves[k + len(step.moves)]
+            if following.obj in step.objects:
+                break
+            longer = Step((*step.moves, following), "plan")
+            if not step_is_valid(longer, view):
+                break
+            step = longer
         for m in step.moves:
             if m.to_buffer:
                 buffered |= {m.obj}
@@ -113,7 +134,7 @@ def _fits(queue: list[Move], view: TaskView) -> bool:
 
 
 class BaselineTaskPlanner:
-    """Optimal single-arm plan, split over two arms by pairing consecutive actions."""
+    """Optimal single-arm plan, split over the view's arms by grouping consecutive actions."""
 
     def __init__(self, node_budget: int | None = 200_000) -> None:
         self.node_budget = node_budget
@@ -132,7 +153,9 @@ class BaselineTaskPlanner:
             fvs = feedback_vertex_set(view.graph, node_budget=self.node_budget)
             self.exact = self.exact and fvs.exact
             self._queue = optimal_single_arm_plan(view.graph, view.in_buffer, fvs.members)
-        planned = pair_consecutive(self._queue[:2], view.graph, view.in_buffer)[0]
+        planned = group_consecutive(
+            self._queue[: view.arms], view.graph, view.in_buffer, view.arms
+        )[0]
         out = [planned]
         seen = {planned.moves}
         fallbacks = [Step((m,), "plan", 1) for m in planned.moves]

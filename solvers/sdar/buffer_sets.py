@@ -10,13 +10,19 @@ Two problems share one exact search:
   strongly connected component has at most two objects. A 2-cycle ``i <-> j`` is resolved by a
   dual-arm swap, and objects resolved in one synchronous step form at most a pair, so
   ``n + |minimum buffer set|`` is the fewest actions of two synchronous arms.
+* **buffer set for k synchronous arms** (``arms=k``): remove vertices until every strongly
+  connected component has at most ``k`` objects: ``k`` arms lift every object of such a
+  component at once and place each at its goal (a rotation, which generalises the swap).
+  ``arms=1`` is the feedback vertex set, ``arms=2`` the dual-arm buffer set.
 
 Search: iterative deepening on the set size. A vertex set is split into its bad components
-(size >= 2, or >= 3 with swaps), solved one by one; inside a component it branches on the vertices
-of a small obstruction, one of which every solution contains: a shortest cycle (of length >= 3
-with swaps; when all cycles are 2-cycles, a path ``a <-> b <-> c``). A packing of disjoint
-obstructions bounds from below; failed (set, size) pairs are memoised. ``node_budget`` caps the
-search nodes; past it the component falls back to a greedy set and ``exact`` is ``False``.
+(more than ``k`` objects), solved one by one; inside a component it branches on the vertices of
+a small obstruction, one of which every solution contains: for ``k <= 2`` a shortest cycle (of
+length >= 3 with swaps; when all cycles are 2-cycles, a path ``a <-> b <-> c``); for ``k >= 3`` a
+strongly connected set of more than ``k`` objects grown from a shortest cycle by shortest ears
+(a path out of the set and back). A packing of disjoint obstructions bounds from below; failed
+(set, size) pairs are memoised. ``node_budget`` caps the search nodes; past it the component
+falls back to a greedy set and ``exact`` is ``False``.
 """
 
 from __future__ import annotations
@@ -40,13 +46,22 @@ class _OutOfBudget(Exception):
     pass
 
 
+def _largest(allow_swaps: bool, arms: int | None) -> int:
+    """The largest component a solution may leave: ``arms``, else 2 with swaps, else 1."""
+    if arms is None:
+        return 2 if allow_swaps else 1
+    if arms < 1:
+        raise ParameterError(f"arms must be None or >= 1, got {arms}")
+    return arms
+
+
 class _Search:
-    def __init__(self, graph: DependencyGraph, allow_swaps: bool, budget: int | None) -> None:
+    def __init__(self, graph: DependencyGraph, largest: int, budget: int | None) -> None:
         self.succ: list[set[int]] = [set() for _ in range(graph.n)]
         for i, j in graph.edges:
             if i != j:
                 self.succ[i].add(j)
-        self.min_size = 3 if allow_swaps else 2
+        self.min_size = largest + 1
         self.budget = budget
         self.nodes = 0
         self.lower: dict[frozenset[int], int] = {}
@@ -119,12 +134,54 @@ class _Search:
 
     def obstruction(self, comp: frozenset[int]) -> list[int]:
         """Vertices of which every solution holds one, most connected first."""
+        if self.min_size > 3:
+            return self.grown(comp)
         cycle = self.short_cycle(comp)
         if cycle is None:  # swaps allowed and only 2-cycles: a path a <-> b <-> c
             b = min(comp, key=lambda v: (-len(self.succ[v] & comp), v))
             a, c = sorted(self.succ[b] & comp)[:2]
             cycle = [b, a, c]
         return sorted(cycle, key=lambda v: (-len(self.succ[v] & comp), v))
+
+    def grown(self, comp: frozenset[int]) -> list[int]:
+        """A strongly connected set of at least ``min_size`` vertices of ``comp`` (a bad
+        component): a shortest cycle, then shortest ears (out of the set and back) until it
+        is large enough. A solution that kept all of it would keep a component too large."""
+        found: list[int] | None = None
+        for v in sorted(comp):
+            for u in sorted(self.succ[v] & comp):
+                path = self.path(u, v, comp, None)
+                if path is not None and (found is None or len(path) < len(found)):
+                    found = [v, *path[:-1]]
+        assert found is not None  # a bad component holds a cycle
+        members = set(found)
+        while len(members) < self.min_size:
+            best: list[int] | None = None
+            for v in sorted(members):
+                for w in sorted((self.succ[v] & comp) - members):
+                    back = self._path_to(w, members, comp)
+                    if back is not None and (best is None or len(back) < len(best)):
+                        best = back
+            assert best is not None  # comp is strongly connected and larger than members
+            members |= set(best)
+        return sorted(members, key=lambda v: (-len(self.succ[v] & comp), v))
+
+    def _path_to(self, src: int, targets: set[int], comp: frozenset[int]) -> list[int] | None:
+        """The vertices of a shortest path from ``src`` into ``targets`` (before entering)."""
+        parent = {src: src}
+        queue = deque([src])
+        while queue:
+            v = queue.popleft()
+            for w in sorted(self.succ[v] & comp):
+                if w in targets:
+                    out = [v]
+                    while out[-1] != src:
+                        out.append(parent[out[-1]])
+                    return out
+                if w not in parent:
+                    parent[w] = v
+                    queue.append(w)
+        return None
 
     def short_cycle(self, comp: frozenset[int]) -> list[int] | None:
         best: list[int] | None = None
@@ -173,12 +230,17 @@ class _Search:
 
 
 def feedback_vertex_set(
-    graph: DependencyGraph, *, allow_swaps: bool = False, node_budget: int | None = None
+    graph: DependencyGraph,
+    *,
+    allow_swaps: bool = False,
+    node_budget: int | None = None,
+    arms: int | None = None,
 ) -> FeedbackSet:
-    """A minimum FVS (or buffer set with ``allow_swaps``); greedy per component past the budget."""
+    """A minimum FVS (or buffer set with ``allow_swaps``, or for ``arms`` arms); greedy per
+    component past the budget."""
     if node_budget is not None and node_budget < 1:
         raise ParameterError(f"node_budget must be None or >= 1, got {node_budget}")
-    search = _Search(graph, allow_swaps, node_budget)
+    search = _Search(graph, _largest(allow_swaps, arms), node_budget)
     members: set[int] = set()
     exact = True
     for comp in search.bad_components(frozenset(range(graph.n))):
@@ -196,27 +258,35 @@ def minimum_feedback_vertex_set(graph: DependencyGraph) -> frozenset[str]:
     return feedback_vertex_set(graph).members
 
 
-def minimum_buffer_set(graph: DependencyGraph) -> frozenset[str]:
-    """The fewest objects to buffer when 2-cycles are swapped by two synchronous arms."""
-    return feedback_vertex_set(graph, allow_swaps=True).members
+def minimum_buffer_set(graph: DependencyGraph, arms: int = 2) -> frozenset[str]:
+    """The fewest objects to buffer when cycles of up to ``arms`` objects are rotated by that
+    many synchronous arms (two: 2-cycles swapped)."""
+    return feedback_vertex_set(graph, arms=arms).members
 
 
-def breaks_cycles(graph: DependencyGraph, members: frozenset[str], allow_swaps: bool) -> bool:
-    """Removing ``members`` leaves no cycle (no component above two objects with swaps)."""
-    search = _Search(graph, allow_swaps, None)
+def breaks_cycles(
+    graph: DependencyGraph, members: frozenset[str], allow_swaps: bool, arms: int | None = None
+) -> bool:
+    """Removing ``members`` leaves no cycle (no component above two objects with swaps, above
+    ``arms`` objects when given)."""
+    search = _Search(graph, _largest(allow_swaps, arms), None)
     keep = frozenset(i for i, name in enumerate(graph.names) if name not in members)
     return not search.bad_components(keep)
 
 
 def optimal_choices(
-    graph: DependencyGraph, *, allow_swaps: bool, node_budget: int | None = None
+    graph: DependencyGraph,
+    *,
+    allow_swaps: bool,
+    node_budget: int | None = None,
+    arms: int | None = None,
 ) -> frozenset[str] | None:
     """The objects that belong to some minimum set; ``None`` when the budget ran out.
 
     Buffering any of them first keeps the total optimal: the rest of the graph then needs one
-    object fewer.
+    object fewer. ``arms`` replaces ``allow_swaps`` (see the module docstring).
     """
-    search = _Search(graph, allow_swaps, node_budget)
+    search = _Search(graph, _largest(allow_swaps, arms), node_budget)
     good: set[int] = set()
     try:
         for comp in search.bad_components(frozenset(range(graph.n))):
@@ -233,9 +303,10 @@ def extending_minimum(
     *,
     allow_swaps: bool,
     node_budget: int | None = None,
+    arms: int | None = None,
 ) -> list[frozenset[str]] | None:
     """The ``options`` that some minimum set contains; ``None`` when the budget ran out."""
-    search = _Search(graph, allow_swaps, node_budget)
+    search = _Search(graph, _largest(allow_swaps, arms), node_budget)
     everything = frozenset(range(graph.n))
     out: list[frozenset[str]] = []
     try:

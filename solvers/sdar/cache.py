@@ -130,5 +130,13 @@ class StreamCache:
         (d,) = next(self.state.atoms(self.voc.atdualconf))
         return d
 
+    def current_arm_conf(self, arm: str) -> str:
+        """The configuration of ``arm`` in the current cell configuration (its ``confin``)."""
+        d = self.current_dualconf()
+        for d2, a, q in self.state.atoms(self.voc.confin):
+            if d2 == d and a == arm:
+                return q
+        raise ParameterError(f"no ({self.voc.confin} {d} {arm} ?q) fact for the current state")
+
     def current_poses(self) -> dict[str, str]:
         return {o: p for o, p in self.state.atoms(self.voc.atpose)}

@@ -3,6 +3,12 @@
 Every motion of a grounding is planned, in the state it starts from, before any action is
 applied, so a failed grounding leaves nothing in the plan. Applied actions are checked
 against the domain's lifted preconditions (:class:`~solvers.sdar.state.LiftedState`).
+
+Gripper actions at one configuration: one gripper is a ``pick`` / ``place``, two are a
+``pick-both`` / ``place-both`` (the two-arm swap's), three or more are consecutive ``pick`` /
+``place`` actions with no ``move`` between (one instant and one dwell on the plan's timeline;
+each placement's precondition then sees the objects placed before it, whose clearance is
+certified for every ordered pair).
 """
 
 from __future__ import annotations
@@ -138,11 +144,11 @@ class Executor:
         ]
         single = voc.pick if which == "pick" else voc.place
         both = voc.pick_both if which == "pick" else voc.place_both
-        if len(parts) == 1:
-            arm, obj, pose, grasp, conf = parts[0]
-            self.apply(single, arm, obj, pose, grasp, conf, d)
-        else:
+        if len(parts) == 2:
             self.apply(both, d, *parts[0], *parts[1])
+            return
+        for arm, obj, pose, grasp, conf in parts:  # one, or more grippers at one instant
+            self.apply(single, arm, obj, pose, grasp, conf, d)
 
     def _certify_placements(self, g: Grounding, targets: Sequence[str]) -> None:
         cfree = self.cache.voc.cfree
@@ -151,12 +157,12 @@ class Executor:
         for obj, target in placed:
             for other, pose in resting.items():
                 self.cache.test(cfree, (obj, target, other, pose))
-        if len(placed) == 2:
-            self.cache.test(cfree, (*placed[0], *placed[1]))
+        for a, b in _placed_pairs(placed):
+            self.cache.test(cfree, (*a, *b))
 
     def _placeable(self, g: Grounding, targets: Sequence[str]) -> bool:
         """Every target is certified clear of the objects resting after the pick (and of the
-        other target)."""
+        other targets)."""
         cache = self.cache
         lifted = set(g.step.objects)
         resting = {o: p for o, p in cache.current_poses().items() if o not in lifted}
@@ -167,6 +173,15 @@ class Executor:
             for obj, t in placed
             for other, p in resting.items()
         )
-        if len(placed) == 2:
-            clear = clear and cache.state.has(cfree, *placed[0], *placed[1])
-        return clear
+        return clear and all(cache.state.has(cfree, *a, *b) for a, b in _placed_pairs(placed))
+
+
+def _placed_pairs(
+    placed: Sequence[tuple[str, str]],
+) -> list[tuple[tuple[str, str], tuple[str, str]]]:
+    """The (object, target) pairs whose clearance placing them at once needs: for two objects
+    the one ``place-both`` requires; for more, placed one after another at one instant, every
+    ordered pair (each placement sees the ones before it resting)."""
+    if len(placed) == 2:
+        return [(placed[0], placed[1])]
+    return [(a, b) for a in placed for b in placed if a is not b]

@@ -1,11 +1,19 @@
-"""Grounding of candidate steps: grasps, IK at both ends, buffers and dual-arm configurations.
+"""Grounding of candidate steps: grasps, IK at both ends, buffers and cell configurations.
 
 For a candidate step and an assignment of arms, :class:`Grounder` asks the streams for a few
-(grasp, pick IK, target, place IK) options per move, combines them into collision-free
-dual-arm configurations (or, for the one-arm-at-a-time motion planner, a sequence of gripper
-events with the other arm at home) and ranks the groundings by the task planner's rank and
-then by the estimated motion time. Groundings that failed before are skipped (see
-:class:`~solvers.sdar.attempts.TabuLists`).
+(grasp, pick IK, target, place IK) options per move, combines them into collision-free cell
+configurations (every arm; an arm without a move waits at home), or, for the one-arm-at-a-time
+motion planner, a sequence of gripper events with the other arms at home, and ranks the
+groundings by the task planner's rank and then by the estimated motion time. Groundings that
+failed before are skipped (see :class:`~solvers.sdar.attempts.TabuLists`).
+
+Assignments of moves to arms: with two arms every one (two at most). With more, bounded: for
+each move the arms that reach its object and target (the first grasp option of that arm), by
+the estimated time of that arm's pick and transfer, the ``moves + 1`` soonest; of their
+combinations with distinct arms the ``SdarOptions.assignments`` of least total estimate. The
+options of a step of ``m > 2`` moves are cut so that their combinations stay within
+:data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
+those bringing more objects to their goals come first (then the estimated motion time).
 """
 
 from __future__ import annotations
@@ -110,11 +118,49 @@ class Grounder:
                 peers += peer
             for arms in self._assignments(step):
                 found.extend(self._ground(step, arms, mode))
-            found.sort(key=lambda g: (g.step.rank, g.estimate))
+            if len(self.home) > 2:
+                found.sort(key=lambda g: (g.step.rank, -g.step.progress, g.estimate))
+            else:
+                found.sort(key=lambda g: (g.step.rank, g.estimate))
         return found
 
     def _assignments(self, step: Step) -> list[tuple[str, ...]]:
-        return list(itertools.permutations(sorted(self.home), len(step.moves)))
+        """Arms for the step's moves, in order (see the module docstring)."""
+        arms = sorted(self.home)
+        m = len(step.moves)
+        if len(arms) <= 2:
+            return list(itertools.permutations(arms, m))
+        lifted = frozenset(step.objects)
+        cost: dict[tuple[str, int], float] = {}
+        for i, move in enumerate(step.moves):
+            for a in arms:
+                options = self._move_options(a, move, lifted, 1, self.options.grasps,
+                                             None, step.moves)  # fmt: skip
+                if options:
+                    here = self.cache.current_arm_conf(a)
+                    pick, place = options[0].pick, options[0].place
+                    cost[a, i] = self.cache.arm_distance(here, pick) + self.cache.arm_distance(
+                        pick, place
+                    )
+        per_move = [
+            [a for _, a in sorted((cost[a, i], a) for a in arms if (a, i) in cost)][: m + 1]
+            for i in range(m)
+        ]
+        alone = [step.moves[i] for i, reach in enumerate(per_move) if not reach]
+        if alone:
+            show = self.cache.show
+            self.failures.unassigned(step, "no arm has a grasp with IK at " + ", ".join(
+                f"{show(mv.obj)} and at {'a buffer' if mv.to_buffer else 'its goal'}"
+                for mv in alone
+            ))  # fmt: skip
+            return []
+        tuples = [t for t in itertools.product(*per_move) if len(set(t)) == m]
+        if not tuples:
+            self.failures.unassigned(
+                step, "no assignment gives its moves distinct arms that reach them"
+            )
+        tuples.sort(key=lambda t: (sum(cost[a, i] for i, a in enumerate(t)), t))
+        return tuples[: self.options.assignments]
 
     def _ground(self, step: Step, arms: tuple[str, ...], mode: MotionMode) -> list[Grounding]:
         """Every grounding of ``step`` with ``arms`` not yet tried, cheapest estimate first:
@@ -127,10 +173,15 @@ class Grounder:
         stage with more grasps is reached even when the earlier ones ran out of options."""
         lifted = frozenset(step.objects)
         opt = self.options
-        stages = [(opt.options_per_move, opt.grasps)]
-        if step.kind in opt.expand_kinds and opt.more_options > opt.options_per_move:
-            stages.append((opt.more_options, opt.grasps))
-        if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps:
+        first, more = opt.options_per_move, opt.more_options
+        size = len(step.moves)
+        if size > 2:  # keep the combinations of a stage within MAX_COMBINATIONS
+            cut = max(1, int(MAX_COMBINATIONS ** (1.0 / size) + 1e-9))
+            first, more = min(first, cut), min(more, cut)
+        stages = [(first, opt.grasps)]
+        if step.kind in opt.expand_kinds and more > first:
+            stages.append((more, opt.grasps))
+        if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps and size <= 2:
             stages.append((opt.pair_grasps, opt.pair_grasps))
         found: list[Grounding] = []
         misses: Counter[str] = Counter()  # why combinations of options failed
@@ -312,20 +363,25 @@ class Grounder:
         return found
 
     def _grippers_clear(self, step: Step, combo: tuple[Option, ...]) -> bool:
-        """Two objects placed at once: each gripper is clear of the other object at its
-        target (the domain's gripper test, when it has one; the IK of a placement sees only
-        the objects that stay)."""
+        """Objects placed at once: each gripper is clear of every other object at its target
+        (the domain's gripper test, when it has one; the IK of a placement sees only the
+        objects that stay)."""
         test = self.cache.voc.grasp_cfree
-        if len(combo) != 2 or test not in self.cache.streams:
+        if len(combo) < 2 or test not in self.cache.streams:
             return True
-        (a, b), (oa, ob) = step.objects, combo
-        return self.cache.test(test, (a, oa.target, oa.grasp, b, ob.target)) and self.cache.test(
-            test, (b, ob.target, ob.grasp, a, oa.target)
+        placed = list(zip(step.objects, combo, strict=True))
+        return all(
+            self.cache.test(test, (a, oa.target, oa.grasp, b, ob.target))
+            and self.cache.test(test, (b, ob.target, ob.grasp, a, oa.target))
+            for (a, oa), (b, ob) in itertools.combinations(placed, 2)
         )
 
     def _combine(self, confs: Mapping[str, str]) -> str | None:
-        (a1, q1), (a2, q2) = sorted(confs.items())
-        out = self.cache.outputs(self.cache.voc.combine, (a1, q1, a2, q2), 1)
+        """The cell configuration of ``confs`` (arm -> configuration), the arms not in it at
+        home, through the domain's combine stream (one pair per arm, in arm order)."""
+        every = {**self.home, **confs}
+        inputs = tuple(x for arm, q in sorted(every.items()) for x in (arm, q))
+        out = self.cache.outputs(self.cache.voc.combine, inputs, 1)
         return out[0][0] if out else None
 
     def _ground_one_arm(
@@ -353,9 +409,12 @@ class Grounder:
     def _one_arm_order(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
         """``(move index, pick?)`` in execution order. A move whose target is clear of every
         other resting object goes first, alone, then the other; otherwise (a swap) the first
-        arm picks and waits at home holding its object while the second arm works."""
+        arm picks and waits at home holding its object while the second arm works. More than
+        two moves: :meth:`_one_arm_order_k`."""
         if len(step.moves) == 1:
             return [(0, True), (0, False)]
+        if len(step.moves) > 2:
+            return self._one_arm_order_k(step, targets)
         current = self.cache.current_poses()
         for k, (obj, target) in enumerate(zip(step.objects, targets, strict=True)):
             if all(
@@ -366,7 +425,47 @@ class Grounder:
                 return [(k, True), (k, False), (1 - k, True), (1 - k, False)]
         return [(0, True), (1, True), (1, False), (0, False)]
 
+    def _one_arm_order_k(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
+        """One arm at a time for a step of more than two moves: a held object whose target is
+        clear of the resting objects is placed (the last picked first); else an object whose
+        target is clear is picked (to be placed next); else the first object left is picked
+        and held (its arm waits at home holding it); when nothing held can be placed and
+        nothing is left to pick, the last picked is placed anyway (the placement check of the
+        execution then refuses the grounding)."""
+        cache, cfree = self.cache, self.cache.voc.cfree
+        resting = dict(cache.current_poses())
 
+        def clear(k: int) -> bool:
+            obj = step.objects[k]
+            return all(
+                cache.test(cfree, (obj, targets[k], other, pose))
+                for other, pose in resting.items()
+                if other != obj
+            )
+
+        order: list[tuple[int, bool]] = []
+        todo = list(range(len(step.moves)))
+        held: list[int] = []
+        while todo or held:
+            place = next((k for k in reversed(held) if clear(k)), None)
+            if place is None and not todo:
+                place = held[-1]
+            if place is not None:
+                held.remove(place)
+                resting[step.objects[place]] = targets[place]
+                order.append((place, False))
+                continue
+            pick = next((k for k in todo if clear(k)), todo[0])
+            todo.remove(pick)
+            resting.pop(step.objects[pick])
+            held.append(pick)
+            order.append((pick, True))
+        return order
+
+
+#: The most combinations of options per stage grounded for a step of more than two moves (the
+#: two-arm expanded stage's 6 x 6).
+MAX_COMBINATIONS = 36
 #: IK solutions asked per grasp and pose when no other object is on the table (every branch,
 #: and every branch of the half-turn twin where the IK stream offers it).
 _BRANCHES = 16

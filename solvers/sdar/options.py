@@ -25,7 +25,10 @@ class SdarOptions:
     # the first options works (a swap of touching objects needs two compatible grasps, often
     # two moderately tilted ones: the grasp stream's pair grasps come after its grasp set)
     pair_kinds: tuple[str, ...] = ("swap",)
-    expand_kinds: tuple[str, ...] = ("pair", "swap", "chain", "cycle")  # two-move steps
+    expand_kinds: tuple[str, ...] = ("pair", "swap", "chain", "cycle", "rotate")  # steps of
+    # several moves
+    assignments: int = 6  # with more than two arms: assignments of arms to a step's moves
+    # grounded (the soonest by estimate, among the arms that reach; every one with two arms)
     buffers: int = 4  # buffer poses tried per buffer move
     place_branches: int = 4  # IK solutions at a target compared by the time from the pick
     one_arm_at_a_time: bool = False  # the baseline motion planner (one arm moves at a time)

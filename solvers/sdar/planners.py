@@ -10,7 +10,7 @@ TASK_PLANNERS = ("sdar", "baseline")
 
 def make_task_planner(name: str) -> TaskPlanner:
     """A fresh task planner: ``sdar`` (SDAR-T) or ``baseline`` (our reconstruction of the
-    optimal single-arm plan split over two arms)."""
+    optimal single-arm plan split over the cell's arms)."""
     if name == "sdar":
         from solvers.sdar.sdar_t import SdarTaskPlanner
 

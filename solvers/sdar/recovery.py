@@ -148,12 +148,13 @@ class Recovery:
                   where, depth, ", ".join(map(show, sorted(members))),
                   ", ".join(map(show, free)) or "none")  # fmt: skip
         base = 3 * depth
+        pairs = len(self.arms) >= 2  # two-move evictions need two arms
         for m in free:
             why = ((m, boxed),)
-            if depth == 0 and boxed.lifted and len(members) == 1:
+            if pairs and depth == 0 and boxed.lifted and len(members) == 1:
                 self._add(out, base, order, Step((Move(boxed.obj), Move(m, True)), "evict"), why)
             self._add(out, base + 1, order, Step((Move(m, True),), "evict"), why)
-        if len(free) >= 2:
+        if pairs and len(free) >= 2:
             a, b = free[:2]
             step = Step((Move(a, True), Move(b, True)), "evict")
             self._add(out, base + 2, order, step, ((a, boxed), (b, boxed)))

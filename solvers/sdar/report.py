@@ -48,6 +48,13 @@ class Failures:
         self.reasons.append(f"{step.kind} ({what}): {reason}")
         LOG.debug("sdar: %s (%s): %s", step.kind, what, reason)
 
+    def unassigned(self, step: Step, reason: str) -> None:
+        """``step`` got no arms (``reason`` says why)."""
+        show = self._show
+        what = ", ".join(f"{show(m.obj)}{'->buffer' if m.to_buffer else ''}" for m in step.moves)
+        self.reasons.append(f"{step.kind} ({what}): {reason}")
+        LOG.debug("sdar: %s (%s): %s", step.kind, what, reason)
+
 
 @dataclass(frozen=True)
 class RunSummary:

@@ -1,4 +1,4 @@
-"""SDAR-T: dependency-driven dual-arm task planning (paper, section IV-A, Alg. 1).
+"""SDAR-T: dependency-driven task planning for k synchronous arms (paper, section IV-A, Alg. 1).
 
 Alg. 1 returns a task list; here it is a ranked list of :class:`~solvers.sdar.tasks.Step`
 candidates which SDAR-M grounds best first, falling back down the list. ``B(x)`` are the objects
@@ -45,6 +45,24 @@ cycle breaks of one ``x`` with partners of as many predecessors), so that SDAR-M
 among them by expected motion time. Steps of two moves are capped at ``max_candidates``; one-move
 steps are always kept. :meth:`~SdarTaskPlanner.commit` does nothing: SDAR-T replans from the
 view at every step.
+
+The number of arms is the view's (:attr:`~solvers.sdar.tasks.TaskView.arms`); the list above is
+the list for two arms. With one arm a step holds one move: classes 1 (an object to its free
+goal; objects waiting on a buffer first), 5 (``x`` of a minimum feedback vertex set to a
+buffer), 7 (another object of a cycle to a buffer), 8 and 9 as above; a first-candidate run
+takes ``n + |minimum FVS|`` actions, the single-arm optimum. With ``k > 2`` arms the buffer sets
+leave components of up to ``k`` objects (:mod:`solvers.sdar.buffer_sets`, ``arms=k``), and the
+candidates are bounded so (:mod:`solvers.sdar.k_steps`): the first ``max_candidates`` two-move
+steps of the ranked list and its one-move steps (class 6 included) are each extended greedily
+with goal moves of units whose goals are free once the step's objects are lifted, up to ``k``
+moves; the extended
+step and its base are both kept (the base is the fallback when the larger step cannot be
+grounded); closed components of ``3..k`` objects are proposed as ``rotate`` steps of class 1 (an
+``m``-cycle rotated by ``m`` arms without a buffer; a component of ``3..k`` objects can still be
+broken at class 7, for when the rotation is geometrically impossible). Within a class, steps
+bringing more objects to their goals come first. So a list holds at most
+``2 max_candidates`` steps of several moves, plus one rotation per component, plus the one-move
+steps; no set of ``k`` objects is enumerated.
 """
 
 from __future__ import annotations
@@ -54,6 +72,7 @@ from itertools import combinations
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
 from solvers.sdar.buffer_sets import extending_minimum, optimal_choices
+from solvers.sdar.k_steps import TaskScene, extend, rotations
 from solvers.sdar.tasks import Move, Step, TaskView
 
 _Edges = tuple[tuple[int, int], ...]
@@ -63,22 +82,7 @@ _DOUBLE_FIRSTS = 3  # double buffer moves are sought for the best three first ob
 
 _Key = tuple[int, ...]
 _Ranked = list[tuple[_Key, Step]]
-
-
-class _Scene:
-    """The view's blockers and predecessors by name, and how much a lift frees."""
-
-    def __init__(self, view: TaskView) -> None:
-        self.names = view.remaining
-        self.order = {x: k for k, x in enumerate(self.names)}
-        self.blockers = {x: view.blockers(x) for x in self.names}
-        self.preds = {x: sum(1 for y in self.names if x in self.blockers[y]) for x in self.names}
-
-    def frees(self, lifted: frozenset[str]) -> tuple[int, int]:
-        """Objects whose goals become free, and edges removed, when ``lifted`` move."""
-        others = [y for y in self.names if y not in lifted]
-        freed = sum(1 for y in others if self.blockers[y] and self.blockers[y] <= lifted)
-        return freed, sum(1 for y in others for x in lifted if x in self.blockers[y])
+_Scene = TaskScene
 
 
 class SdarTaskPlanner:
@@ -93,7 +97,7 @@ class SdarTaskPlanner:
         self.node_budget = node_budget
         self.exact = True
         """``False`` once a cycle was broken by the greedy score (exact search over budget)."""
-        self._choices: dict[tuple[tuple[str, ...], _Edges], frozenset[str]] = {}
+        self._choices: dict[tuple[tuple[str, ...], _Edges, int], frozenset[str]] = {}
 
     @property
     def name(self) -> str:
@@ -107,15 +111,20 @@ class SdarTaskPlanner:
         if len(names) <= 1:
             return [Step((Move(x, bool(view.blockers(x))),), "last", LAST, ()) for x in names]
         scene = _Scene(view)
-        goal_pairs = self._goal_pairs(scene)
-        ranked = goal_pairs + self._cycle_breaks(scene, view, bool(goal_pairs))
-        ranked.sort(key=lambda item: item[0])
-        kept = [item for item in ranked if len(item[1].moves) == 2][: self.max_candidates]
-        kept += [item for item in ranked if len(item[1].moves) == 1]
-        for x in names:
-            if not scene.blockers[x]:
-                key: _Key = (SINGLE, -scene.preds[x], scene.order[x])
-                kept.append((key, Step((Move(x),), "single", SINGLE, key[1:-1])))
+        if view.arms == 1:
+            kept = self._one_arm(scene, view)
+        else:
+            goal_pairs = self._goal_pairs(scene)
+            ranked = goal_pairs + self._cycle_breaks(scene, view, bool(goal_pairs))
+            ranked.sort(key=lambda item: item[0])
+            kept = [item for item in ranked if len(item[1].moves) == 2][: self.max_candidates]
+            kept += [item for item in ranked if len(item[1].moves) == 1]
+            for x in names:
+                if not scene.blockers[x]:
+                    key: _Key = (SINGLE, -scene.preds[x], scene.order[x])
+                    kept.append((key, Step((Move(x),), "single", SINGLE, key[1:-1])))
+            if view.arms > 2:
+                kept = self._more_arms(scene, view.arms, kept)
         movable = [x for x in names if x not in view.in_buffer]
         if not movable and not kept:
             movable = list(names)  # nothing else is possible: allow a buffer-to-buffer move
@@ -137,6 +146,43 @@ class SdarTaskPlanner:
         if not any(not m.to_buffer and view.must_wait(m.obj) for m in step.moves):
             return item
         return (WAIT, *key), Step(step.moves, step.kind, WAIT)
+
+    def _one_arm(self, scene: _Scene, view: TaskView) -> _Ranked:
+        """One arm: an object to its free goal (class 1), else a cycle broken by one buffer
+        move (class 5 for an object of a minimum feedback vertex set, 7 for another)."""
+        out: _Ranked = []
+        for x in scene.names:
+            if not scene.blockers[x]:
+                key: _Key = (GOAL_PAIR, int(x not in view.in_buffer), -scene.preds[x],
+                             scene.order[x])  # fmt: skip
+                out.append((key, Step((Move(x),), "single", GOAL_PAIR, key[1:-1])))
+        optimal, breakable = self._break_choices(view)
+        for x in breakable:
+            freed, removed = scene.frees(frozenset((x,)))
+            rank = CYCLE_ALONE if x in optimal else DETOUR
+            key = (rank, -freed, -scene.preds[x], -removed, scene.order[x])
+            out.append((key, Step((Move(x, to_buffer=True),), "cycle", rank, key[1:-1])))
+        return out
+
+    @staticmethod
+    def _more_arms(scene: _Scene, arms: int, kept: _Ranked) -> _Ranked:
+        """More than two arms: every kept step extended greedily (its base kept too), plus
+        the rotations of closed components; within a class more goal moves first; one step
+        per set of moves (the best ranked). See :mod:`solvers.sdar.k_steps`."""
+        out: _Ranked = []
+        for key, step in kept:
+            wider = extend(scene, step, arms)
+            if wider is not step:
+                out.append(((key[0], -wider.progress, *key[1:]), wider))
+            out.append(((key[0], -step.progress, *key[1:]), step))
+        for key, step in rotations(scene, arms):
+            rotate = Step(step.moves, step.kind, GOAL_PAIR, step.tie)
+            out.append(((GOAL_PAIR, -rotate.progress, *key), rotate))
+        out.sort(key=lambda item: item[0])
+        best: dict[frozenset[Move], tuple[_Key, Step]] = {}
+        for item in out:
+            best.setdefault(frozenset(item[1].moves), item)
+        return list(best.values())
 
     def _goal_pairs(self, scene: _Scene) -> _Ranked:
         """Class 1: both objects to their goals."""
@@ -189,7 +235,7 @@ class SdarTaskPlanner:
         optimal: set[str] = set()
         breakable: list[str] = []
         for comp in graph.components():
-            if len(comp) < 3:
+            if len(comp) < min(3, view.arms + 1):
                 continue
             local = {v: k for k, v in enumerate(comp)}
             sub = DependencyGraph(
@@ -197,13 +243,16 @@ class SdarTaskPlanner:
                 tuple((local[i], local[j]) for i, j in graph.edges if i in local and j in local),
             )
             breakable.extend(sub.names)
-            if (sub.names, sub.edges) not in self._choices:
-                found = optimal_choices(sub, allow_swaps=True, node_budget=self.node_budget)
+            key = (sub.names, sub.edges, view.arms)
+            if key not in self._choices:
+                found = optimal_choices(
+                    sub, allow_swaps=True, node_budget=self.node_budget, arms=view.arms
+                )
                 if found is None:
                     self.exact = False
                     found = frozenset(sub.names)
-                self._choices[sub.names, sub.edges] = found
-            optimal |= self._choices[sub.names, sub.edges]
+                self._choices[key] = found
+            optimal |= self._choices[key]
         return frozenset(optimal), breakable
 
     @staticmethod
@@ -232,7 +281,11 @@ class SdarTaskPlanner:
         if not options:
             return []
         found = extending_minimum(
-            view.graph, list(options), allow_swaps=True, node_budget=self.node_budget
+            view.graph,
+            list(options),
+            allow_swaps=True,
+            node_budget=self.node_budget,
+            arms=view.arms,
         )
         if found is None:
             self.exact = False

@@ -4,7 +4,8 @@ The solver executes rather than searches. From the current state it asks the tas
 (:mod:`solvers.sdar.sdar_t` or :mod:`solvers.sdar.baseline`) for ranked candidate steps, built
 from the dependency graph that the domain's overlap test stream induces; it grounds the best
 candidates through the streams (grasps, IK at the current pose and at the target with the same
-grasp, buffers, dual-arm configurations) for both arm assignments, ranks the groundings by the
+grasp, buffers, cell configurations) for the assignments of arms to its moves (every one with
+two arms, a bounded few with more: :mod:`~solvers.sdar.grounding`), ranks the groundings by the
 task planner's rank and then by the estimated motion time (the domain's distance function),
 plans the two synchronous motions of the chosen one (to the objects, then to the targets; the
 motion stream carries the fallback ladder of trajectory optimisation, arm untangling and one
@@ -144,7 +145,7 @@ class SdarSolver:
         )
         done = frozenset(o for o, g in self.goals.items() if current.get(o) == g)
         graph = DependencyGraph(remaining, tuple(edges))
-        return TaskView(graph, done, buffered, frozenset(waits))
+        return TaskView(graph, done, buffered, frozenset(waits), arms=len(self.home))
 
     # -- the loop ----------------------------------------------------------------------------
     def solve(self) -> Solution:
@@ -163,9 +164,9 @@ class SdarSolver:
             if self.options.progress is not None:
                 self.options.progress(len(view.done), len(self.goals))
             self.visited.add(self._arrangement())
-            candidates = self._new_arrangements(
-                self.recovery.allowed(self.planner.candidates(view))
-            )
+            proposed = self.planner.candidates(view)
+            self._check_sizes(proposed)
+            candidates = self._new_arrangements(self.recovery.allowed(proposed))
             self.failures.clear()
             if self._decide(view, candidates, decision):
                 continue
@@ -192,6 +193,20 @@ class SdarSolver:
             self.executor.cost,
         )
         return build_solution(self.cache, summary, self.records)
+
+    def _check_sizes(self, candidates: Sequence[Step]) -> None:
+        """Every candidate holds at most one move per arm.
+
+        Raises:
+            ParameterError: the task planner proposed a step of more moves than arms.
+        """
+        for step in candidates:
+            if len(step.moves) > len(self.home):
+                raise ParameterError(
+                    f"task planner {self.planner.name!r} proposed a step of {len(step.moves)} "
+                    f"moves ({', '.join(map(self.cache.show, step.objects))}) for a cell of "
+                    f"{len(self.home)} arm(s)"
+                )
 
     def _arrangement(self, at_goal: Sequence[str] = ()) -> frozenset[tuple[str, str]]:
         """The current arrangement (object, pose), with the objects ``at_goal`` moved to their

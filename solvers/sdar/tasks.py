@@ -1,10 +1,11 @@
 """The vocabulary shared by rearrangement task planners (SDAR-T and the baseline) and SDAR-M.
 
 A task planner looks at a :class:`TaskView` of the current arrangement (the dependency graph of
-the objects not yet at their goals, and which objects sit in buffers) and proposes ranked
-:class:`Step` candidates: one or two object moves done in one synchronous dual-arm step (both
-arms pick, both place). SDAR-M assigns arms, grounds the candidates through the streams, picks
-one and reports it back with :meth:`TaskPlanner.commit`.
+the objects not yet at their goals, which objects sit in buffers, and how many arms the cell
+has) and proposes ranked :class:`Step` candidates: up to ``view.arms`` object moves done in one
+synchronous step (every acting arm picks, then every one places). SDAR-M assigns arms, grounds
+the candidates through the streams, picks one and reports it back with
+:meth:`TaskPlanner.commit`.
 """
 
 from __future__ import annotations
@@ -25,10 +26,12 @@ class Move:
 
 @dataclass(frozen=True)
 class Step:
-    """One synchronous step: one or two moves of distinct objects, arms not yet assigned.
+    """One synchronous step: one or more moves of distinct objects (at most one per arm of the
+    cell, see :func:`step_is_valid`), arms not yet assigned.
 
-    ``kind`` names the rule that proposed it (``pair``, ``chain``, ``swap``, ``cycle``,
-    ``single``, ``buffer``, ``last``, ``plan``); ``rank`` orders candidates (lower is better).
+    ``kind`` names the rule that proposed it (``pair``, ``chain``, ``swap``, ``rotate``,
+    ``cycle``, ``single``, ``buffer``, ``last``, ``plan``, ``evict``); ``rank`` orders candidates
+    (lower is better).
     ``tie``: candidates of one rank with equal ties are alike to the task planner (their order
     is only by object name), so the motion planner may take whichever it expects to execute
     soonest; None: the task planner's order stands.
@@ -40,8 +43,8 @@ class Step:
     tie: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
-        if not 1 <= len(self.moves) <= 2:
-            raise ValueError(f"a step has one or two moves, got {len(self.moves)}")
+        if not self.moves:
+            raise ValueError("a step has at least one move, got none")
         if len({m.obj for m in self.moves}) != len(self.moves):
             raise ValueError(f"a step moves distinct objects, got {self.moves}")
 
@@ -68,13 +71,18 @@ class TaskView:
     current pose of ``j``, or one of them leaves the other no grasp); ``done`` are the objects
     at their goals; ``in_buffer`` the objects resting on a buffer; ``waits`` pairs ``(i, j)``:
     ``i`` at its goal would leave ``j`` no grasp at the goal of ``j``, so ``i`` goes to its
-    goal after ``j``.
+    goal after ``j``. ``arms``: the arms of the cell, the most moves a step may hold (>= 1).
     """
 
     graph: DependencyGraph
     done: frozenset[str]
     in_buffer: frozenset[str]
     waits: frozenset[tuple[str, str]] = frozenset()
+    arms: int = 2
+
+    def __post_init__(self) -> None:
+        if self.arms < 1:
+            raise ValueError(f"a task view needs arms >= 1, got {self.arms}")
 
     @property
     def remaining(self) -> tuple[str, ...]:
@@ -111,8 +119,11 @@ class TaskPlanner(Protocol):
 
 
 def step_is_valid(step: Step, view: TaskView) -> bool:
-    """Every goal move of ``step`` lands on a free goal once the step's objects are lifted."""
+    """The step has at most one move per arm, and every goal move of it lands on a free goal
+    once the step's objects are lifted."""
     lifted = frozenset(step.objects)
+    if len(step.moves) > view.arms:
+        return False
     return all(m.obj in view.graph.names for m in step.moves) and all(
         m.to_buffer or view.goal_free_after(m.obj, lifted) for m in step.moves
     )

@@ -25,7 +25,8 @@ class SdarVocabulary:
     grasp: str = "sample-grasp"  # (?o) -> ?g
     ik: str = "inverse-kinematics"  # (?arm ?o ?p ?g) -> ?q, fluent atpose
     buffer: str = "sample-buffer"  # (?o) -> ?p, fluent atpose
-    combine: str = "combine-confs"  # (?a1 ?q1 ?a2 ?q2) -> ?d
+    combine: str = "combine-confs"  # (?a1 ?q1 ... ?ak ?qk) -> ?d: one pair per arm, in
+    # arm-name order (the problem declares it for its cell's k arms)
     motion: str = "plan-dual-motion"  # (?d1 ?d2) -> ?t, fluents atpose holding
     quick_motion: str = "plan-dual-motion-quick"  # the same, cheaper and weaker (optional)
     distance: str = "distance"  # function (?d1 ?d2): estimated motion time (optional)
@@ -49,7 +50,7 @@ class SdarVocabulary:
     move: str = "move"
     pick: str = "pick"
     place: str = "place"
-    pick_both: str = "pick-both"
+    pick_both: str = "pick-both"  # two grippers at once; three or more: consecutive picks
     place_both: str = "place-both"
 
     def check(

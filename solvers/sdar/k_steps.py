@@ -1,0 +1,103 @@
+"""SDAR-T's steps beyond two arms: rotations of closed components and greedy extension.
+
+With ``k`` arms a synchronous step lifts up to ``k`` objects and then places them, so a group
+``U`` of objects can go to their goals in one step whenever every blocker of a member is a
+member too (``B(x) <= U`` for every ``x`` in ``U``), whatever the edges inside ``U``. Two kinds
+of such groups matter:
+
+* a *rotation*: a strongly connected component of ``3 <= m <= k`` objects that nothing outside
+  blocks (an ``m``-cycle among them). Every object is lifted, then every object is placed: no
+  buffer. With ``m = 2`` this is the dual-arm swap (SDAR-T's class 1 already has it).
+* a *unit*: a strongly connected component of the graph left once a step's objects are lifted
+  (one object, most of the time). :func:`extend` adds to a step, greedily, the unit whose goals
+  become free with the step's objects lifted and that frees the most (then removes most edges,
+  then is the largest, then comes first by object order), until ``k`` moves or nothing fits;
+  a unit holding an object that must wait (:meth:`~solvers.sdar.tasks.TaskView.must_wait`) is
+  never added.
+
+Both are bounded: rotations are at most one per component; :func:`extend` runs once per
+candidate it is given (SDAR-T gives it the first ``max_candidates`` steps of its two-arm list)
+and costs ``k`` rounds over the units. No set of ``k`` objects is enumerated.
+"""
+
+from __future__ import annotations
+
+from sdar_tamp.graph import strongly_connected_components
+from solvers.sdar.tasks import Move, Step, TaskView
+
+
+class TaskScene:
+    """The view's blockers and predecessors by name, and how much a lift frees."""
+
+    def __init__(self, view: TaskView) -> None:
+        self.view = view
+        self.names = view.remaining
+        self.order = {x: k for k, x in enumerate(self.names)}
+        self.blockers = {x: view.blockers(x) for x in self.names}
+        self.preds = {x: sum(1 for y in self.names if x in self.blockers[y]) for x in self.names}
+
+    def frees(self, lifted: frozenset[str]) -> tuple[int, int]:
+        """Objects whose goals become free, and edges removed, when ``lifted`` move."""
+        others = [y for y in self.names if y not in lifted]
+        freed = sum(1 for y in others if self.blockers[y] and self.blockers[y] <= lifted)
+        return freed, sum(1 for y in others for x in lifted if x in self.blockers[y])
+
+    def units(self, lifted: frozenset[str]) -> list[tuple[str, ...]]:
+        """The strongly connected components of the graph on the objects not in ``lifted``
+        (members in object order)."""
+        rest = [x for x in self.names if x not in lifted]
+        index = {x: k for k, x in enumerate(rest)}
+        edges = tuple((index[x], index[y]) for x in rest for y in self.blockers[x] if y in index)
+        comps = strongly_connected_components(len(rest), edges)
+        return [tuple(sorted((rest[k] for k in c), key=self.order.__getitem__)) for c in comps]
+
+    def closed(self, group: frozenset[str]) -> bool:
+        """Every blocker of a member of ``group`` is in ``group``."""
+        return all(self.blockers[x] <= group for x in group)
+
+
+def rotations(scene: TaskScene, arms: int) -> list[tuple[tuple[int, ...], Step]]:
+    """Closed components of ``3 <= m <= arms`` objects, each as one step of ``m`` goal moves
+    (kind ``rotate``); the key ``(-freed, -edges removed, first object's order)`` ranks them."""
+    out: list[tuple[tuple[int, ...], Step]] = []
+    for unit in scene.units(frozenset()):
+        group = frozenset(unit)
+        if 3 <= len(unit) <= arms and scene.closed(group):
+            freed, removed = scene.frees(group)
+            key = (-freed, -removed, scene.order[unit[0]])
+            out.append((key, Step(tuple(Move(x) for x in unit), "rotate", 0, key[:-1])))
+    return out
+
+
+def extend(scene: TaskScene, step: Step, arms: int) -> Step:
+    """``step`` with goal moves of units added greedily (see the module docstring); ``step``
+    itself when nothing fits. The added moves follow the step's own, in the order added."""
+    lifted = frozenset(step.objects)
+    if len(lifted) >= arms:
+        return step
+    view = scene.view
+    units = [u for u in scene.units(lifted) if not any(view.must_wait(x) for x in u)]
+    added: list[str] = []
+    while len(lifted) < arms:
+        fits = [
+            u
+            for u in units
+            if len(u) <= arms - len(lifted)
+            and all(scene.blockers[y] <= lifted | frozenset(u) for y in u)
+        ]
+        if not fits:
+            break
+        worth = {u: _worth(scene, lifted, u) for u in fits}
+        best = min(fits, key=worth.__getitem__)
+        added.extend(best)
+        lifted = lifted | frozenset(best)
+        units.remove(best)
+    if not added:
+        return step
+    return Step((*step.moves, *(Move(x) for x in added)), step.kind, step.rank, step.tie)
+
+
+def _worth(scene: TaskScene, lifted: frozenset[str], unit: tuple[str, ...]) -> tuple[int, ...]:
+    """Order of the units that fit a step: more freed, more edges removed, larger, first."""
+    freed, removed = scene.frees(lifted | frozenset(unit))
+    return (-freed, -removed, -len(unit), scene.order[unit[0]])
