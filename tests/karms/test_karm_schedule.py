@@ -9,17 +9,17 @@ from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule.pieces import arm_blocks
-from sdar_tamp.schedule.scheduler import _Placement, groups
+from sdar_tamp.schedule.scheduler import Placement, groups
 from sdar_tamp.schedule.sweep import WorldSweep
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
 
 
-def _placement(plan: PlanFile, scene: Scene, instance: Instance) -> _Placement:
+def _placement(plan: PlanFile, scene: Scene, instance: Instance) -> Placement:
     options = ScheduleOptions()
     blocks = [arm_blocks(plan, scene, i, options.tick) for i in range(len(scene.arms))]
     sweep = WorldSweep(instance, scene, options.max_tcp_step)
-    return _Placement(plan, blocks, sweep, options, "objects")
+    return Placement(plan, blocks, sweep, options, "objects")
 
 
 def test_every_arm_has_its_blocks_and_groups_hold_every_arm(
