@@ -255,9 +255,10 @@ class Timelines(Placement):
     def shortcut(self, block: Block, slow_start: bool) -> FloatArray | None:
         """A faster path for ``block`` (samples one tick apart), or None (see the module
         docstring)."""
-        if self.shortcuts.tries == 0 or len(block.q) < 4:
-            return None
         arm, timer = block.arm, self.retimers[block.arm]
+        path_timer = timer.timer
+        if path_timer is None or self.shortcuts.tries == 0 or len(block.q) < 4:
+            return None
         slow_end = block.event is not None
         path = thin(block.q, timer.spacing)
         if len(path) < 3:
@@ -286,8 +287,7 @@ class Timelines(Placement):
                 continue
             candidate = np.concatenate([current[: a + 1], current[b:]])
             caps = timer.tool_caps(candidate, slow_start, slow_end)
-            assert timer.timer is not None
-            _, samples = timer.timer(candidate, timer.v_max, timer.a_max, caps, timer.tick)
+            _, samples = path_timer(candidate, timer.v_max, timer.a_max, caps, timer.tick)
             if len(samples) >= len(best):
                 continue
             samples = np.array(samples)
