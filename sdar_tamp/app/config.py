@@ -36,8 +36,10 @@ from streams.motion.optimiser_records import TrajOptOptions
 TASK_PLANNERS = ("sdar", "baseline")
 MOTION_PLANNERS = ("sdar", "plain", "sequential")
 #: How the plan is executed: one synchronous timeline, or each arm on its own
-#: (:mod:`sdar_tamp.schedule`, kept only when shorter and valid).
-EXECUTIONS = ("sync", "async")
+#: (:mod:`sdar_tamp.schedule`, kept only when shorter and valid): ``async`` re-times the
+#: synchronous steps, ``timelines`` gives each arm its own timeline (prioritised planning in
+#: time) and keeps the shorter of the two.
+EXECUTIONS = ("sync", "async", "timelines")
 GRIPPER_TIME = GRIPPER_DWELL  # [s] one gripper action (both grippers at once take as long)
 _DURATION = Real(0.0, closed=True, unit="s")  # gripper_time
 

@@ -1,7 +1,13 @@
 """How a synchronous plan is executed asynchronously: the scheduler's options, with each arm's
 motions re-timed by the same time-optimal path timing the motion planner uses
 (:func:`streams.motion.timing.time_parameterize`) and the same slow tool travel at gripper
-events."""
+events.
+
+Two schedules (:data:`SCHEDULERS`): ``"retime"``, the synchronous plan's steps re-timed
+(:func:`sdar_tamp.schedule.schedule_async`), and ``"timelines"``, one timeline per arm by
+prioritised planning in time (:func:`sdar_tamp.schedule.timelines.schedule_timelines`), which
+also computes the re-timing and keeps the shorter of the two. Either way the result is replayed
+by the independent validator and the synchronous plan kept when the replay rejects it."""
 
 from __future__ import annotations
 
@@ -9,10 +15,12 @@ import dataclasses
 import logging
 from collections.abc import Callable
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.replay import ReplayReport, validate_plan
 from sdar_tamp.schedule import Schedule, ScheduleOptions, schedule_async
 from sdar_tamp.schedule.retiming import PathTimer
+from sdar_tamp.schedule.timelines import schedule_timelines
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
@@ -20,6 +28,9 @@ from streams.motion.shape import ShapeOptions
 from streams.motion.timing import time_parameterize
 
 _log = logging.getLogger(__name__)
+
+#: The asynchronous schedules: the synchronous steps re-timed, or one timeline per arm.
+SCHEDULERS = ("retime", "timelines")
 
 
 def path_timer(safety: float) -> PathTimer:
@@ -56,12 +67,14 @@ def schedule_plan(
     scene: Scene,
     shape: ShapeOptions | None = None,
     options: ScheduleOptions | None = None,
+    scheduler: str = "retime",
 ) -> Schedule:
-    """``plan`` re-scheduled for asynchronous execution (``options``: default
-    :func:`execution_options`), and the result replayed by the independent validator: a
-    schedule it rejects is dropped for the synchronous plan (and logged), so the plan returned
-    is never longer than ``plan`` and valid whenever ``plan`` is."""
-    return _checked_schedule(plan, instance, scene, shape, options, None)[0]
+    """``plan`` re-scheduled for asynchronous execution by ``scheduler`` (one of
+    :data:`SCHEDULERS`; ``options``: default :func:`execution_options`), and the result
+    replayed by the independent validator: a schedule it rejects is dropped for the
+    synchronous plan (and logged), so the plan returned is never longer than ``plan`` and valid
+    whenever ``plan`` is."""
+    return _checked_schedule(plan, instance, scene, shape, options, None, scheduler)[0]
 
 
 def schedule_and_validate(
@@ -71,11 +84,12 @@ def schedule_and_validate(
     shape: ShapeOptions | None = None,
     options: ScheduleOptions | None = None,
     stage: Callable[[str], None] | None = None,
+    scheduler: str = "retime",
 ) -> tuple[Schedule, ReplayReport]:
     """:func:`schedule_plan`, and the independent replay's report on the plan it returns: the
     schedule's own replay when the schedule is kept, else a replay of ``plan`` (each plan is
     replayed once). ``stage("validating")`` is called when the first replay starts."""
-    result, report = _checked_schedule(plan, instance, scene, shape, options, stage)
+    result, report = _checked_schedule(plan, instance, scene, shape, options, stage, scheduler)
     return result, report or validate_plan(instance, result.plan, scene)
 
 
@@ -86,22 +100,37 @@ def _checked_schedule(
     shape: ShapeOptions | None,
     options: ScheduleOptions | None,
     stage: Callable[[str], None] | None,
+    scheduler: str,
 ) -> tuple[Schedule, ReplayReport | None]:
     """The schedule with the replay's report when the schedule is kept; the synchronous plan
-    and None (not replayed) when there is none or the replay rejects it."""
+    and None (not replayed) when there is none or the replay rejects it. With
+    ``"timelines"``, the shorter of the two schedules that the replay accepts."""
+    if scheduler not in SCHEDULERS:
+        raise ParameterError(f"scheduler must be one of {', '.join(SCHEDULERS)}; got {scheduler!r}")
     options = options or execution_options(scene, shape)
-    result = schedule_async(plan, instance, scene, options)
+    candidates = [schedule_async(plan, instance, scene, options)]
+    if scheduler == "timelines":
+        candidates.insert(0, schedule_timelines(plan, instance, scene, options))
     if stage is not None:
         stage("validating")
-    if not result.asynchronous:
-        return result, None
-    report = validate_plan(instance, result.plan, scene)
-    if report.ok:
-        return result, report
-    why = "the replay rejects the schedule" + (
+    kept = [c for c in candidates if c.asynchronous]
+    kept.sort(key=lambda c: c.plan.duration)
+    result = candidates[-1]
+    for result in kept:
+        report = validate_plan(instance, result.plan, scene)
+        if report.ok:
+            return result, report
+        _log.warning("%s: %s", instance.name, _rejected(report))
+    if not kept:
+        return candidates[-1], None
+    why = _rejected(report)
+    _log.warning("%s: %s; the synchronous plan is kept", instance.name, why)
+    return dataclasses.replace(result, plan=plan, asynchronous=False, reason=why), None
+
+
+def _rejected(report: ReplayReport) -> str:
+    return "the replay rejects the schedule" + (
         f" at t={report.violation.t:.3f} s: {report.violation.kind}: {report.violation.message}"
         if report.violation is not None
         else ""
     )
-    _log.warning("%s: %s; the synchronous plan is kept", instance.name, why)
-    return dataclasses.replace(result, plan=plan, asynchronous=False, reason=why), None

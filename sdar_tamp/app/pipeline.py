@@ -125,12 +125,17 @@ def solve_instance(
         "buffer_moves": figures.buffer_moves,
     }
     plan = plan_file_from_solution(rearrangement, solution, metrics)
-    if config.execution == "async":
+    if config.execution in ("async", "timelines"):
         if stage is not None:
             stage("scheduling")
         started = time.perf_counter()
         schedule, report = schedule_and_validate(
-            plan, instance, rearrangement.ctx.scene, world.planner.shape, stage=stage
+            plan,
+            instance,
+            rearrangement.ctx.scene,
+            world.planner.shape,
+            stage=stage,
+            scheduler="timelines" if config.execution == "timelines" else "retime",
         )
         plan = schedule.plan
         figures = dataclasses.replace(figures, schedule_time=time.perf_counter() - started)

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from sdar_tamp.app.config import EXECUTIONS
 from sdar_tamp.arguments import COUNT, SEED, TIME_LIMIT, output_file
 from sdar_tamp.cli.log_options import FORCE_HELP, JSON_HELP, SCENE_HELP
 
@@ -90,10 +91,13 @@ def add_solve_parser(sub: argparse._SubParsersAction[Any]) -> None:
     )
     solve.add_argument(
         "--execution",
-        choices=("sync", "async"),
+        choices=EXECUTIONS,
         default="async",
-        help="sync: both arms on one synchronous timeline; async: each arm on its own, "
-        "re-timed for itself, kept only when shorter and valid (default: async)",
+        help="sync: every arm on one synchronous timeline; async: each arm on its own, "
+        "the synchronous steps re-timed for itself; timelines: one timeline per arm, each "
+        "arm's next motion started as soon as it is done, against the other arms' committed "
+        "motions (the shorter of it and async); async modes are kept only when shorter and "
+        "valid (default: async; see docs/execution.md)",
     )
     solve.add_argument("--json", action="store_true", help=JSON_HELP + " (implies -q)")
     solve.add_argument("-q", "--quiet", action="store_true", help="no progress bar")

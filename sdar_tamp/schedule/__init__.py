@@ -1,4 +1,5 @@
-"""Asynchronous dual-arm execution of a synchronous plan (see :mod:`.scheduler`)."""
+"""Asynchronous execution of a synchronous plan: its steps re-timed per arm (:mod:`.scheduler`)
+or one timeline per arm by prioritised planning in time (:mod:`.timelines`)."""
 
 from sdar_tamp.schedule.scheduler import ORDERS, Schedule, ScheduleOptions, schedule_async
 

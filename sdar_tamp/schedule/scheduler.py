@@ -19,7 +19,7 @@ earliest tick that
   land on free spots. An arm whose next block is not placed yet stands where its last block left it.
 
 When a block finds no start, the group is taken back and tried with each other arm leading in
-turn (:meth:`_Placement.reorderings`; for two arms: the other arm first); when that fails too,
+turn (:meth:`Placement.reorderings`; for two arms: the other arm first); when that fails too,
 the group goes as in the synchronous plan (every arm at its synchronous pace and offsets),
 shifted as early as its arms allow: in the same configurations and world as there, so it
 passes. Every stretch of the result is replayed once every arm is fixed there, so the
@@ -99,8 +99,8 @@ class ScheduleOptions:
 class Schedule:
     """The outcome: ``plan`` (the asynchronous one when it is shorter, else the input),
     ``asynchronous``, both durations [s] (``async_duration`` None when no schedule was found),
-    the ``order`` that worked, ``reason`` (why the synchronous plan was kept) and ``checks``
-    (collision queries made)."""
+    the ``order`` that worked, ``reason`` (why the synchronous plan was kept), ``checks``
+    (collision queries made) and ``figures`` (what the scheduler measured, by name)."""
 
     plan: PlanFile
     asynchronous: bool
@@ -109,10 +109,11 @@ class Schedule:
     order: str
     reason: str
     checks: int
+    figures: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
-class _Entry:
+class Entry:
     """A block to place, as samples ``q`` ``(n + 1, k)`` (the arm's ``k`` joints), ``offset``
     ticks after the start
     of its group."""
@@ -123,13 +124,13 @@ class _Entry:
     offset: int
 
 
-def _events_of(entries: list[_Entry], new: list[TimedEvent]) -> list[TimedEvent | None]:
+def _events_of(entries: list[Entry], new: list[TimedEvent]) -> list[TimedEvent | None]:
     """The new event of each entry (None for an entry without one)."""
     found = {id(e.event): e for e in new}
     return [found.get(id(x.block.event)) if x.block.event is not None else None for x in entries]
 
 
-class _NoPlacement(Exception):
+class NoPlacement(Exception):
     def __init__(self, block: Block, conflict: Conflict | None, detail: str) -> None:
         super().__init__(detail)
         self.block, self.conflict = block, conflict
@@ -149,8 +150,8 @@ def schedule_async(
     reasons = []
     for order in options.orders:
         try:
-            result = _Placement(plan, blocks, sweep, options, order).run()
-        except _NoPlacement as exc:
+            result = Placement(plan, blocks, sweep, options, order).run()
+        except NoPlacement as exc:
             reasons.append(f"order {order}: {exc}")
             continue
         limit = check_timeline(result, scene, options.dwell)
@@ -196,7 +197,7 @@ def groups(blocks: list[list[Block]]) -> list[list[Block]]:
     return [sorted(g, key=lambda b: (b.sync_key, b.arm)) for g in out]
 
 
-class _Placement:
+class Placement:
     """The greedy placement of every arm's blocks for one event ordering."""
 
     def __init__(
@@ -236,7 +237,7 @@ class _Placement:
                 continue
             self.undo(mark)
             first = min(b.sync_index for b in group)
-            self.place([_Entry(b.arm, b, b.q_sync, b.sync_index - first) for b in group])
+            self.place([Entry(b.arm, b, b.q_sync, b.sync_index - first) for b in group])
         return self.assemble()
 
     def alone(self, group: list[Block]) -> bool:
@@ -247,8 +248,8 @@ class _Placement:
         try:
             for block in group:
                 latest = math.ceil(block.sync_end / self.tick - 1e-9) - block.motion_ticks
-                self.place([_Entry(block.arm, block, block.q, 0)], latest)
-        except _NoPlacement:
+                self.place([Entry(block.arm, block, block.q, 0)], latest)
+        except NoPlacement:
             self.undo(mark)
             return False
         return True
@@ -299,7 +300,7 @@ class _Placement:
             return False
         return self.order == "events" or other.object == e.object
 
-    def earliest(self, entry: _Entry) -> int:
+    def earliest(self, entry: Entry) -> int:
         """The first start tick of the group the arm's horizon and the event orderings
         allow for ``entry``."""
         s = self.horizon(entry.arm)
@@ -319,14 +320,14 @@ class _Placement:
         idx = np.minimum(np.arange(k0, k1 + 1), len(traj) - 1)
         return np.array([traj[i] for i in idx])
 
-    def length(self, entry: _Entry) -> int:
+    def length(self, entry: Entry) -> int:
         """Ticks of the entry's motion and of the dwell after its event."""
         return len(entry.q) - 1 + (self.dwell if entry.block.event is not None else 0)
 
-    def place(self, entries: list[_Entry], latest: int | None = None) -> None:
+    def place(self, entries: list[Entry], latest: int | None = None) -> None:
         """Place the blocks of ``entries`` (an arm's in order, apart by their offsets) at the
         earliest common start ``s`` (each at ``s + offset``), at most ``latest`` when given,
-        whose replay passes; raises :class:`_NoPlacement`."""
+        whose replay passes; raises :class:`NoPlacement`."""
         arms = [e.arm for e in entries]
         k0 = min(self.horizon(a) for a in arms)
         start = max(self.earliest(e) for e in entries)
@@ -367,10 +368,10 @@ class _Placement:
         )
         if conflict is not None:
             detail += f"; at t = {conflict.tick * self.tick:.2f} s: {conflict.message}"
-        raise _NoPlacement(block, conflict, detail)
+        raise NoPlacement(block, conflict, detail)
 
     def commit(
-        self, entry: _Entry, s: int, rows: FloatArray, k0: int, timed: TimedEvent | None
+        self, entry: Entry, s: int, rows: FloatArray, k0: int, timed: TimedEvent | None
     ) -> None:
         horizon = self.horizon(entry.arm)
         self.traj[entry.arm].extend(rows[horizon - k0 + 1 :])

@@ -303,10 +303,13 @@ def test_the_command_line_reaches_the_planner_config(
     with pytest.raises(Stop):
         main(["solve", instance, "-q"])
     assert seen[-1].execution == "async"  # the default of `sdar solve`
+    with pytest.raises(Stop):
+        main(["solve", instance, "-q", "--execution", "timelines"])
+    assert seen[-1].execution == "timelines"
     with pytest.raises(SystemExit):
         main(["solve", instance, "--execution", "later"])
     assert "argument --execution: invalid choice: 'later'" in capsys.readouterr().err
-    with pytest.raises(ParameterError, match="execution must be one of sync, async"):
+    with pytest.raises(ParameterError, match="execution must be one of sync, async, timelines"):
         PlannerConfig(execution="later")
     with pytest.raises(SystemExit):
         main(["solve", instance, "--grasps", "0"])
@@ -354,3 +357,31 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(
         assert "asynchronous (synchronous" in format_summary(outcome)
     else:
         assert "synchronous kept" in format_summary(outcome)
+
+
+def test_a_timelines_run_keeps_the_shorter_schedule_and_replays_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``execution="timelines"``: both schedules are made, the scheduler is told which, and
+    the plan kept is valid and never longer than the synchronous one."""
+    from sdar_tamp.app import execution
+    from sdar_tamp.app.pipeline import solve_instance
+    from sdar_tamp.world.instance import save_instance
+
+    a = ObjectSpec("a", SQUARE, Pose2D(-0.1, 0.15, 0.0), Pose2D(0.1, -0.15, 0.3))
+    b = ObjectSpec("b", SQUARE, Pose2D(0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.0))
+    path = save_instance(Instance("two", WORKSPACE, (a, b)), tmp_path / "two.yaml")
+    made: list[str] = []
+    real = execution.schedule_timelines
+
+    def counting(*args: Any, **kwargs: Any) -> Any:
+        made.append("timelines")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr("sdar_tamp.app.execution.schedule_timelines", counting)
+    outcome = solve_instance(path, PlannerConfig(execution="timelines"), time_limit=BUDGET)
+    assert outcome.plan is not None and outcome.valid, outcome.violation
+    assert made == ["timelines"]
+    metrics = outcome.plan.metrics
+    if metrics.execution == "async":
+        assert float(metrics.execution_time) < float(metrics.execution_time_sync)

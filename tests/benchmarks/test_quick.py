@@ -55,6 +55,7 @@ def _arm_ik(out: Summary) -> None:
 def _async(out: Summary) -> None:
     assert out["instances"] == 1 and out["all_valid"] is True
     assert out["median_ratio"] <= 1.0  # the scheduler never returns a longer plan
+    assert out["median_ratio_timelines"] <= out["median_ratio"]  # the shorter of the two
 
 
 def _cells(out: Summary) -> None:

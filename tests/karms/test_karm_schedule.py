@@ -5,21 +5,23 @@ from __future__ import annotations
 
 import pytest
 
+from sdar_tamp.app.execution import execution_options, schedule_plan
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule.pieces import arm_blocks
-from sdar_tamp.schedule.scheduler import _Placement, groups
+from sdar_tamp.schedule.scheduler import Placement, groups
 from sdar_tamp.schedule.sweep import WorldSweep
+from sdar_tamp.schedule.timelines import schedule_timelines
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
 
 
-def _placement(plan: PlanFile, scene: Scene, instance: Instance) -> _Placement:
+def _placement(plan: PlanFile, scene: Scene, instance: Instance) -> Placement:
     options = ScheduleOptions()
     blocks = [arm_blocks(plan, scene, i, options.tick) for i in range(len(scene.arms))]
     sweep = WorldSweep(instance, scene, options.max_tcp_step)
-    return _Placement(plan, blocks, sweep, options, "objects")
+    return Placement(plan, blocks, sweep, options, "objects")
 
 
 def test_every_arm_has_its_blocks_and_groups_hold_every_arm(
@@ -64,3 +66,27 @@ def test_k_arm_schedules_replay(
     assert result.plan.arm_names == plans[k].arm_names
     report = validate_plan(instances[k], result.plan, cells[k])
     assert report.ok, report.violation
+
+
+@pytest.mark.parametrize("k", (1, 3, 4))
+def test_k_arm_timelines_replay(
+    k: int, plans: dict[int, PlanFile], cells: dict[int, Scene], instances: dict[int, Instance]
+) -> None:
+    """One timeline per arm for one, three and four arms: never longer than the synchronous
+    plan, every arm's motions committed, and the result replays."""
+    plan, scene = plans[k], cells[k]
+    result = schedule_timelines(plan, instances[k], scene, execution_options(scene))
+    assert result.plan.duration <= plan.duration
+    assert result.plan.arm_names == plan.arm_names
+    figures = dict(result.figures)
+    blocks = sum(len(arm_blocks(plan, scene, i, 0.02)) for i in range(k))
+    assert figures["motions"] + figures["together"] <= blocks
+    assert result.asynchronous, result.reason
+    # the arms carry their objects at once: alone, each goes at its own limits, straighter
+    retimed = schedule_async(plan, instances[k], scene, execution_options(scene))
+    assert result.plan.duration < retimed.plan.duration
+    report = validate_plan(instances[k], result.plan, scene)
+    assert report.ok, report.violation
+    kept = schedule_plan(plan, instances[k], scene, scheduler="timelines")
+    assert kept.plan.duration <= min(result.plan.duration, plan.duration) + 1e-9
+    assert validate_plan(instances[k], kept.plan, scene).ok

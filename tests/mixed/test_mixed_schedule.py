@@ -19,7 +19,7 @@ from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_rules import LIMIT_RTOL, check_timeline
 from sdar_tamp.schedule.pieces import Block, arm_blocks, arm_columns
 from sdar_tamp.schedule.retiming import ArmRetimer, PathTimer
-from sdar_tamp.schedule.scheduler import ScheduleOptions, _Placement
+from sdar_tamp.schedule.scheduler import Placement, ScheduleOptions
 from sdar_tamp.schedule.sweep import Conflict, TimedEvent
 from sdar_tamp.world._pin import PinRobot
 from sdar_tamp.world.kinematics import ArmKinematics
@@ -139,7 +139,7 @@ def test_the_asynchronous_placement_assembles_both_arms(plan: PlanFile, cell: Sc
     blocks: list[list[Block]] = [
         arm_blocks(plan, cell, i, TICK, True, _retimer(cell, i, None)) for i in range(2)
     ]
-    result = _Placement(plan, blocks, FreeSweep(), options, "objects").run()  # type: ignore[arg-type]
+    result = Placement(plan, blocks, FreeSweep(), options, "objects").run()  # type: ignore[arg-type]
     assert result.q.shape == (len(result.t), 13)
     assert result.layout.dofs == (6, 7)
     assert check_timeline(result, cell) is None

@@ -24,7 +24,7 @@ from sdar_tamp.replay_sampling import tcp_subdivisions
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule import sweep as sweep_module
 from sdar_tamp.schedule.pieces import arm_blocks, arm_columns, on_ticks
-from sdar_tamp.schedule.scheduler import Schedule, _Placement, groups
+from sdar_tamp.schedule.scheduler import Placement, Schedule, groups
 from sdar_tamp.schedule.spline import ClampedSpline, retime
 from sdar_tamp.schedule.sweep import Conflict, TimedEvent, WorldSweep
 from sdar_tamp.world.instance import Instance, load_instance
@@ -137,7 +137,7 @@ def test_without_the_separation_the_validator_rejects_the_schedule(crowded: Solv
     scene, options = crowded.ctx.scene, ScheduleOptions()
     blocks = [arm_blocks(crowded.plan, scene, i, options.tick) for i in range(2)]
     blind = _Blind(crowded.instance, scene, options.max_tcp_step)
-    mutant = _Placement(crowded.plan, blocks, blind, options, "objects").run()
+    mutant = Placement(crowded.plan, blocks, blind, options, "objects").run()
     assert check_timeline(mutant, scene) is None  # limits and dwells still hold
     report = validate_plan(crowded.instance, mutant, scene)
     assert not report.ok and report.violation is not None
