@@ -23,7 +23,7 @@ def format_summary(outcome: SolveOutcome) -> str:
     lines = [
         head + (", plan valid" if outcome.valid else f", plan INVALID ({outcome.violation})"),
         f"  actions {m.actions} ({f.buffer_moves} to buffers), synchronous steps "
-        f"{m.steps} ({m.dual_arm_steps} with both arms moving at once)",
+        f"{m.steps} ({m.dual_arm_steps} with {_together(len(outcome.plan.arms))} moving at once)",
         f"  execution time {float(_given(m.execution_time)):.2f} s"
         + _async_note(m, f.schedule_time),
         *_bound_line(outcome),
@@ -159,3 +159,8 @@ def terminal_progress(label: str, stream: TextIO = sys.stderr) -> ProgressBar | 
     or a pipe gets the summary lines only, not the bar's redraws."""
     isatty = getattr(stream, "isatty", None)
     return ProgressBar(label, stream) if callable(isatty) and isatty() else None
+
+
+def _together(arms: int) -> str:
+    """What a step counted in ``dual_arm_steps`` moves, worded for the cell's arm count."""
+    return "both arms" if arms == 2 else "two arms or more"

@@ -352,6 +352,12 @@ def test_an_asynchronous_run_is_scheduled_validated_and_reported(
     ratio = float(metrics.execution_time) / outcome.bound.seconds
     assert outcome.execution_over_bound == pytest.approx(ratio)
     assert f"bound {outcome.bound.seconds:.1f} s ({ratio:.2f}x)" in format_summary(outcome)
+    assert "with both arms moving at once" in format_summary(outcome)
+    plan = outcome.plan
+    three = dataclasses.replace(
+        outcome, plan=dataclasses.replace(plan, arms=(*plan.arms, plan.arms[0]))
+    )
+    assert "with two arms or more moving at once" in format_summary(three)
     if metrics.execution == "async":
         assert float(metrics.execution_time) < float(metrics.execution_time_sync)
         assert "asynchronous (synchronous" in format_summary(outcome)
