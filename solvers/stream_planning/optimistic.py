@@ -17,10 +17,11 @@ adds nothing to the optimistic world). That value is what later optimistic calls
 of the placeholder, so optimistic values chain through streams. ``gen_fn`` is called once per
 instance and solve.
 
-Functions on placeholders take their optimistic value (``FunctionInfo.opt_fn``, default 1,
-called with the Python values of real inputs, the optimistic value of placeholders that have
-one and an :class:`~.opt_values.OptimisticValue` for the others);
-predicates on placeholders are optimistically true unless the domain uses them negated.
+Functions on placeholders, and deferred ones on real inputs (:mod:`.deferred`), take their
+optimistic value (``FunctionInfo.opt_fn``, default 1, called with the Python values of real
+inputs, the optimistic value of placeholders that have one and an
+:class:`~.opt_values.OptimisticValue` for the others); predicates on placeholders, and deferred
+ones, are optimistically true unless the domain uses them negated.
 """
 
 from __future__ import annotations
@@ -86,6 +87,9 @@ class OptimisticBuilder:
         # (stream, inputs) -> the output tuples of its callable opt_gen_fn
         self._generated: dict[tuple[str, tuple[str, ...]], list[tuple[object, ...]]] = {}
         self._later: set[str] = set()  # placeholders of later calls (see _further)
+        # the optimistic results (and values) of deferred instances on real inputs
+        self._deferred: dict[tuple[str, tuple[str, ...], int], list[OptResult]] = {}
+        self._deferred_values: dict[tuple[str, tuple[str, ...], int], float] = {}
 
     def placeholder(self, key: tuple[object, ...]) -> str:
         name = self._placeholders.get(key)
@@ -206,18 +210,27 @@ class OptimisticBuilder:
             ]
         if name in engine.functions:
             function = engine.functions[name]
-            if real:
+            if not real:
+                return self._function(function, inputs, level, world)
+            if (name, inputs) not in engine.deferred:
                 return []  # evaluated for real by the engine
-            return self._function(function, inputs, level, world)
-        if real:
-            return []  # rules on real facts were applied by the engine
+            # a deferred instance: the same optimistic result in every build
+            key = (name, inputs, level)
+            cached = self._deferred.get(key)
+            if cached is None:
+                cached = self._deferred[key] = self._function(function, inputs, level, world)
+            elif not function.is_predicate:
+                world.numeric[(name, inputs)] = self._deferred_values[key]
+            return cached
         rule = engine.rules[name]
         mapping = dict(zip(rule.parameters, inputs, strict=True))
-        certified = tuple(
-            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.certified
-        )
         domain = tuple(
             Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.domain
+        )
+        if real and all(a in engine.store for a in domain):
+            return []  # rules on real facts were applied by the engine
+        certified = tuple(
+            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.certified
         )
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
 
@@ -364,6 +377,7 @@ class OptimisticBuilder:
         opt_fn = getattr(function.info, "opt_fn", None)
         value = float(opt_fn(*self._values(inputs))) if opt_fn is not None else 1.0
         world.numeric[(function.name, inputs)] = value
+        self._deferred_values[(function.name, inputs, level)] = value
         return [
             OptResult(
                 function.name,
