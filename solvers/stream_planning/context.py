@@ -212,8 +212,9 @@ class SolveContext:
     def sweep_deferred(self, name: str, inputs: tuple[str, ...]) -> int:
         """A deferred predicate a plan used came out false: evaluate other deferred instances
         of it, those sharing the most inputs with it first (the likeliest to fail too), up to
-        ``search_sample_ratio`` times the real facts known (the next search costs at least
-        that much). Returns the calls made."""
+        ``search_sample_ratio`` times the real facts known. (:meth:`sweep_test` allows as many
+        as the facts of the last search; here those include every deferred instance, so that
+        budget would call nearly all of them.) Returns the calls made."""
         engine = self.engine
         budget = self.options.search_sample_ratio * max(len(engine.store), 1)
         siblings = [k for k in engine.deferred if k[0] == name]

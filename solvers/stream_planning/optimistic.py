@@ -131,7 +131,18 @@ class OptimisticBuilder:
         ]
         queries += [Query(n, r.parameters, r.domain) for n, r in engine.rules.items()]
         instantiator = Instantiator(queries, store)
-        pending = list(instantiator.initial())
+        # functions and predicates on real facts alone: the engine evaluated them or holds
+        # them deferred, so only the deferred ones are offered (no join over every combination)
+        functions = {q.name: q for q in queries if q.name in engine.functions}
+        pending = list(instantiator.initial(skip=functions))
+        for (name, inputs), level in engine.deferred.items():
+            query = functions.get(name)
+            hidden = engine.hidden and not all(  # its domain holds in one fluent state only
+                a in store for a in engine.functions[name].domain(inputs)
+            )
+            if query is not None and not hidden:
+                instantiator.seen.add((name, inputs))
+                pending.append((query, inputs, level))
         steps = 0
         while pending:
             steps += 1
