@@ -14,10 +14,11 @@ run, on the same seeds:
   idiom): the test and the costs are evaluated for the candidate plans' instances only;
 - ``auto``: no stream options; the test is negated automatically (PDDLStream's namo idiom).
 
-Per run: status, wall time [s], plan cost, and calls per stream. Prints a table, then one JSON
-line.
+Per run: status, wall time [s], plan cost, and calls per stream. The samplers here take
+microseconds; ``--call-ms`` makes each collision test and handling cost spend that long, as a
+real geometric check would. Prints a table, then one JSON line.
 
-    python benchmarks/bench_deferred.py [--seeds 3] [--max-time 120] [--clutter 3]
+    python benchmarks/bench_deferred.py [--seeds 3] [--max-time 120] [--clutter 3] [--call-ms 0]
     python benchmarks/bench_deferred.py --quick    # one seed, two clutter objects
 """
 
@@ -38,8 +39,10 @@ COST = "handlingcost"
 QUICK = {"seeds": 1, "clutter": 2, "max_time": 120.0}
 
 
-def run(mode: str, seed: int, clutter: int, max_time: float) -> dict[str, Any]:
-    problem = make_problem(seed=seed, clutter=clutter)
+def run(
+    mode: str, seed: int, clutter: int, max_time: float, call_ms: float = 0.0
+) -> dict[str, Any]:
+    problem = make_problem(seed=seed, clutter=clutter, call_seconds=call_ms / 1000)
     start = time.perf_counter()
     solution = solve_adaptive(
         problem,
@@ -92,6 +95,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--clutter", type=int, default=3, help="objects already on the shelf")
     parser.add_argument("--max-time", type=float, default=120.0, help="[s] per run")
     parser.add_argument("--modes", nargs="+", choices=MODES, default=list(MODES))
+    parser.add_argument(
+        "--call-ms", type=float, default=0.0, help="[ms] each test and cost call spends"
+    )
     parser.add_argument("--quick", action="store_true", help="one seed, a smaller shelf")
     args = parser.parse_args(argv)
     if args.quick:
@@ -102,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         )
     logging.basicConfig(level=logging.ERROR)
     rows = [
-        run(mode, seed, args.clutter, args.max_time)
+        run(mode, seed, args.clutter, args.max_time, args.call_ms)
         for seed in range(args.seeds)
         for mode in args.modes
     ]
@@ -112,6 +118,7 @@ def main(argv: list[str] | None = None) -> int:
         "clutter": args.clutter,
         "seeds": args.seeds,
         "max_time": args.max_time,
+        "call_ms": args.call_ms,
         "runs": rows,
         "modes": {mode: summary(rows, mode) for mode in args.modes},
     }

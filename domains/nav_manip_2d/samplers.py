@@ -20,6 +20,7 @@ instance as soon as its inputs exist).
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -46,8 +47,15 @@ Point = tuple[float, float]
 class House:
     """The samplers of one problem, drawing from one seeded generator."""
 
-    def __init__(self, seed: int) -> None:
+    def __init__(self, seed: int, call_seconds: float = 0.0) -> None:
         self.rng = np.random.default_rng(seed)
+        self.call_seconds = call_seconds
+
+    def _work(self) -> None:
+        """Spend ``call_seconds`` [s] (stands for the geometry a real test or cost computes)."""
+        end = time.perf_counter() + self.call_seconds
+        while time.perf_counter() < end:
+            pass
 
     @staticmethod
     def nav_poses(location: str) -> list[tuple[Point]]:
@@ -76,6 +84,14 @@ class House:
     def collision_free(o1: str, p1: Point, o2: str, p2: Point) -> bool:
         return o1 == o2 or math.dist(p1, p2) >= OBJECT - 1e-9
 
+    def timed_collision_free(self, o1: str, p1: Point, o2: str, p2: Point) -> bool:
+        self._work()
+        return self.collision_free(o1, p1, o2, p2)
+
+    def timed_handling_cost(self, location: str, obj: str, pose: Point, conf: Point) -> float:
+        self._work()
+        return self.handling_cost(location, obj, pose, conf)
+
     @staticmethod
     def path_length(path: tuple[Point, Point]) -> float:
         return round(math.dist(*path), 4)
@@ -101,15 +117,18 @@ def stream_info(mode: str = "negate") -> dict[str, StreamInfo | FunctionInfo]:
     return info
 
 
-def make_problem(seed: int = 0, movers: int = 2, clutter: int = 3) -> PDDLProblem:
+def make_problem(
+    seed: int = 0, movers: int = 2, clutter: int = 3, call_seconds: float = 0.0
+) -> PDDLProblem:
     """Carry ``movers`` objects from the counter to the shelf, which holds ``clutter`` others.
 
     Args:
         seed: seeds the placement sampler.
         movers: objects to move (1-4).
         clutter: objects already on the shelf (0-4), spread along its back edge.
+        call_seconds: [s] time each collision test and handling cost spends (0: none).
     """
-    house = House(seed)
+    house = House(seed, call_seconds)
     start = House.nav_poses("counter")[0]
     init: list[tuple[object, ...]] = [
         ("Robot", "robot"),
@@ -137,9 +156,9 @@ def make_problem(seed: int = 0, movers: int = 2, clutter: int = 3) -> PDDLProble
             "sample-navpose": from_list_fn(house.list_nav_poses),
             "plan-path": from_gen_fn(House.plan_path),
             "sample-place": from_gen_fn(house.sample_place),
-            "test-collision-free": from_test(House.collision_free),
+            "test-collision-free": from_test(house.timed_collision_free),
             "pathlength": House.path_length,
-            "handlingcost": House.handling_cost,
+            "handlingcost": house.timed_handling_cost,
         },
         init,
         And(*goal),

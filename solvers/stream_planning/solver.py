@@ -176,7 +176,8 @@ class StreamSolver:
                     # a deferred test it relied on is false: plan again without it
                     self._end("plan on deferred tests: one failed")
                     continue
-                if valid and context.deferred_calls > evaluated and check.cost > cost + 1e-9:
+                dearer = not options.unit_costs and check.cost > cost + 1e-9
+                if valid and dearer and context.deferred_calls > evaluated:
                     # its cost terms, evaluated now, cost more than the search assumed: keep
                     # it, and search again at this level for a plan cheaper than it, with the
                     # values known (no such plan: this one stands)
