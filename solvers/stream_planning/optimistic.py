@@ -17,11 +17,10 @@ adds nothing to the optimistic world). That value is what later optimistic calls
 of the placeholder, so optimistic values chain through streams. ``gen_fn`` is called once per
 instance and solve.
 
-Functions on placeholders, and deferred ones on real inputs (:mod:`.deferred`), take their
-optimistic value (``FunctionInfo.opt_fn``, default 1, called with the Python values of real
-inputs, the optimistic value of placeholders that have one and an
-:class:`~.opt_values.OptimisticValue` for the others); predicates on placeholders, and deferred
-ones, are optimistically true unless the domain uses them negated.
+Functions on placeholders and deferred ones (:mod:`.deferred`) take their optimistic value
+(``FunctionInfo.opt_fn``, default 1, called with the values of real inputs, the optimistic value
+of placeholders that have one, an :class:`~.opt_values.OptimisticValue` for the others);
+predicates on placeholders and deferred ones are true unless the domain uses them negated.
 """
 
 from __future__ import annotations
@@ -131,8 +130,7 @@ class OptimisticBuilder:
         ]
         queries += [Query(n, r.parameters, r.domain) for n, r in engine.rules.items()]
         instantiator = Instantiator(queries, store)
-        # functions and predicates on real facts alone: the engine evaluated them or holds
-        # them deferred, so only the deferred ones are offered (no join over every combination)
+        # functions on real facts alone: the engine evaluated them or holds them deferred
         functions = {q.name: q for q in queries if q.name in engine.functions}
         pending = list(instantiator.initial(skip=functions))
         for (name, inputs), level in engine.deferred.items():
