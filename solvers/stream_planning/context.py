@@ -18,6 +18,7 @@ from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.classical.fast_downward import plan_task_with_fast_downward
+from solvers.stream_planning.assumed import Assumed
 from solvers.stream_planning.blocked_calls import Blocks, guard_fluent_uses
 from solvers.stream_planning.calls import CallRunner
 from solvers.stream_planning.costs import guard_costs
@@ -50,7 +51,6 @@ class SolveContext:
         self.problem = problem
         self.options = options
         self.start = time.perf_counter()
-        self.domain: Domain = guard_costs(problem.domain)
         self.goal = problem.facts.goal
         negated = negated_predicates(problem.domain, self.goal)
         stream_info = resolve_negated_uses(problem.streams, stream_info, problem.domain, negated)
@@ -58,7 +58,17 @@ class SolveContext:
         # incremental plans on real facts only: it evaluates every function at once
         defer = options.algorithm != "incremental"
         self.engine = Engine(problem, stream_info, self.runner, defer, negated)
-        self.builder = OptimisticBuilder(self.engine, negated)
+        functions = self.engine.functions
+        deferred = {n: f for n, f in functions.items() if self.engine.defers(f)}
+        self.assumed = Assumed(
+            {n: f for n, f in deferred.items() if f.is_predicate},
+            {n: f for n, f in deferred.items() if not f.is_predicate},
+            frozenset(problem.domain.types.parents) | {"object"},
+        )
+        # the search's domain and goal: deferred instances assumed (see assumed.py)
+        self.domain: Domain = self.assumed.rewrite(guard_costs(problem.domain))
+        self.search_goal = self.assumed.formula(self.goal)
+        self.builder = OptimisticBuilder(self.engine, negated, self.assumed)
         self.fluent_streams = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
         self.blocks = Blocks(guard_fluent_uses(self.domain, problem.streams.streams))
         self.stats = SearchStatistics()
@@ -117,7 +127,7 @@ class SolveContext:
             domain,
             self.objects(facts),
             frozenset(facts) | self.blocks.facts(),
-            self.goal,
+            self.search_goal,
             numeric,
             use_costs=not self.options.unit_costs,
             extra_cost=extra,
@@ -281,7 +291,13 @@ class SolveContext:
         engine = self.engine
         start = time.perf_counter()
         resolve_plan(
-            engine, self.evaluate_deferred, self.problem.domain, self.objects, actions, self.goal
+            engine,
+            self.assumed,
+            self.evaluate_deferred,
+            self.problem.domain,
+            self.objects,
+            actions,
+            self.goal,
         )
         self.stats.sample_time += time.perf_counter() - start
         facts = engine.store.levels

@@ -25,6 +25,7 @@ from collections.abc import Callable, Collection, Iterable, Mapping
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import Atom, Formula, FunctionTerm, IncreaseCost
 from sdar_tamp.language.traversal import iter_effects
+from solvers.stream_planning.assumed import Assumed
 from solvers.stream_planning.engine import Engine
 from solvers.stream_planning.preimage import simulate
 
@@ -47,6 +48,7 @@ def cost_terms(domain: Domain, actions: Iterable[tuple[str, tuple[str, ...]]]) -
 
 def resolve_plan(
     engine: Engine,
+    assumed: Assumed,
     evaluate: Callable[[str, tuple[str, ...]], bool],
     domain: Domain,
     objects: Callable[[Collection[Atom]], Mapping[str, str]],
@@ -57,33 +59,31 @@ def resolve_plan(
     many were called.
 
     The cost terms first; then, as long as the plan is not valid on the real facts, it is run
-    on the real facts plus every deferred predicate fact taken as true, and the deferred facts
-    that run needs are evaluated in order until one is false (the run then needs other facts:
-    run it again) or none is left. Each pass evaluates at least one instance, so this ends.
+    on the real facts with every deferred predicate instance whose domain holds assumed true
+    (unless refuted: :class:`~.assumed.AssumedFacts`), and the assumed facts that run needs are
+    evaluated in order until one is false (the run then needs other facts: run it again) or
+    none is left. Each pass evaluates at least one instance, so this ends.
     """
     calls = 0
     for term in cost_terms(domain, actions):
         calls += evaluate(term.predicate, term.args)
-    while engine.deferred:
+    if not assumed.predicates:
+        return calls
+    view = assumed.view(engine.refuted)
+    while True:
         # a deferred predicate is used positively only (the negated ones are never deferred):
         # a plan valid without its facts stays valid whatever they turn out to be
         real = engine.store.levels
         if simulate(domain, objects(real), real, actions, goal).valid:
             break
-        assumed = {
-            Atom(name, inputs): level
-            for (name, inputs), level in engine.deferred.items()
-            if engine.functions[name].is_predicate
-        }
-        if not assumed:
-            break
-        facts = {**engine.store.levels, **assumed}
-        check = simulate(domain, objects(facts), facts, actions, goal)
-        needed = sorted((a for a in check.needed if a in assumed), key=str)
-        if not needed:
-            break
+        check = simulate(domain, objects(real), real, actions, goal, view=view)
+        needed = assumed.assumed_in(check.needed, engine.store.levels)
+        made = 0
         for atom in needed:
-            calls += evaluate(atom.predicate, atom.args)
+            made += evaluate(atom.predicate, atom.args)
             if atom not in engine.store:
                 break
+        calls += made
+        if not made:
+            break
     return calls

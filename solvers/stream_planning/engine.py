@@ -100,6 +100,7 @@ class Engine:
         self.negated = negated  # predicates the domain uses negated: never deferred
         # (function or predicate, inputs) -> level: instances whose domain holds, not evaluated
         self.deferred: dict[tuple[str, tuple[str, ...]], int] = {}
+        self.refuted: set[Atom] = set()  # deferred predicate instances evaluated false
         self.runner = runner if runner is not None else CallRunner()
         self.table: ObjectTable = problem.objects.copy()
         self._eager: list[InstanceState] = []  # eager instances not called yet
@@ -118,6 +119,18 @@ class Engine:
         }
         streams = problem.streams
         self.rules = {f"{RULE_PREFIX}{i}": rule for i, rule in enumerate(streams.rules)}
+        # predicates some external needs in its domain: never deferred (what follows from
+        # them must follow in the optimistic world too)
+        self._needed = frozenset(
+            a.predicate
+            for declaration in (
+                *(s.declaration for s in self.streams.values()),
+                *(f.declaration for f in self.functions.values()),
+                *self.rules.values(),
+            )
+            for a in declaration.domain
+        )
+        self._evaluated_at_once = negated | self._needed
         self.store = FactStore()
         self.numeric: dict[tuple[str, tuple[str, ...]], float] = dict(problem.facts.numeric)
         self.instances: dict[tuple[str, tuple[str, ...]], InstanceState] = {}
@@ -208,7 +221,7 @@ class Engine:
         """Is a function or predicate evaluated only when a plan uses it?"""
         if not self.defer or external.info.eager:
             return False
-        return not (external.is_predicate and external.name in self.negated)
+        return not (external.is_predicate and external.name in self._evaluated_at_once)
 
     def _value(self, external: FunctionExternal, inputs: tuple[str, ...]) -> list[Atom]:
         """Evaluate a function or predicate instance: the facts its value makes known."""
@@ -225,7 +238,10 @@ class Engine:
         level = self.deferred.pop((name, inputs), None)
         if level is None:
             return False
-        self.add_facts(self._value(self.functions[name], inputs), level)
+        external = self.functions[name]
+        self.add_facts(self._value(external, inputs), level)
+        if external.is_predicate and Atom(name, inputs) not in self.store:
+            self.refuted.add(Atom(name, inputs))
         return True
 
     def _fluents(self, external: StreamExternal) -> tuple[Atom, ...]:

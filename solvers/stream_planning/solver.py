@@ -238,11 +238,20 @@ class StreamSolver:
         context = self.context
         stream_plan: list[OptResult] = []
         check = None
-        if world.provenance:  # (else all facts are real)
+        assumed = context.assumed
+        if world.provenance or assumed.predicates:  # (else all facts are real)
             check = simulate(
                 context.problem.domain, context.objects(world.facts), world.facts, actions,
-                context.goal,
+                context.goal, view=assumed.view(context.engine.refuted),
             )  # fmt: skip
+            for atom in assumed.assumed_in(check.needed, world.facts):
+                # a deferred predicate instance the plan relies on: a result of the plan
+                external = assumed.predicates[atom.predicate]
+                domain = external.domain(atom.args)
+                level = max((world.facts.get(a, 0) for a in domain), default=0)
+                world.provenance[atom] = OptResult(
+                    atom.predicate, atom.args, (), domain, (atom,), level, "predicate"
+                )
             stream_plan = extract_stream_plan(check.needed, world)
         # The same actions on the same optimistic results: nothing learnt since this plan was
         # met, as if none. (The same actions on real facts are new.)
