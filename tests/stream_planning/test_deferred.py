@@ -11,11 +11,14 @@ from typing import Any
 import pytest
 
 from domains.nav_manip_2d.samplers import make_problem, stream_info
+from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import from_test
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solve import solve
+from solvers.stream_planning.context import SolveContext
 from solvers.stream_planning.externals import StreamError
+from solvers.stream_planning.options import StreamOptions
 
 # A row of slots; a robot carries object ``a`` from the start to a slot on the shelf, where the
 # obstacles stand. A slot is free when it is at least 1 apart from every obstacle at the shelf;
@@ -109,6 +112,56 @@ def test_deferred_test_and_cost_are_called_for_the_plan_only(algorithm: str) -> 
     assert asked == set(OBSTACLES.items())
     assert solution.streams["test-cfree"].calls == len(calls)
     assert solution.streams["handling"].calls == len(costs)
+
+
+def test_the_optimistic_world_holds_no_deferred_instance() -> None:
+    """Deferred tests and costs add nothing per instance to the optimistic world: the search's
+    domain assumes them; a refuted instance adds one fact, which blocks it in the next search."""
+    calls: list[tuple[Any, ...]] = []
+    costs: list[tuple[Any, ...]] = []
+    problem = slots_problem(calls, costs, lambda *_a: 1.0)
+    context = SolveContext(problem, StreamOptions(), {"test-cfree": StreamInfo(negate=True)})
+    engine = context.engine
+    engine.start()
+    assert len(engine.deferred) == 2 * combinations()  # recorded, not called
+    world = context.builder.build(0)
+    assert set(world.facts) == set(engine.store.levels)
+    key = next(k for k in engine.deferred if k[0] == "handling")
+    assert key in world.numeric and world.numeric[key] == 1.0  # its optimistic value
+    assert not costs
+    # `a` on slot 10 collides with `b` on slot 10: evaluated, it is refuted
+    name = engine.table.name
+    inputs = (name("a"), name(10), name("b"), name(10))
+    assert engine.evaluate("cfree", inputs)
+    assert calls == [("a", 10, "b", 10)]
+    assert engine.refuted == {Atom("cfree", inputs)}
+    world = context.builder.build(0)
+    assert set(world.facts) - set(engine.store.levels) == {Atom("@refuted:cfree", inputs)}
+    # the search's domain reads (CFree ...) as its domain facts and "not refuted"
+    unsafe = next(a for a in context.domain.axioms if a.predicate == "unsafe")
+    assert "@refuted:cfree" in str(unsafe.body) and "(cfree " not in str(unsafe.body)
+
+
+def test_a_predicate_a_stream_domain_needs_is_not_deferred() -> None:
+    """What follows from a predicate (a stream on its facts) must follow optimistically too:
+    such a predicate is evaluated as soon as its domain holds."""
+    streams = STREAMS.replace(
+        "(:function (Handling",
+        "(:stream mark :inputs (?o ?p ?o2 ?p2) :domain (CFree ?o ?p ?o2 ?p2) "
+        ":outputs (?m) :certified (Obj ?m))\n  (:function (Handling",
+    )
+    problem = slots_problem([], [], lambda *_a: 1.0)
+    assert isinstance(problem.stream_map, dict)
+    problem = PDDLProblem(
+        problem.domain_pddl,
+        {},
+        streams,
+        {**problem.stream_map, "mark": lambda *_a: iter(())},
+        problem.init,
+        problem.goal,
+    )
+    context = SolveContext(problem, StreamOptions(), {"test-cfree": StreamInfo(negate=True)})
+    assert not context.assumed.predicates and set(context.assumed.functions) == {"handling"}
 
 
 def test_eager_evaluates_every_combination() -> None:
