@@ -20,7 +20,9 @@ A deferred ``:function`` costs nothing per instance either: the cost guard ``(@f
 value when it grounds an action that needs it (:class:`OptimisticCosts`).
 
 A predicate is assumed only when no stream, function or rule needs it in its domain (else the
-optimistic world would miss what follows from it); the engine evaluates those at once.
+optimistic world would miss what follows from it); the engine evaluates those at once. As in
+PDDLStream, the search reads an assumed predicate through its domain only: a fact of it given in
+the initial state whose domain facts do not hold is not used.
 """
 
 from __future__ import annotations
@@ -135,6 +137,13 @@ class AssumedFacts(FactIndex):
             d in self.atoms or (len(d.args) == 1 and d.predicate in self.assumed.types)
             for d in external.domain(atom.args)
         )
+
+    def args_of(self, predicate: str) -> Collection[tuple[str, ...]]:
+        # the known atoms of an assumed predicate are not all of them: an existential takes
+        # its candidates from the other atoms of its body, or from the objects of its type
+        if predicate in self.assumed.predicates:
+            return ()
+        return super().args_of(predicate)
 
 
 class OptimisticCosts(dict[tuple[str, tuple[str, ...]], float]):

@@ -296,3 +296,22 @@ def test_endless_placements_are_drawn_from_the_seed() -> None:
     again = list(itertools.islice(House(3).sample_place("shelf", "m"), 5))
     assert first == again
     assert len({p for (p,) in first}) == 5
+
+
+def test_the_plan_check_view_assumes_what_the_search_assumes() -> None:
+    """The view a candidate plan is simulated on holds an assumed atom exactly when its domain
+    holds and it is not refuted; its known atoms are not offered as the only candidates."""
+    problem = slots_problem([], [], lambda *_a: 1.0)
+    context = SolveContext(problem, StreamOptions(), {"test-cfree": StreamInfo(negate=True)})
+    engine = context.engine
+    engine.start()
+    name = engine.table.name
+    free = (name("a"), name(10), name("b"), name(14))
+    clash = (name("a"), name(10), name("b"), name(10))
+    assert engine.evaluate("cfree", free) and engine.evaluate("cfree", clash)
+    view = context.assumed.view(engine.refuted)(frozenset(engine.store.levels))
+    untried = (name("a"), name(12), name("c"), name(18))
+    assert Atom("cfree", free) in view and Atom("cfree", untried) in view
+    assert Atom("cfree", clash) not in view  # refuted
+    assert Atom("cfree", (name("a"), "nowhere", name("b"), name(10))) not in view  # no domain
+    assert view.args_of("cfree") == () and view.args_of("obj")
