@@ -36,7 +36,8 @@ class StreamInfo:
             instance's (optimistic) input values whose first batch of output tuples gives the
             optimistic outputs and their values (see ``solvers.stream_planning.optimistic``).
         negate: for a test stream certifying one fact over its inputs: the domain may use
-            that fact negated; ``(not (fact ...))`` holds where the test returns False.
+            that fact negated; ``(not (fact ...))`` holds where the test returns False. Such
+            a test is evaluated when a candidate plan uses it (or at once with ``eager``).
         simultaneous: evaluate all instances of this stream together.
         verbose: log each call.
         defer_fn: decides whether the stream is evaluated only after a plan is found.
@@ -66,7 +67,14 @@ class StreamInfo:
 
 @dataclass(frozen=True)
 class FunctionInfo:
-    """How a solver should treat one ``:function``: ``opt_fn`` gives its optimistic value."""
+    """How a solver should treat one ``:function`` or ``:predicate``.
+
+    Attributes:
+        opt_fn: its optimistic value on inputs not evaluated yet (called with the inputs'
+            values; default 1 for a function, true for a predicate).
+        eager: evaluate each instance as soon as its inputs exist; by default the optimistic
+            algorithms evaluate only the instances a candidate plan uses.
+    """
 
     opt_fn: Callable[..., Any] | None = None
     eager: bool = False

@@ -5,14 +5,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from sdar_tamp.language.domain_model import ActionSchema, Domain
 from sdar_tamp.language.evaluator import Evaluator, Support
 from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Formula
 from sdar_tamp.language.state_changes import Changes, CostOf, effect_changes
-from sdar_tamp.language.state_index import FactIndex, Objects
+from sdar_tamp.language.state_index import FactIndex, Facts, Objects
 from sdar_tamp.language.substitution import bind
 
 
@@ -66,10 +66,14 @@ def run_plan(
     cost_of: CostOf | None = None,
     *,
     explain: bool = False,
+    view: Callable[[frozenset[Atom]], Facts] = FactIndex,
 ) -> PlanRun:
     """Execute ``plan`` (``(action name, arguments)`` steps) from ``init`` and evaluate
     ``goal`` at the end. A step that names no action of ``domain``, has bad arguments or whose
     precondition does not hold ends the run (see :class:`PlanRun`).
+
+    ``view`` makes what conditions are evaluated on from a state (by default its facts as they
+    are; a solver may let it answer for atoms it assumes, which then appear in the supports).
 
     Raises:
         EvaluationError: a formula has a variable that nothing binds.
@@ -94,7 +98,7 @@ def run_plan(
         if problem is not None:
             return stop(step, problem)
         binding = bind(action, args)
-        evaluator = Evaluator(domain, FactIndex(state), objects, explain=explain)
+        evaluator = Evaluator(domain, view(state), objects, explain=explain)
         found = evaluator.support(action.precondition, binding)
         if found is None:
             return stop(step, f"the precondition of {shown} does not hold")
@@ -103,7 +107,7 @@ def run_plan(
         supports.append(found | done.support)
         changes.append(done)
         state = done.apply(state)
-    evaluator = Evaluator(domain, FactIndex(state), objects, explain=explain)
+    evaluator = Evaluator(domain, view(state), objects, explain=explain)
     goal_support = evaluator.support(goal, {})
     if goal_support is None:
         return stop(-1, "the goal does not hold at the end of the plan")

@@ -150,8 +150,9 @@ class _Normalizer:
             lit.atom.predicate for a in domain.actions for lit in iter_effect_literals(a.effect)
         }
         self.changing = changed | domain.derived_predicates | {EQUALITY}
-        # static atoms of the conjunctions enclosing the formula being normalised (no
-        # quantifier or disjunction in between)
+        self.derived = domain.derived_predicates | {EQUALITY}
+        # positive atoms of the conjunctions enclosing the formula being normalised (no
+        # quantifier or disjunction in between), derived ones left out
         self.guards: list[Atom] = []
 
     def type_lit(self, parameter: Parameter) -> Lit:
@@ -176,7 +177,7 @@ class _Normalizer:
             self.guards += [
                 part
                 for part in formula.parts
-                if isinstance(part, Atom) and part.predicate not in self.changing
+                if isinstance(part, Atom) and part.predicate not in self.derived
             ]
             try:
                 return [lit for part in formula.parts for lit in self.conjunction(part, context)]
@@ -187,7 +188,12 @@ class _Normalizer:
                 return self.conjunction(formula.parts[0], context)
             if any(isinstance(p, AndF) and not p.parts for p in formula.parts):
                 return []  # a true disjunct
-            return [self.auxiliary(formula, (), formula.parts, context)]
+            # the atoms of the enclosing conjunction bind the disjunction's variables (its
+            # auxiliary predicate is used there only, in the same state): without them, a
+            # variable that no positive atom of a disjunct names would range over every object
+            free = free_variables(formula)
+            guards = [g for g in self.guards if free.intersection(g.args)]
+            return [self.auxiliary(formula, (), formula.parts, context, guards)]
         if isinstance(formula, Exists):
             return [self.auxiliary(formula, formula.parameters, (formula.body,), context)]
         if isinstance(formula, Imply):
@@ -198,7 +204,11 @@ class _Normalizer:
             counter = nnf(formula.body, negate=True)
             exists = Exists(formula.parameters, counter)
             free = free_variables(exists)
-            guards = [g for g in self.guards if free.intersection(g.args)]
+            guards = [
+                g
+                for g in self.guards
+                if free.intersection(g.args) and g.predicate not in self.changing
+            ]
             lit = self.auxiliary(exists, formula.parameters, (counter,), context, guards)
             return [Lit(lit.predicate, lit.args, positive=False)]
         # ForAll over few objects: normalise the body once, then expand.

@@ -18,9 +18,11 @@ from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
 from solvers.classical import plan as classical_plan
 from solvers.classical.fast_downward import plan_task_with_fast_downward
+from solvers.stream_planning.assumed import Assumed
 from solvers.stream_planning.blocked_calls import Blocks, guard_fluent_uses
 from solvers.stream_planning.calls import CallRunner
 from solvers.stream_planning.costs import guard_costs
+from solvers.stream_planning.deferred import resolve_plan
 from solvers.stream_planning.engine import Engine, InstanceState
 from solvers.stream_planning.negation import negated_predicates, resolve_negated_uses
 from solvers.stream_planning.optimistic import OptimisticBuilder, OptimisticWorld
@@ -49,18 +51,30 @@ class SolveContext:
         self.problem = problem
         self.options = options
         self.start = time.perf_counter()
-        self.domain: Domain = guard_costs(problem.domain)
         self.goal = problem.facts.goal
         negated = negated_predicates(problem.domain, self.goal)
         stream_info = resolve_negated_uses(problem.streams, stream_info, problem.domain, negated)
         self.runner = CallRunner(self.start + options.max_time, options.enforce_max_time)
-        self.engine = Engine(problem, stream_info, self.runner)
-        self.builder = OptimisticBuilder(self.engine, negated)
+        # incremental plans on real facts only: it evaluates every function at once
+        defer = options.algorithm != "incremental"
+        self.engine = Engine(problem, stream_info, self.runner, defer, negated)
+        functions = self.engine.functions
+        deferred = {n: f for n, f in functions.items() if self.engine.defers(f)}
+        self.assumed = Assumed(
+            {n: f for n, f in deferred.items() if f.is_predicate},
+            {n: f for n, f in deferred.items() if not f.is_predicate},
+            frozenset(problem.domain.types.parents) | {"object"},
+        )
+        # the search's domain and goal: deferred instances assumed (see assumed.py)
+        self.domain: Domain = self.assumed.rewrite(guard_costs(problem.domain))
+        self.search_goal = self.assumed.formula(self.goal)
+        self.builder = OptimisticBuilder(self.engine, negated, self.assumed)
         self.fluent_streams = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
         self.blocks = Blocks(guard_fluent_uses(self.domain, problem.streams.streams))
         self.stats = SearchStatistics()
         self.best: tuple[float, PlanSteps, frozenset[Atom]] | None = None
         self.calls = 0  # stream calls made so far (the queue's work is counted in calls)
+        self.deferred_calls = 0  # deferred tests and functions evaluated for candidate plans
         self.unreachable = False  # the last plan search found the goal relaxed-unreachable
         self.searched = 0  # facts the last plan search planned over
         self._order = 0
@@ -113,7 +127,7 @@ class SolveContext:
             domain,
             self.objects(facts),
             frozenset(facts) | self.blocks.facts(),
-            self.goal,
+            self.search_goal,
             numeric,
             use_costs=not self.options.unit_costs,
             extra_cost=extra,
@@ -192,6 +206,41 @@ class SolveContext:
                 self.failed(state)
         return calls
 
+    def evaluate_deferred(self, name: str, inputs: tuple[str, ...]) -> bool:
+        """Evaluate a deferred function or predicate instance a plan uses (False: it was not
+        deferred)."""
+        self.check_time()
+        start = time.perf_counter()
+        called = self.engine.evaluate(name, inputs)
+        self.stats.sample_time += time.perf_counter() - start
+        self.deferred_calls += called
+        false = called and Atom(name, inputs) not in self.engine.store
+        if false and self.engine.functions[name].is_predicate:
+            self.sweep_deferred(name, inputs)
+        return called
+
+    def sweep_deferred(self, name: str, inputs: tuple[str, ...]) -> int:
+        """A deferred predicate a plan used came out false: evaluate other deferred instances
+        of it, those sharing the most inputs with it first (the likeliest to fail too), up to
+        ``search_sample_ratio`` times the real facts known. (:meth:`sweep_test` allows as many
+        as the facts of the last search; here those include every deferred instance, so that
+        budget would call nearly all of them.) Returns the calls made."""
+        engine = self.engine
+        budget = self.options.search_sample_ratio * max(len(engine.store), 1)
+        siblings = [k for k in engine.deferred if k[0] == name]
+        if len(siblings) > budget:
+            siblings.sort(key=lambda k: -sum(a == b for a, b in zip(k[1], inputs, strict=True)))
+        calls = 0
+        start = time.perf_counter()
+        for key in siblings:
+            if calls >= budget:
+                break
+            self.check_time()
+            calls += engine.evaluate(*key)
+        self.stats.sample_time += time.perf_counter() - start
+        self.deferred_calls += calls
+        return calls
+
     def drain(self, level: int) -> int:
         """No new plan at ``level`` while some samplers could still give more: call them.
 
@@ -236,8 +285,21 @@ class SolveContext:
     ) -> tuple[bool, PlanCheck]:
         """Is the plan valid on the real facts, each fact a fluent stream certified used only
         in the state it was certified in (or ``trusted``: bound by the plan's skeleton)? The
-        check also gives the facts it needs and its cost."""
+        deferred tests and functions the plan relies on are evaluated first
+        (:func:`~.deferred.resolve_plan`). The check also gives the facts it needs and its
+        cost."""
         engine = self.engine
+        start = time.perf_counter()
+        resolve_plan(
+            engine,
+            self.assumed,
+            self.evaluate_deferred,
+            self.problem.domain,
+            self.objects,
+            actions,
+            self.goal,
+        )
+        self.stats.sample_time += time.perf_counter() - start
         facts = engine.store.levels
         numeric = engine.numeric
 

@@ -3,8 +3,14 @@
 Real facts have complexity levels: init facts are level 0; a result of an instance whose domain
 facts reach level ``d`` and that was called ``k`` times before has level ``d + k + 1``, or
 ``d + k`` for a test (a stream without outputs: its first answer makes nothing new).
-``:function`` and ``:predicate`` instances are evaluated as soon as their domain holds (they are
-cheap, and negated predicates need their value); ``:rule`` facts are added at once.
+``:rule`` facts are added at once. ``:function`` and ``:predicate`` instances (and negated tests,
+which become predicates) are *deferred* when the engine is made with ``defer=True`` (the
+optimistic algorithms): an instance whose domain holds is only recorded (:attr:`Engine.deferred`),
+the optimistic world gives it its optimistic value, and :meth:`Engine.evaluate` calls it for real
+when a candidate plan uses it (:mod:`.deferred`). Those are evaluated at once instead: with
+``eager=True`` in their ``StreamInfo``/``FunctionInfo``, every one without ``defer`` (incremental
+plans on real facts only), and predicates the domain uses negated (a plan relies on their
+absence, which no plan check can name).
 
 A ``:fluents`` stream has one instance per input tuple and fluent state. The instance made when
 its domain first holds sees the initial state's facts of its fluent predicates; the algorithms
@@ -50,7 +56,7 @@ SUPPORTED_STREAM_OPTIONS = {"opt_gen_fn", "eager", "p_success", "overhead", "eff
 #: Calls of eager stream instances one engine makes at most (a generator feeding its own
 #: inputs would otherwise never stop).
 EAGER_BUDGET = 10_000
-SUPPORTED_FUNCTION_OPTIONS = {"opt_fn"}
+SUPPORTED_FUNCTION_OPTIONS = {"opt_fn", "eager"}
 RULE_PREFIX = "@rule"
 
 
@@ -86,8 +92,15 @@ class Engine:
         problem: PDDLProblem,
         stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None,
         runner: CallRunner | None = None,
+        defer: bool = False,
+        negated: frozenset[str] = frozenset(),
     ) -> None:
         self.problem = problem
+        self.defer = defer
+        self.negated = negated  # predicates the domain uses negated: never deferred
+        # (function or predicate, inputs) -> level: instances whose domain holds, not evaluated
+        self.deferred: dict[tuple[str, tuple[str, ...]], int] = {}
+        self.refuted: set[Atom] = set()  # deferred predicate instances evaluated false
         self.runner = runner if runner is not None else CallRunner()
         self.table: ObjectTable = problem.objects.copy()
         self._eager: list[InstanceState] = []  # eager instances not called yet
@@ -97,8 +110,8 @@ class Engine:
             problem, stream_info, SUPPORTED_STREAM_OPTIONS | {"negate"}
         )
         debug = isinstance(problem.stream_map, str)
-        self.streams, negated = split_negated(streams_bound, functions, debug)
-        functions.update(negated)
+        self.streams, negated_tests = split_negated(streams_bound, functions, debug)
+        functions.update(negated_tests)
         used = cost_functions(problem.domain)
         # a :function no action's cost mentions cannot change a plan: it is never evaluated
         self.functions = {
@@ -106,6 +119,18 @@ class Engine:
         }
         streams = problem.streams
         self.rules = {f"{RULE_PREFIX}{i}": rule for i, rule in enumerate(streams.rules)}
+        # predicates some external needs in its domain: never deferred (what follows from
+        # them must follow in the optimistic world too)
+        self._needed = frozenset(
+            a.predicate
+            for declaration in (
+                *(s.declaration for s in self.streams.values()),
+                *(f.declaration for f in self.functions.values()),
+                *self.rules.values(),
+            )
+            for a in declaration.domain
+        )
+        self._evaluated_at_once = negated | self._needed
         self.store = FactStore()
         self.numeric: dict[tuple[str, tuple[str, ...]], float] = dict(problem.facts.numeric)
         self.instances: dict[tuple[str, tuple[str, ...]], InstanceState] = {}
@@ -179,13 +204,10 @@ class Engine:
                     self._eager.append(state)
             elif query.name in self.functions:
                 external = self.functions[query.name]
-                value = external.evaluate(inputs, self.table, self.runner)
-                if external.is_predicate:
-                    if value:
-                        derived.append(Atom(query.name, inputs))
+                if self.defers(external):
+                    self.deferred[(query.name, inputs)] = level
                 else:
-                    self.numeric[(query.name, inputs)] = float(value)
-                    derived.append(Atom(function_guard(query.name), inputs))
+                    derived.extend(self._value(external, inputs))
             else:
                 rule: Rule = self.rules[query.name]
                 mapping = dict(zip(rule.parameters, inputs, strict=True))
@@ -194,6 +216,33 @@ class Engine:
                     for a in rule.certified
                 )
         return derived  # rules and predicates take the level of the fact that completed them
+
+    def defers(self, external: FunctionExternal) -> bool:
+        """Is a function or predicate evaluated only when a plan uses it?"""
+        if not self.defer or external.info.eager:
+            return False
+        return not (external.is_predicate and external.name in self._evaluated_at_once)
+
+    def _value(self, external: FunctionExternal, inputs: tuple[str, ...]) -> list[Atom]:
+        """Evaluate a function or predicate instance: the facts its value makes known."""
+        value = external.evaluate(inputs, self.table, self.runner)
+        if external.is_predicate:
+            return [Atom(external.name, inputs)] if value else []
+        self.numeric[(external.name, inputs)] = float(value)
+        return [Atom(function_guard(external.name), inputs)]
+
+    def evaluate(self, name: str, inputs: tuple[str, ...]) -> bool:
+        """Evaluate a deferred instance for real (its facts join the store); False when it is
+        not deferred (unknown, or evaluated before). User code: may raise
+        :class:`CallTimeout`."""
+        level = self.deferred.pop((name, inputs), None)
+        if level is None:
+            return False
+        external = self.functions[name]
+        self.add_facts(self._value(external, inputs), level)
+        if external.is_predicate and Atom(name, inputs) not in self.store:
+            self.refuted.add(Atom(name, inputs))
+        return True
 
     def _fluents(self, external: StreamExternal) -> tuple[Atom, ...]:
         """The initial state's facts of a stream's ``:fluents`` (what its first instance sees)."""

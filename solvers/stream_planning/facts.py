@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Collection, Iterator, Sequence
 from dataclasses import dataclass
 
 from sdar_tamp.language.formula_model import Atom, is_variable
@@ -111,9 +111,12 @@ class Instantiator:
             for position, atom in enumerate(query.domain):
                 self._by_predicate.setdefault(atom.predicate, []).append((query, position))
 
-    def initial(self) -> Iterator[tuple[Query, tuple[str, ...], int]]:
-        """Instances from the facts already in the store (and those of empty domains)."""
+    def initial(self, skip: Collection[str] = ()) -> Iterator[tuple[Query, tuple[str, ...], int]]:
+        """Instances from the facts already in the store (and those of empty domains), but
+        for the queries named in ``skip``."""
         for query in self.queries:
+            if query.name in skip:
+                continue
             for binding, level in self.store.join(query.domain, {}):
                 yield from self._emit(query, binding, level)
 

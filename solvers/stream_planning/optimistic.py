@@ -17,10 +17,12 @@ adds nothing to the optimistic world). That value is what later optimistic calls
 of the placeholder, so optimistic values chain through streams. ``gen_fn`` is called once per
 instance and solve.
 
-Functions on placeholders take their optimistic value (``FunctionInfo.opt_fn``, default 1,
-called with the Python values of real inputs, the optimistic value of placeholders that have
-one and an :class:`~.opt_values.OptimisticValue` for the others);
-predicates on placeholders are optimistically true unless the domain uses them negated.
+Functions on placeholders and deferred ones (:mod:`.deferred`) take their optimistic value
+(``FunctionInfo.opt_fn``, default 1, called with the values of real inputs, the optimistic value
+of placeholders that have one, an :class:`~.opt_values.OptimisticValue` for the others);
+predicates on placeholders and deferred ones are true unless the domain uses them negated.
+Deferred ones add no fact to the world: the search's domain assumes them (:mod:`.assumed`),
+and their values are read when the search asks for them.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from typing import Any
 
 from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import SINGLE_CALL
+from solvers.stream_planning.assumed import Assumed, OptimisticCosts, refuted_fact
 from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
@@ -61,7 +64,7 @@ class OptResult:
 class OptimisticWorld:
     facts: dict[Atom, int]
     provenance: dict[Atom, OptResult]
-    numeric: dict[tuple[str, tuple[str, ...]], float]
+    numeric: dict[tuple[str, tuple[str, ...]], float]  # an OptimisticCosts with deferred ones
     placeholders: list[str] = field(default_factory=list)
     complete: bool = True  # no instance was left out for the limit or for being disabled
     # later calls of some instance were left out for the limit (see OptimisticBuilder._further):
@@ -74,9 +77,12 @@ class OptimisticWorld:
 class OptimisticBuilder:
     """Builds optimistic worlds for one engine (placeholders keep their names across builds)."""
 
-    def __init__(self, engine: Engine, negated: frozenset[str]) -> None:
+    def __init__(
+        self, engine: Engine, negated: frozenset[str], assumed: Assumed | None = None
+    ) -> None:
         self.engine = engine
         self.negated = negated
+        self.assumed = assumed if assumed is not None else Assumed({}, {})
         self._placeholders: dict[tuple[object, ...], str] = {}
         self.producers: dict[str, str] = {}  # placeholder -> the stream that makes it
         # placeholder -> the value a callable opt_gen_fn gave it
@@ -86,6 +92,8 @@ class OptimisticBuilder:
         # (stream, inputs) -> the output tuples of its callable opt_gen_fn
         self._generated: dict[tuple[str, tuple[str, ...]], list[tuple[object, ...]]] = {}
         self._later: set[str] = set()  # placeholders of later calls (see _further)
+        # the optimistic values of deferred function terms (asked for by the search)
+        self._optimistic: dict[tuple[str, tuple[str, ...]], float] = {}
 
     def placeholder(self, key: tuple[object, ...]) -> str:
         name = self._placeholders.get(key)
@@ -113,7 +121,11 @@ class OptimisticBuilder:
         facts = engine.planning_facts()
         for atom, level in facts.items():
             store.add(atom, level)
-        world = OptimisticWorld(dict(facts), {}, dict(engine.numeric))
+        numeric = OptimisticCosts(engine.numeric, frozenset(self.assumed.functions), self.value)
+        world = OptimisticWorld(dict(facts), {}, numeric)
+        for atom in engine.refuted:
+            world.facts[refuted_fact(atom)] = 0
+        assumed = self.assumed.names()
         queries = [
             Query(s.name, s.declaration.inputs, s.declaration.domain)
             for s in engine.streams.values()
@@ -122,12 +134,14 @@ class OptimisticBuilder:
             Query(f.name, f.declaration.inputs, f.declaration.domain)
             for f in engine.functions.values()
             # a negated predicate adds nothing here: real values come from the engine and
-            # placeholders are optimistically false
-            if not (f.is_predicate and f.name in self.negated)
+            # placeholders are optimistically false; deferred ones are assumed by the domain
+            if not (f.is_predicate and f.name in self.negated) and f.name not in assumed
         ]
         queries += [Query(n, r.parameters, r.domain) for n, r in engine.rules.items()]
         instantiator = Instantiator(queries, store)
-        pending = list(instantiator.initial())
+        # functions on real facts alone: the engine evaluated them or holds them deferred
+        functions = {q.name: q for q in queries if q.name in engine.functions}
+        pending = list(instantiator.initial(skip=functions))
         steps = 0
         while pending:
             steps += 1
@@ -206,18 +220,18 @@ class OptimisticBuilder:
             ]
         if name in engine.functions:
             function = engine.functions[name]
-            if real:
-                return []  # evaluated for real by the engine
-            return self._function(function, inputs, level, world)
-        if real:
-            return []  # rules on real facts were applied by the engine
+            if not real:
+                return self._function(function, inputs, level, world)
+            return []  # evaluated for real by the engine
         rule = engine.rules[name]
         mapping = dict(zip(rule.parameters, inputs, strict=True))
-        certified = tuple(
-            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.certified
-        )
         domain = tuple(
             Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.domain
+        )
+        if real and all(a in engine.store for a in domain):
+            return []  # rules on real facts were applied by the engine
+        certified = tuple(
+            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.certified
         )
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
 
@@ -361,9 +375,7 @@ class OptimisticBuilder:
                     "predicate",
                 )
             ]
-        opt_fn = getattr(function.info, "opt_fn", None)
-        value = float(opt_fn(*self._values(inputs))) if opt_fn is not None else 1.0
-        world.numeric[(function.name, inputs)] = value
+        world.numeric[(function.name, inputs)] = self._opt_value(function, inputs)
         return [
             OptResult(
                 function.name,
@@ -375,3 +387,15 @@ class OptimisticBuilder:
                 "function",
             )
         ]
+
+    def _opt_value(self, function: FunctionExternal, inputs: tuple[str, ...]) -> float:
+        opt_fn = getattr(function.info, "opt_fn", None)
+        return float(opt_fn(*self._values(inputs))) if opt_fn is not None else 1.0
+
+    def value(self, name: str, inputs: tuple[str, ...]) -> float:
+        """The optimistic value of deferred function ``name`` on ``inputs`` (kept)."""
+        key = (name, inputs)
+        found = self._optimistic.get(key)
+        if found is None:
+            found = self._optimistic[key] = self._opt_value(self.engine.functions[name], inputs)
+        return found

@@ -9,14 +9,14 @@ needs, and a finished plan is validated against the real facts (and its cost com
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import Atom, Formula
 from sdar_tamp.language.plan_run import run_plan
 from sdar_tamp.language.state_changes import CostOf
-from sdar_tamp.language.state_index import TypedObjects
+from sdar_tamp.language.state_index import FactIndex, Facts, TypedObjects
 
 
 @dataclass(frozen=True)
@@ -46,13 +46,15 @@ def simulate(
     plan: Sequence[tuple[str, tuple[str, ...]]],
     goal: Formula,
     cost_of: CostOf | None = None,
+    view: Callable[[frozenset[Atom]], Facts] = FactIndex,
 ) -> PlanCheck:
     """Run ``plan`` from ``init``; report validity and the initial facts it relies on.
 
-    ``cost_of`` gives a ground cost term's value (without it, costs count 0).
+    ``cost_of`` gives a ground cost term's value (without it, costs count 0); ``view`` what
+    conditions are evaluated on (:func:`~sdar_tamp.language.plan_run.run_plan`).
     """
     run = run_plan(
-        domain, TypedObjects(domain, objects), init, plan, goal, cost_of, explain=True
+        domain, TypedObjects(domain, objects), init, plan, goal, cost_of, explain=True, view=view
     )  # fmt: skip
     added: set[Atom] = set()
     needed: set[Atom] = set()

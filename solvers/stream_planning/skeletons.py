@@ -42,9 +42,15 @@ class SkeletonBinder:
         self.disable_failures = disable_failures
 
     def sample_first_layer(self, skeleton: Skeleton) -> None:
-        """Call once each instance of the stream plan whose inputs are all real (focused)."""
+        """Call once each instance of the stream plan whose inputs are all real, and evaluate
+        its deferred predicates on real inputs (focused)."""
         for index, result in enumerate(skeleton.stream_plan):
-            if result.kind != "stream" or any(is_placeholder(n) for n in result.inputs):
+            if any(is_placeholder(n) for n in result.inputs):
+                continue
+            if result.kind == "predicate":
+                self.context.evaluate_deferred(result.external, result.inputs)
+                continue
+            if result.kind != "stream":
                 continue
             state = self.instance(skeleton, index, result.inputs, {})
             if state is None:
@@ -86,6 +92,7 @@ class SkeletonBinder:
             if any(is_placeholder(n) for n in inputs):
                 return None
             if result.kind == "predicate":
+                self.context.evaluate_deferred(result.external, inputs)
                 if Atom(result.external, inputs) not in store:
                     return self._upstream_retry(skeleton, index)
                 continue

@@ -52,6 +52,9 @@ class StreamSolver:
         self.context = SolveContext(problem, options, stream_info)
         self.policy = policy_for(self.context)
         self.log = RoundLog(options.verbose)
+        # a real plan cost more than assumed once its deferred functions were evaluated: the
+        # search goes on at its level only for a cheaper one
+        self.confirming = False
 
     def solve(self) -> Solution:
         context = self.context
@@ -132,6 +135,9 @@ class StreamSolver:
                 # no new plan: work on the queued skeletons, and raise the level (what they
                 # wait for may lie above it)
                 missed = "no plan" if found is None else "plan met before"
+                if self.confirming and context.best is not None:
+                    self._end(f"{missed} cheaper than the best real plan")
+                    return Status.SOLVED
                 if policy.no_new_plan(len(world.facts)):
                     self._end(f"{missed}; a queued skeleton is solved")
                     return Status.SOLVED
@@ -159,9 +165,28 @@ class StreamSolver:
             if not any(r.kind == "stream" for r in ordered.stream_plan) and not any(
                 is_placeholder(a) for _, args in actions for a in args
             ):
+                evaluated = context.deferred_calls
+                for result in ordered.stream_plan:  # its deferred predicates, in order
+                    if result.kind == "predicate":
+                        context.evaluate_deferred(result.external, result.inputs)
+                        if Atom(result.external, result.inputs) not in context.engine.store:
+                            break
                 valid, check = context.real_check(actions)
+                if not valid and context.deferred_calls > evaluated:
+                    # a deferred test it relied on is false: plan again without it
+                    self._end("plan on deferred tests: one failed")
+                    continue
+                dearer = not options.unit_costs and check.cost > cost + 1e-9
+                if valid and dearer and context.deferred_calls > evaluated:
+                    # its cost terms, evaluated now, cost more than the search assumed: keep
+                    # it, and search again at this level for a plan cheaper than it, with the
+                    # values known (no such plan: this one stands)
+                    self.confirming = True
+                    context.record(actions, check)
+                    self._end(f"real plan at cost {check.cost:g} (assumed {cost:g}): search again")
+                    continue
                 self._end(
-                    f"real plan ({len(actions)} actions, cost {cost:g})"
+                    f"real plan ({len(actions)} actions, cost {check.cost:g})"
                     if valid
                     else "real plan failed validation"
                 )
@@ -213,11 +238,20 @@ class StreamSolver:
         context = self.context
         stream_plan: list[OptResult] = []
         check = None
-        if world.provenance:  # (else all facts are real)
+        assumed = context.assumed
+        if world.provenance or assumed.predicates:  # (else all facts are real)
             check = simulate(
                 context.problem.domain, context.objects(world.facts), world.facts, actions,
-                context.goal,
+                context.goal, view=assumed.view(context.engine.refuted),
             )  # fmt: skip
+            for atom in assumed.assumed_in(check.needed, world.facts):
+                # a deferred predicate instance the plan relies on: a result of the plan
+                external = assumed.predicates[atom.predicate]
+                domain = external.domain(atom.args)
+                level = max((world.facts.get(a, 0) for a in domain), default=0)
+                world.provenance[atom] = OptResult(
+                    atom.predicate, atom.args, (), domain, (atom,), level, "predicate"
+                )
             stream_plan = extract_stream_plan(check.needed, world)
         # The same actions on the same optimistic results: nothing learnt since this plan was
         # met, as if none. (The same actions on real facts are new.)

@@ -8,8 +8,11 @@ import pytest
 from classical_helpers import load, load_text
 
 from sdar_tamp.language.domain_model import ActionSchema, Axiom, Domain, TypeHierarchy
+from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.formula_model import And, Atom, Literal, Not, Parameter
-from solvers.classical import GroundingError, PlanStatus, ground, plan
+from solvers.classical import GroundingError, PlanningTask, PlanStatus, ground, plan
+from solvers.classical.normalize import normalize
+from solvers.classical.reachability import reachable_facts
 
 
 def test_blocksworld_grounding_counts_and_statics() -> None:
@@ -111,3 +114,40 @@ def test_goal_on_a_static_fact_that_is_false_is_unsolvable() -> None:
     task = load_text("logistics", text)
     assert not ground(task).goal_reachable
     assert plan(task).status is PlanStatus.UNSOLVABLE
+
+
+GUARDED = """
+(define (domain guarded)
+  (:requirements :strips :negative-preconditions :derived-predicates :existential-preconditions)
+  (:predicates (P ?x ?y) (Q ?y) (R ?x ?y) (Bad ?x) (Done ?x) (Item ?x))
+  (:derived (Bad ?x) (exists (?y) (and (P ?x ?y) (not (and (Q ?y) (not (R ?x ?y)))))))
+  (:action finish :parameters (?x) :precondition (and (Item ?x) (not (Bad ?x)))
+    :effect (Done ?x)))
+"""
+
+
+def test_a_disjunction_is_grounded_within_its_enclosing_conjunction() -> None:
+    """``(not (and (Q ?y) (not (R ?x ?y))))`` becomes a disjunction with an auxiliary predicate
+    over ``?x ?y``; no positive atom of its disjuncts names them, so it takes its bindings from
+    the conjunction around it (``(P ?x ?y)``), not from every pair of objects."""
+    objects = {f"o{i}": "object" for i in range(40)}
+    init = {Atom("p", ("o0", "o1")), Atom("p", ("o2", "o3")), Atom("q", ("o1",))}
+    init |= {Atom("q", ("o3",)), Atom("r", ("o2", "o3")), Atom("item", ("o0",))}
+    init.add(Atom("item", ("o2",)))
+    task = PlanningTask(
+        parse_domain(GUARDED, "guarded.pddl"),
+        objects,
+        frozenset(init),
+        And((Atom("done", ("o0",)),)),
+    )
+    norm = normalize(task)
+    base = reachable_facts(norm)
+    aux = {p: facts for p, facts in base.relations.items() if p.startswith("~aux")}
+    assert aux and sum(len(facts) for facts in aux.values()) <= 4  # not 40 * 40
+    assert {f"(bad {x})" for (x,) in base.relations.get("bad", ())} == {"(bad o2)"}
+    # the meaning is unchanged: o2's partner o3 is in Q and in R with o2, o0's is in Q only
+    result = plan(task)
+    assert result.status is PlanStatus.SOLVED
+    assert [str(a) for a in result.plan or []] == ["(finish o0)"]
+    blocked = dataclasses.replace(task, goal=And((Atom("done", ("o2",)),)))
+    assert plan(blocked).status is PlanStatus.UNSOLVABLE
