@@ -10,6 +10,7 @@ declared for the cell's arms (:func:`~sdar_tamp.app.cell_streams.streams_for_arm
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -21,7 +22,8 @@ from sdar_tamp.language.generators import from_gen_fn, from_test
 from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.logs import get_logger
 from sdar_tamp.resources import domain_file
-from sdar_tamp.world.instance import Instance
+from sdar_tamp.world.instance import Instance, Pose2D
+from solvers.sdar.options import Plane
 from streams.context import WorldContext
 from streams.grasps import sample_grasps
 from streams.motion.planner import MotionPlanner
@@ -119,10 +121,24 @@ def rearrangement_problem(
         goal,
         solve_defaults={
             "task_planner": config.task_planner,
-            "sdar_options": config.sdar_options(),
+            "sdar_options": dataclasses.replace(config.sdar_options(), plane=table_plane(ctx)),
         },
     )
     return Rearrangement(instance, ctx, problem, home, config)
+
+
+def table_plane(ctx: WorldContext) -> Plane:
+    """Where poses lie on the table for SDAR-T's steps of more than two moves: a pose's
+    ``(x, y)``, the arms' base positions (:class:`solvers.sdar.options.Plane`)."""
+    bases = {
+        a: (float(ctx.scene.arm(a).base_xyz[0]), float(ctx.scene.arm(a).base_xyz[1]))
+        for a in ctx.arm_names
+    }
+    return Plane(_plane_xy, bases)
+
+
+def _plane_xy(value: object) -> tuple[float, float] | None:
+    return (value.x, value.y) if isinstance(value, Pose2D) else None
 
 
 def grasp_set_sizes(instance: Instance, ctx: WorldContext, config: PlannerConfig) -> dict[str, int]:

@@ -16,7 +16,7 @@ import time
 from collections.abc import Callable
 
 from sdar_tamp.app.config import PlannerConfig
-from sdar_tamp.app.problem import Rearrangement
+from sdar_tamp.app.problem import Rearrangement, table_plane
 from sdar_tamp.arguments import MAX_TIME
 from solvers.solution import Solution, Status
 from solvers.solve import solve
@@ -65,7 +65,9 @@ def solve_rearrangement(
         algorithm="sdar",
         task_planner=run.task_planner,
         max_time=run.max_time,
-        sdar_options=run.sdar_options(progress),
+        sdar_options=dataclasses.replace(
+            run.sdar_options(progress), plane=table_plane(rearrangement.ctx)
+        ),
         verbose=False,
     )
     if not prove:

@@ -10,7 +10,8 @@ failed before are skipped (see :class:`~solvers.sdar.attempts.TabuLists`).
 Assignments of moves to arms: with two arms every one (two at most). With more, bounded: for
 each move the arms that reach its object and target (the first grasp option of that arm), by
 the estimated time of that arm's pick and transfer, the ``moves + 1`` soonest; of their
-combinations with distinct arms the ``SdarOptions.assignments`` of least total estimate. The
+combinations with distinct arms the ``SdarOptions.assignments`` of least total estimate (with
+the view's :class:`~solvers.sdar.tasks.Layout`, fewest crossing pairs of arms first). The
 options of a step of ``m > 2`` moves are cut so that their combinations stay within
 :data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
 those bringing more objects to their goals come first (then the estimated motion time).
@@ -29,7 +30,7 @@ from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.report import Failures
-from solvers.sdar.tasks import Move, Step
+from solvers.sdar.tasks import Layout, Move, Step
 
 if TYPE_CHECKING:
     from solvers.sdar.options import SdarOptions
@@ -93,6 +94,9 @@ class Grounder:
         self._free: dict[Hashable, tuple[frozenset[str], ...]] = {}
         self.buffer_check: BufferCheck | None = None
         """Keeps only the buffers it accepts for (the step's moves, object, buffer pose)."""
+        self.layout: Layout | None = None
+        """With more than two arms: the current view's layout; assignments whose arms cross
+        (:meth:`~solvers.sdar.tasks.Layout.conflicts`) come after the others."""
 
     def key(self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...]) -> Hashable:
         """The tabu key of a grounding in the current arrangement."""
@@ -159,7 +163,16 @@ class Grounder:
             self.failures.unassigned(
                 step, "no assignment gives its moves distinct arms that reach them"
             )
-        tuples.sort(key=lambda t: (sum(cost[a, i] for i, a in enumerate(t)), t))
+        layout = self.layout
+        if layout is not None and all(mv.obj in layout.places for mv in step.moves):
+            index = {a: k for k, a in enumerate(arms)}
+            seats = {
+                t: [(index[a], mv.obj) for a, mv in zip(t, step.moves, strict=True)] for t in tuples
+            }
+            crossings = {t: layout.conflicts(seats[t]) for t in tuples}
+            tuples.sort(key=lambda t: (crossings[t], sum(cost[a, i] for i, a in enumerate(t)), t))
+        else:
+            tuples.sort(key=lambda t: (sum(cost[a, i] for i, a in enumerate(t)), t))
         return tuples[: self.options.assignments]
 
     def _ground(self, step: Step, arms: tuple[str, ...], mode: MotionMode) -> list[Grounding]:

@@ -13,17 +13,23 @@ of such groups matter:
   become free with the step's objects lifted and that frees the most (then removes most edges,
   then is the largest, then comes first by object order), until ``k`` moves or nothing fits;
   a unit holding an object that must wait (:meth:`~solvers.sdar.tasks.TaskView.must_wait`) is
-  never added.
+  never added. When the view has a :class:`~solvers.sdar.tasks.Layout` (three arms or more,
+  positions given by the app), the extension is spatial: the step's objects are seated on
+  arms (:func:`_seat`: each on the free arm crossing the fewest seated ones, then reaching
+  least far), a unit fits only if free arms move it without crossing a seated arm
+  (:meth:`~solvers.sdar.tasks.Layout.crosses`), and units farther than the layout's clearance
+  from the step's poses and goals come first. :func:`extensions` offers the spatial extension
+  and the one by dependencies alone.
 
 Both are bounded: rotations are at most one per component; :func:`extend` runs once per
 candidate it is given (SDAR-T gives it the first ``max_candidates`` steps of its two-arm list)
-and costs ``k`` rounds over the units. No set of ``k`` objects is enumerated.
+and costs ``k`` rounds over the units (twice with a layout). No set of ``k`` objects is enumerated.
 """
 
 from __future__ import annotations
 
 from sdar_tamp.graph import strongly_connected_components
-from solvers.sdar.tasks import Move, Step, TaskView
+from solvers.sdar.tasks import Layout, Move, Step, TaskView
 
 
 class TaskScene:
@@ -69,14 +75,19 @@ def rotations(scene: TaskScene, arms: int) -> list[tuple[tuple[int, ...], Step]]
     return out
 
 
-def extend(scene: TaskScene, step: Step, arms: int) -> Step:
+def extend(scene: TaskScene, step: Step, arms: int, spatial: bool = True) -> Step:
     """``step`` with goal moves of units added greedily (see the module docstring); ``step``
-    itself when nothing fits. The added moves follow the step's own, in the order added."""
+    itself when nothing fits. The added moves follow the step's own, in the order added.
+    ``spatial``: with a layout in the view, only units an arm can move without crossing the
+    arms already in the step (:func:`_seat`), those away from the step's objects first;
+    False: by dependencies only."""
     lifted = frozenset(step.objects)
     if len(lifted) >= arms:
         return step
     view = scene.view
+    layout = view.layout if spatial else None
     units = [u for u in scene.units(lifted) if not any(view.must_wait(x) for x in u)]
+    seated = _seat(layout, (), step.objects)[1] if layout is not None else ()
     added: list[str] = []
     while len(lifted) < arms:
         fits = [
@@ -85,16 +96,56 @@ def extend(scene: TaskScene, step: Step, arms: int) -> Step:
             if len(u) <= arms - len(lifted)
             and all(scene.blockers[y] <= lifted | frozenset(u) for y in u)
         ]
+        if layout is not None:
+            seats = {u: _seat(layout, seated, u) for u in fits}
+            fits = [u for u in fits if seats[u][0] == 0]
         if not fits:
             break
         worth = {u: _worth(scene, lifted, u) for u in fits}
+        if layout is not None:
+            near = {u: int(layout.gap(u, lifted) < layout.clearance) for u in fits}
+            worth = {u: (near[u], *w) for u, w in worth.items()}
         best = min(fits, key=worth.__getitem__)
+        if layout is not None:
+            seated = seats[best][1]
         added.extend(best)
         lifted = lifted | frozenset(best)
         units.remove(best)
     if not added:
         return step
     return Step((*step.moves, *(Move(x) for x in added)), step.kind, step.rank, step.tie)
+
+
+def extensions(scene: TaskScene, step: Step, arms: int) -> list[Step]:
+    """The extensions of ``step`` SDAR-T offers, best first: the spatial one and, when the view
+    has a layout and it differs, the one by dependencies only; empty when nothing fits."""
+    out: list[Step] = []
+    for spatial in (True, False) if scene.view.layout is not None else (False,):
+        wider = extend(scene, step, arms, spatial)
+        if wider is not step and all(set(w.moves) != set(wider.moves) for w in out):
+            out.append(wider)
+    return out
+
+
+def _seat(
+    layout: Layout, seated: tuple[tuple[int, str], ...], objs: tuple[str, ...]
+) -> tuple[int, tuple[tuple[int, str], ...]]:
+    """Arms for ``objs`` besides those ``seated`` (arm index, object), greedily in order:
+    each the free arm crossing the fewest seated ones (:meth:`~solvers.sdar.tasks.Layout.
+    crosses`), then reaching least far; the crossings added and every seat. An object with
+    no free arm counts one crossing per seated arm."""
+    crossings = 0
+    out = list(seated)
+    for x in objs:
+        free = [a for a in range(len(layout.bases)) if all(a != b for b, _ in out)]
+        if not free:
+            crossings += len(out)
+            continue
+        cost = {a: sum(1 for b, y in out if layout.crosses(a, x, b, y)) for a in free}
+        arm = min(free, key=lambda a: (cost[a], layout.reach(a, x), a))
+        crossings += cost[arm]
+        out.append((arm, x))
+    return crossings, tuple(out)
 
 
 def _worth(scene: TaskScene, lifted: frozenset[str], unit: tuple[str, ...]) -> tuple[int, ...]:

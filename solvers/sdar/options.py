@@ -4,10 +4,23 @@ can read them without importing the decision loop."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from solvers.sdar.vocabulary import SdarVocabulary
+
+
+@dataclass(frozen=True)
+class Plane:
+    """Where poses lie on the table, for SDAR-T's steps of more than two moves (the
+    :class:`~solvers.sdar.tasks.Layout` of each view): ``locate`` gives the ``(x, y)`` [m] of a
+    pose value (None: a value it does not know), ``bases`` arm -> base ``(x, y)`` [m],
+    ``clearance`` [m] the distance under which two objects count as neighbours. Built by the
+    app from the scene; the solvers see only these numbers."""
+
+    locate: Callable[[object], tuple[float, float] | None]
+    bases: Mapping[str, tuple[float, float]]
+    clearance: float = 0.08
 
 
 @dataclass(frozen=True)
@@ -34,4 +47,5 @@ class SdarOptions:
     one_arm_at_a_time: bool = False  # the baseline motion planner (one arm moves at a time)
     quick_attempts: int = 6  # best-ranked groundings tried with the quick motion stream first
     progress: Callable[[int, int], None] | None = None  # (objects at goal, objects) per step
+    plane: Plane | None = None  # with more than two arms: where objects are (see Plane)
     vocabulary: SdarVocabulary = field(default_factory=SdarVocabulary)

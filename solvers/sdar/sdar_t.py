@@ -72,7 +72,7 @@ from itertools import combinations
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
 from solvers.sdar.buffer_sets import extending_minimum, optimal_choices
-from solvers.sdar.k_steps import TaskScene, extend, rotations
+from solvers.sdar.k_steps import TaskScene, extensions, rotations
 from solvers.sdar.tasks import Move, Step, TaskView
 
 _Edges = tuple[tuple[int, int], ...]
@@ -171,8 +171,7 @@ class SdarTaskPlanner:
         per set of moves (the best ranked). See :mod:`solvers.sdar.k_steps`."""
         out: _Ranked = []
         for key, step in kept:
-            wider = extend(scene, step, arms)
-            if wider is not step:
+            for wider in extensions(scene, step, arms):
                 out.append(((key[0], -wider.progress, *key[1:]), wider))
             out.append(((key[0], -step.progress, *key[1:]), step))
         for key, step in rotations(scene, arms):

@@ -43,7 +43,7 @@ from solvers.sdar.grounding import Grounder
 from solvers.sdar.options import SdarOptions
 from solvers.sdar.recovery import Recovery
 from solvers.sdar.report import Failures, RunSummary, TaskRecord, build_solution
-from solvers.sdar.tasks import Step, TaskPlanner, TaskView
+from solvers.sdar.tasks import Layout, Step, TaskPlanner, TaskView
 from solvers.solution import Solution, Status
 
 __all__ = ["Decision", "SdarOptions", "SdarSolver"]  # SdarOptions: its home is options.py
@@ -145,7 +145,30 @@ class SdarSolver:
         )
         done = frozenset(o for o, g in self.goals.items() if current.get(o) == g)
         graph = DependencyGraph(remaining, tuple(edges))
-        return TaskView(graph, done, buffered, frozenset(waits), arms=len(self.home))
+        layout = self._layout(remaining, current)
+        return TaskView(graph, done, buffered, frozenset(waits), len(self.home), layout)
+
+    def _layout(self, remaining: tuple[str, ...], current: dict[str, str]) -> Layout | None:
+        """With more than two arms and a :class:`~solvers.sdar.options.Plane`: the plane
+        positions of the remaining objects' poses and goals and of the arms' bases; None
+        otherwise, or when a pose is not one the plane locates."""
+        plane = self.options.plane
+        if plane is None or len(self.home) <= 2:
+            return None
+        arms = {a: self.cache.table.value(a) for a in sorted(self.home)}
+        if any(not isinstance(v, str) or v not in plane.bases for v in arms.values()):
+            return None
+        places = {}
+        for obj in remaining:
+            if obj not in current:
+                return None
+            here = plane.locate(self.cache.table.value(current[obj]))
+            goal = plane.locate(self.cache.table.value(self.goals[obj]))
+            if here is None or goal is None:
+                return None
+            places[obj] = (here, goal)
+        bases = tuple(plane.bases[str(v)] for v in arms.values())
+        return Layout(places, bases, plane.clearance)
 
     # -- the loop ----------------------------------------------------------------------------
     def solve(self) -> Solution:
@@ -157,6 +180,7 @@ class SdarSolver:
             view = self.view()
             if not view.remaining:
                 break
+            self.grounder.layout = view.layout
             if time.perf_counter() - start > self.options.max_time:
                 status = Status.TIMEOUT
                 diagnosis.append(f"max_time reached with {len(view.remaining)} object(s) left")

@@ -10,6 +10,9 @@ the candidates through the streams, picks one and reports it back with
 
 from __future__ import annotations
 
+import itertools
+import math
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -63,6 +66,81 @@ class Step:
 
 
 @dataclass(frozen=True)
+class Layout:
+    """Where the objects and arms are, in the table plane, as plain numbers [m]: ``places``
+    object -> ``(x, y)`` of its current pose and ``(x, y)`` of its goal; ``bases`` the arms'
+    base positions; ``clearance`` the distance under which two objects count as neighbours
+    (their grippers would meet). Built outside the solvers (the app knows the poses)."""
+
+    places: Mapping[str, tuple[tuple[float, float], tuple[float, float]]]
+    bases: tuple[tuple[float, float], ...]
+    clearance: float = 0.08
+
+    def __post_init__(self) -> None:
+        if not self.bases:
+            raise ValueError("a layout needs at least one arm base")
+        if self.clearance < 0:
+            raise ValueError(f"a layout needs clearance >= 0, got {self.clearance}")
+
+    def reach(self, arm: int, obj: str) -> float:
+        """How far arm ``arm`` (an index into ``bases``) reaches for ``obj``: the distances
+        from its base to the object's current pose and to its goal, summed [m]."""
+        here, goal = self.places[obj]
+        return math.dist(self.bases[arm], here) + math.dist(self.bases[arm], goal)
+
+    def side(self, obj: str) -> int:
+        """The arm that reaches ``obj`` least far (:meth:`reach`; the first of equals)."""
+        return min(range(len(self.bases)), key=lambda k: (self.reach(k, obj), k))
+
+    def gap(self, group: Iterable[str], others: Iterable[str]) -> float:
+        """The least distance between a pose or goal of ``group`` and one of ``others``."""
+        mine = [p for x in group for p in self.places[x]]
+        theirs = [p for y in others for p in self.places[y]]
+        return min((math.dist(a, b) for a in mine for b in theirs), default=math.inf)
+
+    def crosses(self, arm: int, obj: str, other_arm: int, other: str) -> bool:
+        """Arm ``arm`` moving ``obj`` while ``other_arm`` moves ``other`` in the same step:
+        the segments from their bases to the objects come closer than ``clearance`` at the
+        picks (current poses) or at the places (goals); two arms reaching so meet."""
+        return any(
+            _segment_gap(
+                self.bases[arm], self.places[obj][k], self.bases[other_arm], self.places[other][k]
+            )
+            < self.clearance
+            for k in (0, 1)
+        )
+
+    def conflicts(self, assigned: Sequence[tuple[int, str]]) -> int:
+        """Pairs of (arm, object) in ``assigned`` that :meth:`crosses`."""
+        return sum(
+            1 for (a, x), (b, y) in itertools.combinations(assigned, 2) if self.crosses(a, x, b, y)
+        )
+
+
+def _segment_gap(
+    p: tuple[float, float], q: tuple[float, float], r: tuple[float, float], s: tuple[float, float]
+) -> float:
+    """The distance between the plane segments ``pq`` and ``rs`` (0 when they cross)."""
+
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    d1, d2, d3, d4 = cross(r, s, p), cross(r, s, q), cross(p, q, r), cross(p, q, s)
+    if d1 * d2 < 0 and d3 * d4 < 0:
+        return 0.0
+    return min(_point_gap(p, r, s), _point_gap(q, r, s), _point_gap(r, p, q), _point_gap(s, p, q))
+
+
+def _point_gap(p: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+    """The distance from ``p`` to the segment ``ab``."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    length2 = dx * dx + dy * dy
+    t = 0.0 if length2 == 0 else ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / length2
+    t = min(1.0, max(0.0, t))
+    return math.dist(p, (a[0] + t * dx, a[1] + t * dy))
+
+
+@dataclass(frozen=True)
 class TaskView:
     """The current arrangement as a task planner sees it.
 
@@ -72,6 +150,8 @@ class TaskView:
     at their goals; ``in_buffer`` the objects resting on a buffer; ``waits`` pairs ``(i, j)``:
     ``i`` at its goal would leave ``j`` no grasp at the goal of ``j``, so ``i`` goes to its
     goal after ``j``. ``arms``: the arms of the cell, the most moves a step may hold (>= 1).
+    ``layout``: where the remaining objects and the arms are (:class:`Layout`), when known;
+    SDAR-T's steps of more than two moves use it (:mod:`solvers.sdar.k_steps`).
     """
 
     graph: DependencyGraph
@@ -79,6 +159,7 @@ class TaskView:
     in_buffer: frozenset[str]
     waits: frozenset[tuple[str, str]] = frozenset()
     arms: int = 2
+    layout: Layout | None = None
 
     def __post_init__(self) -> None:
         if self.arms < 1:

@@ -21,7 +21,7 @@ from sdar_tamp.app import (
     solve_rearrangement,
 )
 from sdar_tamp.app.plan_export import GripperAction
-from sdar_tamp.app.problem import grasp_set_sizes
+from sdar_tamp.app.problem import grasp_set_sizes, table_plane
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.domain_reader import parse_domain
 from sdar_tamp.language.problem import PDDLProblem
@@ -117,8 +117,10 @@ def test_both_entry_points_pass_the_same_sdar_options(
     assert kwargs["algorithm"] == "sdar" and kwargs["task_planner"] == "baseline"
     assert kwargs["max_time"] == 9.0
     expected = dataclasses.replace(config.sdar, max_time=9.0, one_arm_at_a_time=True)
-    assert kwargs["sdar_options"] == dataclasses.replace(expected, quick_attempts=0)
-    assert kwargs["sdar_options"] == r.config.replace(max_time=9.0).sdar_options()
+    plane = table_plane(ctx)  # where poses lie: the cell's (used beyond two arms)
+    assert kwargs["sdar_options"] == dataclasses.replace(expected, quick_attempts=0, plane=plane)
+    configured = r.config.replace(max_time=9.0).sdar_options()
+    assert kwargs["sdar_options"] == dataclasses.replace(configured, plane=plane)
 
 
 def test_plain_solve_of_a_rearrangement_plans_as_solve_rearrangement(
@@ -145,7 +147,9 @@ def test_plain_solve_of_a_rearrangement_plans_as_solve_rearrangement(
     solve(r.problem, algorithm="sdar", max_time=9.0, task_planner="sdar", verbose=False)
     explicit = SdarOptions(candidates=2)
     solve(r.problem, algorithm="sdar", max_time=9.0, sdar_options=explicit, verbose=False)
-    expected = r.config.replace(max_time=9.0).sdar_options()
+    expected = dataclasses.replace(
+        r.config.replace(max_time=9.0).sdar_options(), plane=table_plane(ctx)
+    )
     assert expected.one_arm_at_a_time and expected.grasps == 12
     assert seen[0][1] == expected and seen[1][1] == expected
     assert seen[2][1] == dataclasses.replace(explicit, max_time=9.0)
