@@ -9,6 +9,15 @@ from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.transforms import FloatArray
 
 
+def _line_targets(T0: FloatArray, distance: float, step: float) -> FloatArray:
+    """TCP poses ``(m, n, 4, 4)`` moving each pose of ``T0`` ``(m, 4, 4)`` by ``distance`` [m]
+    along its own z axis in ``n = ceil(|distance| / step)`` (at least one) equal steps."""
+    n = max(1, int(np.ceil(abs(distance) / step)))
+    T = np.repeat(T0[:, None], n, axis=1)
+    T[:, :, :3, 3] += (distance * np.arange(1, n + 1) / n)[None, :, None] * T0[:, None, :3, 2]
+    return T
+
+
 def straight_tool_move(
     kin: ArmKinematics,
     q: FloatArray,
@@ -23,19 +32,12 @@ def straight_tool_move(
     unreachable or jumps by more than ``max_joint_step`` [rad] on some joint.
     """
     q = np.asarray(q, dtype=np.float64)
-    T0 = kin.fk_tcp(q)
-    n = max(1, int(np.ceil(abs(distance) / step)))
-    T = np.repeat(T0[None], n, axis=0)
-    T[:, :3, 3] += (distance * np.arange(1, n + 1) / n)[:, None] * T0[:3, 2][None]
-    out = [q]
     if not kin.closed_form:  # every step solved from q, its redundancy pulled toward q
-        near = kin.ik_tcp_from(T, np.repeat(q[None, None], n, axis=0))
-        path = np.concatenate([q[None], near.q[:, 0]])
-        if not near.valid.all() or np.abs(np.diff(path, axis=0)).max() > max_joint_step:
-            return None
-        return path
+        return straight_tool_moves(kin, q[None], distance, step, max_joint_step)[0]
+    T = _line_targets(kin.fk_tcp(q)[None], distance, step)[0]
+    out = [q]
     sol = kin.ik_tcp(T)
-    for k in range(n):
+    for k in range(len(T)):
         d = np.where(sol.valid[k], np.abs(sol.q[k] - out[-1]).max(axis=1), np.inf)
         b = int(np.argmin(d))
         if not np.isfinite(d[b]) or d[b] > max_joint_step:
@@ -57,10 +59,8 @@ def straight_tool_moves(
     q_all = np.asarray(qs, dtype=np.float64).reshape(-1, kin.dof)
     if kin.closed_form or len(q_all) == 0:
         return [straight_tool_move(kin, q, distance, step, max_joint_step) for q in q_all]
-    n = max(1, int(np.ceil(abs(distance) / step)))
-    T0 = np.stack([kin.fk_tcp(q) for q in q_all])  # (m, 4, 4)
-    T = np.repeat(T0[:, None], n, axis=1)  # (m, n, 4, 4)
-    T[:, :, :3, 3] += (distance * np.arange(1, n + 1) / n)[None, :, None] * T0[:, None, :3, 2]
+    T = _line_targets(np.stack([kin.fk_tcp(q) for q in q_all]), distance, step)  # (m, n, 4, 4)
+    n = T.shape[1]
     starts = np.repeat(q_all[:, None, None], n, axis=1).reshape(-1, 1, kin.dof)
     near = kin.ik_tcp_from(T.reshape(-1, 4, 4), starts)
     steps, valid = near.q[:, 0].reshape(len(q_all), n, kin.dof), near.valid[:, 0].reshape(-1, n)
