@@ -159,12 +159,12 @@ class _Checker:
         if not self.world.in_collision(full):
             return set()
         found: set[str] = set()
-        arm_prefix = f"{c.arm}_"
+        owner = self.world.owner
         for p in self.world.report():
-            a, b = (p.first, p.second) if p.first.startswith(arm_prefix) else (p.second, p.first)
-            if not a.startswith(arm_prefix):
+            a, b = (p.first, p.second) if owner(p.first) == c.arm else (p.second, p.first)
+            if owner(a) != c.arm:
                 continue  # pairs of the other arms only: left out
-            if b.startswith(arm_prefix):
+            if owner(b) == c.arm:
                 found.add("self")
             elif b == "table":
                 found.add("table")
