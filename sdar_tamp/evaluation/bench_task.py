@@ -48,11 +48,14 @@ def _worker_cache() -> PlannerCache:
 
 
 @functools.cache
-def _abstract_figures(path: Path, task_planner: str) -> AbstractFigures:
-    """The task planner's geometry-free counts, once per worker, instance and planner."""
+def _abstract_figures(path: Path, task_planner: str, scene: Path | None) -> AbstractFigures:
+    """The task planner's geometry-free counts, once per worker, instance, planner and cell:
+    for the arms of ``scene`` where the run replaces the instance's own cell."""
     from sdar_tamp.app.abstract import abstract_figures
+    from sdar_tamp.world.scene import load_scene
 
-    return abstract_figures(path, task_planner)
+    arms = None if scene is None else len(load_scene(scene).arms)
+    return abstract_figures(path, task_planner, arms)
 
 
 def task_row(task: BenchTask, status: str, diagnosis: str) -> BenchRow:
@@ -73,7 +76,7 @@ def run_task(task: BenchTask) -> RunAnswer:
 
     e, c = task.entry, task.combo
     path = e.path if task.files is None else unpack(task.files)
-    abstract = _abstract_figures(path, c.task_planner)
+    abstract = _abstract_figures(path, c.task_planner, task.scene)
     start = time.perf_counter()
     try:
         outcome = solve_instance(

@@ -240,3 +240,15 @@ def test_abstract_figures_count_the_arms_of_the_instances_scene() -> None:
     assert (one.actions, one.steps) == (3, 3)
     with pytest.raises(ParameterError, match="arms"):
         abstract_figures(data / "one_arm_chain.yaml", "sdar", arms=0)
+
+
+def test_the_benchmark_counts_the_arms_of_the_cell_that_replaces_the_instances() -> None:
+    """`sdar bench --scene CELL`: the geometry-free figures are those of CELL's arms."""
+    from sdar_tamp.evaluation.bench_task import _abstract_figures
+
+    data = Path(__file__).parent / "data"
+    cells = Path(__file__).parents[2] / "domains" / "dual_arm_rearrangement" / "cells"
+    own = _abstract_figures(data / "three_arm_cycle.yaml", "sdar", None)
+    assert (own.actions, own.buffer_moves) == (3, 0)
+    two = _abstract_figures(data / "three_arm_cycle.yaml", "sdar", cells / "ur5e_table_2arm.yaml")
+    assert (two.actions, two.buffer_moves) == (4, 1)
