@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from sdar_tamp.plan_file import (
 from sdar_tamp.plan_metrics import MetricValue, PlanMetrics
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
+
+if TYPE_CHECKING:
+    from sdar_tamp.world.kinematics import ArmKinematics
 
 
 @dataclass(frozen=True, eq=False)
@@ -202,6 +206,11 @@ class PlanBuilder:
         self._parts.append(part)
         return part
 
+    @property
+    def parts(self) -> tuple[PlanPart, ...]:
+        """Every part taken so far, in order."""
+        return tuple(self._parts)
+
     def finish(self, instance_name: str, metrics: Mapping[str, MetricValue]) -> PlanFile:
         """The plan file: the timeline ends with the dwell of its last gripper events; the
         metrics of :data:`COMPUTED_METRICS` replace those in ``metrics``. No item may be
@@ -224,17 +233,25 @@ class PlanBuilder:
                 "execution_time": float(t_all[-1]),
             }
         )
-        arms = tuple(
-            ArmInfo(
-                a.name,
-                plan_joint_names(a.name, a.joint_names),
-                a.T_world_base,
-                self.kins[a.name].T_tool0_tcp,
-                np.array(a.home),
-            )
-            for a in self.scene.arms
-        )
+        arms = plan_arms(self.scene, self.kins)
         return PlanFile(instance_name, arms, t_all, q_all, events, dict(self.final), out, steps)
+
+
+def plan_arms(scene: Scene, kins: Mapping[str, ArmKinematics] | None = None) -> tuple[ArmInfo, ...]:
+    """The plan file's ``arms`` of ``scene`` (``kins``: the arms' kinematics, when built)."""
+    from sdar_tamp.world.kinematics import ArmKinematics  # pinocchio: imported on use
+
+    kins = kins or {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+    return tuple(
+        ArmInfo(
+            a.name,
+            plan_joint_names(a.name, a.joint_names),
+            a.T_world_base,
+            kins[a.name].T_tool0_tcp,
+            np.array(a.home),
+        )
+        for a in scene.arms
+    )
 
 
 def build_plan_file(

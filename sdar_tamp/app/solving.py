@@ -1,26 +1,32 @@
 """How a rearrangement is solved: ``solve(problem, algorithm="sdar")`` with its configuration.
 
-:func:`solve_rearrangement` is the same call a user makes with
-``solve(r.problem, algorithm="sdar", task_planner=..., sdar_options=r.config.sdar_options())``,
-so both entry points plan alike; before it, the quick infeasibility proofs of
-:mod:`streams.feasibility` run (well under a second for 24 objects): when they prove the
-instance unsolvable, the solution says ``infeasible`` at once, naming the stuck objects and
-what their grasps hit (at the planner's IK clearance; the diagnosis says when no valid plan
-exists at all).
+:func:`solve_rearrangement` runs the solver a user gets with
+``solve(r.problem, algorithm="sdar", task_planner=..., sdar_options=r.config.sdar_options())``
+(:func:`solvers.solve.sdar_solver`), so both entry points plan alike;
+:func:`rearrangement_steps` yields its steps one at a time. Before it, the quick
+infeasibility proofs of :mod:`streams.feasibility` run (well under a second for 24
+objects): when they prove the instance unsolvable, the solution says ``infeasible`` at
+once, naming the stuck objects and what their grasps hit (at the planner's IK clearance;
+the diagnosis says when no valid plan exists at all).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 
 from sdar_tamp.app.config import PlannerConfig
 from sdar_tamp.app.problem import Rearrangement, table_plane
 from sdar_tamp.arguments import MAX_TIME
+from sdar_tamp.logs import get_logger
+from solvers.sdar.report import PlannedStep
+from solvers.sdar.solver import run_to_end
 from solvers.solution import Solution, Status
-from solvers.solve import solve
+from solvers.solve import sdar_solver
 from streams.feasibility import prove_unplannable
+
+LOG = get_logger(__name__)
 
 
 def solve_rearrangement(
@@ -40,6 +46,29 @@ def solve_rearrangement(
     ``task_planner`` and ``max_time``, when given, replace its fields. The motion planner
     is the problem's (its streams are built for it). ``prove``: run the infeasibility proofs
     first (their time is ``statistics["proof_time"]`` [s], part of ``planning_time``).
+    :func:`rearrangement_steps` run to its end.
+
+    Raises:
+        ParameterError: ``max_time`` out of range or an unknown ``task_planner``.
+    """
+    steps = rearrangement_steps(
+        rearrangement, task_planner, max_time, progress, config=config, prove=prove
+    )
+    return run_to_end(steps)
+
+
+def rearrangement_steps(
+    rearrangement: Rearrangement,
+    task_planner: str | None = None,
+    max_time: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    *,
+    config: PlannerConfig | None = None,
+    prove: bool = True,
+) -> Generator[PlannedStep, None, Solution]:
+    """:func:`solve_rearrangement` one step at a time: the proofs, then the SDAR solver that
+    ``solve(r.problem, algorithm="sdar", ...)`` builds (:func:`solvers.solve.sdar_solver`),
+    each executed decision yielded as soon as it is planned; returns the solution.
 
     Raises:
         ParameterError: ``max_time`` out of range or an unknown ``task_planner``.
@@ -52,6 +81,7 @@ def solve_rearrangement(
         max_time=max_time,
         motion_planner=rearrangement.config.motion_planner,
     )
+    options = dataclasses.replace(run.sdar_options(progress), plane=table_plane(rearrangement.ctx))
     started = time.perf_counter()
     proof = (
         prove_unplannable(rearrangement.ctx, rearrangement.instance, run.grasps) if prove else None
@@ -60,15 +90,13 @@ def solve_rearrangement(
     if proof is not None:
         figures = {"planning_time": proof_time, "proof_time": proof_time}
         return Solution(None, status=Status.INFEASIBLE, statistics=figures, diagnosis=proof.lines())
-    solution = solve(
-        rearrangement.problem,
-        algorithm="sdar",
-        task_planner=run.task_planner,
-        max_time=run.max_time,
-        sdar_options=dataclasses.replace(
-            run.sdar_options(progress), plane=table_plane(rearrangement.ctx)
-        ),
-        verbose=False,
+    solver = sdar_solver(rearrangement.problem, run.task_planner, run.max_time, None, options)
+    solution = yield from solver.steps()
+    LOG.debug(
+        "sdar: %s, %d action(s), %.3f s",
+        solution.status.value,
+        len(solution.plan or ()),
+        float(solution.statistics.get("planning_time", 0.0)),
     )
     if not prove:
         return solution
