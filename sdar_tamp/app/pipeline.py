@@ -112,9 +112,11 @@ def prepare_solve(
     execution: str | None = None,
     cache: PlannerCache | None = None,
     scene: Path | None = None,
+    defer_build: bool = False,
 ) -> PreparedSolve:
     """The first half of :func:`solve_instance` (same arguments): the values checked, the
-    instance read, the world built (or taken from ``cache``), the problem made.
+    instance read, the world built (or taken from ``cache``; ``defer_build``: see
+    :meth:`PlannerCache.world`), the problem made.
 
     Raises:
         ParameterError: a value out of range or an unknown planner name.
@@ -138,7 +140,7 @@ def prepare_solve(
     )
     instance = load_instance(instance_path, grasp=None)
     scene_path = Path(scene) if scene is not None else instance.scene_path(Path(instance_path))
-    world = (cache or PlannerCache()).world(scene_path, config.trajopt)
+    world = (cache or PlannerCache()).world(scene_path, config.trajopt, defer_build)
     instance = load_instance(instance_path, world.ctx.scene.grasp_limits)
     rearrangement = rearrangement_problem(instance, world.ctx, config=config, planner=world.planner)
     return PreparedSolve(config, instance, world, rearrangement)

@@ -13,6 +13,11 @@ stretch stops the stream with :class:`StepRejected`. When the iteration ends,
 :attr:`PlanStream.outcome` holds what ``solve_instance`` returns: the whole plan file,
 replayed by the independent validator.
 
+The first step is the one a robot waits for: the trajectory optimiser's background build
+(a few tenths of a second of CPU, holding the interpreter much of the time) is deferred until
+that step is out, unless the step needs the optimiser, which then starts the build and waits
+for it (:class:`~streams.motion.optimiser_build.OptimiserBuild`).
+
 Timing: a stream carries the synchronous execution (``execution="sync"``), the only timing
 that is fixed when a step is planned: the asynchronous modes re-time every step against the
 whole plan once it is complete. The concatenation of the steps is then the plan that
@@ -97,6 +102,9 @@ class PlanStream:
             if violation is not None:
                 steps.close()
                 raise StepRejected(planned.index, violation)
+            # the optimiser's build, deferred, starts once the first step is out (a step that
+            # needs the optimiser starts it itself and waits for it)
+            prepared.world.planner.start_build()
             yield StreamStep(
                 planned.index,
                 task.kind,
@@ -140,5 +148,6 @@ def solve_stream(
         execution="sync",
         cache=cache,
         scene=scene,
+        defer_build=True,
     )
     return PlanStream(prepared, progress, started)
