@@ -8,11 +8,14 @@ run to run:
 
 * ``first_step_s``: from the ``solve_stream`` call (the instance read, the world built, the
   optimiser's compiled library started in the background) to the first step yielded,
-  planned and checked;
+  planned and checked; ``first_step_after_load_s``: from the call's return (the instance
+  loaded, the world and the problem built) to the first step;
 * ``stream_total_s``: from that call to the last step yielded (planning finished);
   ``stream_done_s`` also holds the end (the whole plan's replay and the figures);
 * ``batch_total_s``: the ``solve_instance`` call, start to return (planning, the plan file,
   its replay);
+* ``*_cpu_s``: the same spans in CPU time of the process (every thread: the optimiser's
+  build included), less sensitive than wall time to a loaded machine;
 * ``same_plan``: the streamed plan equals the batch plan (every field but the run's timings).
 
     python benchmarks/bench_stream.py [--instances M1 D4] [--runs 3] [--seed 0]
@@ -43,7 +46,9 @@ from sdar_tamp.resources import domain_file
 
 #: The plan file's metrics that time the run (they differ between any two runs).
 TIMING = {"planning_time", "planning_time_selection", "planning_time_motion", "step_time_median"}
-KEYS = ("first_step_s", "stream_total_s", "stream_done_s", "batch_total_s", "steps")
+KEYS = ("first_step_s", "stream_total_s", "stream_done_s", "batch_total_s", "steps",
+        "first_step_cpu_s", "stream_total_cpu_s", "batch_total_cpu_s",
+        "first_step_after_load_s", "first_step_after_load_cpu_s")  # fmt: skip
 
 
 def same_plan(a: PlanFile, b: PlanFile) -> bool:
@@ -54,23 +59,33 @@ def same_plan(a: PlanFile, b: PlanFile) -> bool:
     return x == y
 
 
-def batch(path: Path, seed: int, time_limit: float) -> tuple[float, PlanFile | None]:
-    start = time.perf_counter()
+def batch(path: Path, seed: int, time_limit: float) -> tuple[dict[str, float], PlanFile | None]:
+    start, cpu = time.perf_counter(), time.process_time()
     outcome = solve_instance(
         path, seed=seed, time_limit=time_limit, execution="sync", cache=PlannerCache()
     )
-    return time.perf_counter() - start, outcome.plan if outcome.success else None
+    figures = {
+        "batch_total_s": time.perf_counter() - start,
+        "batch_total_cpu_s": time.process_time() - cpu,
+    }
+    return figures, outcome.plan if outcome.success else None
 
 
 def stream(path: Path, seed: int, time_limit: float) -> tuple[dict[str, float], PlanFile | None]:
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     planned = solve_stream(path, seed=seed, time_limit=time_limit, cache=PlannerCache())
-    times = [time.perf_counter() - start for _ in planned]
+    loaded = (time.perf_counter() - start, time.process_time() - cpu)
+    times = [(time.perf_counter() - start, time.process_time() - cpu) for _ in planned]
     done = time.perf_counter() - start
     outcome = planned.outcome
+    first, last = (times[0], times[-1]) if times else ((done, 0.0), (done, 0.0))
     figures = {
-        "first_step_s": times[0] if times else done,
-        "stream_total_s": times[-1] if times else done,
+        "first_step_s": first[0],
+        "first_step_cpu_s": first[1],
+        "first_step_after_load_s": first[0] - loaded[0],
+        "first_step_after_load_cpu_s": first[1] - loaded[1],
+        "stream_total_s": last[0],
+        "stream_total_cpu_s": last[1],
         "stream_done_s": done,
         "steps": float(len(times)),
     }
@@ -85,11 +100,9 @@ def run_instance(name: str, runs: int, seed: int, time_limit: float) -> dict[str
         row: dict[str, Any] = {}
         plans: dict[str, PlanFile | None] = {}
         for which in order:
-            if which == "batch":
-                row["batch_total_s"], plans["batch"] = batch(path, seed, time_limit)
-            else:
-                figures, plans["stream"] = stream(path, seed, time_limit)
-                row.update(figures)
+            run = batch if which == "batch" else stream
+            figures, plans[which] = run(path, seed, time_limit)
+            row.update(figures)
         a, b = plans["stream"], plans["batch"]
         row["same_plan"] = a is not None and b is not None and same_plan(a, b)
         shown = " ".join(f"{k} {row[k]:.3f}" for k in KEYS if k != "steps")
