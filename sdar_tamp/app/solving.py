@@ -1,13 +1,13 @@
 """How a rearrangement is solved: ``solve(problem, algorithm="sdar")`` with its configuration.
 
-:func:`solve_rearrangement` runs the solver a user gets with
-``solve(r.problem, algorithm="sdar", task_planner=..., sdar_options=r.config.sdar_options())``
-(:func:`solvers.solve.sdar_solver`), so both entry points plan alike;
-:func:`rearrangement_steps` yields its steps one at a time. Before it, the quick
-infeasibility proofs of :mod:`streams.feasibility` run (well under a second for 24
-objects): when they prove the instance unsolvable, the solution says ``infeasible`` at
-once, naming the stuck objects and what their grasps hit (at the planner's IK clearance;
-the diagnosis says when no valid plan exists at all).
+:func:`solve_rearrangement` is the same call a user makes with
+``solve(r.problem, algorithm="sdar", task_planner=..., sdar_options=r.config.sdar_options())``,
+so both entry points plan alike; :func:`rearrangement_steps` runs the same solver
+(:func:`solvers.solve.sdar_solver`, which ``solve`` builds it with) one step at a time.
+Before either, the quick infeasibility proofs of :mod:`streams.feasibility` run (well under
+a second for 24 objects): when they prove the instance unsolvable, the solution says
+``infeasible`` at once, naming the stuck objects and what their grasps hit (at the
+planner's IK clearance; the diagnosis says when no valid plan exists at all).
 """
 
 from __future__ import annotations
@@ -19,14 +19,11 @@ from collections.abc import Callable, Generator
 from sdar_tamp.app.config import PlannerConfig
 from sdar_tamp.app.problem import Rearrangement, table_plane
 from sdar_tamp.arguments import MAX_TIME
-from sdar_tamp.logs import get_logger
+from solvers.sdar.options import SdarOptions
 from solvers.sdar.report import PlannedStep
-from solvers.sdar.solver import run_to_end
 from solvers.solution import Solution, Status
-from solvers.solve import sdar_solver
+from solvers.solve import sdar_solver, solve
 from streams.feasibility import prove_unplannable
-
-LOG = get_logger(__name__)
 
 
 def solve_rearrangement(
@@ -46,15 +43,23 @@ def solve_rearrangement(
     ``task_planner`` and ``max_time``, when given, replace its fields. The motion planner
     is the problem's (its streams are built for it). ``prove``: run the infeasibility proofs
     first (their time is ``statistics["proof_time"]`` [s], part of ``planning_time``).
-    :func:`rearrangement_steps` run to its end.
 
     Raises:
         ParameterError: ``max_time`` out of range or an unknown ``task_planner``.
     """
-    steps = rearrangement_steps(
-        rearrangement, task_planner, max_time, progress, config=config, prove=prove
+    run = _run_config(rearrangement, task_planner, max_time, config)
+    proof, proof_time = _proof(rearrangement, run, prove)
+    if proof is not None:
+        return proof
+    solution = solve(
+        rearrangement.problem,
+        algorithm="sdar",
+        task_planner=run.task_planner,
+        max_time=run.max_time,
+        sdar_options=_sdar_options(rearrangement, run, progress),
+        verbose=False,
     )
-    return run_to_end(steps)
+    return _with_proof_time(solution, proof_time) if prove else solution
 
 
 def rearrangement_steps(
@@ -66,40 +71,66 @@ def rearrangement_steps(
     config: PlannerConfig | None = None,
     prove: bool = True,
 ) -> Generator[PlannedStep, None, Solution]:
-    """:func:`solve_rearrangement` one step at a time: the proofs, then the SDAR solver that
-    ``solve(r.problem, algorithm="sdar", ...)`` builds (:func:`solvers.solve.sdar_solver`),
-    each executed decision yielded as soon as it is planned; returns the solution.
+    """:func:`solve_rearrangement` (same arguments) one step at a time: the proofs, then the
+    solver that ``solve(r.problem, algorithm="sdar", ...)`` runs
+    (:func:`solvers.solve.sdar_solver`), each executed decision yielded as soon as it is
+    planned (:meth:`~solvers.sdar.solver.SdarSolver.steps`); returns the solution.
 
     Raises:
         ParameterError: ``max_time`` out of range or an unknown ``task_planner``.
     """
+    run = _run_config(rearrangement, task_planner, max_time, config)
+    proof, proof_time = _proof(rearrangement, run, prove)
+    if proof is not None:
+        return proof
+    options = _sdar_options(rearrangement, run, progress)
+    solver = sdar_solver(rearrangement.problem, run.task_planner, run.max_time, None, options)
+    solution = yield from solver.steps()
+    return _with_proof_time(solution, proof_time) if prove else solution
+
+
+def _run_config(
+    rearrangement: Rearrangement,
+    task_planner: str | None,
+    max_time: float | None,
+    config: PlannerConfig | None,
+) -> PlannerConfig:
     if max_time is not None:
         MAX_TIME.check("max_time", max_time)
     base = config or rearrangement.config
-    run = base.replace(
+    return base.replace(
         task_planner=task_planner,
         max_time=max_time,
         motion_planner=rearrangement.config.motion_planner,
     )
-    options = dataclasses.replace(run.sdar_options(progress), plane=table_plane(rearrangement.ctx))
-    started = time.perf_counter()
-    proof = (
-        prove_unplannable(rearrangement.ctx, rearrangement.instance, run.grasps) if prove else None
-    )
-    proof_time = time.perf_counter() - started if prove else 0.0
-    if proof is not None:
-        figures = {"planning_time": proof_time, "proof_time": proof_time}
-        return Solution(None, status=Status.INFEASIBLE, statistics=figures, diagnosis=proof.lines())
-    solver = sdar_solver(rearrangement.problem, run.task_planner, run.max_time, None, options)
-    solution = yield from solver.steps()
-    LOG.debug(
-        "sdar: %s, %d action(s), %.3f s",
-        solution.status.value,
-        len(solution.plan or ()),
-        float(solution.statistics.get("planning_time", 0.0)),
-    )
+
+
+def _sdar_options(
+    rearrangement: Rearrangement,
+    run: PlannerConfig,
+    progress: Callable[[int, int], None] | None,
+) -> SdarOptions:
+    return dataclasses.replace(run.sdar_options(progress), plane=table_plane(rearrangement.ctx))
+
+
+def _proof(
+    rearrangement: Rearrangement, run: PlannerConfig, prove: bool
+) -> tuple[Solution | None, float]:
+    """The infeasibility proofs (with ``prove``): an ``infeasible`` solution when they prove
+    it, and their time [s]."""
     if not prove:
-        return solution
+        return None, 0.0
+    started = time.perf_counter()
+    proof = prove_unplannable(rearrangement.ctx, rearrangement.instance, run.grasps)
+    proof_time = time.perf_counter() - started
+    if proof is None:
+        return None, proof_time
+    figures = {"planning_time": proof_time, "proof_time": proof_time}
+    solution = Solution(None, status=Status.INFEASIBLE, statistics=figures, diagnosis=proof.lines())
+    return solution, proof_time
+
+
+def _with_proof_time(solution: Solution, proof_time: float) -> Solution:
     stats = dict(solution.statistics)
     stats["proof_time"] = proof_time
     stats["planning_time"] = float(stats.get("planning_time", 0.0)) + proof_time

@@ -128,10 +128,11 @@ def test_solve_entry_point_runs_sdar(solved_swap: tuple[Rearrangement, Solution]
 def test_both_entry_points_configure_sdar_alike(
     ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """With the default motion planner, ``solve_rearrangement`` and ``solve(algorithm="sdar")``
-    build the same solver (problem, task planner, options), so what the tests check of one
-    holds for the other."""
-    from solvers.sdar.solver import SdarSolver
+    """With the default motion planner, ``solve_rearrangement``, ``solve(algorithm="sdar")``
+    and ``rearrangement_steps`` build the same solver (problem, task planner, options), so what
+    the tests check of one holds for the others."""
+    from sdar_tamp.app.solving import rearrangement_steps
+    from solvers.sdar.solver import SdarSolver, run_to_end
 
     built: list[tuple[Any, ...]] = []
 
@@ -144,7 +145,8 @@ def test_both_entry_points_configure_sdar_alike(
     r = rearrangement_problem(_swap(), ctx, planner=planner)
     solve(r.problem, algorithm="sdar", max_time=BUDGET, verbose=False)
     solve_rearrangement(r, "sdar", BUDGET)
-    assert len(built) == 2 and built[0] == built[1]
+    run_to_end(rearrangement_steps(r, "sdar", BUDGET))  # a stream's steps: the same solver
+    assert len(built) == 3 and built[0] == built[1] == built[2]
 
 
 def test_steps_yield_each_decision_and_return_the_solution(
