@@ -115,7 +115,8 @@ class PlanStream:
                 part,
             )
         self.outcome = finish_solve(prepared, solution, None, builder)
-        self.last_part = builder.parts[-1]
+        if self.outcome.plan is not None:  # the builder finished the plan: its last part
+            self.last_part = builder.parts[-1]
 
 
 def solve_stream(

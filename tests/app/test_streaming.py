@@ -201,3 +201,27 @@ def test_step_validator_errors_and_end_rules() -> None:
         checker.check(np.zeros(1), home, ())
     end = checker.finish()  # nothing moved: the objects are not at their goals
     assert end is not None and end.kind == "goal"
+
+
+def test_an_unsolvable_instance_streams_no_step_and_says_why(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, save_instance
+    from sdar_tamp.world.scene import Workspace
+
+    size = (0.08, 0.04, 0.05)
+    starts = [Pose2D(0.0, 0.045 * (i - 1), 0.0) for i in range(3)]  # 5 mm apart: none can
+    goals = [Pose2D(0.15 * (i - 1), -0.2, 0.0) for i in range(3)]  # be picked first
+    objects = tuple(ObjectSpec(f"o{i}", size, starts[i], goals[i]) for i in range(3))
+    workspace = Workspace((-0.25, 0.25), (-0.30, 0.30))
+    path = save_instance(Instance("boxed", workspace, objects), tmp_path / "boxed.yaml")
+    assert main(["solve", str(path), "--stream", "-q", "--time-limit", "600"]) == 1
+    captured = capsys.readouterr()
+    records = _lines(captured.out)
+    assert [r["type"] for r in records] == ["header", "end"]
+    end = records[-1]
+    assert end["status"] == "infeasible" and end["valid"] is False and "final_poses" not in end
+    assert any("can ever be picked first" in line for line in end["diagnosis"])
+    assert "boxed: infeasible" in captured.err
+    with pytest.raises(ParameterError, match="ended without a plan"):
+        plan_from_records(records)
