@@ -178,8 +178,8 @@ def check_timeline(
     found = [
         v
         for v in (
-            _joint_limits(plan, scene),
-            _velocity(plan, scene, v_tol),
+            _joint_limits(plan.t, plan.q, scene),
+            _velocity(plan.t, plan.q, scene, v_tol),
             _acceleration(plan, scene, a_tol),
             _dwell(plan, scene, dwell),
         )
@@ -199,9 +199,18 @@ def _joint(scene: Scene, j: int) -> str:
     return f"{arm} {joint_label(scene.arm(arm).joint_names[k])}"
 
 
-def _joint_limits(plan: PlanFile, scene: Scene) -> Violation | None:
+def check_samples(
+    t: FloatArray, q: FloatArray, scene: Scene, v_tol: float = LIMIT_RTOL
+) -> Violation | None:
+    """The earliest joint-limit or velocity violation of samples ``q`` ``(n, dof)`` [rad] at
+    ``t`` ``(n,)`` [s] (any stretch of a timeline: both rules are per sample and per
+    interval)."""
+    found = [v for v in (_joint_limits(t, q, scene), _velocity(t, q, scene, v_tol)) if v]
+    return min(found, key=lambda v: v.t) if found else None
+
+
+def _joint_limits(t: FloatArray, q: FloatArray, scene: Scene) -> Violation | None:
     lo, hi = scene.joint_array("lower"), scene.joint_array("upper")
-    t, q = plan.t, plan.q
     bad = (q < lo - JOINT_TOL) | (q > hi + JOINT_TOL)
     if not bad.any():
         return None
@@ -210,12 +219,11 @@ def _joint_limits(plan: PlanFile, scene: Scene) -> Violation | None:
     return Violation(float(t[i]), "joint limit", msg)
 
 
-def _velocity(plan: PlanFile, scene: Scene, tol: float) -> Violation | None:
+def _velocity(t: FloatArray, q: FloatArray, scene: Scene, tol: float) -> Violation | None:
     v_max = scene.joint_array("velocity_limit")
-    t = plan.t
     if len(t) < 2:
         return None
-    vel = np.diff(plan.q, axis=0) / np.diff(t)[:, None]
+    vel = np.diff(q, axis=0) / np.diff(t)[:, None]
     bad = np.abs(vel) > v_max * (1.0 + tol)
     if not bad.any():
         return None

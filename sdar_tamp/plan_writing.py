@@ -19,26 +19,26 @@ def plan_to_dict(plan: PlanFile) -> dict[str, Any]:
         "version": VERSION,
         "units": dict(UNITS),
         "instance": plan.instance,
-        "arms": _json(plan.arms),
+        "arms": json_value(plan.arms),
         "trajectory": {"t": plan.t.tolist(), "q": plan.q.tolist()},
-        "events": _json(plan.events),
-        "final_poses": _json(plan.final_poses),
+        "events": json_value(plan.events),
+        "final_poses": json_value(plan.final_poses),
         "metrics": plan.metrics.as_json(),
-        "steps": _json(plan.steps),
+        "steps": json_value(plan.steps),
     }
 
 
-def _json(value: Any) -> Any:
+def json_value(value: Any) -> Any:
     """Dataclasses as objects (field order), arrays and tuples as lists, numpy scalars as
     Python numbers."""
     if isinstance(value, np.ndarray | np.generic):
         return value.tolist()
     if is_dataclass(value):
-        return {f.name: _json(getattr(value, f.name)) for f in fields(value)}
+        return {f.name: json_value(getattr(value, f.name)) for f in fields(value)}
     if isinstance(value, dict):
-        return {k: _json(v) for k, v in value.items()}
+        return {k: json_value(v) for k, v in value.items()}
     if isinstance(value, tuple | list):
-        return [_json(v) for v in value]
+        return [json_value(v) for v in value]
     return value
 
 

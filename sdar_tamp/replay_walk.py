@@ -7,11 +7,12 @@ The rules and tolerances are those of :mod:`sdar_tamp.replay` (``POS_TOL`` [m] a
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import PlanEvent, PlanFile
 from sdar_tamp.plan_rules import STILL_TOL, Violation
 from sdar_tamp.replay_sampling import tcp_subdivisions
@@ -72,12 +73,14 @@ def describe_contacts(pairs: list[CollisionPair], world: CollisionWorld, limit: 
 
 class ReplayWalk:
     """The state of the world along the timeline (resting and held objects), walked once in
-    time order by :meth:`walk`, which returns the first violation of the replay rules."""
+    time order by :meth:`walk`, which returns the first violation of the replay rules.
+    Without a ``plan``, the timeline comes in stretches to :meth:`walk_samples` (a plan being
+    planned) and :meth:`final` checks nothing about ``final_poses``."""
 
     def __init__(
         self,
         instance: Instance,
-        plan: PlanFile,
+        plan: PlanFile | None,
         scene: Scene,
         step: float,
         kins: dict[str, ArmKinematics],
@@ -132,12 +135,27 @@ class ReplayWalk:
     def walk(self, t_stop: float) -> Violation | None:
         """Replay until ``t_stop`` [s] (exclusive); the first violation, or None."""
         plan = self.plan
-        knot_t = np.union1d(plan.t, [e.t for e in plan.events])
+        if plan is None:
+            raise ParameterError("the walk has no plan: walk its samples with walk_samples")
+        found = self.walk_samples(plan.t, plan.q, plan.events, t_stop)
+        end = max(float(plan.t[-1]), max((e.t for e in plan.events), default=0.0))
+        if found is not None or t_stop <= end:
+            return found
+        return self.final(end)
+
+    def walk_samples(
+        self, t: FloatArray, q: FloatArray, events: Sequence[PlanEvent], t_stop: float = math.inf
+    ) -> Violation | None:
+        """Replay samples ``q`` ``(n, dof)`` at ``t`` ``(n,)`` [s] and ``events`` (sorted by
+        time, within ``t``) until ``t_stop`` [s] (exclusive), from the state the walk is in;
+        the first violation, or None. Walking a timeline in consecutive stretches (each
+        starting with the last sample of the one before) checks what one walk checks."""
+        knot_t = np.union1d(t, [e.t for e in events])
         knot_t = knot_t[: int(np.searchsorted(knot_t, t_stop)) + 1]  # the last one: to t_stop
         columns = range(self.layout.dof)
-        knot_q = np.stack([np.interp(knot_t, plan.t, plan.q[:, j]) for j in columns], axis=1)
+        knot_q = np.stack([np.interp(knot_t, t, q[:, j]) for j in columns], axis=1)
         counts = self.subdivisions(knot_q) if len(knot_t) > 1 else np.zeros(0, dtype=int)
-        pending = list(plan.events)
+        pending = list(events)
         for k, tk in enumerate(knot_t):
             if tk >= t_stop:
                 return None
@@ -155,14 +173,14 @@ class ReplayWalk:
             if k + 1 < len(knot_t):
                 n = int(counts[k])
                 for s in range(1, n):
-                    t = float(tk + (knot_t[k + 1] - tk) * s / n)
-                    if t >= t_stop:
+                    t_s = float(tk + (knot_t[k + 1] - tk) * s / n)
+                    if t_s >= t_stop:
                         return None
-                    q = knot_q[k] + (knot_q[k + 1] - knot_q[k]) * (s / n)
-                    found = self.collide(q, t)
+                    q_s = knot_q[k] + (knot_q[k + 1] - knot_q[k]) * (s / n)
+                    found = self.collide(q_s, t_s)
                     if found is not None:
                         return found
-        return self.final(float(knot_t[-1]))
+        return None
 
     def apply(self, e: PlanEvent, q: FloatArray, t: float) -> Violation | None:
         """Check and perform one gripper event at configuration ``q`` ``(dof,)``."""
@@ -240,10 +258,10 @@ class ReplayWalk:
             what = ", ".join(f"{a} holds {o}" for a, (o, _) in self.held.items())
             return Violation(t, "held", f"the plan ends with {what}")
         for o in self.instance.objects:
-            for kind, ref in (
-                ("goal", o.goal.as_tuple()),
-                ("final poses", self.plan.final_poses[o.name]),
-            ):
+            refs = [("goal", o.goal.as_tuple())]
+            if self.plan is not None:
+                refs.append(("final poses", self.plan.final_poses[o.name]))
+            for kind, ref in refs:
                 d, a = _planar_error(self.rest[o.name], ref)
                 if d > POS_TOL or a > ANGLE_TOL:
                     x, y, yaw = self.rest[o.name]

@@ -34,6 +34,7 @@ from solvers.stream_planning.solver import StreamSolver
 
 if TYPE_CHECKING:
     from solvers.sdar.options import SdarOptions
+    from solvers.sdar.solver import SdarSolver
 
 LOG = get_logger(__name__)
 INF = math.inf
@@ -334,17 +335,38 @@ def _solve_sdar(
     verbose: bool,
     sdar_options: SdarOptions | None,
 ) -> Solution:
+    solver = sdar_solver(problem, task_planner, max_time, stream_info, sdar_options)
+    return _summarised(solver.solve(), "sdar", verbose)
+
+
+def sdar_solver(
+    problem: PDDLProblem,
+    task_planner: str | None = None,
+    max_time: float = INF,
+    stream_info: Mapping[str, StreamInfo | FunctionInfo] | None = None,
+    sdar_options: SdarOptions | None = None,
+) -> SdarSolver:
+    """The SDAR solver that ``solve(problem, algorithm="sdar", ...)`` runs, built alike (the
+    problem's ``solve_defaults`` for what is not given), for a caller that takes its steps
+    one at a time (:meth:`~solvers.sdar.solver.SdarSolver.steps`).
+
+    Raises:
+        ParameterError: ``max_time`` out of range, an unknown task planner, or
+            ``sdar_options`` that is not a :class:`~solvers.sdar.options.SdarOptions`.
+    """
     from solvers.sdar.options import SdarOptions
     from solvers.sdar.planners import make_task_planner
     from solvers.sdar.solver import SdarSolver
 
-    planner = make_task_planner(task_planner)
+    max_time = MAX_TIME.check("max_time", max_time)
+    name, sdar_options = _sdar_defaults(problem, task_planner, sdar_options)
+    planner = make_task_planner(name)
     if sdar_options is not None and not isinstance(sdar_options, SdarOptions):
         raise ParameterError(
             f"sdar_options must be a SdarOptions, got {type(sdar_options).__name__}"
         )
     options = dataclasses.replace(sdar_options or SdarOptions(), max_time=max_time)
-    return _summarised(SdarSolver(problem, planner, options, stream_info).solve(), "sdar", verbose)
+    return SdarSolver(problem, planner, options, stream_info)
 
 
 def create_parser(default_algorithm: str = "adaptive") -> argparse.ArgumentParser:

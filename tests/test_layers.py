@@ -39,6 +39,7 @@ LAYERS: dict[str, str] = {
     "sdar_tamp.replay": "plan",
     "sdar_tamp.replay_walk": "plan",
     "sdar_tamp.replay_sampling": "plan",
+    "sdar_tamp.replay_steps": "plan",
     # planners, geometric streams, the declarative domains' samplers
     "solvers": "solvers",
     "streams": "streams",

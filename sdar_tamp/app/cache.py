@@ -32,14 +32,17 @@ class PlannerCache:
         self._world: tuple[WorldContext, MotionPlanner] | None = None
         self.builds = 0  # worlds built so far
 
-    def world(self, scene_path: Path | None, trajopt: TrajOptOptions) -> PlanningWorld:
+    def world(
+        self, scene_path: Path | None, trajopt: TrajOptOptions, defer_build: bool = False
+    ) -> PlanningWorld:
         """The world of ``scene_path`` (None: the shipped scene) with a motion planner using
-        ``trajopt``."""
+        ``trajopt``; ``defer_build``: a new planner's optimiser build waits for
+        :meth:`~streams.motion.planner.MotionPlanner.start_build` or its first use."""
         start = time.perf_counter()
         key = (scene_path, trajopt)
         if self._world is None or self._key != key:
             ctx = WorldContext.load(scene_path)
-            self._world = (ctx, MotionPlanner(ctx, trajopt))
+            self._world = (ctx, MotionPlanner(ctx, trajopt, defer_build=defer_build))
             self._key = key
             self.builds += 1
         ctx, planner = self._world

@@ -10,10 +10,11 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from sdar_tamp.app.bound import run_bound
-from sdar_tamp.app.cache import PlannerCache
+from sdar_tamp.app.cache import PlannerCache, PlanningWorld
 from sdar_tamp.app.config import (
     EXECUTIONS,
     MOTION_PLANNERS,
@@ -22,14 +23,21 @@ from sdar_tamp.app.config import (
     check_choice,
 )
 from sdar_tamp.app.execution import schedule_and_validate
-from sdar_tamp.app.plan_export import decoder_of, motion_levels, plan_file_from_solution
-from sdar_tamp.app.problem import rearrangement_problem
+from sdar_tamp.app.plan_export import (
+    decoder_of,
+    motion_levels,
+    plan_file_from_solution,
+    plan_metrics,
+)
+from sdar_tamp.app.problem import Rearrangement, rearrangement_problem
 from sdar_tamp.app.records import RunFigures, SolveOutcome, task_records
 from sdar_tamp.app.solving import solve_rearrangement
 from sdar_tamp.arguments import SEED, TIME_LIMIT
+from sdar_tamp.plan_building import PlanBuilder
 from sdar_tamp.plan_rules import Violation
 from sdar_tamp.replay import validate_plan
-from sdar_tamp.world.instance import load_instance
+from sdar_tamp.world.instance import Instance, load_instance
+from solvers.solution import Solution
 
 
 def solve_instance(
@@ -67,6 +75,52 @@ def solve_instance(
     Raises:
         ParameterError: a value out of range or an unknown planner name.
     """
+    prepared = prepare_solve(
+        instance_path,
+        config,
+        time_limit=time_limit,
+        seed=seed,
+        task_planner=task_planner,
+        motion_planner=motion_planner,
+        execution=execution,
+        cache=cache,
+        scene=scene,
+    )
+    solution = solve_rearrangement(prepared.rearrangement, progress=progress)
+    return finish_solve(prepared, solution, stage)
+
+
+@dataclass(frozen=True)
+class PreparedSolve:
+    """An instance ready to plan: the configuration, the loaded instance, the world (with the
+    time it took) and the rearrangement problem."""
+
+    config: PlannerConfig
+    instance: Instance
+    world: PlanningWorld
+    rearrangement: Rearrangement
+
+
+def prepare_solve(
+    instance_path: Path,
+    config: PlannerConfig | None = None,
+    *,
+    time_limit: float | None = None,
+    seed: int | None = None,
+    task_planner: str | None = None,
+    motion_planner: str | None = None,
+    execution: str | None = None,
+    cache: PlannerCache | None = None,
+    scene: Path | None = None,
+    defer_build: bool = False,
+) -> PreparedSolve:
+    """The first half of :func:`solve_instance` (same arguments): the values checked, the
+    instance read, the world built (or taken from ``cache``; ``defer_build``: see
+    :meth:`PlannerCache.world`), the problem made.
+
+    Raises:
+        ParameterError: a value out of range or an unknown planner name.
+    """
     if time_limit is not None:
         TIME_LIMIT.check("time_limit", time_limit)
     if seed is not None:
@@ -86,10 +140,23 @@ def solve_instance(
     )
     instance = load_instance(instance_path, grasp=None)
     scene_path = Path(scene) if scene is not None else instance.scene_path(Path(instance_path))
-    world = (cache or PlannerCache()).world(scene_path, config.trajopt)
+    world = (cache or PlannerCache()).world(scene_path, config.trajopt, defer_build)
     instance = load_instance(instance_path, world.ctx.scene.grasp_limits)
     rearrangement = rearrangement_problem(instance, world.ctx, config=config, planner=world.planner)
-    solution = solve_rearrangement(rearrangement, progress=progress)
+    return PreparedSolve(config, instance, world, rearrangement)
+
+
+def finish_solve(
+    prepared: PreparedSolve,
+    solution: Solution,
+    stage: Callable[[str], None] | None = None,
+    builder: PlanBuilder | None = None,
+) -> SolveOutcome:
+    """The second half of :func:`solve_instance`: the figures, the plan file (built from the
+    solution, or finished by ``builder`` when its items were added as they were planned), its
+    asynchronous schedule (``config.execution``) and the independent replay."""
+    config, instance, world = prepared.config, prepared.instance, prepared.world
+    rearrangement = prepared.rearrangement
     stats = solution.statistics
     figures = RunFigures(
         task_planner=config.task_planner,
@@ -124,7 +191,10 @@ def solve_instance(
         "step_time_median": figures.step_time_median,
         "buffer_moves": figures.buffer_moves,
     }
-    plan = plan_file_from_solution(rearrangement, solution, metrics)
+    if builder is None:
+        plan = plan_file_from_solution(rearrangement, solution, metrics)
+    else:
+        plan = builder.finish(instance.name, plan_metrics(solution, metrics))
     if config.execution in ("async", "timelines"):
         if stage is not None:
             stage("scheduling")

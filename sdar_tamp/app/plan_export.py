@@ -26,7 +26,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.language.domain_model import ActionSchema, Domain
 from sdar_tamp.language.stream_model import StreamFile
 from sdar_tamp.language.traversal import iter_atoms, iter_effect_literals
-from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, PlanBuilder, build_plan_file
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.world.transforms import inverse
 from solvers.sdar.vocabulary import SdarVocabulary
@@ -171,13 +171,6 @@ def plan_file_from_solution(
     if solution.plan is None:
         raise ParameterError("solution has no plan (status: " + solution.status.value + ")")
     instance = rearrangement.instance
-    stats = solution.statistics
-    figures: dict[str, float | int | str] = {
-        "planning_time": float(stats.get("planning_time", 0.0)),
-        "planning_time_selection": float(stats.get("selection_time", 0.0)),
-        "planning_time_motion": float(stats.get("motion_time", 0.0)),
-    }
-    figures.update(metrics or {})
     items = timeline(solution.plan, task_records(solution), decoder_of(rearrangement))
     return build_plan_file(
         rearrangement.ctx.scene,
@@ -185,7 +178,35 @@ def plan_file_from_solution(
         {o.name: o.start.as_tuple() for o in instance.objects},
         {o.name: o.size for o in instance.objects},
         items,
-        figures,
+        plan_metrics(solution, metrics),
         gripper_time=rearrangement.config.gripper_time if gripper_time is None else gripper_time,
         q_start=rearrangement.home.q,
     )
+
+
+def plan_builder(rearrangement: Rearrangement, gripper_time: float | None = None) -> PlanBuilder:
+    """The :class:`~sdar_tamp.plan_building.PlanBuilder` that :func:`plan_file_from_solution`
+    builds its plan file with (``gripper_time`` [s] defaults to the configuration's), for a
+    caller that adds the items of each step as it is planned."""
+    instance = rearrangement.instance
+    return PlanBuilder(
+        rearrangement.ctx.scene,
+        {o.name: o.start.as_tuple() for o in instance.objects},
+        {o.name: o.size for o in instance.objects},
+        rearrangement.home.q,
+        rearrangement.config.gripper_time if gripper_time is None else gripper_time,
+    )
+
+
+def plan_metrics(
+    solution: Solution, metrics: Mapping[str, float | int | str] | None = None
+) -> dict[str, float | int | str]:
+    """The plan file's planning figures of ``solution``, with ``metrics`` added."""
+    stats = solution.statistics
+    figures: dict[str, float | int | str] = {
+        "planning_time": float(stats.get("planning_time", 0.0)),
+        "planning_time_selection": float(stats.get("selection_time", 0.0)),
+        "planning_time_motion": float(stats.get("motion_time", 0.0)),
+    }
+    figures.update(metrics or {})
+    return figures

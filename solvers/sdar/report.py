@@ -57,6 +57,46 @@ class Failures:
 
 
 @dataclass(frozen=True)
+class PlannedStep:
+    """One decision as :meth:`~solvers.sdar.solver.SdarSolver.steps` yields it, once its
+    motions are planned and its actions applied: its index (from 0), the task (the problem's
+    Python values) and the plan actions it added, in order."""
+
+    index: int
+    task: TaskTrace
+    actions: tuple[Action, ...]
+
+
+def task_trace(cache: StreamCache, record: TaskRecord) -> TaskTrace:
+    """``record`` with the problem's Python values for its objects and arms."""
+    value = cache.table.value
+    return TaskTrace(
+        kind=record.kind,
+        objects=tuple(value(o) for o in record.objects),
+        arms=tuple(value(a) for a in record.arms),
+        to_buffer=tuple(record.to_buffer),
+        selection_time=record.selection_time,
+        motion_time=record.motion_time,
+        motions=record.motions,
+        tried=record.tried,
+        motion_times=tuple(record.motion_times),
+    )
+
+
+def planned_step(
+    cache: StreamCache,
+    index: int,
+    record: TaskRecord,
+    actions: Sequence[tuple[str, tuple[str, ...]]],
+) -> PlannedStep:
+    """The :class:`PlannedStep` of decision ``index``: its record and its ``actions``
+    (names and argument ids)."""
+    value = cache.table.value
+    plan = tuple(Action(name, tuple(value(a) for a in args)) for name, args in actions)
+    return PlannedStep(index, task_trace(cache, record), plan)
+
+
+@dataclass(frozen=True)
 class RunSummary:
     """The outcome of a run, before it becomes a :class:`~solvers.solution.Solution`."""
 
@@ -96,20 +136,7 @@ def build_solution(
             *((n, f.counters) for n, f in cache.functions.items()),
         )
     }
-    trace = tuple(
-        TaskTrace(
-            kind=r.kind,
-            objects=tuple(value(o) for o in r.objects),
-            arms=tuple(value(a) for a in r.arms),
-            to_buffer=tuple(r.to_buffer),
-            selection_time=r.selection_time,
-            motion_time=r.motion_time,
-            motions=r.motions,
-            tried=r.tried,
-            motion_times=tuple(r.motion_times),
-        )
-        for r in records
-    )
+    trace = tuple(task_trace(cache, r) for r in records)
     solved = summary.status is Status.SOLVED
     return Solution(
         plan if solved else None,

@@ -12,6 +12,9 @@ motion stream carries the fallback ladder of trajectory optimisation, arm untang
 arm at a time) and applies the domain's actions. When a candidate cannot be grounded or its
 motion fails, the next one is tried; single-arm candidates come last. The run ends when the
 goal holds, when no candidate works (``infeasible``, with the reasons) or at ``max_time``.
+:meth:`SdarSolver.steps` yields each executed decision (a
+:class:`~solvers.sdar.report.PlannedStep`) as soon as it is executed, and
+:meth:`SdarSolver.solve` runs it to its end: one loop for both.
 
 Every applied action is checked against the domain's lifted precondition
 (:class:`solvers.sdar.state.LiftedState`), so the plan is a plan of ``domain.pddl``.
@@ -27,7 +30,7 @@ the quick-stream ladder). This module holds the decision loop.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Generator, Mapping, Sequence
 from dataclasses import dataclass
 
 from sdar_tamp.errors import ParameterError
@@ -42,11 +45,19 @@ from solvers.sdar.execution import Executor
 from solvers.sdar.grounding import Grounder
 from solvers.sdar.options import SdarOptions
 from solvers.sdar.recovery import Recovery
-from solvers.sdar.report import Failures, RunSummary, TaskRecord, build_solution
+from solvers.sdar.report import (
+    Failures,
+    PlannedStep,
+    RunSummary,
+    TaskRecord,
+    build_solution,
+    planned_step,
+)
 from solvers.sdar.tasks import Layout, Step, TaskPlanner, TaskView
 from solvers.solution import Solution, Status
 
-__all__ = ["Decision", "SdarOptions", "SdarSolver"]  # SdarOptions: its home is options.py
+# SdarOptions and PlannedStep: their homes are options.py and report.py
+__all__ = ["Decision", "PlannedStep", "SdarOptions", "SdarSolver", "run_to_end"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +67,16 @@ class Decision:
 
     start: float  # [s] (time.perf_counter)
     motion_time: float  # [s]
+
+
+def run_to_end(steps: Generator[PlannedStep, None, Solution]) -> Solution:
+    """What a generator of :meth:`SdarSolver.steps` returns, after running it to its end."""
+    while True:
+        try:
+            next(steps)
+        except StopIteration as end:
+            solution: Solution = end.value
+            return solution
 
 
 class SdarSolver:
@@ -172,6 +193,15 @@ class SdarSolver:
 
     # -- the loop ----------------------------------------------------------------------------
     def solve(self) -> Solution:
+        """Run :meth:`steps` to its end; its solution."""
+        return run_to_end(self.steps())
+
+    def steps(self) -> Generator[PlannedStep, None, Solution]:
+        """The decision loop, one executed decision at a time: each is yielded as soon as its
+        motions are planned and its actions applied (a :class:`PlannedStep`: the task and the
+        plan actions it added); the generator returns the :class:`Solution` (the plan of every
+        step yielded, in order). The clock of ``max_time`` runs from the first ``next``, the
+        caller's time between steps included."""
         start = self.deadline.start()
         status = Status.SOLVED
         diagnosis: list[str] = []
@@ -192,7 +222,10 @@ class SdarSolver:
             self._check_sizes(proposed)
             candidates = self._new_arrangements(self.recovery.allowed(proposed))
             self.failures.clear()
+            planned = len(self.executor.plan)
             if self._decide(view, candidates, decision):
+                added = self.executor.plan[planned:]
+                yield planned_step(self.cache, len(self.records) - 1, self.records[-1], added)
                 continue
             if self.deadline.passed():
                 status = Status.TIMEOUT

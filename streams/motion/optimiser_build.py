@@ -19,22 +19,48 @@ class OptimiserBuild:
     takes a few tenths of a second of CPU; planning that needs no optimisation goes on meanwhile).
 
     :meth:`get` waits for it (``waited`` [s] adds up the waits) and re-raises an error of
-    the build. ``build_time`` [s] is the CPU time of the build (NaN until it is done)."""
+    the build. ``build_time`` [s] is the CPU time of the build (NaN until it is done).
 
-    def __init__(self, ctx: WorldContext, options: TrajOptOptions, background: bool = True) -> None:
+    ``start=False`` defers the background build to :meth:`start` (or to the first
+    :meth:`get`): a caller whose first planning needs no optimiser keeps the build's CPU
+    time (and its hold on the interpreter) out of it."""
+
+    def __init__(
+        self,
+        ctx: WorldContext,
+        options: TrajOptOptions,
+        background: bool = True,
+        start: bool = True,
+    ) -> None:
         self.options = options
         self.build_time = float("nan")
         self.waited = 0.0
         self._result: TrajectoryOptimiser | None = None
         self._error: BaseException | None = None
         self._done = threading.Event()
-        if background:
-            # Not a daemon: the interpreter waits for a build in progress before it shuts down
-            # (CasADi code still running during finalisation crashes the process).
-            name = "sdar-trajopt-build"
-            threading.Thread(target=self._run, args=(ctx,), name=name, daemon=False).start()
-        else:
+        self._ctx: WorldContext | None = ctx
+        self._lock = threading.Lock()
+        if not background:
+            self._ctx = None
             self._run(ctx)
+        elif start:
+            self.start()
+
+    @property
+    def started(self) -> bool:
+        """The build has started (or is done)."""
+        return self._ctx is None
+
+    def start(self) -> None:
+        """Start the background build, unless it has started already."""
+        with self._lock:
+            ctx, self._ctx = self._ctx, None
+        if ctx is None:
+            return
+        # Not a daemon: the interpreter waits for a build in progress before it shuts down
+        # (CasADi code still running during finalisation crashes the process).
+        name = "sdar-trajopt-build"
+        threading.Thread(target=self._run, args=(ctx,), name=name, daemon=False).start()
 
     def _run(self, ctx: WorldContext) -> None:
         start = time.thread_time()
@@ -63,6 +89,8 @@ class OptimiserBuild:
         return self._done.is_set()
 
     def get(self) -> TrajectoryOptimiser:
+        """The optimiser, once built (a deferred build starts now)."""
+        self.start()
         if not self._done.is_set():
             start = time.perf_counter()
             _log.info("waiting for the trajectory optimiser to be built")

@@ -22,14 +22,19 @@ class OptimiserCache:
         self._lock = threading.Lock()
 
     def get(
-        self, ctx: WorldContext, options: TrajOptOptions | None = None, background: bool = True
+        self,
+        ctx: WorldContext,
+        options: TrajOptOptions | None = None,
+        background: bool = True,
+        start: bool = True,
     ) -> OptimiserBuild:
-        """The build for ``ctx.scene`` and ``options`` (started now if it is the first)."""
+        """The build for ``ctx.scene`` and ``options`` (started now if it is the first,
+        unless ``start=False``: see :class:`OptimiserBuild`)."""
         key = (ctx.scene, options or TrajOptOptions())
         with self._lock:
             build = self._builds.get(key)
             if build is None:
-                build = self._builds[key] = OptimiserBuild(ctx, key[1], background)
+                build = self._builds[key] = OptimiserBuild(ctx, key[1], background, start)
         return build
 
     def __len__(self) -> int:

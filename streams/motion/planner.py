@@ -53,7 +53,9 @@ class MotionPlanner:
     straight-line test still applies); ``refine_bent``: a bent path is handed to the optimiser
     as its warm start and the result kept when it executes faster and passes the same check
     (see :class:`~streams.motion.transfers.Transfers`); ``shape``: lift heights and blending
-    (:mod:`streams.motion.shape`). Trajectories use the scene's ``velocity_safety``."""
+    (:mod:`streams.motion.shape`). Trajectories use the scene's ``velocity_safety``.
+    ``defer_build``: the optimiser's build starts at :meth:`start_build` or when it is first
+    needed, not now."""
 
     def __init__(
         self,
@@ -66,12 +68,13 @@ class MotionPlanner:
         optimisers: OptimiserCache | None = None,
         shape: ShapeOptions | None = None,
         refine_bent: bool = REFINE_BENT,
+        defer_build: bool = False,
     ) -> None:
         if direct_margin < 0.0:
             raise ParameterError(f"direct_margin must be >= 0 [m], got {direct_margin}")
         self.ctx = ctx
         cache = optimisers if optimisers is not None else OptimiserCache()
-        self._build = cache.get(ctx, options)
+        self._build = cache.get(ctx, options, start=not defer_build)
         self.subsets = SubsetOptimisers(ctx, self._build.options, cache)
         self.world = ctx.new_world()
         self.margin_world = ctx.new_world(margin=direct_margin)
@@ -86,6 +89,10 @@ class MotionPlanner:
     def trajopt(self) -> TrajectoryOptimiser:
         """The trajectory optimiser; the first access waits for its background build."""
         return self._build.get()
+
+    def start_build(self) -> None:
+        """Start the optimiser's background build if it has not started."""
+        self._build.start()
 
     @property
     def limits(self) -> tuple[FloatArray, FloatArray]:

@@ -126,6 +126,12 @@ def _solve(out: Summary) -> None:
     assert out["runs"] == 1 and out["this"]["all_valid"] is True
 
 
+def _stream(out: Summary) -> None:
+    assert out["instances"] == 1 and out["all_same_plan"] is True and out["steps"] >= 1
+    assert 0.0 < out["first_step_s"] <= out["stream_total_s"] <= out["stream_done_s"]
+    assert out["batch_total_s"] > 0.0
+
+
 def _spheres(out: Summary) -> None:
     for model in out["models"].values():
         assert model["min_coverage"] >= 0.999 and model["max_volume_ratio"] <= 3.0
@@ -160,6 +166,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_sdar", BOUNDS): _bounds,
     ("bench_solve", ()): _solve,
     ("bench_spheres", ()): _spheres,
+    ("bench_stream", ()): _stream,
     ("bench_streams", ()): _streams,
     ("bench_world", ()): _world,
 }

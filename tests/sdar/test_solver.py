@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from typing import Any
 
 import numpy as np
@@ -21,6 +21,7 @@ from sdar_tamp.replay import validate_plan
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.scene import Workspace
+from solvers.sdar.report import PlannedStep
 from solvers.solution import Certificate, Solution, Status
 from solvers.solve import solve
 from streams.context import WorldContext
@@ -127,22 +128,50 @@ def test_solve_entry_point_runs_sdar(solved_swap: tuple[Rearrangement, Solution]
 def test_both_entry_points_configure_sdar_alike(
     ctx: WorldContext, planner: MotionPlanner, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """With the default motion planner, ``solve_rearrangement`` and ``solve(algorithm="sdar")``
-    build the same solver (problem, task planner, options), so what the tests check of one
-    holds for the other."""
-    from solvers.sdar.solver import SdarSolver
+    """With the default motion planner, ``solve_rearrangement``, ``solve(algorithm="sdar")``
+    and ``rearrangement_steps`` build the same solver (problem, task planner, options), so what
+    the tests check of one holds for the others."""
+    from sdar_tamp.app.solving import rearrangement_steps
+    from solvers.sdar.solver import SdarSolver, run_to_end
 
     built: list[tuple[Any, ...]] = []
 
-    def record(self: SdarSolver) -> Solution:
+    def record(self: SdarSolver) -> Generator[PlannedStep, None, Solution]:
         built.append((self.cache.problem, type(self.planner), self.options))
         return Solution(None, math.inf, Certificate((), ()))
+        yield  # a generator, as the decision loop is
 
-    monkeypatch.setattr(SdarSolver, "solve", record)
+    monkeypatch.setattr(SdarSolver, "steps", record)  # solve() runs steps() to its end
     r = rearrangement_problem(_swap(), ctx, planner=planner)
     solve(r.problem, algorithm="sdar", max_time=BUDGET, verbose=False)
     solve_rearrangement(r, "sdar", BUDGET)
-    assert len(built) == 2 and built[0] == built[1]
+    run_to_end(rearrangement_steps(r, "sdar", BUDGET))  # a stream's steps: the same solver
+    assert len(built) == 3 and built[0] == built[1] == built[2]
+
+
+def test_steps_yield_each_decision_and_return_the_solution(
+    ctx: WorldContext, planner: MotionPlanner, solved_three: tuple[Rearrangement, Solution]
+) -> None:
+    """``steps()`` yields each executed decision as it is executed: its actions, in order,
+    are the plan ``solve()`` returns (the same loop), and the generator returns that
+    solution."""
+    from sdar_tamp.app.solving import rearrangement_steps
+
+    r = rearrangement_problem(_three(), ctx, planner=planner)
+    steps = rearrangement_steps(r, "sdar", BUDGET)
+    yielded: list[PlannedStep] = []
+    while True:
+        try:
+            yielded.append(next(steps))
+        except StopIteration as end:
+            solution = end.value
+            break
+    assert [s.index for s in yielded] == list(range(len(yielded))) and len(yielded) >= 2
+    assert solution.plan is not None
+    assert [a for s in yielded for a in s.actions] == list(solution.plan)
+    assert tuple(s.task for s in yielded) == solution.trace
+    batch = solved_three[1].plan
+    assert batch is not None and [a.name for a in solution.plan] == [a.name for a in batch]
 
 
 def test_no_ik_gives_infeasible_with_a_diagnosis(ctx: WorldContext, planner: MotionPlanner) -> None:

@@ -36,3 +36,26 @@ def test_optimisers_are_built_once_per_scene_and_options(
     broken = cache.get(ctx, TrajOptOptions(knots=3, compiled=False))
     with pytest.raises(ParameterError, match="no NLP with 3 knots"):
         broken.get()
+
+
+def test_a_deferred_build_starts_when_asked_or_first_needed(
+    ctx: WorldContext, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    built: list[int] = []
+
+    class Fake:
+        def __init__(self, ctx: WorldContext, options: TrajOptOptions) -> None:
+            built.append(options.knots)
+
+    monkeypatch.setattr(optimiser_build, "TrajectoryOptimiser", Fake)
+    cache = OptimiserCache()
+    planner = MotionPlanner(ctx, TrajOptOptions(knots=6, compiled=False), optimisers=cache,
+                            defer_build=True)  # fmt: skip
+    assert not planner.build.started and not planner.build.ready and built == []
+    planner.start_build()
+    assert planner.build.started and planner.trajopt is planner.build.get()
+    planner.start_build()  # once started, nothing more
+    assert built == [6]
+    later = cache.get(ctx, TrajOptOptions(knots=7, compiled=False), start=False)
+    assert not later.started and built == [6]
+    assert isinstance(later.get(), Fake) and later.started and built == [6, 7]  # get() starts it
