@@ -187,5 +187,5 @@ def plan_file_from_solution(
         items,
         figures,
         gripper_time=rearrangement.config.gripper_time if gripper_time is None else gripper_time,
-        q_start=rearrangement.home.q,
+        q_start=rearrangement.start_conf.q,
     )

@@ -66,7 +66,9 @@ def solve_rearrangement(
         task_planner=run.task_planner,
         max_time=run.max_time,
         sdar_options=dataclasses.replace(
-            run.sdar_options(progress), plane=table_plane(rearrangement.ctx)
+            run.sdar_options(progress),
+            plane=table_plane(rearrangement.ctx),
+            home=None if rearrangement.start is None else rearrangement.home,
         ),
         verbose=False,
     )
