@@ -36,7 +36,7 @@ def continuation_instance(
     goals = {o.name: o.goal for o in instance.objects}
     objects: list[ObjectSpec] = []
     names = sorted(resting, key=lambda n: (n not in goals, n))
-    todo = [n for n in names if n in goals]
+    todo = [n for n in names if n in goals and goals[n].as_tuple() != tuple(resting[n])]
     moved: list[str] = []
     for name in names:
         here = Pose2D(*resting[name])

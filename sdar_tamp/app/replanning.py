@@ -32,19 +32,17 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from sdar_tamp.app.cache import PlannerCache, PlanningWorld
 from sdar_tamp.app.config import PlannerConfig
 from sdar_tamp.app.plan_export import plan_file_from_solution
 from sdar_tamp.app.problem import rearrangement_problem
+from sdar_tamp.app.repair import repair as repair_plan
 from sdar_tamp.app.replan_world import continuation_instance, start_configuration
 from sdar_tamp.app.solving import solve_rearrangement
+from sdar_tamp.app.splicing import splice, tail, walk_from
 from sdar_tamp.plan_file import PlanFile, PlanObservation
-from sdar_tamp.plan_rules import check_timeline
-from sdar_tamp.plan_state import Cut, PlanState, cut_point, prefix_plan, shift_steps, state_at
+from sdar_tamp.plan_state import Cut, PlanState, cut_point, prefix_plan, state_at
 from sdar_tamp.replay import validate_plan
-from sdar_tamp.replay_walk import ReplayWalk
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.instance import Instance, Pose2D
 from sdar_tamp.world.kinematics import ArmKinematics
@@ -133,7 +131,7 @@ def replan(
     old = dataclasses.replace(past, observations=(*past.observations, seen))
     cut = cut_point(old, at)
     prefix = prefix_plan(old, cut)
-    walk = _walk(instance, prefix, scene, kins, collision, state, at)
+    walk = walk_from(instance, prefix, scene, kins, collision, state)
     found = walk.walk(float(prefix.t[-1]), at)
     if found is not None:
         return ReplanOutcome(
@@ -143,10 +141,13 @@ def replan(
             _objects_in(found.message, sizes),
         )  # fmt: skip
     at_cut = dict(walk.rest)
+    t_hold = float(prefix.t[-1])
     if repair:
-        kept = _keep_rest(instance, old, prefix, cut, scene, kins, collision, at_cut)
-        if kept is not None:
-            return _finish("repaired", kept, instance, scene, cut, started, validate)
+        rest = splice(prefix, tail(old, cut))
+        empty = PlanState(t_hold, prefix.q[-1], {}, at_cut)
+        fixed = repair_plan(world, config, instance, rest, empty, kins, collision, sizes)
+        if fixed is not None:
+            return _finish("repaired", fixed, instance, scene, cut, started, validate)
     cont_instance, moved = continuation_instance(instance, at_cut, sizes, config.seed)
     start = start_configuration(
         _home(world), prefix.q[-1], {a: scene.layout.slice(a) for a in scene.arm_names}
@@ -172,98 +173,6 @@ def _pose(p: tuple[float, ...]) -> Pose2D:
 def _home(world: PlanningWorld) -> CellConf:
     ctx = world.ctx
     return CellConf(*(ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in ctx.arm_names))
-
-
-def _walk(
-    instance: Instance, plan: PlanFile, scene: Scene, kins: dict[str, ArmKinematics],
-    world: CollisionWorld, state: PlanState, at: float,
-) -> ReplayWalk:  # fmt: skip
-    """The validator's walk of ``plan`` from ``at``, begun in ``state``."""
-    for arm in scene.arm_names:
-        if world.held_by(arm) is not None:
-            world.detach(arm)
-    walk = ReplayWalk(instance, plan, scene, 0.005, kins, world)
-    grips = _grips(plan, at)
-    walk.start_from(state.resting, state.held, state.q, grips)
-    return walk
-
-
-def _grips(plan: PlanFile, at: float) -> dict[str, np.ndarray]:
-    """Arm -> ``T_tcp_object`` of its last grasp before ``at``."""
-    out: dict[str, np.ndarray] = {}
-    for e in plan.events:
-        if e.t >= at:
-            break
-        if e.type == "grasp":
-            out[e.arm] = e.T_tcp_object
-    return out
-
-
-def _keep_rest(
-    instance: Instance, old: PlanFile, prefix: PlanFile, cut: Cut, scene: Scene,
-    kins: dict[str, ArmKinematics], world: CollisionWorld, at_cut: dict[str, Pose3],
-) -> PlanFile | None:  # fmt: skip
-    """The prefix followed by the old plan's rest (after the cut), when that still validates
-    from the cut in the observed world; None otherwise."""
-    rest_t = old.t[cut.index :] - cut.t
-    rest = dataclasses.replace(
-        old, t=rest_t, q=old.q[cut.index :],
-        events=tuple(dataclasses.replace(e, t=e.t - cut.t) for e in old.events[cut.events :]),
-        steps=shift_steps(tuple(s for s in old.steps if s.t_start >= cut.t - 1e-9), -cut.t),
-        observations=(),
-    )  # fmt: skip
-    spliced = splice(prefix, rest)
-    if check_timeline(spliced, scene) is not None:
-        return None
-    t_hold = float(prefix.t[-1])
-    q_hold = prefix.q[-1]
-    empty = PlanState(t_hold, q_hold, {}, at_cut)
-    walk = _walk(instance, spliced, scene, kins, world, empty, t_hold)
-    final = _final_poses(walk, spliced, t_hold)
-    walk.plan = dataclasses.replace(spliced, final_poses=final)
-    if walk.walk(np.inf, t_hold) is not None:
-        return None
-    return walk.plan
-
-
-def _final_poses(
-    walk: ReplayWalk, plan: PlanFile, t_from: float
-) -> dict[str, tuple[float, float, float]]:
-    """Where the objects end: the plan's events from ``t_from`` [s] followed by forward
-    kinematics (as the plan builder places releases), from the arrangement ``walk`` begins in."""
-    resting = dict(walk.rest)
-    for e in plan.events:
-        if e.t < t_from:
-            continue
-        if e.type == "grasp":
-            resting.pop(e.object, None)
-            continue
-        T = walk.tcp(e.arm, _q_at(plan, e.t)) @ e.T_tcp_object
-        resting[e.object] = (float(T[0, 3]), float(T[1, 3]), float(np.arctan2(T[1, 0], T[0, 0])))
-    return {n: (float(p[0]), float(p[1]), float(p[2])) for n, p in resting.items()}
-
-
-def _q_at(plan: PlanFile, t: float) -> np.ndarray:
-    return np.array([np.interp(t, plan.t, plan.q[:, j]) for j in range(plan.q.shape[1])])
-
-
-def splice(prefix: PlanFile, continuation: PlanFile) -> PlanFile:
-    """``continuation`` (from ``t = 0`` at the prefix's last configuration) appended after
-    ``prefix``: times, events and steps shifted by the prefix's duration; the continuation's
-    ``final_poses``; execution time and step counts of the whole."""
-    dt = float(prefix.t[-1])
-    t = np.concatenate([prefix.t, continuation.t[1:] + dt])
-    q = np.concatenate([prefix.q, continuation.q[1:]])
-    events = prefix.events + tuple(dataclasses.replace(e, t=e.t + dt) for e in continuation.events)
-    steps = prefix.steps + shift_steps(continuation.steps, dt)
-    metrics = continuation.metrics.updated(
-        {"execution_time": float(t[-1]), "steps": len(steps),
-         "actions": sum(e.type == "release" for e in events)}
-    )  # fmt: skip
-    return PlanFile(
-        prefix.instance, prefix.arms, t, q, events, dict(continuation.final_poses), metrics,
-        steps, prefix.observations,
-    )  # fmt: skip
 
 
 def _objects_in(text: str, sizes: dict[str, tuple[float, float, float]]) -> tuple[str, ...]:
