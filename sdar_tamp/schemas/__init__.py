@@ -2,9 +2,10 @@
 
 ``instance`` (rearrangement instance YAML), ``scene`` (scene YAML), ``plan`` (plan file
 JSON) and ``observed`` (observed state YAML, ``sdar replan``); :func:`schema` returns one
-as a dict, :func:`schema_path` its file. YAML files are checked on their parsed value (for example ``yaml.safe_load``). The schemas describe the
-shape (keys, types, lengths, signs); the loaders check more (finite numbers, ``lower <
-upper``, the rules listed in each schema's ``description``), so a document a schema accepts
+as a dict, :func:`schema_path` its file. YAML files are checked on their parsed value (for
+example ``yaml.safe_load``). The schemas describe the shape (keys, types, lengths, signs);
+the loaders check more (finite numbers, ``lower < upper``, the rules listed in each schema's
+``description``), so a document a schema accepts
 may still be refused by its loader.
 """
 
