@@ -1,9 +1,9 @@
 """Benchmark: re-planning from perturbed observed states on the paper suite.
 
-Every instance is solved by ``sdar solve``'s code path with synchronous execution (or its plan
-is read from ``--plans DIR/<name>.json``, written there after a solve with ``--save``). Then,
-at seeded random times ``T`` of its plan, one resting object is perturbed as a camera would
-see it: ``nudge`` (moved 1-3 cm in a random direction and turned 5-20 degrees), ``remove``
+Every instance is solved by ``sdar solve``'s code path with synchronous execution (or its
+plan is read from ``--plans DIR/<name>.json`` when it exists, written there after a solve with
+``--save``). Then, at seeded random times ``T`` of its plan, one resting object is perturbed
+as a camera would see it: ``nudge`` (moved 1-3 cm in a random direction and turned 5-20 degrees), ``remove``
 (gone) or ``add`` (a new object inside the workspace); a perturbation the observation checks
 refuse (an overlap, an object in an arm, off the workspace) is drawn again (``redrawn``).
 :func:`sdar_tamp.app.replanning.replan` re-plans (repair first, a fresh SDAR continuation as
@@ -75,7 +75,7 @@ def _suite_files(suite: str) -> list[Path]:
 
 def _plan(path: Path, args: argparse.Namespace, cache: PlannerCache) -> PlanFile | None:
     stored = args.plans / f"{path.stem}.json" if args.plans is not None else None
-    if stored is not None and stored.exists() and not args.save:
+    if stored is not None and stored.exists():
         return load_plan(stored)
     config = PlannerConfig(max_time=args.time_limit, execution="sync")
     outcome = solve_instance(path, config, cache=cache)

@@ -17,6 +17,7 @@ failed step) the caller solves afresh.
 from __future__ import annotations
 
 import dataclasses
+import time
 from collections.abc import Mapping
 
 import numpy as np
@@ -43,6 +44,7 @@ from streams.stream_types import ArmConf, CellConf
 
 Pose3 = tuple[float, float, float]
 MAX_TASKS = 3  #: tasks repaired in turn before the caller solves afresh
+BUDGET = 3.0  #: [s] of planning the repair may take before the caller solves afresh
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,18 +87,26 @@ def repair(
     kins: Mapping[str, ArmKinematics],
     collision: CollisionWorld,
     sizes: Mapping[str, tuple[float, float, float]],
-) -> PlanFile | None:
+) -> tuple[PlanFile, tuple[str, ...]] | None:
     """``plan`` (the prefix to ``state.t`` followed by the old plan's rest) repaired from
-    ``state`` (every arm empty and still), or None when the repair fails."""
+    ``state`` (every arm empty and still) and the added objects it moves away, or None when
+    the repair fails."""
     scene = world.ctx.scene
+    moved: tuple[str, ...] = ()
+    deadline = time.perf_counter() + min(BUDGET, config.max_time)
     for _ in range(MAX_TASKS + 1):
         plan, bad, _why = check_from(instance, plan, scene, kins, collision, state)
         if bad is None:
-            return plan
-        fixed = _repair_task(world, config, instance, plan, state, kins, collision, sizes, bad)
+            return plan, moved
+        left = deadline - time.perf_counter()
+        if left <= 0.0:
+            return None
+        budget = config.replace(max_time=left)
+        fixed = _repair_task(world, budget, instance, plan, state, kins, collision, sizes, bad)
         if fixed is None:
             return None
-        plan = fixed
+        plan, more = fixed
+        moved = tuple(dict.fromkeys((*moved, *more)))
     return None
 
 
@@ -104,7 +114,7 @@ def _repair_task(
     world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile,
     state: PlanState, kins: Mapping[str, ArmKinematics], collision: CollisionWorld,
     sizes: Mapping[str, tuple[float, float, float]], bad: float,
-) -> PlanFile | None:  # fmt: skip
+) -> tuple[PlanFile, tuple[str, ...]] | None:  # fmt: skip
     """The task of ``plan`` in which time ``bad`` [s] falls planned again (see the module
     docstring)."""
     scene = world.ctx.scene
@@ -123,7 +133,7 @@ def _repair_task(
     fake = Instance(instance.name, instance.workspace,
                     tuple(ObjectSpec(n, sizes[n], Pose2D(*here[n]), g) for n, g in goals.items()),
                     instance.scene)  # fmt: skip
-    mini, _moved = continuation_instance(fake, here, sizes, config.seed)
+    mini, moved = continuation_instance(fake, here, sizes, config.seed)
     head = prefix_plan(plan, begin)
     q0 = head.q[-1]
     start = start_configuration(
@@ -141,7 +151,7 @@ def _repair_task(
                              gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
     nxt = next((e.t for e in plan.events if e.t >= task.end - 1e-9 and e.type == "grasp"), None)
     if nxt is None:
-        return splice(head, middle)
+        return splice(head, middle), moved
     join = cut_at(plan, nxt)
     grasping = {e.arm for e in plan.events if abs(e.t - join.t) < 1e-9}
     acted = _last_actors(items)
@@ -158,7 +168,7 @@ def _repair_task(
     items.append(MotionSegment(traj.t, traj.q, result.level or "", (), "rejoin"))
     middle = build_plan_file(scene, instance.name, here, sizes_here, items, {},
                              gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
-    return splice(splice(head, middle), tail(plan, join))
+    return splice(splice(head, middle), tail(plan, join)), moved
 
 
 def _last_actors(items: list[MotionSegment | GripperEvent]) -> set[str]:

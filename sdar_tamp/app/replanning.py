@@ -11,7 +11,10 @@ camera sees -> one new plan, the executed prefix spliced with a continuation.
 2. The arms cannot jump: the plan runs on to its next cut point (:func:`~sdar_tamp.plan_state.
    cut_point`: every arm at rest with an empty gripper, the events of that instant left to
    the continuation); the stretch from ``at`` to the cut is replayed in the observed world
-   (the validator's walk) and a contact there ends the re-plan as ``infeasible``.
+   (the validator's walk) and a contact there ends the re-plan as ``infeasible``. When the
+   cut falls on grasps about to happen and the plan's next cut is reached without violation
+   through them, that later cut is taken (with ``repair``): the arms then stop clear of the
+   objects rather than with open fingers around them.
 3. Repair: the rest of the old plan after the cut is kept as it is when it still validates
    from the cut in the observed world (a change that touches none of its steps).
 4. Otherwise a fresh SDAR solve of the objects resting at the cut
@@ -43,7 +46,7 @@ from sdar_tamp.app.splicing import splice, tail, walk_from
 from sdar_tamp.plan_file import PlanFile, PlanObservation
 from sdar_tamp.plan_state import Cut, PlanState, cut_point, prefix_plan, state_at
 from sdar_tamp.replay import validate_plan
-from sdar_tamp.world.collision import CollisionWorld
+from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.instance import Instance, Pose2D
 from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.observed import (
@@ -120,7 +123,13 @@ def replan(
     known = tuple(sorted(set(sizes)))
     arrangement = observed_arrangement(observed, resting, state.holder, known, instance.workspace)
     collision = CollisionWorld(scene)
-    check_clear_of_arms(arrangement, scene, state.q, at, observed, collision)
+    grips = {e.arm: e.T_tcp_object for e in past.events if e.t < at and e.type == "grasp"}
+    held = {
+        arm: (obj, ObjectBox(kins[arm].fk_tcp(scene.layout.part(state.q, arm)) @ grips[arm],
+                             sizes[obj]))
+        for arm, obj in state.held.items()
+    }  # fmt: skip
+    check_clear_of_arms(arrangement, scene, state.q, at, observed, collision, held)
     for obj in observed.added:
         sizes[obj.name] = obj.size
     seen = PlanObservation(
@@ -140,6 +149,14 @@ def replan(
              f"arms can stop at t = {cut.t:.3f} s: {found.kind}: {found.message}",),
             _objects_in(found.message, sizes),
         )  # fmt: skip
+    if repair and any(abs(e.t - cut.t) <= 1e-9 for e in old.events):
+        # the arms stop at grasps about to happen: when those still hold in the observed
+        # world, the plan runs on through them to its next cut (its grippers clear again)
+        later = cut_point(old, cut.t + 1e-6)
+        longer = prefix_plan(old, later)
+        ahead = walk_from(instance, longer, scene, kins, collision, state)
+        if later.t > cut.t and ahead.walk(float(longer.t[-1]), at) is None:
+            cut, prefix, walk = later, longer, ahead
     at_cut = dict(walk.rest)
     t_hold = float(prefix.t[-1])
     if repair:
@@ -147,7 +164,7 @@ def replan(
         empty = PlanState(t_hold, prefix.q[-1], {}, at_cut)
         fixed = repair_plan(world, config, instance, rest, empty, kins, collision, sizes)
         if fixed is not None:
-            return _finish("repaired", fixed, instance, scene, cut, started, validate)
+            return _finish("repaired", fixed[0], instance, scene, cut, started, validate, fixed[1])
     cont_instance, moved = continuation_instance(instance, at_cut, sizes, config.seed)
     start = start_configuration(
         _home(world), prefix.q[-1], {a: scene.layout.slice(a) for a in scene.arm_names}

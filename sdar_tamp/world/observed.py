@@ -218,25 +218,32 @@ def check_clear_of_arms(
     t: float,
     observed: ObservedState,
     world: CollisionWorld | None = None,
+    held: Mapping[str, tuple[str, ObjectBox]] | None = None,
 ) -> None:
     """No resting object inside an arm at configuration ``q`` ``(dof,)`` (the arms at time
     ``t`` [s]); raises :class:`ObservedStateError` naming the object, the arm's shapes and
     the configuration. ``world``: a collision world of ``scene`` to reuse (its objects are
-    replaced)."""
+    replaced); ``held``: arm -> (name, box in the world frame) of what each arm holds."""
     world = world or CollisionWorld(scene)
     boxes = {
         name: ObjectBox(pose_xyz_yaw(r.pose.x, r.pose.y, r.size[2] / 2.0, r.pose.yaw), r.size)
         for name, r in arrangement.items()
     }
+    for arm in scene.arm_names:
+        if world.held_by(arm) is not None:
+            world.detach(arm)
     world.set_objects(boxes)
+    for arm, (name, box) in (held or {}).items():  # what the arms hold, in their grippers
+        world.set_object(name, box)
+        world.attach(arm, name, scene.layout.part(q, arm))
     for pair in world.report(q) if world.in_collision(q) else ():
         names = [s[len("object:") :] for s in (pair.first, pair.second) if s.startswith("object:")]
         owners = [world.owner(s) for s in (pair.first, pair.second)]
-        arm = next((a for a in owners if a is not None), None)
-        if len(names) == 1 and arm is not None:
-            conf = ", ".join(f"{v:.3f}" for v in scene.layout.part(q, arm))
+        owner = next((a for a in owners if a is not None), None)
+        if len(names) == 1 and owner is not None:
+            conf = ", ".join(f"{v:.3f}" for v in scene.layout.part(q, owner))
             raise ObservedStateError(
-                f"object {names[0]!r} is inside arm {arm!r} ({pair.first} with {pair.second}) "
+                f"object {names[0]!r} is inside arm {owner!r} ({pair.first} with {pair.second}) "
                 f"at t = {t:.3f} s, the arm at [{conf}] rad",
                 observed.where(names[0]),
             )
