@@ -1,13 +1,14 @@
 """Benchmark: re-planning from perturbed observed states on the paper suite.
 
 Every instance is solved by ``sdar solve``'s code path with synchronous execution (or its
-plan is read from ``--plans DIR/<name>.json`` when it exists, written there after a solve with
-``--save``). Then, at seeded random times ``T`` of its plan, one resting object is perturbed
-as a camera would see it: ``nudge`` (moved 1-3 cm in a random direction and turned 5-20
-degrees), ``remove`` (gone) or ``add`` (a new object inside the workspace); a perturbation the
-observation checks refuse (an overlap, an object in an arm, off the workspace) is drawn again (``redrawn``).
-:func:`sdar_tamp.app.replanning.replan` re-plans (repair first, a fresh SDAR continuation as
-fallback) and the whole spliced plan is validated by the independent replay.
+plan is read from ``--plans DIR/<name>.json`` when it exists, written there after a solve
+with ``--save``). Then, at seeded random times ``T`` of its plan, one resting object is
+perturbed as a camera would see it: ``nudge`` (moved 1-3 cm in a random direction and turned
+5-20 degrees), ``remove`` (gone) or ``add`` (a new object inside the workspace); a
+perturbation the observation checks refuse (an overlap, an object in an arm, off the
+workspace) is drawn again (``redrawn``). :func:`sdar_tamp.app.replanning.replan` re-plans
+(repair first, a fresh SDAR continuation as fallback) and the whole spliced plan is validated
+by the independent replay.
 
 Counted apart (not solvable by any re-plan from ``T``): ``cannot_stop``, where the running
 plan meets the observed world before its arms reach the next point at which they are at rest
