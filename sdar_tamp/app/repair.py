@@ -105,7 +105,7 @@ def repair(
         fixed = _repair_task(world, budget, instance, plan, state, kins, collision, sizes, bad)
         if fixed is None:
             return None
-        plan, more = fixed
+        plan, more, state = fixed  # the next replay begins where the repaired task does
         moved = tuple(dict.fromkeys((*moved, *more)))
     return None
 
@@ -114,9 +114,9 @@ def _repair_task(
     world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile,
     state: PlanState, kins: Mapping[str, ArmKinematics], collision: CollisionWorld,
     sizes: Mapping[str, tuple[float, float, float]], bad: float,
-) -> tuple[PlanFile, tuple[str, ...]] | None:  # fmt: skip
+) -> tuple[PlanFile, tuple[str, ...], PlanState] | None:  # fmt: skip
     """The task of ``plan`` in which time ``bad`` [s] falls planned again (see the module
-    docstring)."""
+    docstring), the added objects moved away, and the state where the new task begins."""
     scene = world.ctx.scene
     task = next((k for k in tasks_of(plan, state.t) if k.start <= bad < k.end), None)
     if task is None:
@@ -136,6 +136,7 @@ def _repair_task(
     mini, moved = continuation_instance(fake, here, sizes, config.seed)
     head = prefix_plan(plan, begin)
     q0 = head.q[-1]
+    restart = PlanState(float(head.t[-1]), q0, {}, here)
     start = start_configuration(
         _home(world), q0, {a: scene.layout.slice(a) for a in scene.arm_names}
     )
@@ -151,7 +152,7 @@ def _repair_task(
                              gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
     nxt = next((e.t for e in plan.events if e.t >= task.end - 1e-9 and e.type == "grasp"), None)
     if nxt is None:
-        return splice(head, middle), moved
+        return splice(head, middle), moved, restart
     join = cut_at(plan, nxt)
     grasping = {e.arm for e in plan.events if abs(e.t - join.t) < 1e-9}
     acted = _last_actors(items)
@@ -168,7 +169,7 @@ def _repair_task(
     items.append(MotionSegment(traj.t, traj.q, result.level or "", (), "rejoin"))
     middle = build_plan_file(scene, instance.name, here, sizes_here, items, {},
                              gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
-    return splice(splice(head, middle), tail(plan, join)), moved
+    return splice(splice(head, middle), tail(plan, join)), moved, restart
 
 
 def _last_actors(items: list[MotionSegment | GripperEvent]) -> set[str]:

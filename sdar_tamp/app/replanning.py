@@ -35,6 +35,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from sdar_tamp.app.cache import PlannerCache, PlanningWorld
 from sdar_tamp.app.config import PlannerConfig
 from sdar_tamp.app.plan_export import plan_file_from_solution
@@ -42,7 +44,7 @@ from sdar_tamp.app.problem import rearrangement_problem
 from sdar_tamp.app.repair import repair as repair_plan
 from sdar_tamp.app.replan_world import continuation_instance, start_configuration
 from sdar_tamp.app.solving import solve_rearrangement
-from sdar_tamp.app.splicing import splice, tail, walk_from
+from sdar_tamp.app.splicing import cut_at, splice, tail, walk_from
 from sdar_tamp.plan_file import PlanFile, PlanObservation
 from sdar_tamp.plan_state import Cut, PlanState, cut_point, prefix_plan, state_at
 from sdar_tamp.replay import validate_plan
@@ -160,7 +162,7 @@ def replan(
     at_cut = dict(walk.rest)
     t_hold = float(prefix.t[-1])
     if repair:
-        rest = splice(prefix, tail(old, cut))
+        rest = splice(prefix, tail(old, _resume(old, cut, float(prefix.t[-1]))))
         empty = PlanState(t_hold, prefix.q[-1], {}, at_cut)
         fixed = repair_plan(world, config, instance, rest, empty, kins, collision, sizes)
         if fixed is not None:
@@ -181,6 +183,17 @@ def replan(
     continuation = plan_file_from_solution(r, solution)
     spliced = splice(prefix, continuation)
     return _finish("replanned", spliced, instance, scene, cut, started, validate, moved)
+
+
+def _resume(plan: PlanFile, cut: Cut, t_hold: float) -> Cut:
+    """Where ``plan`` goes on after a prefix held still until ``t_hold`` [s]: there, when the
+    plan itself stands still from ``cut`` to then with no event between (a gripper's dwell:
+    not waited twice); else at ``cut``."""
+    resume = cut_at(plan, t_hold)
+    q = plan.q[cut.index : resume.index + 1]
+    if resume.events == cut.events and np.abs(q - plan.q[cut.index]).max() <= 1e-9:
+        return resume
+    return cut
 
 
 def _pose(p: tuple[float, ...]) -> Pose2D:
