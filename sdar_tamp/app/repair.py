@@ -17,6 +17,7 @@ failed step) the caller solves afresh.
 from __future__ import annotations
 
 import dataclasses
+import re
 import time
 from collections.abc import Mapping
 
@@ -95,14 +96,15 @@ def repair(
     moved: tuple[str, ...] = ()
     deadline = time.perf_counter() + min(BUDGET, config.max_time)
     for _ in range(MAX_TASKS + 1):
-        plan, bad, _why = check_from(instance, plan, scene, kins, collision, state)
+        plan, bad, why = check_from(instance, plan, scene, kins, collision, state)
         if bad is None:
             return plan, moved
         left = deadline - time.perf_counter()
         if left <= 0.0:
             return None
         budget = config.replace(max_time=left)
-        fixed = _repair_task(world, budget, instance, plan, state, kins, collision, sizes, bad)
+        fixed = _repair_task(world, budget, instance, plan, state, kins, collision, sizes, bad,
+                             why)  # fmt: skip
         if fixed is None:
             return None
         plan, more, state = fixed  # the next replay begins where the repaired task does
@@ -113,10 +115,12 @@ def repair(
 def _repair_task(
     world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile,
     state: PlanState, kins: Mapping[str, ArmKinematics], collision: CollisionWorld,
-    sizes: Mapping[str, tuple[float, float, float]], bad: float,
+    sizes: Mapping[str, tuple[float, float, float]], bad: float, why: str,
 ) -> tuple[PlanFile, tuple[str, ...], PlanState] | None:  # fmt: skip
     """The task of ``plan`` in which time ``bad`` [s] falls planned again (see the module
-    docstring), the added objects moved away, and the state where the new task begins."""
+    docstring), the added objects moved away, and the state where the new task begins.
+    ``why``: the replay's violation there; an object it names outside the task (a nudged or
+    added object in the task's way) is moved too: to its goal, or away (added objects)."""
     scene = world.ctx.scene
     task = next((k for k in tasks_of(plan, state.t) if k.start <= bad < k.end), None)
     if task is None:
@@ -128,12 +132,14 @@ def _repair_task(
     here = dict(walk.rest)
     targets = _placements(plan, task, kins, scene.layout)
     goals = {n: Pose2D(*targets[n]) for n in task.objects if n in here and n in targets}
-    known = set(instance.names)
+    known = {o.name: o.goal for o in instance.objects}
+    culprits = {n for n in re.findall(r"[A-Za-z0-9_.\-]+", why) if n in here} - set(goals)
+    goals.update({n: known[n] for n in culprits if n in known})
     goals.update({n: Pose2D(*p) for n, p in here.items() if n not in goals and n in known})
     fake = Instance(instance.name, instance.workspace,
                     tuple(ObjectSpec(n, sizes[n], Pose2D(*here[n]), g) for n, g in goals.items()),
                     instance.scene)  # fmt: skip
-    mini, moved = continuation_instance(fake, here, sizes, config.seed)
+    mini, moved = continuation_instance(fake, here, sizes, config.seed, frozenset(culprits))
     head = prefix_plan(plan, begin)
     q0 = head.q[-1]
     restart = PlanState(float(head.t[-1]), q0, {}, here)

@@ -29,10 +29,12 @@ def continuation_instance(
     resting: Mapping[str, Pose3],
     sizes: Mapping[str, tuple[float, float, float]],
     seed: int = 0,
+    force: frozenset[str] = frozenset(),
 ) -> tuple[Instance, tuple[str, ...]]:
     """The instance of the continuation and the added objects it moves away (their goals are
-    free poses); raises nothing: an added object for which no free pose is found keeps its
-    pose as goal (the solve then names it as blocking)."""
+    free poses; those in ``force`` whether they block a goal or not); raises nothing: an added
+    object for which no free pose is found keeps its pose as goal (the solve then names it as
+    blocking)."""
     goals = {o.name: o.goal for o in instance.objects}
     objects: list[ObjectSpec] = []
     names = sorted(resting, key=lambda n: (n not in goals, n))
@@ -43,7 +45,7 @@ def continuation_instance(
         goal = goals.get(name)
         if goal is None:
             goal = here
-            if _blocks(name, here, sizes, {n: goals[n] for n in todo}):
+            if name in force or _blocks(name, here, sizes, {n: goals[n] for n in todo}):
                 free = _free_pose(name, here, instance, resting, sizes, goals, seed)
                 if free is not None:
                     goal = free
