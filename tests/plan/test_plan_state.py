@@ -175,3 +175,26 @@ def test_an_object_gone_at_the_end_needs_no_goal(d5: tuple[Instance, PlanFile, S
     report = validate_plan(instance, stale, scene)
     assert report.violation is not None and report.violation.kind == "final poses"
     assert "['o2']" in report.violation.message
+
+
+def test_the_instance_rule_with_observations(d5: tuple[Instance, PlanFile, Scene]) -> None:
+    instance, plan, scene = d5
+    starts = _starts(instance)
+    first = PlanObservation(1.0, starts, {})
+    unsorted = dataclasses.replace(plan, observations=(first, dataclasses.replace(first, t=0.5)))
+    report = validate_plan(instance, unsorted, scene)
+    assert report.violation is not None and report.violation.kind == "format"
+    assert "observations[1].t: expected sorted times" in report.violation.message
+    stranger = dataclasses.replace(
+        plan, observations=(first,),
+        events=(dataclasses.replace(plan.events[0], object="zz"), *plan.events[1:]),
+    )  # fmt: skip
+    report = validate_plan(instance, stranger, scene)
+    assert report.violation is not None and report.violation.kind == "instance"
+    assert "['zz'] are neither the instance's nor added once" in report.violation.message
+    clash = dataclasses.replace(
+        plan, observations=(PlanObservation(1.0, starts, {"o1": (0.1,) * 3}),)
+    )
+    report = validate_plan(instance, clash, scene)
+    assert report.violation is not None and report.violation.kind == "instance"
+    assert "['o1']" in report.violation.message
