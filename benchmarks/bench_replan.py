@@ -15,8 +15,9 @@ plan meets the observed world before its arms reach the next point at which they
 with empty grippers (the cut). ``success_rate``: valid new plans over the other perturbed
 states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
 time of ``replan`` without the final validation. For every nudge re-planned, a fresh
-continuation from the same cut (``replan(..., repair=False)``) is planned too, and
-``nudge_execution_ratio`` is the new plan's execution from the cut over the fresh one's.
+continuation from the same cut (``replan(..., repair=False)``) is planned too:
+``nudge_execution_ratio`` is the new plan's execution from the cut over the fresh one's, and
+``nudge_latency_median_s`` / ``nudge_fresh_latency_median_s`` the two latencies side by side.
 
     python benchmarks/bench_replan.py [--suite paper] [--only R4,D5] [--per-instance 6]
                                       [--seed 0] [--plans DIR] [--save] [--time-limit 60]
@@ -189,7 +190,8 @@ def main() -> None:
                     row["ratio"] = (out.plan.duration - hold) / (fresh.plan.duration - hold)
                     row["fresh_latency"] = fresh.latency
             rows.append(row)
-            ratio = f" ratio {row['ratio']:.3f}" if "ratio" in row else ""
+            ratio = (f" ratio {row['ratio']:.3f} (fresh {row['fresh_latency']:.3f} s)"
+                     if "ratio" in row else "")  # fmt: skip
             print(f"{path.stem:4s} {kind:6s} t={p.at:6.2f} {p.what:28s} {out.status:10s} "
                   f"valid={out.valid} {out.latency:6.3f} s{ratio}", flush=True)  # fmt: skip
     solvable = [r for r in rows if not r["cannot_stop"]]
@@ -227,6 +229,12 @@ def main() -> None:
         "nudge_execution_ratio_median": median(ratios),
         "nudge_execution_ratio_max": round(max(ratios), 4) if ratios else None,
         "nudges_compared": len(ratios),
+        "nudge_fresh_latency_median_s": median(
+            [float(r["fresh_latency"]) for r in rows if "fresh_latency" in r]  # type: ignore[arg-type]
+        ),
+        "nudge_latency_median_s": median(
+            [float(r["latency"]) for r in rows if "fresh_latency" in r]  # type: ignore[arg-type]
+        ),
         "by_kind": by_kind,
         "statuses": {s: sum(r["status"] == s for r in rows) for s in statuses},
         "seconds": round(time.perf_counter() - started, 1),

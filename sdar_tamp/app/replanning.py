@@ -13,8 +13,8 @@ camera sees -> one new plan, the executed prefix spliced with a continuation.
    the continuation); the stretch from ``at`` to the cut is replayed in the observed world
    (the validator's walk) and a contact there ends the re-plan as ``infeasible``. When the
    cut falls on grasps about to happen and the plan's next cut is reached without violation
-   through them, that later cut is taken (with ``repair``): the arms then stop clear of the
-   objects rather than with open fingers around them.
+   through them, that later cut is taken: the arms then stop clear of the objects rather than
+   with open fingers around them.
 3. Repair: the rest of the old plan after the cut is kept as it is when it still validates
    from the cut in the observed world (a change that touches none of its steps).
 4. Otherwise a fresh SDAR solve of the objects resting at the cut
@@ -151,7 +151,7 @@ def replan(
              f"arms can stop at t = {cut.t:.3f} s: {found.kind}: {found.message}",),
             _objects_in(found.message, sizes),
         )  # fmt: skip
-    if repair and any(abs(e.t - cut.t) <= 1e-9 for e in old.events):
+    if any(abs(e.t - cut.t) <= 1e-9 for e in old.events):
         # the arms stop at grasps about to happen: when those still hold in the observed
         # world, the plan runs on through them to its next cut (its grippers clear again)
         later = cut_point(old, cut.t + 1e-6)
