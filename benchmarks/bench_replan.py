@@ -14,7 +14,9 @@ Counted apart (not solvable by any re-plan from ``T``): ``cannot_stop``, where t
 plan meets the observed world before its arms reach the next point at which they are at rest
 with empty grippers (the cut). ``success_rate``: valid new plans over the other perturbed
 states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
-time of ``replan`` without the final validation. For every nudge re-planned, a fresh
+time of ``replan`` without the final validation (``cpu_median_s``: the process's CPU time
+of the call, the validation included: on a loaded machine the wall time grows, the CPU time
+hardly). For every nudge re-planned, a fresh
 continuation from the same cut (``replan(..., repair=False)``) is planned too:
 ``nudge_execution_ratio`` is the new plan's execution from the cut over the fresh one's, and
 ``nudge_latency_median_s`` / ``nudge_fresh_latency_median_s`` the two latencies side by side.
@@ -175,11 +177,13 @@ def main() -> None:
             p = _draw(kind, instance, plan, scene, rng, world)
             if p is None:
                 continue
+            cpu = time.process_time()
             out = replan(instance, plan, p.at, p.observed, config=config, cache=cache)
+            cpu = time.process_time() - cpu  # the final validation included
             row: dict[str, object] = {
                 "instance": path.stem, "kind": kind, "at": round(p.at, 3), "what": p.what,
                 "redrawn": p.redrawn, "status": out.status, "valid": out.valid,
-                "latency": out.latency, "cut": out.cut,
+                "latency": out.latency, "cpu": cpu, "cut": out.cut,
                 "cannot_stop": any("before the arms can stop" in r for r in out.reasons),
             }  # fmt: skip
             if kind == "nudge" and out.plan is not None:
@@ -193,7 +197,8 @@ def main() -> None:
             ratio = (f" ratio {row['ratio']:.3f} (fresh {row['fresh_latency']:.3f} s)"
                      if "ratio" in row else "")  # fmt: skip
             print(f"{path.stem:4s} {kind:6s} t={p.at:6.2f} {p.what:28s} {out.status:10s} "
-                  f"valid={out.valid} {out.latency:6.3f} s{ratio}", flush=True)  # fmt: skip
+                  f"valid={out.valid} {out.latency:6.3f} s (cpu {cpu:.3f} s){ratio}",
+                  flush=True)  # fmt: skip
     solvable = [r for r in rows if not r["cannot_stop"]]
     ok = [r for r in solvable if r["valid"] is True]
     latencies = [float(r["latency"]) for r in solvable]  # type: ignore[arg-type]
@@ -225,6 +230,7 @@ def main() -> None:
         "valid": len(ok),
         "success_rate": round(len(ok) / len(solvable), 4) if solvable else None,
         "latency_median_s": median(latencies),
+        "cpu_median_s": median([float(r["cpu"]) for r in solvable]),  # type: ignore[arg-type]
         "latency_p90_s": round(float(np.percentile(latencies, 90)), 4) if latencies else None,
         "nudge_execution_ratio_median": median(ratios),
         "nudge_execution_ratio_max": round(max(ratios), 4) if ratios else None,
