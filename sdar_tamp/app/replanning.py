@@ -98,20 +98,23 @@ def replan(
     cache: PlannerCache | None = None,
     validate: bool = True,
     repair: bool = True,
+    retry: bool = True,
 ) -> ReplanOutcome:
     """Re-plan ``plan`` of ``instance`` at time ``at`` [s] from the ``observed`` state (see
     the module docstring). ``config``: the planner configuration of a fresh continuation
     (its ``seed``, budgets and time limit); ``scene_path``: the cell (default: the
     instance's); ``cache``: keeps the world and motion planner between calls; ``validate``:
     replay the whole new plan independently; ``repair``: try keeping the old plan's rest
-    first (False: always a fresh continuation).
+    first (False: always a fresh continuation); ``retry``: when a fresh continuation fails the
+    replay (``validate``), solve once more with the next seed and keep that one if valid.
 
     Raises:
         ObservedStateError: the observed state cannot be (located at its file entry).
         ParameterError: ``at`` outside the plan.
     """
     config = config or PlannerConfig()
-    world = (cache or PlannerCache()).world(scene_path or instance.scene_path(), config.trajopt)
+    cache = cache or PlannerCache()
+    world = cache.world(scene_path or instance.scene_path(), config.trajopt)
     started = time.perf_counter()
     scene = world.ctx.scene
     kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
@@ -182,7 +185,14 @@ def replan(
                              blocking, moved)  # fmt: skip
     continuation = plan_file_from_solution(r, solution)
     spliced = splice(prefix, continuation)
-    return _finish("replanned", spliced, instance, scene, cut, started, validate, moved)
+    out = _finish("replanned", spliced, instance, scene, cut, started, validate, moved)
+    if out.valid is False and retry:  # rare: one more solve with the next seed
+        again = replan(instance, plan, at, observed, config=config.replace(seed=config.seed + 1),
+                       scene_path=scene_path, cache=cache, validate=True, repair=False,
+                       retry=False)  # fmt: skip
+        if again.valid:
+            return dataclasses.replace(again, latency=time.perf_counter() - started)
+    return out
 
 
 def _resume(plan: PlanFile, cut: Cut, t_hold: float) -> Cut:
