@@ -123,6 +123,8 @@ COST_BOUND = Real(0.0, closed=True, allow_inf=True)
 FPS = Real(0.0, unit="1/s")
 #: The weight of weighted A*.
 SEARCH_WEIGHT = Real(1.0, closed=True)
+#: A time within a plan [s]: finite and >= 0.
+PLAN_TIME = Real(0.0, closed=True, unit="s")
 #: A random seed.
 SEED = Integer(0)
 #: A number of things (objects, workers, ...).

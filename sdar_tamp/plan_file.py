@@ -14,7 +14,9 @@ Layout (``version`` 2; every length in m, angle in rad, time in s)::
                 # after its gripper event an arm stands still GRIPPER_DWELL (0.5 s)
      "final_poses": {"o1": [x, y, yaw]},
      "metrics": {"actions", "steps", "dual_arm_steps", "execution_time", "planning_time", ...},
-     "steps": [{"t_start", "t_end", "level", "objects", "kind"}]}   # optional
+     "steps": [{"t_start", "t_end", "level", "objects", "kind"}],   # optional
+     "observations": [{"t", "resting": {"o1": [x, y, yaw]}, "added": {"b1": [lx, ly, lz]}}]}
+                # optional: at time t the observed arrangement replaces the planned one
 
 ``arms`` is a list of any length >= 1 (a cell of one to four arms, or more: nothing caps it),
 with distinct names; ``dual_arm_steps`` counts the motions in which two arms or more move at
@@ -126,6 +128,18 @@ class StepRecord:
     kind: str
 
 
+@dataclass(frozen=True)
+class PlanObservation:
+    """The world seen at time ``t`` [s] (a re-planned plan): from then on the objects resting
+    on the table are exactly ``resting`` (name -> ``(x, y, yaw)`` [m, m, rad]); what the arms
+    hold stays held. ``added``: name -> side lengths [m] of objects the instance does not know.
+    An instance object neither resting nor held is gone (its goal no longer applies)."""
+
+    t: float
+    resting: dict[str, tuple[float, float, float]]
+    added: dict[str, tuple[float, float, float]]
+
+
 @dataclass(frozen=True, eq=False)
 class PlanFile:
     """A timed plan: samples ``q`` ``(n, layout.dof)`` [rad] at ``t`` ``(n,)`` [s] (the arms'
@@ -140,6 +154,7 @@ class PlanFile:
     final_poses: dict[str, tuple[float, float, float]]
     metrics: PlanMetrics
     steps: tuple[StepRecord, ...] = ()
+    observations: tuple[PlanObservation, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "t", readonly(self.t))

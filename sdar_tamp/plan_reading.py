@@ -37,6 +37,7 @@ from sdar_tamp.plan_file import (
     PlanEvent,
     PlanFile,
     PlanFileError,
+    PlanObservation,
     StepRecord,
 )
 from sdar_tamp.plan_metrics import MetricValue, PlanMetrics
@@ -179,7 +180,7 @@ def plan_from_dict(data: Any, source: str = "<plan>", layout: ArmLayout | None =
     """A :class:`PlanFile` from its JSON value; ``source`` names it in error messages;
     ``layout``: the cell's arms, whose joint counts the plan's arms must have, in order."""
     r = _Reader(source)
-    top = r.obj(data, "", _TOP, ("steps",))
+    top = r.obj(data, "", _TOP, ("steps", "observations"))
     if top["format"] != FORMAT:
         raise r.fail("format", f"expected {FORMAT!r}, got {_show(top['format'])}")
     version = top["version"]
@@ -212,7 +213,27 @@ def plan_from_dict(data: Any, source: str = "<plan>", layout: ArmLayout | None =
         _step(r, s, f"steps[{i}]") for i, s in enumerate(r.items(top.get("steps", []), "steps"))
     )
     instance = r.text(top["instance"], "instance")
-    return PlanFile(instance, arms, t, q, events, final, PlanMetrics.from_mapping(metrics), steps)
+    seen = tuple(
+        _observation(r, o, f"observations[{i}]", float(t[-1]))
+        for i, o in enumerate(r.items(top.get("observations", []), "observations"))
+    )
+    metrics_ = PlanMetrics.from_mapping(metrics)
+    return PlanFile(instance, arms, t, q, events, final, metrics_, steps, seen)
+
+
+def _observation(r: _Reader, v: Any, key: str, t_end: float) -> PlanObservation:
+    o = r.obj(v, key, ["t", "resting", "added"])
+    t = r.num(o["t"], f"{key}.t")
+    if not 0.0 <= t <= t_end:
+        raise r.fail(f"{key}.t", f"expected a time within the trajectory [0, {t_end}] s, got {t!r}")
+    triples = {}
+    for part in ("resting", "added"):
+        items = r.mapping(o[part], f"{key}.{part}", "object name -> 3 numbers").items()
+        triples[part] = {n: tuple(map(float, r.vec(x, f"{key}.{part}.{n}", 3))) for n, x in items}
+    for name, size in triples["added"].items():
+        if min(size) <= 0.0:
+            raise r.fail(f"{key}.added.{name}", f"expected side lengths > 0 [m], got {list(size)}")
+    return PlanObservation(t, triples["resting"], triples["added"])  # type: ignore[arg-type]
 
 
 def _arm_items(r: _Reader, v: Any, version: int) -> list[Any]:

@@ -156,6 +156,19 @@ def check_instance(plan: PlanFile, instance: Instance) -> Violation | None:
     if plan.instance != instance.name:
         return Violation(0.0, "instance", f"plan for {plan.instance!r}, not {instance.name!r}")
     named = set(plan.final_poses) | {e.object for e in plan.events}
+    if plan.observations:  # objects may come (added) or go (the replay checks the end)
+        added: set[str] = set().union(*(o.added for o in plan.observations))
+        known = set(instance.names) | added
+        clash = sorted(set(instance.names) & added)
+        for i, seen in enumerate(plan.observations):
+            if i and seen.t < plan.observations[i - 1].t:
+                return Violation(seen.t, "format", f"observations[{i}].t: expected sorted times")
+        if clash or not named <= known:
+            what = clash or sorted(named - known)
+            return Violation(
+                0.0, "instance", f"objects {what} are neither the instance's nor added once"
+            )
+        return None
     if named != set(instance.names):
         return Violation(
             0.0,

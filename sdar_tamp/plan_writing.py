@@ -14,7 +14,7 @@ from sdar_tamp.plan_file import FORMAT, UNITS, VERSION, PlanFile
 
 def plan_to_dict(plan: PlanFile) -> dict[str, Any]:
     """The JSON value of ``plan`` (plain lists, dicts, numbers and strings)."""
-    return {
+    out = {
         "format": FORMAT,
         "version": VERSION,
         "units": dict(UNITS),
@@ -26,6 +26,9 @@ def plan_to_dict(plan: PlanFile) -> dict[str, Any]:
         "metrics": plan.metrics.as_json(),
         "steps": json_value(plan.steps),
     }
+    if plan.observations:
+        out["observations"] = json_value(plan.observations)
+    return out
 
 
 def json_value(value: Any) -> Any:

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_file import PlanEvent, PlanFile
+from sdar_tamp.plan_file import PlanEvent, PlanFile, PlanObservation
 from sdar_tamp.plan_rules import STILL_TOL, Violation
 from sdar_tamp.replay_sampling import tcp_subdivisions
 from sdar_tamp.world.collision import CollisionPair, CollisionWorld, ObjectBox
@@ -90,6 +90,8 @@ class ReplayWalk:
         self.kins = kins
         self.layout = scene.layout
         self.sizes = {o.name: o.size for o in instance.objects}
+        for seen in () if plan is None else plan.observations:
+            self.sizes.update(seen.added)
         self.rest = {o.name: o.start.as_tuple() for o in instance.objects}
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
         self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
@@ -132,33 +134,66 @@ class ReplayWalk:
         return tcp_subdivisions(q, self.kins, self.layout, self.step)
 
     # -- the walk -------------------------------------------------------------------------------
-    def walk(self, t_stop: float) -> Violation | None:
-        """Replay until ``t_stop`` [s] (exclusive); the first violation, or None."""
+    def start_from(
+        self, resting: Mapping[str, tuple[float, float, float]], held: Mapping[str, str],
+        q: FloatArray, T_tcp_object: Mapping[str, FloatArray],
+    ) -> None:  # fmt: skip
+        """Begin a walk later than ``t = 0`` (:meth:`walk` with ``t_from``) from a known state:
+        the ``resting`` objects, arm -> ``held`` object (held at ``T_tcp_object[arm]``) at the
+        configuration ``q`` ``(dof,)`` of that time."""
+        self.rest = {n: (float(p[0]), float(p[1]), float(p[2])) for n, p in resting.items()}
+        self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
+        for arm, obj in held.items():
+            T_obj = self.tcp(arm, q) @ T_tcp_object[arm]
+            self.world.set_object(obj, ObjectBox(T_obj, self.sizes[obj]))
+            self.world.attach(arm, obj, self.arm_q(arm, q))
+            self.held[arm] = (obj, np.asarray(T_tcp_object[arm]))
+        self.free = None
+
+    def walk(self, t_stop: float, t_from: float = 0.0) -> Violation | None:
+        """Replay from ``t_from`` (see :meth:`start_from`) until ``t_stop`` [s] (exclusive);
+        the first violation, or None."""
         plan = self.plan
         if plan is None:
             raise ParameterError("the walk has no plan: walk its samples with walk_samples")
-        found = self.walk_samples(plan.t, plan.q, plan.events, t_stop)
-        end = max(float(plan.t[-1]), max((e.t for e in plan.events), default=0.0))
+        events = [e for e in plan.events if e.t >= t_from]
+        seen = [o for o in plan.observations if o.t >= t_from]
+        found = self.walk_samples(plan.t, plan.q, events, t_stop, t_from, seen)
+        moments = [e.t for e in plan.events] + [o.t for o in plan.observations]
+        end = max(float(plan.t[-1]), max(moments, default=0.0))
         if found is not None or t_stop <= end:
             return found
         return self.final(end)
 
     def walk_samples(
-        self, t: FloatArray, q: FloatArray, events: Sequence[PlanEvent], t_stop: float = math.inf
+        self,
+        t: FloatArray,
+        q: FloatArray,
+        events: Sequence[PlanEvent],
+        t_stop: float = math.inf,
+        t_from: float = -math.inf,
+        observations: Sequence[PlanObservation] = (),
     ) -> Violation | None:
-        """Replay samples ``q`` ``(n, dof)`` at ``t`` ``(n,)`` [s] and ``events`` (sorted by
-        time, within ``t``) until ``t_stop`` [s] (exclusive), from the state the walk is in;
-        the first violation, or None. Walking a timeline in consecutive stretches (each
-        starting with the last sample of the one before) checks what one walk checks."""
-        knot_t = np.union1d(t, [e.t for e in events])
+        """Replay samples ``q`` ``(n, dof)`` at ``t`` ``(n,)`` [s], ``events`` and
+        ``observations`` (each sorted by time, within ``t``) from ``t_from`` until ``t_stop``
+        [s] (exclusive), from the state the walk is in; the first violation, or None. Walking
+        a timeline in consecutive stretches (each starting with the last sample of the one
+        before) checks what one walk checks."""
+        knot_t = np.union1d(t, [e.t for e in events] + [o.t for o in observations])
         knot_t = knot_t[: int(np.searchsorted(knot_t, t_stop)) + 1]  # the last one: to t_stop
+        knot_t = knot_t[int(np.searchsorted(knot_t, t_from)) :]
         columns = range(self.layout.dof)
         knot_q = np.stack([np.interp(knot_t, t, q[:, j]) for j in columns], axis=1)
         counts = self.subdivisions(knot_q) if len(knot_t) > 1 else np.zeros(0, dtype=int)
         pending = list(events)
+        seen = list(observations)
         for k, tk in enumerate(knot_t):
             if tk >= t_stop:
                 return None
+            while seen and seen[0].t <= tk:
+                found = self.observe(seen.pop(0))
+                if found is not None:
+                    return found
             group = [e for e in pending if e.t <= tk]
             pending = pending[len(group) :]
             for e in group:
@@ -180,6 +215,44 @@ class ReplayWalk:
                     found = self.collide(q_s, t_s)
                     if found is not None:
                         return found
+        return None
+
+    def observe(self, seen: PlanObservation) -> Violation | None:
+        """The observed arrangement replaces the planned one: footprints inside the workspace
+        and clear of each other, no held object among them (the arms are checked against it
+        by the collision check of the same instant)."""
+        t = seen.t
+        held = {o: a for a, (o, _) in self.held.items()}
+        for name in seen.resting:
+            if name in held:
+                return Violation(
+                    t, "observation", f"{name} is seen resting but {held[name]} holds it"
+                )
+            if name not in self.sizes:
+                return Violation(t, "observation", f"{name} is neither the instance's nor added")
+        names = sorted(seen.resting)
+        if names:
+            rect = corners(
+                np.array([seen.resting[n] for n in names]),
+                np.array([self.sizes[n][:2] for n in names]),
+            )
+            ws = self.instance.workspace
+            out = ~inside_rectangle(rect, (ws.x[0] - POS_TOL, ws.x[1] + POS_TOL),
+                                    (ws.y[0] - POS_TOL, ws.y[1] + POS_TOL))  # fmt: skip
+            if out.any():
+                name = names[int(np.flatnonzero(out)[0])]
+                return Violation(t, "observation", f"{name} is seen outside the workspace")
+            shrunk = corners(
+                np.array([seen.resting[n] for n in names]),
+                np.array([self.sizes[n][:2] for n in names]) - 2.0 * POS_TOL,
+            )
+            over = np.triu(overlap_matrix(shrunk, rect), k=1)
+            if over.any():
+                i, j = np.argwhere(over)[0]
+                return Violation(t, "observation", f"{names[i]} is seen overlapping {names[j]}")
+        self.free = None
+        self.rest = {n: (float(p[0]), float(p[1]), float(p[2])) for n, p in seen.resting.items()}
+        self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
         return None
 
     def apply(self, e: PlanEvent, q: FloatArray, t: float) -> Violation | None:
@@ -257,18 +330,28 @@ class ReplayWalk:
         if self.held:
             what = ", ".join(f"{a} holds {o}" for a, (o, _) in self.held.items())
             return Violation(t, "held", f"the plan ends with {what}")
-        for o in self.instance.objects:
-            refs = [("goal", o.goal.as_tuple())]
-            if self.plan is not None:
-                refs.append(("final poses", self.plan.final_poses[o.name]))
-            for kind, ref in refs:
-                d, a = _planar_error(self.rest[o.name], ref)
+        goals = {o.name: o.goal.as_tuple() for o in self.instance.objects}
+        names = list(goals)
+        plan = self.plan
+        if plan is not None and plan.observations:  # objects gone or come: those on the table
+            names = [n for n in goals if n in self.rest] + sorted(set(self.rest) - set(goals))
+            differ = sorted(set(self.rest) ^ set(plan.final_poses))
+            if differ:
+                return Violation(
+                    t, "final poses", f"final_poses and the objects on the table differ: {differ}"
+                )
+        for name in names:
+            checks = [] if plan is None else [("final poses", plan.final_poses[name])]
+            if name in goals:
+                checks.insert(0, ("goal", goals[name]))
+            for kind, ref in checks:
+                d, a = _planar_error(self.rest[name], ref)
                 if d > POS_TOL or a > ANGLE_TOL:
-                    x, y, yaw = self.rest[o.name]
+                    x, y, yaw = self.rest[name]
                     return Violation(
                         t,
                         kind,
-                        f"{o.name} ends at ({x:.4f}, {y:.4f}, {yaw:.4f}), "
+                        f"{name} ends at ({x:.4f}, {y:.4f}, {yaw:.4f}), "
                         f"{d * 1e3:.1f} mm / {math.degrees(a):.1f} deg from "
                         f"{kind} {tuple(round(v, 4) for v in ref)}",
                     )

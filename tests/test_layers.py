@@ -36,6 +36,7 @@ LAYERS: dict[str, str] = {
     "sdar_tamp.plan_writing": "plan",
     "sdar_tamp.plan_building": "plan",
     "sdar_tamp.plan_rules": "plan",
+    "sdar_tamp.plan_state": "plan",
     "sdar_tamp.replay": "plan",
     "sdar_tamp.replay_walk": "plan",
     "sdar_tamp.replay_sampling": "plan",

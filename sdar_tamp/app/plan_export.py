@@ -180,7 +180,7 @@ def plan_file_from_solution(
         items,
         plan_metrics(solution, metrics),
         gripper_time=rearrangement.config.gripper_time if gripper_time is None else gripper_time,
-        q_start=rearrangement.home.q,
+        q_start=rearrangement.start_conf.q,
     )
 
 

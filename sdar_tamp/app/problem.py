@@ -43,6 +43,12 @@ class Rearrangement:
     problem: PDDLProblem
     home: CellConf
     config: PlannerConfig = field(default_factory=PlannerConfig)
+    start: CellConf | None = None  # where the arms begin (None: at home)
+
+    @property
+    def start_conf(self) -> CellConf:
+        """Where the arms begin: ``start``, else ``home``."""
+        return self.start if self.start is not None else self.home
 
     @property
     def motion(self) -> str:
@@ -68,6 +74,7 @@ def rearrangement_problem(
     planner: MotionPlanner | None = None,
     gripper_time: float | None = None,
     overrides: Mapping[str, Callable[..., Any]] | None = None,
+    start: CellConf | None = None,
 ) -> Rearrangement:
     """The PDDLProblem of ``instance`` (see the module docstring).
 
@@ -76,7 +83,8 @@ def rearrangement_problem(
     fields. ``planner``: a motion planner to share between problems (its optimiser takes a
     few tenths of a second to build; default: a new one with ``config.trajopt``).
     ``overrides``: stream name -> plain callable replacing the shipped stream (same signature
-    and kind as in :mod:`streams.stream_map`).
+    and kind as in :mod:`streams.stream_map`). ``start``: the arms' configuration to begin
+    from (default: home; idle arms still wait at home), with empty grippers.
 
     Raises:
         ParameterError: a value out of range, an unknown motion planner or stream name.
@@ -102,11 +110,20 @@ def rearrangement_problem(
     arms = ctx.arm_names
     confs = {a: ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in arms}
     home = CellConf(*(confs[a] for a in arms))
-    init: list[tuple[Any, ...]] = [("dualconf", home), ("atdualconf", home)]
+    begin = home if start is None or start == home else start
+    init: list[tuple[Any, ...]] = [("dualconf", home), ("atdualconf", begin)]
     init.append(("=", ("gripper-time",), float(config.gripper_time)))
     for a in arms:
         init += [("arm", a), ("empty", a), ("armconf", confs[a]), ("confof", a, confs[a])]
         init.append(("confin", home, a, confs[a]))
+    if begin is not home:
+        init.append(("dualconf", begin))
+        for a in arms:
+            conf = begin.arm(a)
+            init += [("armconf", conf), ("confof", a, conf), ("confin", begin, a, conf)]
+    options = dataclasses.replace(config.sdar_options(), plane=table_plane(ctx))
+    if begin is not home:
+        options = dataclasses.replace(options, home=home)
     for o in instance.objects:
         init += [("obj", o.name), ("pose", o.start), ("pose", o.goal)]
         init += [("objpose", o.name, o.start), ("objpose", o.name, o.goal)]
@@ -121,10 +138,10 @@ def rearrangement_problem(
         goal,
         solve_defaults={
             "task_planner": config.task_planner,
-            "sdar_options": dataclasses.replace(config.sdar_options(), plane=table_plane(ctx)),
+            "sdar_options": options,
         },
     )
-    return Rearrangement(instance, ctx, problem, home, config)
+    return Rearrangement(instance, ctx, problem, home, config, None if begin is home else begin)
 
 
 def table_plane(ctx: WorldContext) -> Plane:

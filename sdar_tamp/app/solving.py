@@ -110,7 +110,11 @@ def _sdar_options(
     run: PlannerConfig,
     progress: Callable[[int, int], None] | None,
 ) -> SdarOptions:
-    return dataclasses.replace(run.sdar_options(progress), plane=table_plane(rearrangement.ctx))
+    return dataclasses.replace(
+        run.sdar_options(progress),
+        plane=table_plane(rearrangement.ctx),
+        home=None if rearrangement.start is None else rearrangement.home,
+    )
 
 
 def _proof(

@@ -21,6 +21,7 @@ from sdar_tamp.cli.export import add_export_parser
 from sdar_tamp.cli.generate import add_generate_parser
 from sdar_tamp.cli.log_options import add_logging_options, configure_logging
 from sdar_tamp.cli.plan import add_plan_parser
+from sdar_tamp.cli.replan import add_replan_parser
 from sdar_tamp.cli.show import add_show_parser
 from sdar_tamp.cli.solve import add_solve_parser
 from sdar_tamp.cli.validate import add_validate_parser
@@ -48,6 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
         add_check_parser,
         add_generate_parser,
         add_solve_parser,
+        add_replan_parser,
         add_show_parser,
         add_validate_parser,
         add_bench_parser,

@@ -1,10 +1,11 @@
 """JSON Schemas (draft 2020-12) of the project's files, shipped with the package.
 
-``instance`` (rearrangement instance YAML), ``scene`` (scene YAML) and ``plan`` (plan file
-JSON); :func:`schema` returns one as a dict, :func:`schema_path` its file. YAML files are
-checked on their parsed value (for example ``yaml.safe_load``). The schemas describe the
-shape (keys, types, lengths, signs); the loaders check more (finite numbers, ``lower <
-upper``, the rules listed in each schema's ``description``), so a document a schema accepts
+``instance`` (rearrangement instance YAML), ``scene`` (scene YAML), ``plan`` (plan file
+JSON) and ``observed`` (observed state YAML, ``sdar replan``); :func:`schema` returns one
+as a dict, :func:`schema_path` its file. YAML files are checked on their parsed value (for
+example ``yaml.safe_load``). The schemas describe the shape (keys, types, lengths, signs);
+the loaders check more (finite numbers, ``lower < upper``, the rules listed in each schema's
+``description``), so a document a schema accepts
 may still be refused by its loader.
 """
 
@@ -17,7 +18,7 @@ from typing import Any
 
 from sdar_tamp.errors import ParameterError
 
-SCHEMAS = ("instance", "scene", "plan")
+SCHEMAS = ("instance", "scene", "plan", "observed")
 
 
 def schema_path(name: str) -> Path:

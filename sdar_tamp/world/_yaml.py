@@ -85,6 +85,26 @@ class Node:
             raise self.error("a non-empty string")
         return self.value
 
+    def as_name(self) -> str:
+        """An object name: a non-empty string, or an integer written as its digits. A value
+        YAML 1.1 reads as a boolean (``on``, ``off``, ``yes``, ``no``, ``true``, ``false``) is
+        refused with the advice to quote it."""
+        if isinstance(self.value, bool):
+            raise self.error_type(
+                f"{self.path}: expected a name, got {self.raw_text()!r}, which YAML reads as the "
+                f"boolean {self.value}; quote it ('{self.raw_text()}')",
+                self.location,
+            )
+        if isinstance(self.value, int):
+            return str(self.value)
+        return self.as_str()
+
+    def raw_text(self) -> str:
+        """The scalar as written in the file (its parsed value's text without a source)."""
+        if isinstance(self.ynode, yaml.ScalarNode):
+            return str(self.ynode.value)
+        return str(self.value)
+
     def as_float(self, *, positive: bool = False) -> float:
         value = _number(self.value)
         if value is None or not math.isfinite(value):
@@ -108,6 +128,13 @@ class Node:
         if not lo < hi:
             raise self.error(expected)
         return lo, hi
+
+
+def yaml_name(name: str) -> str:
+    """``name`` as a YAML scalar that reads back as the same string (quoted when YAML 1.1
+    would read it as something else: ``on``, ``no``, ``1e3``, ``null``, ...)."""
+    plain = yaml.safe_load(name) if name.strip() == name and name else None
+    return name if isinstance(plain, str) and plain == name else "'" + name.replace("'", "''") + "'"
 
 
 def _number(value: object) -> float | None:

@@ -46,3 +46,8 @@ class GenerationError(WorldError):
 class ArmLayoutError(WorldError, ValueError):
     """A bad arm layout (no arms, repeated names, a non-positive DoF) or a configuration
     whose shape does not match the layout, or an arm the layout does not have."""
+
+
+class ObservedStateError(WorldFileError):
+    """A bad observed-state file, or an observed arrangement that cannot be (two objects
+    overlapping, an object inside an arm, off the workspace, an unknown object)."""

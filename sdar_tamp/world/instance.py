@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from sdar_tamp.errors import SourceLocation
-from sdar_tamp.world._yaml import Node, parse_yaml, read_yaml
+from sdar_tamp.world._yaml import Node, parse_yaml, read_yaml, yaml_name
 from sdar_tamp.world.errors import InstanceError
 from sdar_tamp.world.footprint import corners, inside_rectangle, overlap_matrix
 from sdar_tamp.world.graspability import GraspLimits, grasp_problem
@@ -164,7 +164,7 @@ def _from_node(root: Node, grasp: GraspLimits | None) -> Instance:
     locations: dict[str, SourceLocation] = {}
     for node in keys["objects"].items():
         k = node.mapping(["name", "size", "start", "goal"])
-        name = str(k["name"].value) if isinstance(k["name"].value, int) else k["name"].as_str()
+        name = k["name"].as_name()
         size = k["size"].as_floats(3, "[lx, ly, lz] in m, each > 0", positive=True)
         objects.append(ObjectSpec(name, size, _pose(k["start"]), _pose(k["goal"])))  # type: ignore[arg-type]
         locations.setdefault(name, node.location)
@@ -187,7 +187,7 @@ def dump_instance(instance: Instance) -> str:
     """YAML text of ``instance``; floats are written exactly (``repr``), so loading the text
     gives an equal instance."""
     ws = instance.workspace
-    lines = [f"name: {instance.name}"]
+    lines = [f"name: {yaml_name(instance.name)}"]
     if instance.family is not None:
         lines.append(f"family: {instance.family}")
     if instance.seed is not None:
@@ -198,8 +198,8 @@ def dump_instance(instance: Instance) -> str:
     lines.append("objects:  # size [m]; start, goal: [x, y, yaw] in [m, m, rad]")
     for o in instance.objects:
         lines.append(
-            f"  - {{name: {o.name}, size: {_f(o.size)}, start: {_f(o.start.as_tuple())}, "
-            f"goal: {_f(o.goal.as_tuple())}}}"
+            f"  - {{name: {yaml_name(o.name)}, size: {_f(o.size)}, "
+            f"start: {_f(o.start.as_tuple())}, goal: {_f(o.goal.as_tuple())}}}"
         )
     return "\n".join(lines) + "\n"
 

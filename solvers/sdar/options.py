@@ -48,4 +48,6 @@ class SdarOptions:
     quick_attempts: int = 6  # best-ranked groundings tried with the quick motion stream first
     progress: Callable[[int, int], None] | None = None  # (objects at goal, objects) per step
     plane: Plane | None = None  # with more than two arms: where objects are (see Plane)
+    home: object = None  # the cell configuration (a value of the problem) idle arms wait at;
+    # None: the initial one (a plan re-planned from arms away from home gives the home)
     vocabulary: SdarVocabulary = field(default_factory=SdarVocabulary)

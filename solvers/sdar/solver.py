@@ -125,13 +125,14 @@ class SdarSolver:
         return goals
 
     def _home_conf(self, arm: str) -> str:
-        current = self.cache.current_dualconf()
+        home = self.options.home
+        current = self.cache.current_dualconf() if home is None else self.cache.table.name(home)
         for d, a, q in self.cache.state.atoms(self.voc.confin):
             if d == current and a == arm:
                 return q
         raise ParameterError(
             f"algorithm 'sdar' needs the initial ({self.voc.confin} ?d ?arm ?q) facts of the "
-            f"initial ({self.voc.atdualconf} ?d); none for arm {arm!r}"
+            f"initial ({self.voc.atdualconf} ?d) or of SdarOptions.home; none for arm {arm!r}"
         )
 
     def view(self) -> TaskView:

@@ -104,6 +104,12 @@ def _pddlstream(out: Summary) -> None:
     assert out["total"] == 1 and "passed" in out
 
 
+def _replan(out: Summary) -> None:
+    assert out["perturbations"] == 3 and out["instances"] == 1
+    assert out["valid"] == out["solvable"] >= 1 and out["success_rate"] == 1.0
+    assert out["latency_median_s"] > 0 and set(out["by_kind"]) == {"nudge", "remove", "add"}
+
+
 def _sdar(out: Summary) -> None:
     assert out["instances"] == 1 and out["success"] == 1 and out["steps"] > 0
     r4 = out["per_instance"]["R4"]
@@ -161,6 +167,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_numeric_ik", ()): _numeric_ik,
     ("bench_parser", ()): _parser,
     ("bench_pddlstream_compat", ()): _pddlstream,
+    ("bench_replan", ()): _replan,
     ("bench_sdar", ()): _sdar,
     ("bench_sdar", IN_CELL): _sdar_in_cell,
     ("bench_sdar", BOUNDS): _bounds,

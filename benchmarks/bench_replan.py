@@ -1,0 +1,256 @@
+"""Benchmark: re-planning from perturbed observed states on the paper suite.
+
+Every instance is solved by ``sdar solve``'s code path with synchronous execution (or its
+plan is read from ``--plans DIR/<name>.json`` when it exists, written there after a solve
+with ``--save``). Then, at seeded random times ``T`` of its plan, one resting object is
+perturbed as a camera would see it: ``nudge`` (moved 1-3 cm in a random direction and turned
+5-20 degrees), ``remove`` (gone) or ``add`` (a new object inside the workspace); a
+perturbation the observation checks refuse (an overlap, an object in an arm, off the
+workspace) is drawn again (``redrawn``). :func:`sdar_tamp.app.replanning.replan` re-plans
+(repair first, a fresh SDAR continuation as fallback) and the whole spliced plan is validated
+by the independent replay.
+
+Counted apart (not solvable by any re-plan from ``T``): ``cannot_stop``, where the running
+plan meets the observed world before its arms reach the next point at which they are at rest
+with empty grippers (the cut). ``success_rate``: valid new plans over the other perturbed
+states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
+time of ``replan`` without the final validation (``cpu_median_s``: the process's CPU time
+of the call, the validation included: on a loaded machine the wall time grows, the CPU time
+hardly). For every nudge re-planned, a fresh
+continuation from the same cut (``replan(..., repair=False)``) is planned too:
+``nudge_execution_ratio`` is the new plan's execution from the cut over the fresh one's, and
+``nudge_latency_median_s`` / ``nudge_fresh_latency_median_s`` the two latencies side by side.
+
+    python benchmarks/bench_replan.py [--suite paper] [--only R4,D5] [--per-instance 6]
+                                      [--seed 0] [--plans DIR] [--save] [--time-limit 60]
+                                      [--solve-time-limit 60]
+    python benchmarks/bench_replan.py --quick    # R4, one perturbation of each kind
+
+Prints one row per perturbation, then one JSON object on the last line (``success_rate``,
+``latency_median_s``, ``nudge_execution_ratio_median``, counts by kind and status, the load).
+``--quick`` changes only the defaults: ``--only R4 --per-instance 3`` with a 30 s time limit;
+the JSON keys are the same, plus ``"quick": true``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import statistics
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sdar_tamp.app import PlannerCache, PlannerConfig, solve_instance
+from sdar_tamp.app.replanning import replan
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_state import state_at
+from sdar_tamp.plan_writing import save_plan
+from sdar_tamp.resources import domain_file
+from sdar_tamp.world.collision import CollisionWorld
+from sdar_tamp.world.errors import ObservedStateError
+from sdar_tamp.world.instance import Instance, Pose2D, load_instance
+from sdar_tamp.world.observed import (
+    AddedObject,
+    ObservedState,
+    Resting,
+    check_clear_of_arms,
+    observed_arrangement,
+)
+from sdar_tamp.world.scene import Scene, load_scene
+
+KINDS = ("nudge", "remove", "add")
+
+
+def _suite_files(suite: str) -> list[Path]:
+    folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
+
+    def key(p: Path) -> tuple[str, int]:
+        digits = re.sub(r"\D", "", p.stem)
+        return (p.stem[0], int(digits) if digits else 0)
+
+    return sorted(folder.glob("*.yaml"), key=key)
+
+
+def _plan(path: Path, args: argparse.Namespace, cache: PlannerCache) -> PlanFile | None:
+    stored = args.plans / f"{path.stem}.json" if args.plans is not None else None
+    if stored is not None and stored.exists():
+        return load_plan(stored)
+    config = PlannerConfig(max_time=args.solve_time_limit, execution="sync")
+    outcome = solve_instance(path, config, cache=cache)
+    if not outcome.success or outcome.plan is None:
+        return None
+    if stored is not None and args.save:
+        save_plan(outcome.plan, stored)
+    return outcome.plan
+
+
+@dataclass(frozen=True)
+class Perturbation:
+    kind: str
+    at: float
+    observed: ObservedState
+    what: str
+    redrawn: int
+
+
+def _draw(
+    kind: str, instance: Instance, plan: PlanFile, scene: Scene, rng: np.random.Generator,
+    world: CollisionWorld,
+) -> Perturbation | None:  # fmt: skip
+    """A possible perturbation of ``kind`` at a random time (None after 40 refused draws)."""
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    sizes = {o.name: o.size for o in instance.objects}
+    for tries in range(40):
+        at = float(rng.uniform(0.0, 0.9 * plan.duration))
+        state = state_at(plan, starts, scene, at)
+        names = sorted(state.resting)
+        if not names:
+            continue
+        name = names[int(rng.integers(len(names)))]
+        x, y, yaw = state.resting[name]
+        if kind == "nudge":
+            r, a = rng.uniform(0.01, 0.03), rng.uniform(0.0, 2.0 * math.pi)
+            turn = math.radians(rng.uniform(5.0, 20.0)) * rng.choice([-1.0, 1.0])
+            pose = Pose2D(x + r * math.cos(a), y + r * math.sin(a), yaw + turn)
+            observed = ObservedState(poses={name: pose})
+            what = f"{name} by {r * 100:.1f} cm, {math.degrees(turn):+.0f} deg"
+        elif kind == "remove":
+            observed, what = ObservedState(removed=(name,)), name
+        else:
+            ws = instance.workspace
+            size = tuple(float(v) for v in instance.objects[0].size)
+            pose = Pose2D(rng.uniform(*ws.x), rng.uniform(*ws.y), rng.uniform(-math.pi, math.pi))
+            added = AddedObject("extra", (size[0], size[1], size[2]), pose)
+            observed = ObservedState(added=(added,))
+            what = f"extra at ({pose.x:.2f}, {pose.y:.2f})"
+        try:
+            resting = {n: Resting(sizes[n], Pose2D(*p)) for n, p in state.resting.items()}
+            arrangement = observed_arrangement(
+                observed, resting, state.holder, tuple(sizes), instance.workspace
+            )
+            check_clear_of_arms(arrangement, scene, state.q, at, observed, world)
+        except ObservedStateError:
+            continue
+        return Perturbation(kind, at, observed, what, tries)
+    return None
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--suite", default="paper")
+    ap.add_argument("--only", default=None, help="comma-separated instance names")
+    ap.add_argument("--per-instance", type=int, default=None, help="perturbations (default 6)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--plans", type=Path, default=None)
+    ap.add_argument("--save", action="store_true")
+    ap.add_argument("--time-limit", type=float, default=None, help="[s] of a re-plan (60)")
+    ap.add_argument("--solve-time-limit", type=float, default=60.0, help="[s] of a first solve")
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args()
+    only = args.only or ("R4" if args.quick else None)
+    per = args.per_instance or (3 if args.quick else 6)
+    args.time_limit = args.time_limit or (30.0 if args.quick else 60.0)
+    files = [p for p in _suite_files(args.suite) if only is None or p.stem in only.split(",")]
+    cache = PlannerCache()
+    scene = load_scene()
+    world = CollisionWorld(scene)
+    config = PlannerConfig(max_time=args.time_limit, seed=args.seed)
+    rows: list[dict[str, object]] = []
+    unsolved: list[str] = []
+    started = time.perf_counter()
+    for path in files:
+        instance = load_instance(path)
+        plan = _plan(path, args, cache)
+        if plan is None:
+            unsolved.append(path.stem)
+            continue
+        rng = np.random.default_rng([args.seed, sum(map(ord, path.stem))])
+        for k in range(per):
+            kind = KINDS[k % len(KINDS)]
+            p = _draw(kind, instance, plan, scene, rng, world)
+            if p is None:
+                continue
+            cpu = time.process_time()
+            out = replan(instance, plan, p.at, p.observed, config=config, cache=cache)
+            cpu = time.process_time() - cpu  # the final validation included
+            row: dict[str, object] = {
+                "instance": path.stem, "kind": kind, "at": round(p.at, 3), "what": p.what,
+                "redrawn": p.redrawn, "status": out.status, "valid": out.valid,
+                "latency": out.latency, "cpu": cpu, "cut": out.cut,
+                "cannot_stop": any("before the arms can stop" in r for r in out.reasons),
+            }  # fmt: skip
+            if kind == "nudge" and out.plan is not None:
+                fresh = replan(instance, plan, p.at, p.observed, config=config, cache=cache,
+                               repair=False)  # fmt: skip
+                if fresh.plan is not None and fresh.valid:
+                    hold = out.cut
+                    row["ratio"] = (out.plan.duration - hold) / (fresh.plan.duration - hold)
+                    row["fresh_latency"] = fresh.latency
+            rows.append(row)
+            ratio = (f" ratio {row['ratio']:.3f} (fresh {row['fresh_latency']:.3f} s)"
+                     if "ratio" in row else "")  # fmt: skip
+            print(f"{path.stem:4s} {kind:6s} t={p.at:6.2f} {p.what:28s} {out.status:10s} "
+                  f"valid={out.valid} {out.latency:6.3f} s (cpu {cpu:.3f} s){ratio}",
+                  flush=True)  # fmt: skip
+    solvable = [r for r in rows if not r["cannot_stop"]]
+    ok = [r for r in solvable if r["valid"] is True]
+    latencies = [float(r["latency"]) for r in solvable]  # type: ignore[arg-type]
+    ratios = [float(r["ratio"]) for r in rows if "ratio" in r]  # type: ignore[arg-type]
+
+    def median(values: list[float]) -> float | None:
+        return round(statistics.median(values), 4) if values else None
+
+    by_kind = {
+        kind: {
+            "cases": sum(r["kind"] == kind for r in rows),
+            "cannot_stop": sum(r["kind"] == kind and bool(r["cannot_stop"]) for r in rows),
+            "valid": sum(r["kind"] == kind and r["valid"] is True for r in rows),
+            "repaired": sum(r["kind"] == kind and r["status"] == "repaired" for r in rows),
+            "latency_median_s": median([float(r["latency"]) for r in solvable  # type: ignore[arg-type]
+                                        if r["kind"] == kind]),
+        }
+        for kind in KINDS
+    }  # fmt: skip
+    statuses = sorted({str(r["status"]) for r in rows})
+    summary = {
+        "benchmark": "replan",
+        "suite": args.suite,
+        "instances": len(files) - len(unsolved),
+        "unsolved_instances": unsolved,
+        "perturbations": len(rows),
+        "cannot_stop": len(rows) - len(solvable),
+        "solvable": len(solvable),
+        "valid": len(ok),
+        "success_rate": round(len(ok) / len(solvable), 4) if solvable else None,
+        "latency_median_s": median(latencies),
+        "cpu_median_s": median([float(r["cpu"]) for r in solvable]),  # type: ignore[arg-type]
+        "latency_p90_s": round(float(np.percentile(latencies, 90)), 4) if latencies else None,
+        "nudge_execution_ratio_median": median(ratios),
+        "nudge_execution_ratio_max": round(max(ratios), 4) if ratios else None,
+        "nudges_compared": len(ratios),
+        "nudge_fresh_latency_median_s": median(
+            [float(r["fresh_latency"]) for r in rows if "fresh_latency" in r]  # type: ignore[arg-type]
+        ),
+        "nudge_latency_median_s": median(
+            [float(r["latency"]) for r in rows if "fresh_latency" in r]  # type: ignore[arg-type]
+        ),
+        "by_kind": by_kind,
+        "statuses": {s: sum(r["status"] == s for r in rows) for s in statuses},
+        "seconds": round(time.perf_counter() - started, 1),
+        "load_average": os.getloadavg()[0],
+        "quick": bool(args.quick),
+    }  # fmt: skip
+    print(f"success {summary['success_rate']} of {len(solvable)} solvable, median latency "
+          f"{summary['latency_median_s']} s, nudge ratio {median(ratios)}")  # fmt: skip
+    print(json.dumps(summary, sort_keys=True))
+
+
+if __name__ == "__main__":
+    main()

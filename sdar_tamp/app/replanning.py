@@ -1,0 +1,237 @@
+"""Re-planning from an observed state: the plan being executed, the time reached and what the
+camera sees -> one new plan, the executed prefix spliced with a continuation.
+
+:func:`replan` works in five steps:
+
+1. The state at the time ``at`` reached follows from the plan (:func:`~sdar_tamp.plan_state.
+   state_at`: each arm's configuration, what it holds, where the other objects rest); the
+   observation (:mod:`sdar_tamp.world.observed`) replaces the resting arrangement, and an
+   impossible one is refused at its entry of the file (objects overlapping, off the
+   workspace, unknown, held, or inside an arm at the configuration reached).
+2. The arms cannot jump: the plan runs on to its next cut point (:func:`~sdar_tamp.plan_state.
+   cut_point`: every arm at rest with an empty gripper, the events of that instant left to
+   the continuation); the stretch from ``at`` to the cut is replayed in the observed world
+   (the validator's walk) and a contact there ends the re-plan as ``infeasible``. When the
+   cut falls on grasps about to happen and the plan's next cut is reached without violation
+   through them, that later cut is taken: the arms then stop clear of the objects rather than
+   with open fingers around them.
+3. Repair: the rest of the old plan after the cut is kept as it is when it still validates
+   from the cut in the observed world (a change that touches none of its steps).
+4. Otherwise a fresh SDAR solve of the objects resting at the cut
+   (:func:`~sdar_tamp.app.replan_world.continuation_instance`: a removed object's tasks are
+   gone, an added object without a goal stays unless it blocks a goal, then it is moved
+   away), the arms starting where they stand and idle arms waiting at home.
+5. The new plan is the prefix, a still hold at the cut (at least one sample spacing, and
+   until the dwells begun before it are over), then the continuation; it records the
+   observation (``observations`` of the plan file), with which the independent validator
+   replays it: at ``at`` the observed arrangement replaces the planned one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sdar_tamp.app.cache import PlannerCache, PlanningWorld
+from sdar_tamp.app.config import PlannerConfig
+from sdar_tamp.app.plan_export import plan_file_from_solution
+from sdar_tamp.app.problem import rearrangement_problem
+from sdar_tamp.app.repair import repair as repair_plan
+from sdar_tamp.app.replan_world import continuation_instance, start_configuration
+from sdar_tamp.app.solving import solve_rearrangement
+from sdar_tamp.app.splicing import cut_at, splice, tail, walk_from
+from sdar_tamp.plan_file import PlanFile, PlanObservation
+from sdar_tamp.plan_state import Cut, PlanState, cut_point, prefix_plan, state_at
+from sdar_tamp.replay import validate_plan
+from sdar_tamp.world.collision import CollisionWorld, ObjectBox
+from sdar_tamp.world.instance import Instance, Pose2D
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.observed import (
+    ObservedState,
+    Resting,
+    check_clear_of_arms,
+    observed_arrangement,
+)
+from sdar_tamp.world.scene import Scene
+from streams.stream_types import ArmConf, CellConf
+
+Pose3 = tuple[float, float, float]
+STATUSES = ("repaired", "replanned", "infeasible", "timeout")
+
+
+@dataclass(frozen=True)
+class ReplanOutcome:
+    """What :func:`replan` produced: ``status`` (``repaired``: the old plan's rest kept;
+    ``replanned``: a fresh continuation; ``infeasible``, ``timeout``), the spliced ``plan``
+    (None without one), the ``cut`` time [s], the re-planning ``latency`` [s], the reasons
+    and the objects ``blocking`` a plan; ``valid``/``violation``: the independent replay of
+    the whole new plan (when asked)."""
+
+    status: str
+    plan: PlanFile | None
+    cut: float
+    latency: float
+    reasons: tuple[str, ...] = ()
+    blocking: tuple[str, ...] = ()
+    moved_away: tuple[str, ...] = ()
+    valid: bool | None = None
+    violation: str = ""
+
+    @property
+    def success(self) -> bool:
+        return self.plan is not None and self.valid is not False
+
+
+def replan(
+    instance: Instance,
+    plan: PlanFile,
+    at: float,
+    observed: ObservedState,
+    *,
+    config: PlannerConfig | None = None,
+    scene_path: Path | None = None,
+    cache: PlannerCache | None = None,
+    validate: bool = True,
+    repair: bool = True,
+    retry: bool = True,
+) -> ReplanOutcome:
+    """Re-plan ``plan`` of ``instance`` at time ``at`` [s] from the ``observed`` state (see
+    the module docstring). ``config``: the planner configuration of a fresh continuation
+    (its ``seed``, budgets and time limit); ``scene_path``: the cell (default: the
+    instance's); ``cache``: keeps the world and motion planner between calls; ``validate``:
+    replay the whole new plan independently; ``repair``: try keeping the old plan's rest
+    first (False: always a fresh continuation); ``retry``: when a fresh continuation fails the
+    replay (``validate``), solve once more with the next seed and keep that one if valid.
+
+    Raises:
+        ObservedStateError: the observed state cannot be (located at its file entry).
+        ParameterError: ``at`` outside the plan.
+    """
+    config = config or PlannerConfig()
+    cache = cache or PlannerCache()
+    world = cache.world(scene_path or instance.scene_path(), config.trajopt)
+    started = time.perf_counter()
+    scene = world.ctx.scene
+    kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+    sizes = {o.name: o.size for o in instance.objects}
+    for seen in plan.observations:
+        sizes.update(seen.added)
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    past = dataclasses.replace(plan, observations=tuple(o for o in plan.observations if o.t < at))
+    state = state_at(past, starts, scene, at, kins)
+    resting = {n: Resting(sizes[n], _pose(p)) for n, p in state.resting.items()}
+    known = tuple(sorted(set(sizes)))
+    arrangement = observed_arrangement(observed, resting, state.holder, known, instance.workspace)
+    collision = CollisionWorld(scene)
+    grips = {e.arm: e.T_tcp_object for e in past.events if e.t < at and e.type == "grasp"}
+    held = {
+        arm: (obj, ObjectBox(kins[arm].fk_tcp(scene.layout.part(state.q, arm)) @ grips[arm],
+                             sizes[obj]))
+        for arm, obj in state.held.items()
+    }  # fmt: skip
+    check_clear_of_arms(arrangement, scene, state.q, at, observed, collision, held)
+    for obj in observed.added:
+        sizes[obj.name] = obj.size
+    seen = PlanObservation(
+        at,
+        {n: r.pose.as_tuple() for n, r in sorted(arrangement.items())},
+        {o.name: o.size for o in observed.added},
+    )
+    old = dataclasses.replace(past, observations=(*past.observations, seen))
+    cut = cut_point(old, at)
+    prefix = prefix_plan(old, cut)
+    walk = walk_from(instance, prefix, scene, kins, collision, state)
+    found = walk.walk(float(prefix.t[-1]), at)
+    if found is not None:
+        return ReplanOutcome(
+            "infeasible", None, cut.t, time.perf_counter() - started,
+            (f"the running plan meets the observed world at t = {found.t:.3f} s before the "
+             f"arms can stop at t = {cut.t:.3f} s: {found.kind}: {found.message}",),
+            _objects_in(found.message, sizes),
+        )  # fmt: skip
+    if any(abs(e.t - cut.t) <= 1e-9 for e in old.events):
+        # the arms stop at grasps about to happen: when those still hold in the observed
+        # world, the plan runs on through them to its next cut (its grippers clear again)
+        later = cut_point(old, cut.t + 1e-6)
+        longer = prefix_plan(old, later)
+        ahead = walk_from(instance, longer, scene, kins, collision, state)
+        if later.t > cut.t and ahead.walk(float(longer.t[-1]), at) is None:
+            cut, prefix, walk = later, longer, ahead
+    at_cut = dict(walk.rest)
+    t_hold = float(prefix.t[-1])
+    if repair:
+        rest = splice(prefix, tail(old, _resume(old, cut, float(prefix.t[-1]))))
+        empty = PlanState(t_hold, prefix.q[-1], {}, at_cut)
+        fixed = repair_plan(world, config, instance, rest, empty, kins, collision, sizes)
+        if fixed is not None:
+            return _finish("repaired", fixed[0], instance, scene, cut, started, validate, fixed[1])
+    cont_instance, moved = continuation_instance(instance, at_cut, sizes, config.seed)
+    start = start_configuration(
+        _home(world), prefix.q[-1], {a: scene.layout.slice(a) for a in scene.arm_names}
+    )
+    r = rearrangement_problem(cont_instance, world.ctx, config=config, planner=world.planner,
+                              start=start)  # fmt: skip
+    solution = solve_rearrangement(r)
+    if solution.plan is None:
+        reasons = tuple(solution.diagnosis) or (f"no plan ({solution.status.value})",)
+        status = "timeout" if solution.status.value == "timeout" else "infeasible"
+        blocking = _objects_in(" ".join(reasons), sizes)
+        return ReplanOutcome(status, None, cut.t, time.perf_counter() - started, reasons,
+                             blocking, moved)  # fmt: skip
+    continuation = plan_file_from_solution(r, solution)
+    spliced = splice(prefix, continuation)
+    out = _finish("replanned", spliced, instance, scene, cut, started, validate, moved)
+    if out.valid is False and retry:  # rare: one more solve with the next seed
+        again = replan(instance, plan, at, observed, config=config.replace(seed=config.seed + 1),
+                       scene_path=scene_path, cache=cache, validate=True, repair=False,
+                       retry=False)  # fmt: skip
+        if again.valid:
+            return dataclasses.replace(again, latency=time.perf_counter() - started)
+    return out
+
+
+def _resume(plan: PlanFile, cut: Cut, t_hold: float) -> Cut:
+    """Where ``plan`` goes on after a prefix held still until ``t_hold`` [s]: there, when the
+    plan itself stands still from ``cut`` to then with no event between (a gripper's dwell:
+    not waited twice); else at ``cut``."""
+    resume = cut_at(plan, t_hold)
+    q = plan.q[cut.index : resume.index + 1]
+    if resume.events == cut.events and np.abs(q - plan.q[cut.index]).max() <= 1e-9:
+        return resume
+    return cut
+
+
+def _pose(p: tuple[float, ...]) -> Pose2D:
+    return Pose2D(float(p[0]), float(p[1]), float(p[2]))
+
+
+def _home(world: PlanningWorld) -> CellConf:
+    ctx = world.ctx
+    return CellConf(*(ArmConf(a, tuple(float(x) for x in ctx.home(a))) for a in ctx.arm_names))
+
+
+def _objects_in(text: str, sizes: dict[str, tuple[float, float, float]]) -> tuple[str, ...]:
+    """The object names ``text`` mentions (as words), in order of first mention."""
+    words = re.findall(r"[A-Za-z0-9_.\-]+", text)
+    return tuple(dict.fromkeys(w for w in words if w in sizes))
+
+
+def _finish(
+    status: str, plan: PlanFile, instance: Instance, scene: Scene, cut: Cut, started: float,
+    validate: bool, moved: tuple[str, ...] = (),
+) -> ReplanOutcome:  # fmt: skip
+    latency = time.perf_counter() - started
+    plan = dataclasses.replace(plan, metrics=plan.metrics.updated({"planning_time": latency}))
+    valid, violation = None, ""
+    if validate:
+        report = validate_plan(instance, plan, scene)
+        valid = report.ok
+        if report.violation is not None:
+            v = report.violation
+            violation = f"t={v.t:.3f} s: {v.kind}: {v.message}"
+    return ReplanOutcome(status, plan, cut.t, latency, (), (), moved, valid, violation)

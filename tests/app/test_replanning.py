@@ -1,0 +1,206 @@
+"""Re-planning from an observed state (``sdar_tamp.app.replanning``) on D5 of the paper
+suite and its stored plan: a nudged object is re-grasped at its new pose, a removed object's
+remaining tasks disappear, an added object that blocks a goal is moved away, impossible
+observed states are refused with their location, and where the running plan meets the
+observed world before its arms can stop the answer is ``infeasible`` naming the object. Every
+new plan is the spliced whole and validates by the independent replay."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sdar_tamp.app.cache import PlannerCache
+from sdar_tamp.app.config import PlannerConfig
+from sdar_tamp.app.replanning import ReplanOutcome, replan
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_state import state_at
+from sdar_tamp.replay import validate_plan
+from sdar_tamp.resources import domains_root
+from sdar_tamp.world.errors import ObservedStateError
+from sdar_tamp.world.instance import Instance, load_instance
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.observed import parse_observed
+from sdar_tamp.world.scene import load_scene
+
+SOLVED = Path(__file__).parents[1] / "plan" / "solved"
+AT = 4.5  # D5's plan: o3/o0 swapped, o4/o1 on their way; o2 rests until the last task
+CONFIG = PlannerConfig(max_time=60.0, seed=0)
+
+
+@pytest.fixture(scope="module")
+def cache() -> PlannerCache:
+    return PlannerCache()
+
+
+@pytest.fixture(scope="module")
+def d5() -> tuple[Instance, PlanFile]:
+    instance = load_instance(domains_root() / "dual_arm_rearrangement/suites/paper/D5.yaml")
+    return instance, load_plan(SOLVED / "D5.plan.json")
+
+
+def _obj(instance: Instance, name: str):  # type: ignore[no-untyped-def]
+    return next(o for o in instance.objects if o.name == name)
+
+
+def _replan(d5: tuple[Instance, PlanFile], cache: PlannerCache, text: str, at: float = AT,
+            **kw: object) -> ReplanOutcome:  # fmt: skip
+    instance, plan = d5
+    return replan(instance, plan, at, parse_observed(text, "obs.yaml"), config=CONFIG,
+                  cache=cache, **kw)  # type: ignore[arg-type]  # fmt: skip
+
+
+def _grasp_poses(plan: PlanFile, name: str, after: float) -> list[tuple[float, float, float]]:
+    """Where ``plan``'s grasps of ``name`` after ``after`` [s] take the object from."""
+    scene = load_scene()
+    out = []
+    for e in plan.events:
+        if e.object == name and e.type == "grasp" and e.t > after:
+            q = np.array([np.interp(e.t, plan.t, plan.q[:, j]) for j in range(plan.q.shape[1])])
+            T = ArmKinematics.from_scene(scene, e.arm).fk_tcp(scene.layout.part(q, e.arm))
+            T = T @ e.T_tcp_object
+            out.append((float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0])))
+    return out
+
+
+def _assert_valid_whole(d5: tuple[Instance, PlanFile], out: ReplanOutcome) -> PlanFile:
+    instance, old = d5
+    assert out.plan is not None and out.valid is True, out
+    report = validate_plan(instance, out.plan, load_scene())  # the independent replay again
+    assert report.ok, report.violation
+    prefix = out.plan.t <= out.cut
+    assert np.array_equal(out.plan.q[prefix], old.q[old.t <= out.cut])  # the executed prefix
+    assert [o.t for o in out.plan.observations] == [AT]
+    return out.plan
+
+
+@pytest.mark.parametrize("repair", [True, False])
+def test_a_nudged_object_is_regrasped_at_its_new_pose(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, repair: bool
+) -> None:
+    o2 = _obj(d5[0], "o2")
+    new = (o2.start.x + 0.015, o2.start.y - 0.01, o2.start.yaw + 0.15)
+    out = _replan(d5, cache, f"poses: [{{name: o2, pose: [{new[0]}, {new[1]}, {new[2]}]}}]",
+                  repair=repair)  # fmt: skip
+    assert out.status == ("repaired" if repair else "replanned")
+    plan = _assert_valid_whole(d5, out)
+    grasps = _grasp_poses(plan, "o2", out.cut)
+    assert grasps, "o2 is grasped after the cut"
+    d = math.hypot(grasps[0][0] - new[0], grasps[0][1] - new[1])
+    assert d < 1e-3  # at its new pose, not at the old one 18 mm away
+    # the old plan in the observed world fails at its grasp of o2
+    stale = dataclasses.replace(d5[1], observations=plan.observations)
+    report = validate_plan(d5[0], stale, load_scene())
+    assert not report.ok and report.violation is not None and report.violation.t > AT
+
+
+def test_a_removed_object_loses_its_remaining_tasks(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    out = _replan(d5, cache, "removed: [o2]")
+    plan = _assert_valid_whole(d5, out)
+    assert not [e for e in plan.events if e.object == "o2"]
+    assert "o2" not in plan.final_poses and out.plan is not None
+    assert out.plan.duration < d5[1].duration  # its task is gone, the rest is kept
+
+
+def test_an_added_object_on_a_goal_is_moved_away(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    goal = _obj(d5[0], "o2").goal
+    out = _replan(
+        d5, cache,
+        f"added: [{{name: b1, size: [0.05, 0.05, 0.05], pose: [{goal.x}, {goal.y}, 0.3]}}]",
+    )  # fmt: skip
+    plan = _assert_valid_whole(d5, out)
+    assert out.moved_away == ("b1",)
+    assert {e.type for e in plan.events if e.object == "b1"} == {"grasp", "release"}
+    x, y, _ = plan.final_poses["b1"]
+    assert math.hypot(x - goal.x, y - goal.y) > 0.05
+    assert np.allclose(plan.final_poses["o2"][:2], (goal.x, goal.y), atol=1e-3)
+
+
+def test_an_added_object_out_of_the_way_stays(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    out = _replan(d5, cache, "added: [{name: b1, size: [0.04, 0.04, 0.04], pose: [0.2, -0.25, 0]}]")
+    plan = _assert_valid_whole(d5, out)
+    assert out.status == "repaired" and out.moved_away == ()
+    assert not [e for e in plan.events if e.object == "b1"]
+    assert plan.final_poses["b1"] == pytest.approx((0.2, -0.25, 0.0))
+
+
+def test_nothing_changed_keeps_the_old_plan(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    out = _replan(d5, cache, "")
+    plan = _assert_valid_whole(d5, out)
+    assert out.status == "repaired"
+    assert len(plan.events) == len(d5[1].events)
+
+
+def test_the_running_plan_meeting_the_change_is_infeasible_with_the_object(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    o1 = _obj(d5[0], "o1")  # the right arm is on its way to grasp it at 5.71 s
+    out = _replan(
+        d5, cache,
+        f"poses: [{{name: o1, pose: [{o1.start.x + 0.015}, {o1.start.y - 0.01}, "
+        f"{o1.start.yaw + 0.15}]}}]",
+    )  # fmt: skip
+    assert out.status == "infeasible" and out.plan is None and not out.success
+    assert out.blocking == ("o1",)
+    assert "before the arms can stop" in out.reasons[0]
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("poses: [{name: o2, pose: [0.2, 0.04, 0]}]", "objects 'o2' and 'o4' overlap"),
+        ("removed: [o3]", "'o3' is held by arm 'left'"),
+        ("removed: [nope]", "unknown object 'nope'"),
+        ("poses: [{name: o2, pose: [0.9, 0.0, 0]}]", "leaves the workspace"),
+    ],
+)
+def test_impossible_observed_states_are_refused_with_their_location(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, text: str, message: str
+) -> None:
+    with pytest.raises(ObservedStateError) as err:
+        _replan(d5, cache, text, at=2.5)  # at 2.5 s the left arm carries o3
+    assert str(err.value).startswith("obs.yaml:1:") and message in str(err.value)
+
+
+def test_an_object_inside_an_arm_at_the_time_reached(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    instance, plan = d5
+    scene = load_scene()
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    kin = ArmKinematics.from_scene(scene, "right")
+    for at in (2.0, 2.5, 3.0, 7.0, 9.0):  # the right arm in the air, away from resting objects
+        state = state_at(plan, starts, scene, at)
+        tcp = kin.fk_tcp(scene.layout.part(state.q, "right"))
+        text = (f"added: [{{name: b1, size: [0.03, 0.03, {tcp[2, 3] + 0.02:.3f}], "
+                f"pose: [{tcp[0, 3]:.4f}, {tcp[1, 3]:.4f}, 0]}}]")  # fmt: skip
+        try:
+            _replan(d5, cache, text, at=at)
+        except ObservedStateError as err:
+            if "overlap" in str(err):
+                continue  # on a resting object: another time
+            assert re.match(r"obs\.yaml:1:\d+: object 'b1' is inside arm 'right' \(", str(err))
+            assert f"at t = {at:.3f} s, the arm at [" in str(err)
+            return
+        raise AssertionError(f"b1 inside the right arm at {at} s is not refused")
+    raise AssertionError("no time with the right arm clear of the resting objects")
+
+
+def test_a_time_outside_the_plan(d5: tuple[Instance, PlanFile], cache: PlannerCache) -> None:
+    with pytest.raises(ParameterError, match="at: expected a time within the plan"):
+        _replan(d5, cache, "", at=d5[1].duration + 1.0)

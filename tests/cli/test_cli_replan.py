@@ -1,0 +1,88 @@
+"""``sdar replan``: the new plan written and valid, the JSON record, infeasible re-plans and
+every bad input (exit status 2 with a located error)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from sdar_tamp.cli import main
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.resources import domains_root
+
+D5 = str(domains_root() / "dual_arm_rearrangement/suites/paper/D5.yaml")
+PLAN = str(Path(__file__).parents[1] / "plan" / "solved" / "D5.plan.json")
+
+
+def _observed(tmp_path: Path, text: str) -> str:
+    path = tmp_path / "obs.yaml"
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
+def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code  # type: ignore[assignment]
+    out = capsys.readouterr()
+    return int(code), out.out, out.err
+
+
+def test_replan_writes_a_valid_plan(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    obs = _observed(tmp_path, "removed: [o2]\n")
+    new = tmp_path / "new.json"
+    code, out, _ = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs, "-o", str(new)],
+                        capsys)  # fmt: skip
+    assert code == 0, out
+    assert out.startswith("repaired: cut at t = ") and "valid" in out and "wrote" in out
+    assert "o2" not in load_plan(new).final_poses
+    code, out, _ = _run(["validate", D5, str(new)], capsys)
+    assert code == 0 and out.startswith("valid:")
+    code, out, err = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs, "-o",
+                           str(new)], capsys)  # fmt: skip
+    assert code == 2 and "exists" in err  # no overwrite without --force
+
+
+def test_replan_json_and_infeasible(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    obs = _observed(tmp_path, "poses: [{name: o1, pose: [-0.045, -0.064, 1.19]}]\n")
+    code, out, _ = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs, "--json"], capsys)
+    record = json.loads(out)
+    assert code == 1 and record["status"] == "infeasible" and record["blocking"] == ["o1"]
+    assert record["plan_file"] is None and "before the arms can stop" in record["reasons"][0]
+    code, out, _ = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs], capsys)
+    assert code == 1 and out.startswith("infeasible:") and "blocking: o1" in out
+
+
+@pytest.mark.parametrize(
+    ("text", "argv", "message"),
+    [
+        ("removed: [on]\n", [], "obs.yaml:1:11: removed[0]: expected a name, got 'on'"),
+        ("removed: [o9]\n", [], "obs.yaml:1:11: unknown object 'o9'"),
+        ("poses: [{name: o2, pose: [0.2, 0.04, 0]}]\n", [],
+         "obs.yaml:1:16: objects 'o2' and 'o4' overlap by"),
+        ("", ["--at", "-1"], "argument --at: "),
+        ("", ["--at", "1e3"], "at: expected a time within the plan [0, 12.534] s"),
+        ("", ["-o", "new.txt"], ".json"),
+    ],
+)  # fmt: skip
+def test_replan_refuses_bad_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, argv: list[str], message: str
+) -> None:
+    obs = _observed(tmp_path, text)
+    at = [] if "--at" in argv else ["--at", "4.5"]
+    code, out, err = _run(["replan", D5, PLAN, *at, "--observed", obs, *argv], capsys)
+    assert code == 2 and out == "", out
+    assert message in err, err
+
+
+def test_replan_missing_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    obs = _observed(tmp_path, "")
+    for argv in (
+        [D5, str(tmp_path / "none.json"), "--at", "1", "--observed", obs],
+        [D5, PLAN, "--at", "1", "--observed", str(tmp_path / "none.yaml")],
+    ):
+        code, _, err = _run(["replan", *argv], capsys)
+        assert code == 2 and "none." in err
