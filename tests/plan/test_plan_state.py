@@ -198,3 +198,22 @@ def test_the_instance_rule_with_observations(d5: tuple[Instance, PlanFile, Scene
     report = validate_plan(instance, clash, scene)
     assert report.violation is not None and report.violation.kind == "instance"
     assert "['o1']" in report.violation.message
+
+
+def test_the_plan_schema_takes_observations(d5: tuple[Instance, PlanFile, Scene]) -> None:
+    jsonschema = pytest.importorskip("jsonschema")
+    from sdar_tamp.schemas import schema
+
+    instance, plan, _ = d5
+    seen = _observed(plan, 0.5, _starts(instance), {"b1": (0.05, 0.05, 0.05)})
+    document = json.loads(json.dumps(plan_to_dict(seen)))
+    validator = jsonschema.Draft202012Validator(schema("plan"))
+    assert not list(validator.iter_errors(document))
+    document["observations"][0]["added"]["b1"] = [0.05, -1.0, 0.05]
+    assert list(validator.iter_errors(document))
+    observed = jsonschema.Draft202012Validator(schema("observed"))
+    good = {"poses": [{"name": "o1", "pose": [0, 0, 0.1]}], "removed": ["o2", 7],
+            "added": [{"name": "b1", "size": [0.05, 0.05, 0.05], "pose": [0, 0.1, 0]}]}  # fmt: skip
+    assert not list(observed.iter_errors(good)) and not list(observed.iter_errors(None))
+    for bad in ({"removed": [True]}, {"moved": []}, {"added": [{"name": "b1", "pose": [0, 0, 0]}]}):
+        assert list(observed.iter_errors(bad)), bad
