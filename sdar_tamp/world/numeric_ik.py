@@ -12,6 +12,7 @@ uniform draws inside the limits), and the targets no seed solved get fresh seeds
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -273,6 +274,17 @@ def _checked(
     return T_t, lo, hi
 
 
+def target_draws(T_targets: FloatArray, seed: int, shape: tuple[int, ...]) -> FloatArray:
+    """Uniform draws in ``[0, 1)`` of ``shape`` for each target ``(n, 4, 4)``: ``(n, *shape)``,
+    each target's drawn from a generator keyed by ``seed`` and the target's own bytes, so a
+    target gets the same starts whatever batch it is solved in (and in whatever order)."""
+    out = np.empty((len(T_targets), *shape))
+    for i, T in enumerate(T_targets):
+        key = int.from_bytes(hashlib.blake2b(T.tobytes(), digest_size=8).digest(), "little")
+        out[i] = np.random.default_rng([seed, key]).random(shape)
+    return out
+
+
 def numeric_ik_branches(
     chain: Chain,
     T_root_target: FloatArray,
@@ -287,9 +299,12 @@ def numeric_ik_branches(
     """Up to ``branches`` distinct solutions per target (``(n, 4, 4)`` in the root frame):
     ``q`` ``(n, branches, dof)`` and ``valid`` ``(n, branches)``. Every target is solved from
     ``options.seeds`` starts (``q_ref`` first, then uniform draws inside the limits); targets
-    no start solved get fresh starts for up to ``options.rounds`` rounds. Solutions closer
-    than ``distinct`` [rad] on every joint count once; they are ordered by their distance
-    from ``q_ref`` (nearest first). Invalid rows hold ``q_ref``. Deterministic in ``seed``.
+    no start solved get fresh starts for up to ``options.rounds`` rounds. A target's draws
+    depend only on ``seed`` and the target (:func:`target_draws`), and every step of the
+    descent is row by row, so its solutions do not depend on the batch it is solved in.
+    Solutions closer than ``distinct`` [rad] on every joint count once; they are ordered by
+    their distance from ``q_ref`` (nearest first). Invalid rows hold ``q_ref``.
+    Deterministic in ``seed``.
 
     Raises:
         KinematicsError: shapes that do not match the chain, ``lower > upper`` or
@@ -302,15 +317,16 @@ def numeric_ik_branches(
         raise KinematicsError(f"expected a reference of shape ({chain.dof},), got {ref.shape}")
     if branches < 1:
         raise KinematicsError(f"branches must be >= 1, got {branches}")
-    n, dof, s = len(T_t), chain.dof, max(1, opts.seeds)
-    rng = np.random.default_rng(seed)
+    n, s = len(T_t), max(1, opts.seeds)
+    rounds = max(1, opts.rounds)
+    unit = target_draws(T_t, seed, (rounds, s, chain.dof))  # (n, rounds, s, dof) in [0, 1)
     q_out = np.repeat(np.repeat(ref[None, None], n, axis=0), branches, axis=1)
     valid = np.zeros((n, branches), dtype=bool)
-    for round_ in range(max(1, opts.rounds)):
+    for round_ in range(rounds):
         todo = np.flatnonzero(~valid.any(axis=1))
         if len(todo) == 0:
             break
-        draws = rng.uniform(lo, hi, (len(todo), s, dof))
+        draws = lo + (hi - lo) * unit[todo, round_]
         if round_ == 0:
             draws[:, 0] = ref
         q, done = _descend(chain, T_t[todo], draws, lo, hi, ref, opts, enough=branches)

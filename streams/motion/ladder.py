@@ -71,12 +71,19 @@ def _clear_phases(
     planner: MotionPlanner, request: MotionRequest, one_at_a_time: bool
 ) -> tuple[list[FloatArray], list[FloatArray]] | str:
     """Retreat and approach that are collision-free on their own (every strategy shares
-    them): synchronised, else one arm after the other; or why there are none."""
+    them): synchronised, else one arm after the other, else with the retreat one arm after
+    the other in the reverse order (the mirror of an approach made one arm at a time, which
+    may be how the arms came down where they are); or why there are none."""
     reason = "approach or retreat unreachable"
     lifts = (None,) if request.lift is not None else (None, planner.shape.default_lift)
+    orders = [(one_at_a_time, False), (True, False)]
+    if sum(map(bool, request.retreat)) > 1:
+        orders.append((True, True))
     for lift in lifts:  # the clearance lifts, then the fixed default
-        for chained in dict.fromkeys((one_at_a_time, True)):
-            phases = planner.phases(request, one_at_a_time=chained, lift=lift)
+        for chained, last_first in dict.fromkeys(orders):
+            phases = planner.phases(
+                request, one_at_a_time=chained, lift=lift, last_first=last_first
+            )
             if phases is None:
                 break
             for label, paths in zip(("retreat", "approach"), phases, strict=True):

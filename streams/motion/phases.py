@@ -56,11 +56,13 @@ def retreat_and_approach(
     request: MotionRequest,
     one_at_a_time: bool = False,
     lift: float | None = None,
+    last_first: bool = False,
 ) -> tuple[list[FloatArray], list[FloatArray]] | None:
     """Retreat and approach as lists of paths ``(n, dof)``: one synchronised (padded) path
-    each, or, with ``one_at_a_time``, one arm's after the other's (layout order); None if
-    a straight tool move is unreachable. ``lift`` [m]: fixed for every grasp (default:
-    :func:`grasp_lifts`)."""
+    each, or, with ``one_at_a_time``, one arm's after the other's (layout order; with
+    ``last_first`` the retreat in the reverse order, the mirror of an approach made one arm
+    at a time: the arm that came down last goes up first); None if a straight tool move is
+    unreachable. ``lift`` [m]: fixed for every grasp (default: :func:`grasp_lifts`)."""
     ret, app = [], []
     up, down = grasp_lifts(ctx, shape, request, lift)
     step = shape.step
@@ -75,7 +77,8 @@ def retreat_and_approach(
         ret.append(r)
         app.append(a[::-1])
     if one_at_a_time:
-        return chain_arms(ret), chain_arms(app)
+        order = range(len(ret) - 1, -1, -1) if last_first else None
+        return chain_arms(ret, order), chain_arms(app)
     return [sync_arms(ret)], [sync_arms(app)]
 
 

@@ -129,11 +129,15 @@ class MotionPlanner:
         return grasp_lifts(self.ctx, self.shape, request, fixed)
 
     def phases(
-        self, request: MotionRequest, one_at_a_time: bool = False, lift: float | None = None
+        self,
+        request: MotionRequest,
+        one_at_a_time: bool = False,
+        lift: float | None = None,
+        last_first: bool = False,
     ) -> tuple[list[FloatArray], list[FloatArray]] | None:
         """Retreat and approach as lists of paths ``(n, dof)``
         (:func:`~streams.motion.phases.retreat_and_approach`)."""
-        return retreat_and_approach(self.ctx, self.shape, request, one_at_a_time, lift)
+        return retreat_and_approach(self.ctx, self.shape, request, one_at_a_time, lift, last_first)
 
     def transfer_problem(
         self, request: MotionRequest, q_from: FloatArray, q_to: FloatArray

@@ -3,6 +3,8 @@ paths combined into one configuration path (synchronised, or one arm after the o
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from sdar_tamp.world.transforms import FloatArray
@@ -36,14 +38,19 @@ def sync_arms(paths: list[FloatArray]) -> FloatArray:
     return np.concatenate(out, axis=1)
 
 
-def chain_arms(paths: list[FloatArray]) -> list[FloatArray]:
+def chain_arms(paths: list[FloatArray], order: Sequence[int] | None = None) -> list[FloatArray]:
     """Per-arm paths ``(n_i, arm dof)`` as one ``(n_i, dof)`` path per arm: the arms move one
-    after the other in layout order, the others waiting where they are (each timed rest to
-    rest)."""
+    after the other, in ``order`` (indices into ``paths``; default layout order), the others
+    waiting where they are (each timed rest to rest). The paths come in the order of moving."""
+    turns = range(len(paths)) if order is None else order
+    moved: set[int] = set()
     out = []
-    for k, path in enumerate(paths):
-        n = len(path)
-        done = [np.repeat(p[-1:], n, axis=0) for p in paths[:k]]
-        waiting = [np.repeat(p[:1], n, axis=0) for p in paths[k + 1 :]]
-        out.append(np.concatenate([*done, path, *waiting], axis=1))
+    for k in turns:
+        n = len(paths[k])
+        parts = [
+            paths[k] if j == k else np.repeat(p[-1:] if j in moved else p[:1], n, axis=0)
+            for j, p in enumerate(paths)
+        ]
+        out.append(np.concatenate(parts, axis=1))
+        moved.add(k)
     return out

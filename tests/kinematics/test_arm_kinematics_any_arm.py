@@ -223,3 +223,29 @@ def test_numeric_branch_functions_check_their_input(kin7: ArmKinematics) -> None
     target = kin7.fk_batch(home[None])[0]
     q, _ = numeric_ik_from(kin7.chain, target, lo, hi, (home + 10.0)[None, None])
     assert q.shape == (1, 1, 7) and np.all(q >= lo) and np.all(q <= hi)
+
+
+def test_numeric_ik_of_a_pose_does_not_depend_on_its_batch(
+    scene7: Scene, kin7: ArmKinematics
+) -> None:
+    """A pose's solutions are the same alone, in a batch and in a shuffled batch (bit for
+    bit), so the solved-pair table cannot make a plan depend on which batch met a pose first."""
+    _, targets = _reachable(kin7, 24, 5)
+    together = kin7.ik_tool0(targets)
+    order = np.random.default_rng(6).permutation(24)
+    shuffled = kin7.ik_tool0(targets[order])
+    np.testing.assert_array_equal(shuffled.q, together.q[order])
+    np.testing.assert_array_equal(shuffled.valid, together.valid[order])
+    for i in (0, 7, 23):
+        alone = kin7.ik_tool0(targets[i])
+        np.testing.assert_array_equal(alone.q[0], together.q[i])
+        np.testing.assert_array_equal(alone.valid[0], together.valid[i])
+    fresh = ArmKinematics.from_scene(scene7, "left")  # a cold table of pairs
+    lifted = targets @ kin7.T_tool0_tcp
+    lifted[:, :3, 3] -= 0.05 * lifted[:, :3, 2]
+    a = kin7.ik_tcp_pair(targets[:12] @ kin7.T_tool0_tcp, lifted[:12])
+    fresh.ik_tcp_pair(targets[5:] @ kin7.T_tool0_tcp, lifted[5:])  # met first in another batch
+    b = fresh.ik_tcp_pair(targets[:12] @ kin7.T_tool0_tcp, lifted[:12])
+    for x, y in zip(a, b, strict=True):
+        np.testing.assert_array_equal(x.q, y.q)
+        np.testing.assert_array_equal(x.valid, y.valid)

@@ -124,3 +124,26 @@ def test_a_cell_of_maker_arms_without_gripper_or_tcp_frame() -> None:
     boxes = cell_gripper_boxes(scene)
     expected = declared_finger_boxes(scene.arms[0].gripper)
     assert len(boxes) == 2 and boxes[0].half == expected[0].half
+
+
+def test_a_cell_of_seven_joint_maker_arms() -> None:
+    """The xArm7 as ``example-robot-data`` ships it (not a shipped robot): the numeric IK
+    reaches its home's TCP and both arms grasp every point of the cell's workspace."""
+    from sdar_tamp.world.cell_reach import unreached_points
+    from sdar_tamp.world.kinematics import ArmKinematics
+    from sdar_tamp.world.scene import load_scene
+
+    assert SHARE is not None
+    path = Path(__file__).with_name("data") / "maker_xarm7_pair.yaml"
+    scene = load_scene(path, environ={"ROS_PACKAGE_PATH": str(SHARE)})
+    assert scene.arms[0].urdf.name == "xarm7.urdf" and scene.arms[0].dof == 7
+    kin = ArmKinematics.from_scene(scene, "left")
+    assert not kin.closed_form and kin.tool_frame == "link_eef"
+    T = kin.fk_tcp(np.array(scene.arms[0].home))
+    np.testing.assert_allclose(T[:3, 3], [-0.13, 0.0, 0.3], atol=1e-3)
+    assert T[2, 2] == pytest.approx(-1.0)  # top-down
+    sol = kin.ik_tcp(T[None])
+    assert sol.valid.any()
+    missed = unreached_points(scene, 0.1)
+    assert sorted(missed) == ["left", "right"]
+    assert all(len(m) == 0 for m in missed.values())
