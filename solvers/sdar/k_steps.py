@@ -68,8 +68,7 @@ def rotations(scene: TaskScene, arms: int) -> list[tuple[tuple[int, ...], Step, 
     """Closed components of ``3 <= m <= arms`` objects, each as one step of ``m`` goal moves
     (kind ``rotate``); the key ``(-freed, -edges removed, first object's order)`` ranks them.
     The third item: the chance that no two of its arms meet, for the best arms
-    (:meth:`~solvers.sdar.tasks.Layout.best_chance`; 1 without a layout). The objects of a
-    rotation sit on each other's goals, so their arms often meet."""
+    (:meth:`~solvers.sdar.tasks.Layout.best_chance`; 1 without a layout)."""
     out: list[tuple[tuple[int, ...], Step, float]] = []
     layout = scene.view.layout
     for unit in scene.units(frozenset()):

@@ -58,12 +58,11 @@ with goal moves of units whose goals are free once the step's objects are lifted
 moves; the extended
 step and its base are both kept (the base is the fallback when the larger step cannot be
 grounded); closed components of ``3..k`` objects are proposed as ``rotate`` steps of class 1
-(an ``m``-cycle rotated by ``m`` arms without a buffer; class 7 instead when the view's layout
-gives every assignment of arms a chance under :data:`~solvers.sdar.tasks.LIKELY` that no two of
-them meet; a component of ``3..k`` objects can still be broken at class 7, for when the
-rotation is geometrically impossible). Within a class, steps the layout expects to make two
-arms meet come last, then steps bringing more objects to their goals first. So a list holds
-at most
+(an ``m``-cycle rotated by ``m`` arms without a buffer; a component of ``3..k`` objects can
+still be broken at class 7, for when the rotation is geometrically impossible). Within a
+class, steps whose every assignment of arms has a chance under
+:data:`~solvers.sdar.tasks.LIKELY` that no two arms meet (the view's layout) come last, and
+steps bringing more objects to their goals first. So a list holds at most
 ``2 max_candidates`` steps of several moves, plus one rotation per component, plus the one-move
 steps; no set of ``k`` objects is enumerated.
 """
@@ -186,9 +185,8 @@ class SdarTaskPlanner:
                 out.append(((key[0], crossed(wider), -wider.progress, *key[1:]), wider))
             out.append(((key[0], crossed(step), -step.progress, *key[1:]), step))
         for key, step, chance in rotations(scene, arms):
-            rank = GOAL_PAIR if chance >= LIKELY else DETOUR
-            rotate = Step(step.moves, step.kind, rank, step.tie)
-            out.append(((rank, int(chance < LIKELY), -rotate.progress, *key), rotate))
+            rotate = Step(step.moves, step.kind, GOAL_PAIR, step.tie)
+            out.append(((GOAL_PAIR, int(chance < LIKELY), -rotate.progress, *key), rotate))
         out.sort(key=lambda item: item[0])
         best: dict[frozenset[Move], tuple[_Key, Step]] = {}
         for item in out:

@@ -166,16 +166,19 @@ class Layout:
 #: The most assignments of arms :meth:`Layout.best_chance` compares one by one (four arms and
 #: four objects: 24).
 MAX_ASSIGNMENTS = 720
-#: A step whose best :meth:`Layout.chance` is below this is expected to make arms meet.
-LIKELY = 0.35
+#: A step whose best :meth:`Layout.chance` is below this is expected to make arms meet. At 0.35
+#: SDAR-T's four-arm plans of R12-1 and M12-1 took more steps (execution 20.32 and 20.82 s,
+#: against 16.44 and 19.35 s at 0.1, equal to the plans without the chance): its steps of
+#: three moves with a chance of 0.1-0.35 often ground (docs/benchmarks.md).
+LIKELY = 0.1
 #: (gap between two arms' plane segments [m], share of such pairs of arms that collide),
 #: measured on the UR5e shared-table cells with ``benchmarks/bench_layout.py --options 1``
 #: (60 poses of the ``table_4arm`` suite; 14466 pairs of two arms at two objects 0.1 m apart
 #: or more, the other arms at home, each arm at the first IK of the object's first grasp): the
 #: middles of its gap bands. With three options per arm and pose on an empty table the shares
 #: are lower (gaps under 0.04 m: 45%), but among the resting objects of an arrangement a step's
-#: moves have fewer options, and that table let SDAR-T propose steps whose arms met (R12-1 on
-#: the four-arm table: 9 objects left after 300 s, against solved in 54 s with this one).
+#: moves have fewer options: with that table (and :data:`LIKELY` at 0.35) R12-1 on the
+#: four-arm table had 9 objects left after 300 s, against solved in 54 s with this one.
 MEETING = (
     (0.02, 0.93),
     (0.06, 0.77),
