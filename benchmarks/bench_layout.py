@@ -1,18 +1,18 @@
 """Benchmark: how well SDAR-T's plane model predicts that two arms meet at two objects.
 
 SDAR-T and SDAR-M, with three arms or more, model an arm reaching for an object as the plane
-segment from its base to the object (:class:`solvers.sdar.tasks.Layout`): the closer two arms'
-segments come, the likelier the arms meet (``MEETING`` of :mod:`solvers.sdar.tasks`, measured
-with this script). This script measures that model against the exact check. Poses are the
-starts and goals of a suite of the cell's table (``--suite``, default ``table_4arm``);
-``--poses`` of them are drawn (seeded). For every arm and pose, the first configuration of the
-inverse-kinematics stream for each of the object's first ``--options`` grasps that have one
-(default 1, as ``MEETING`` is measured), on a table without other objects; for every two
-arms at two poses at least 0.1 m apart (the other arms at home), the exact arm-arm check of
-``combine-confs`` (coal): the pair collides when every combination of their options
-collides. Against the segments' gap: printed per gap band the share of pairs that collide,
-and per clearance the share of the pairs it keeps (gap at least the clearance) that collide,
-and the share of the pairs that do not collide that it keeps.
+segment from its base to the object (:class:`solvers.sdar.tasks.Layout`): two arms *cross*
+when their segments come closer than the layout's ``clearance`` (0.08 m). This script
+measures that model against the exact check. Poses are the starts and goals of a suite of the
+cell's table (``--suite``, default ``table_4arm``); ``--poses`` of them are drawn (seeded).
+For every arm and pose, the first configuration of the inverse-kinematics stream for each of
+the object's first ``--options`` grasps that have one (default 1), on a table without other
+objects; for every two arms at two poses at least 0.1 m apart (the other arms at home), the
+exact arm-arm check of ``combine-confs`` (coal): the pair collides when every combination of
+their options collides. Against the segments' gap (:meth:`~solvers.sdar.tasks.Layout.
+arm_gap`): printed per gap band the share of pairs that collide, and per clearance the share
+of the pairs it keeps (gap at least the clearance) that collide, and the share of the pairs
+that do not collide that it keeps.
 
     python benchmarks/bench_layout.py [--scene CELL] [--suite table_4arm] [--poses 60]
                                         [--options 1]

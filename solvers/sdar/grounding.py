@@ -11,10 +11,7 @@ Assignments of moves to arms: with two arms every one (two at most). With more, 
 each move the arms that reach its object and target (the first grasp option of that arm), by
 the estimated time of that arm's pick and transfer, the ``moves + 1`` soonest; of their
 combinations with distinct arms the ``SdarOptions.assignments`` of least total estimate (with
-the view's :class:`~solvers.sdar.tasks.Layout`, only those whose chance that no two arms meet,
-:meth:`~solvers.sdar.tasks.Layout.chance`, is at least half the best: an assignment whose arms
-meet where another's do not rarely grounds, and grounding it costs the IK and collision checks
-of every combination of options). The
+the view's :class:`~solvers.sdar.tasks.Layout`, fewest crossing pairs of arms first). The
 options of a step of ``m > 2`` moves are cut so that their combinations stay within
 :data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
 those bringing more objects to their goals come first (then the estimated motion time).
@@ -98,8 +95,8 @@ class Grounder:
         self.buffer_check: BufferCheck | None = None
         """Keeps only the buffers it accepts for (the step's moves, object, buffer pose)."""
         self.layout: Layout | None = None
-        """With more than two arms: the current view's layout; only the assignments whose arms
-        are likeliest not to meet (:meth:`~solvers.sdar.tasks.Layout.chance`) are grounded."""
+        """With more than two arms: the current view's layout; assignments whose arms cross
+        (:meth:`~solvers.sdar.tasks.Layout.conflicts`) come after the others."""
 
     def key(self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...]) -> Hashable:
         """The tabu key of a grounding in the current arrangement."""
@@ -172,10 +169,8 @@ class Grounder:
             seats = {
                 t: [(index[a], mv.obj) for a, mv in zip(t, step.moves, strict=True)] for t in tuples
             }
-            chance = {t: layout.chance(seats[t]) for t in tuples}
-            best = max(chance.values(), default=0.0)
-            tuples = [t for t in tuples if chance[t] >= best / 2]
-            tuples.sort(key=lambda t: (sum(cost[a, i] for i, a in enumerate(t)), t))
+            crossings = {t: layout.conflicts(seats[t]) for t in tuples}
+            tuples.sort(key=lambda t: (crossings[t], sum(cost[a, i] for i, a in enumerate(t)), t))
         else:
             tuples.sort(key=lambda t: (sum(cost[a, i] for i, a in enumerate(t)), t))
         return tuples[: self.options.assignments]

@@ -15,13 +15,11 @@ of such groups matter:
   a unit holding an object that must wait (:meth:`~solvers.sdar.tasks.TaskView.must_wait`) is
   never added. When the view has a :class:`~solvers.sdar.tasks.Layout` (three arms or more,
   positions given by the app), the extension is spatial: the step's objects are seated on
-  arms (:func:`_seat`: each on the free arm that keeps the chance that no two arms meet
-  highest, :meth:`~solvers.sdar.tasks.Layout.chance`, then reaching least far), a unit fits
-  only if its objects are picked and placed at least the layout's clearance from the step's
-  and free arms move it with that chance staying at least :data:`~solvers.sdar.tasks.LIKELY`
-  (or the step's own, when lower), and units farther than the clearance from the step's poses
-  and goals come first. :func:`extensions`
-  offers the spatial extension and the one by dependencies alone.
+  arms (:func:`_seat`: each on the free arm crossing the fewest seated ones, then reaching
+  least far), a unit fits only if free arms move it without crossing a seated arm
+  (:meth:`~solvers.sdar.tasks.Layout.crosses`), and units farther than the layout's clearance
+  from the step's poses and goals come first. :func:`extensions` offers the spatial extension
+  and the one by dependencies alone.
 
 Both are bounded: rotations are at most one per component; :func:`extend` runs once per
 candidate it is given (SDAR-T gives it the first ``max_candidates`` steps of its two-arm list)
@@ -31,7 +29,7 @@ and costs ``k`` rounds over the units (twice with a layout). No set of ``k`` obj
 from __future__ import annotations
 
 from sdar_tamp.graph import strongly_connected_components
-from solvers.sdar.tasks import LIKELY, Layout, Move, Step, TaskView
+from solvers.sdar.tasks import Layout, Move, Step, TaskView
 
 
 class TaskScene:
@@ -64,32 +62,25 @@ class TaskScene:
         return all(self.blockers[x] <= group for x in group)
 
 
-def rotations(scene: TaskScene, arms: int) -> list[tuple[tuple[int, ...], Step, float]]:
+def rotations(scene: TaskScene, arms: int) -> list[tuple[tuple[int, ...], Step]]:
     """Closed components of ``3 <= m <= arms`` objects, each as one step of ``m`` goal moves
-    (kind ``rotate``); the key ``(-freed, -edges removed, first object's order)`` ranks them.
-    The third item: the chance that no two of its arms meet, for the best arms
-    (:meth:`~solvers.sdar.tasks.Layout.best_chance`; 1 without a layout)."""
-    out: list[tuple[tuple[int, ...], Step, float]] = []
-    layout = scene.view.layout
+    (kind ``rotate``); the key ``(-freed, -edges removed, first object's order)`` ranks them."""
+    out: list[tuple[tuple[int, ...], Step]] = []
     for unit in scene.units(frozenset()):
         group = frozenset(unit)
         if 3 <= len(unit) <= arms and scene.closed(group):
             freed, removed = scene.frees(group)
             key = (-freed, -removed, scene.order[unit[0]])
-            chance = layout.best_chance(unit) if layout is not None else 1.0
-            out.append((key, Step(tuple(Move(x) for x in unit), "rotate", 0, key[:-1]), chance))
+            out.append((key, Step(tuple(Move(x) for x in unit), "rotate", 0, key[:-1])))
     return out
 
 
 def extend(scene: TaskScene, step: Step, arms: int, spatial: bool = True) -> Step:
     """``step`` with goal moves of units added greedily (see the module docstring); ``step``
     itself when nothing fits. The added moves follow the step's own, in the order added.
-    ``spatial``: with a layout in the view, only units whose objects are picked and placed
-    at least the layout's clearance from the step's (:meth:`~solvers.sdar.tasks.Layout.
-    apart`: two grippers closing on neighbours meet) and that free arms move keeping the
-    chance that no two arms meet at least :data:`~solvers.sdar.tasks.LIKELY` (or the step's
-    own, when lower; :func:`_seat`), those away from the step's objects first; False: by
-    dependencies only."""
+    ``spatial``: with a layout in the view, only units an arm can move without crossing the
+    arms already in the step (:func:`_seat`), those away from the step's objects first;
+    False: by dependencies only."""
     lifted = frozenset(step.objects)
     if len(lifted) >= arms:
         return step
@@ -97,7 +88,6 @@ def extend(scene: TaskScene, step: Step, arms: int, spatial: bool = True) -> Ste
     layout = view.layout if spatial else None
     units = [u for u in scene.units(lifted) if not any(view.must_wait(x) for x in u)]
     seated = _seat(layout, (), step.objects)[1] if layout is not None else ()
-    floor = min(LIKELY, layout.chance(seated)) if layout is not None else 0.0
     added: list[str] = []
     while len(lifted) < arms:
         fits = [
@@ -108,11 +98,7 @@ def extend(scene: TaskScene, step: Step, arms: int, spatial: bool = True) -> Ste
         ]
         if layout is not None:
             seats = {u: _seat(layout, seated, u) for u in fits}
-            fits = [
-                u
-                for u in fits
-                if seats[u][0] >= floor and layout.apart(u, lifted) >= layout.clearance
-            ]
+            fits = [u for u in fits if seats[u][0] == 0]
         if not fits:
             break
         worth = {u: _worth(scene, lifted, u) for u in fits}
@@ -143,19 +129,23 @@ def extensions(scene: TaskScene, step: Step, arms: int) -> list[Step]:
 
 def _seat(
     layout: Layout, seated: tuple[tuple[int, str], ...], objs: tuple[str, ...]
-) -> tuple[float, tuple[tuple[int, str], ...]]:
+) -> tuple[int, tuple[tuple[int, str], ...]]:
     """Arms for ``objs`` besides those ``seated`` (arm index, object), greedily in order:
-    each on the free arm that keeps the :meth:`~solvers.sdar.tasks.Layout.chance` of the
-    seats highest, then reaching least far; that chance and every seat. An object with no
-    free arm makes the chance 0."""
+    each the free arm crossing the fewest seated ones (:meth:`~solvers.sdar.tasks.Layout.
+    crosses`), then reaching least far; the crossings added and every seat. An object with
+    no free arm counts one crossing per seated arm."""
+    crossings = 0
     out = list(seated)
     for x in objs:
         free = [a for a in range(len(layout.bases)) if all(a != b for b, _ in out)]
         if not free:
-            return 0.0, tuple(out)
-        chance = {a: layout.chance([*out, (a, x)]) for a in free}
-        out.append((min(free, key=lambda a: (-chance[a], layout.reach(a, x), a)), x))
-    return layout.chance(out), tuple(out)
+            crossings += len(out)
+            continue
+        cost = {a: sum(1 for b, y in out if layout.crosses(a, x, b, y)) for a in free}
+        arm = min(free, key=lambda a: (cost[a], layout.reach(a, x), a))
+        crossings += cost[arm]
+        out.append((arm, x))
+    return crossings, tuple(out)
 
 
 def _worth(scene: TaskScene, lifted: frozenset[str], unit: tuple[str, ...]) -> tuple[int, ...]:

@@ -57,12 +57,10 @@ steps of the ranked list and its one-move steps (class 6 included) are each exte
 with goal moves of units whose goals are free once the step's objects are lifted, up to ``k``
 moves; the extended
 step and its base are both kept (the base is the fallback when the larger step cannot be
-grounded); closed components of ``3..k`` objects are proposed as ``rotate`` steps of class 1
-(an ``m``-cycle rotated by ``m`` arms without a buffer; a component of ``3..k`` objects can
-still be broken at class 7, for when the rotation is geometrically impossible). Within a
-class, steps whose every assignment of arms has a chance under
-:data:`~solvers.sdar.tasks.LIKELY` that no two arms meet (the view's layout) come last, and
-steps bringing more objects to their goals first. So a list holds at most
+grounded); closed components of ``3..k`` objects are proposed as ``rotate`` steps of class 1 (an
+``m``-cycle rotated by ``m`` arms without a buffer; a component of ``3..k`` objects can still be
+broken at class 7, for when the rotation is geometrically impossible). Within a class, steps
+bringing more objects to their goals come first. So a list holds at most
 ``2 max_candidates`` steps of several moves, plus one rotation per component, plus the one-move
 steps; no set of ``k`` objects is enumerated.
 """
@@ -75,7 +73,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
 from solvers.sdar.buffer_sets import extending_minimum, optimal_choices
 from solvers.sdar.k_steps import TaskScene, extensions, rotations
-from solvers.sdar.tasks import LIKELY, Move, Step, TaskView
+from solvers.sdar.tasks import Move, Step, TaskView
 
 _Edges = tuple[tuple[int, int], ...]
 _DOUBLE_FIRSTS = 3  # double buffer moves are sought for the best three first objects
@@ -169,24 +167,16 @@ class SdarTaskPlanner:
     @staticmethod
     def _more_arms(scene: _Scene, arms: int, kept: _Ranked) -> _Ranked:
         """More than two arms: every kept step extended greedily (its base kept too), plus
-        the rotations of closed components; within a class, steps whose arms the view's
-        layout predicts to cross whatever arms move them last, then more goal moves first;
-        one step per set of moves (the best ranked). See :mod:`solvers.sdar.k_steps`."""
-        layout = scene.view.layout
-
-        def crossed(step: Step) -> int:
-            if layout is None or len(step.moves) < 2:
-                return 0
-            return int(layout.best_chance(step.objects) < LIKELY)
-
+        the rotations of closed components; within a class more goal moves first; one step
+        per set of moves (the best ranked). See :mod:`solvers.sdar.k_steps`."""
         out: _Ranked = []
         for key, step in kept:
             for wider in extensions(scene, step, arms):
-                out.append(((key[0], crossed(wider), -wider.progress, *key[1:]), wider))
-            out.append(((key[0], crossed(step), -step.progress, *key[1:]), step))
-        for key, step, chance in rotations(scene, arms):
+                out.append(((key[0], -wider.progress, *key[1:]), wider))
+            out.append(((key[0], -step.progress, *key[1:]), step))
+        for key, step in rotations(scene, arms):
             rotate = Step(step.moves, step.kind, GOAL_PAIR, step.tie)
-            out.append(((GOAL_PAIR, int(chance < LIKELY), -rotate.progress, *key), rotate))
+            out.append(((GOAL_PAIR, -rotate.progress, *key), rotate))
         out.sort(key=lambda item: item[0])
         best: dict[frozenset[Move], tuple[_Key, Step]] = {}
         for item in out:

@@ -98,24 +98,11 @@ class Layout:
         theirs = [p for y in others for p in self.places[y]]
         return min((math.dist(a, b) for a in mine for b in theirs), default=math.inf)
 
-    def apart(self, group: Iterable[str], others: Iterable[str]) -> float:
-        """The least distance between the current poses of ``group`` and of ``others``, and
-        between their goals: how close two grippers come picking and placing them at once."""
-        group, others = list(group), list(others)
-        return min(
-            (
-                math.dist(self.places[x][k], self.places[y][k])
-                for x in group
-                for y in others
-                for k in (0, 1)
-            ),
-            default=math.inf,
-        )
-
     def arm_gap(self, arm: int, obj: str, other_arm: int, other: str) -> float:
         """The least distance [m] between the plane segments from the bases of ``arm`` and
         ``other_arm`` to ``obj`` and ``other``, at the picks (current poses) and at the places
-        (goals): how close the two arms come, seen from above, moving them in one step."""
+        (goals): how close the two arms come, seen from above, moving them in one step
+        (``benchmarks/bench_layout.py`` measures how often arms so placed collide)."""
         return min(
             _segment_gap(
                 self.bases[arm], self.places[obj][k], self.bases[other_arm], self.places[other][k]
@@ -123,82 +110,16 @@ class Layout:
             for k in (0, 1)
         )
 
-    def meet(self, arm: int, obj: str, other_arm: int, other: str) -> float:
-        """The chance that ``arm`` moving ``obj`` and ``other_arm`` moving ``other`` in one
-        step collide at the picks or at the places: per instant, the share of pairs of arms
-        that collide at that gap of their segments (:data:`MEETING`, interpolated)."""
-        free = 1.0
-        for k in (0, 1):
-            gap = _segment_gap(
-                self.bases[arm], self.places[obj][k], self.bases[other_arm], self.places[other][k]
-            )
-            free *= 1.0 - _meeting(gap)
-        return 1.0 - free
+    def crosses(self, arm: int, obj: str, other_arm: int, other: str) -> bool:
+        """Arm ``arm`` moving ``obj`` while ``other_arm`` moves ``other`` in the same step:
+        their :meth:`arm_gap` is under ``clearance``; two arms reaching so meet."""
+        return self.arm_gap(arm, obj, other_arm, other) < self.clearance
 
-    def chance(self, assigned: Sequence[tuple[int, str]]) -> float:
-        """The chance that no two (arm, object) of ``assigned`` :meth:`meet` (pairs taken as
-        independent)."""
-        out = 1.0
-        for (a, x), (b, y) in itertools.combinations(assigned, 2):
-            out *= 1.0 - self.meet(a, x, b, y)
-        return out
-
-    def best_chance(self, objs: Sequence[str]) -> float:
-        """The best :meth:`chance` of ``objs`` moved in one step, over the assignments of
-        distinct arms to them: every assignment while there are at most
-        :data:`MAX_ASSIGNMENTS`, else the objects seated greedily in order, each on the free
-        arm that keeps the chance highest. 0 with more objects than arms."""
-        k, m = len(self.bases), len(objs)
-        if m > k:
-            return 0.0
-        if math.perm(k, m) <= MAX_ASSIGNMENTS:
-            return max(
-                self.chance(list(zip(arms, objs, strict=True)))
-                for arms in itertools.permutations(range(k), m)
-            )
-        seated: list[tuple[int, str]] = []
-        for x in objs:
-            free = [a for a in range(k) if all(a != b for b, _ in seated)]
-            seated.append(max(((a, x) for a in free), key=lambda s: self.chance([*seated, s])))
-        return self.chance(seated)
-
-
-#: The most assignments of arms :meth:`Layout.best_chance` compares one by one (four arms and
-#: four objects: 24).
-MAX_ASSIGNMENTS = 720
-#: A step whose best :meth:`Layout.chance` is below this is expected to make arms meet. At 0.35
-#: SDAR-T's four-arm plans of R12-1 and M12-1 took more steps (execution 20.32 and 20.82 s,
-#: against 16.44 and 19.35 s at 0.1, equal to the plans without the chance): its steps of
-#: three moves with a chance of 0.1-0.35 often ground (docs/benchmarks.md).
-LIKELY = 0.1
-#: (gap between two arms' plane segments [m], share of such pairs of arms that collide),
-#: measured on the UR5e shared-table cells with ``benchmarks/bench_layout.py`` (its defaults:
-#: 60 poses of the ``table_4arm`` suite; 18093 pairs of two arms at two objects 0.1 m apart or
-#: more, the other arms at home, each arm at the first IK of the object's first grasp that
-#: has one): the middles of its gap bands. With three grasps per arm and pose (``--options
-#: 3``) the shares are lower, but among the resting objects of an arrangement a step's moves
-#: have fewer options: with such a table (and :data:`LIKELY` at 0.35) R12-1 on the four-arm
-#: table had 9 objects left after 300 s, against solved in 54 s with one option.
-MEETING = (
-    (0.02, 0.80),
-    (0.06, 0.71),
-    (0.10, 0.58),
-    (0.14, 0.31),
-    (0.18, 0.18),
-    (0.225, 0.05),
-    (0.275, 0.02),
-    (0.35, 0.0),
-)
-
-
-def _meeting(gap: float) -> float:
-    """:data:`MEETING` at ``gap`` [m], linear between its points, constant beyond them."""
-    if gap <= MEETING[0][0]:
-        return MEETING[0][1]
-    for (g0, p0), (g1, p1) in itertools.pairwise(MEETING):
-        if gap <= g1:
-            return p0 + (p1 - p0) * (gap - g0) / (g1 - g0)
-    return MEETING[-1][1]
+    def conflicts(self, assigned: Sequence[tuple[int, str]]) -> int:
+        """Pairs of (arm, object) in ``assigned`` that :meth:`crosses`."""
+        return sum(
+            1 for (a, x), (b, y) in itertools.combinations(assigned, 2) if self.crosses(a, x, b, y)
+        )
 
 
 def _segment_gap(

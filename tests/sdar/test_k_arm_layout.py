@@ -4,7 +4,6 @@ and SDAR-M's assignment of arms with more than two arms."""
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 from pathlib import Path
 
@@ -18,17 +17,7 @@ from solvers.sdar.k_steps import TaskScene, extend, extensions
 from solvers.sdar.options import SdarOptions
 from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
-from solvers.sdar.tasks import (
-    LIKELY,
-    MAX_ASSIGNMENTS,
-    MEETING,
-    Layout,
-    Move,
-    Step,
-    TaskView,
-    _meeting,
-    _segment_gap,
-)
+from solvers.sdar.tasks import Layout, Move, Step, TaskView, _segment_gap
 from streams.context import WorldContext
 
 DATA = Path(__file__).parent / "data"
@@ -60,45 +49,12 @@ def test_arms_reaching_across_each_other_cross_and_arms_on_their_own_side_do_not
     layout = _view(places, 4).layout
     assert layout is not None
     assert layout.side("a") == 0 and layout.side("c") == 2
-    assert layout.meet(0, "a", 1, "b") > 0.9  # north reaches over the table onto south's object
-    assert layout.meet(0, "a", 2, "c") == 0.0  # far apart
-    assert layout.arm_gap(0, "a", 1, "b") < 0.06 < 0.3 < layout.arm_gap(0, "a", 2, "c")
-    both = layout.chance([(0, "a"), (1, "b"), (2, "c")])
-    pairs = [(0, "a", 1, "b"), (0, "a", 2, "c"), (1, "b", 2, "c")]
-    assert both == pytest.approx(math.prod(1 - layout.meet(*p) for p in pairs))
-    assert layout.best_chance(["a", "c"]) == 1.0
-    assert layout.best_chance(["a", "b"]) < LIKELY  # neighbours: any two arms meet
-    assert layout.best_chance(["a", "b", "c", "a2", "x"]) == 0.0  # more objects than arms
+    assert layout.crosses(0, "a", 1, "b")  # north reaches over the table onto south's object
+    assert not layout.crosses(0, "a", 2, "c")
+    assert layout.arm_gap(0, "a", 1, "b") < 0.08 < 0.3 < layout.arm_gap(0, "a", 2, "c")
+    assert layout.arm_gap(0, "a", 1, "b") == layout.arm_gap(1, "b", 0, "a")
+    assert layout.conflicts([(0, "a"), (1, "b"), (2, "c")]) == 1
     assert layout.gap(["a"], ["b"]) < 0.08 < layout.gap(["a"], ["c"])
-
-
-def test_objects_apart_are_compared_pick_with_pick_and_goal_with_goal() -> None:
-    places = {
-        "a": ((0.0, 0.0), (0.3, 0.0)),
-        "b": ((0.3, 0.0), (0.0, 0.2)),  # on a's goal now: a chain, not neighbours
-        "c": ((0.0, 0.05), (0.6, 0.0)),  # beside a's pose
-    }
-    layout = Layout(places, BASES)
-    assert layout.apart(["b"], ["a"]) == pytest.approx(0.3)  # the poses (goals: 0.36)
-    assert layout.gap(["b"], ["a"]) == 0.0  # any pose or goal with any
-    assert layout.apart(["c"], ["a", "b"]) == pytest.approx(0.05)
-    assert layout.apart([], ["a"]) == math.inf
-
-
-def test_the_chance_of_meeting_follows_the_measured_table() -> None:
-    assert _meeting(0.0) == MEETING[0][1] and _meeting(1.0) == 0.0
-    assert _meeting(0.08) == pytest.approx((0.71 + 0.58) / 2)
-    gaps = [k / 100 for k in range(40)]
-    assert all(_meeting(a) >= _meeting(b) for a, b in itertools.pairwise(gaps))
-
-
-def test_the_best_chance_seats_objects_greedily_beyond_the_assignments_compared() -> None:
-    bases = tuple((math.cos(k), math.sin(k)) for k in range(8))  # 8 arms on a unit circle
-    places = {f"o{k}": ((0.5 * x, 0.5 * y), (0.5 * x, 0.5 * y)) for k, (x, y) in enumerate(bases)}
-    layout = Layout(places, bases)
-    objs = [f"o{k}" for k in range(5)]  # 8 * 7 * 6 * 5 * 4 = 6720 assignments: greedy
-    assert math.perm(8, 5) > MAX_ASSIGNMENTS
-    assert layout.best_chance(objs) == 1.0  # each on the arm behind it: far apart
 
 
 def test_the_extension_adds_an_object_another_arm_reaches_apart_not_a_neighbour() -> None:
@@ -167,7 +123,7 @@ def test_the_app_builds_the_plane_of_the_cell_and_the_solver_a_layout_beyond_two
     assert SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions(plane=blind)).view().layout is None
 
 
-def test_only_the_assignments_likeliest_to_keep_the_arms_apart_are_grounded() -> None:
+def test_assignments_whose_arms_cross_come_last() -> None:
     path = DATA / "four_arm_cycle.yaml"
     instance = load_instance(path)
     ctx = WorldContext.load(instance.scene_path(path))
@@ -176,16 +132,12 @@ def test_only_the_assignments_likeliest_to_keep_the_arms_apart_are_grounded() ->
     solver = SdarSolver(r.problem, SdarTaskPlanner(), options)
     view = solver.view()
     solver.grounder.layout = view.layout
-    layout = view.layout
-    assert layout is not None
-    rotate = next(s for s in solver.planner.candidates(view) if s.kind == "rotate")
+    assert view.layout is not None
+    rotate = solver.planner.candidates(view)[0]
     found = solver.grounder._assignments(rotate)
     index = {a: k for k, a in enumerate(sorted(solver.home))}
-
-    def chance(arms: tuple[str, ...]) -> float:
-        return layout.chance([(index[a], m.obj) for a, m in zip(arms, rotate.moves, strict=True)])
-
-    every = list(itertools.permutations(sorted(solver.home), len(rotate.moves)))
-    best = max(map(chance, every))
-    assert found and all(chance(arms) >= best / 2 for arms in found)
-    assert len(found) < len(every)  # some assignments make two arms meet
+    crossings = [
+        view.layout.conflicts([(index[a], m.obj) for a, m in zip(arms, rotate.moves, strict=True)])
+        for arms in found
+    ]
+    assert crossings == sorted(crossings) and crossings[0] < crossings[-1]
