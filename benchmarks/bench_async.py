@@ -14,6 +14,9 @@ together at their synchronous pace (swap halves), ``cut`` the time [s] shortened
 
     python benchmarks/bench_async.py [--suite paper] [--only R4,R6,D5] [--plans DIR] [--save]
                                      [--time-limit 60] [--sync-pace]
+
+``--suite`` may be a suite of the shared table's cells (``table_1arm`` ... ``table_4arm``: each
+instance names its cell).
     python benchmarks/bench_async.py --quick    # R4 alone: seconds
 
 Prints one row per instance (``bound``: the busier arm's motions and dwells, a lower bound
@@ -46,7 +49,7 @@ from sdar_tamp.schedule.scheduler import retimer
 from sdar_tamp.schedule.timelines import schedule_timelines
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.scene import load_scene
-from sdar_tamp.world.suites import SUITES
+from sdar_tamp.world.suites import CELL_SUITES, SUITES
 
 
 def _suite_files(suite: str) -> list[Path]:
@@ -77,7 +80,7 @@ QUICK = {"only": "R4", "time_limit": 30.0}
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--suite", default="paper", choices=SUITES)
+    ap.add_argument("--suite", default="paper", choices=(*SUITES, *CELL_SUITES))
     ap.add_argument("--only", default="", help="comma-separated instance names")
     ap.add_argument("--plans", type=Path, default=None, help="folder of plan files <name>.json")
     ap.add_argument("--save", action="store_true", help="solve and write the plans to --plans")

@@ -98,17 +98,22 @@ class Layout:
         theirs = [p for y in others for p in self.places[y]]
         return min((math.dist(a, b) for a in mine for b in theirs), default=math.inf)
 
-    def crosses(self, arm: int, obj: str, other_arm: int, other: str) -> bool:
-        """Arm ``arm`` moving ``obj`` while ``other_arm`` moves ``other`` in the same step:
-        the segments from their bases to the objects come closer than ``clearance`` at the
-        picks (current poses) or at the places (goals); two arms reaching so meet."""
-        return any(
+    def arm_gap(self, arm: int, obj: str, other_arm: int, other: str) -> float:
+        """The least distance [m] between the plane segments from the bases of ``arm`` and
+        ``other_arm`` to ``obj`` and ``other``, at the picks (current poses) and at the places
+        (goals): how close the two arms come, seen from above, moving them in one step
+        (``benchmarks/bench_layout.py`` measures how often arms so placed collide)."""
+        return min(
             _segment_gap(
                 self.bases[arm], self.places[obj][k], self.bases[other_arm], self.places[other][k]
             )
-            < self.clearance
             for k in (0, 1)
         )
+
+    def crosses(self, arm: int, obj: str, other_arm: int, other: str) -> bool:
+        """Arm ``arm`` moving ``obj`` while ``other_arm`` moves ``other`` in the same step:
+        their :meth:`arm_gap` is under ``clearance``; two arms reaching so meet."""
+        return self.arm_gap(arm, obj, other_arm, other) < self.clearance
 
     def conflicts(self, assigned: Sequence[tuple[int, str]]) -> int:
         """Pairs of (arm, object) in ``assigned`` that :meth:`crosses`."""

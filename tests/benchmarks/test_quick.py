@@ -72,6 +72,12 @@ def _feasibility(out: Summary) -> None:
         assert out[label]["seconds"], label
 
 
+def _layout(out: Summary) -> None:
+    assert out["benchmark"] == "layout" and out["poses"] == 12 and out["pairs"] > 0
+    near, far = out["clearances"]["0.08"], out["clearances"]["0.20"]
+    assert far["collide_kept"] <= near["collide_kept"] and far["free_kept"] <= near["free_kept"]
+
+
 def _motion(out: Summary) -> None:
     assert out["segments"] == 3 and 0.0 <= out["success_rate_with_fallbacks"] <= 1.0
     assert out["validation_failures_returned_as_success"] == 0
@@ -161,6 +167,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_cells", ()): _cells,
     ("bench_classical", ()): _classical,
     ("bench_feasibility", ()): _feasibility,
+    ("bench_layout", ()): _layout,
     ("bench_motion", ()): _motion,
     ("bench_motion", ("--hard", "1")): _motion_hard,
     ("bench_motion_arms", ()): _motion_arms,

@@ -51,6 +51,8 @@ def test_arms_reaching_across_each_other_cross_and_arms_on_their_own_side_do_not
     assert layout.side("a") == 0 and layout.side("c") == 2
     assert layout.crosses(0, "a", 1, "b")  # north reaches over the table onto south's object
     assert not layout.crosses(0, "a", 2, "c")
+    assert layout.arm_gap(0, "a", 1, "b") < 0.08 < 0.3 < layout.arm_gap(0, "a", 2, "c")
+    assert layout.arm_gap(0, "a", 1, "b") == layout.arm_gap(1, "b", 0, "a")
     assert layout.conflicts([(0, "a"), (1, "b"), (2, "c")]) == 1
     assert layout.gap(["a"], ["b"]) < 0.08 < layout.gap(["a"], ["c"])
 
