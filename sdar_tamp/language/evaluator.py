@@ -7,7 +7,9 @@ objects:
 * ``and``/``or``/``not``/``imply`` as in logic, ``(= a b)`` by name, ``And(())`` true and
   ``Or(())`` false;
 * ``exists`` looks for a witness: a parameter named by a positive atom of the body takes its
-  values from that atom's facts, any other ranges over the objects of its type; ``forall``
+  values from that atom's facts (the atom with the fewest), any other ranges over the objects
+  of its type (the first witness is the same whichever atom gave the values; a refutation
+  covers those bindings only: elsewhere an absent fact makes the body false); ``forall``
   ranges over the objects of its types, but for a body ``(imply A C)`` a parameter that a
   positive atom of ``A`` names takes its values from that atom's facts (a binding outside
   them makes ``A`` false: the body holds, and relies on no fact when ``A`` is a conjunction
@@ -178,10 +180,10 @@ class Evaluator:
     ) -> Iterator[dict[str, str]]:
         """Candidate bindings of an existential's ``parameters`` (a superset of its witnesses):
         a parameter that a positive atom of ``body`` names takes the values of that atom's
-        facts (of the parameter's type; the first such atom with facts), any other ranges over
-        its type. In lexicographic order of the parameters' values."""
+        facts (of the parameter's type; of the atom with the fewest facts), any other ranges
+        over its type. In lexicographic order of the parameters' values."""
         hints = _positive_atoms(body)
-        return _extend(parameters, [self._values(p, hints, False) for p in parameters], binding)
+        return _extend(parameters, [self._values(p, hints) for p in parameters], binding)
 
     def every(
         self, parameters: Sequence[Parameter], binding: Binding, body: Formula | None = None
@@ -192,7 +194,7 @@ class Evaluator:
         values of that atom's facts only (elsewhere ``A`` is false, so the body holds; with
         ``explain``, only when ``A`` is a conjunction of atoms, whose refutation is empty)."""
         guards = self._guards(body) if body is not None else []
-        return _extend(parameters, [self._values(p, guards, True) for p in parameters], binding)
+        return _extend(parameters, [self._values(p, guards) for p in parameters], binding)
 
     def _guards(self, body: Formula) -> list[Atom]:
         """The positive atoms of the antecedent of a universal's ``body`` (see :meth:`every`)."""
@@ -208,11 +210,10 @@ class Evaluator:
                 return []
         return _positive_atoms(antecedent)
 
-    def _values(self, param: Parameter, hints: Sequence[Atom], fewest: bool) -> Sequence[str]:
-        """The values ``param`` takes: those of a (non-derived) atom of ``hints`` naming it
-        (the first with facts, or with ``fewest`` the one with the fewest), of the parameter's
-        type, sorted; the objects of its type when none names it or none has facts (a view may
-        not list every atom it holds)."""
+    def _values(self, param: Parameter, hints: Sequence[Atom]) -> Sequence[str]:
+        """The values ``param`` takes: those of the (non-derived) atom of ``hints`` naming it
+        with the fewest facts, of the parameter's type, sorted; the objects of its type when
+        none names it or none has facts (a view may not list every atom it holds)."""
         best: Collection[tuple[str, ...]] | None = None
         position = 0
         for atom in hints:
@@ -221,8 +222,6 @@ class Evaluator:
             found = self.facts.args_of(atom.predicate)
             if found and (best is None or len(found) < len(best)):
                 best, position = found, atom.args.index(param.name)
-                if not fewest:
-                    break
         if best is None:
             return self.objects.objects_of(param.type)
         return sorted(

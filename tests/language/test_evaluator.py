@@ -194,3 +194,28 @@ def test_forall_with_a_negated_antecedent_is_not_narrowed_when_explaining(domain
     body = Imply(And((Not(Atom("clean", ("?i",))), Atom("on", ("?i", "p1")))), Atom("lit"))
     assert len(list(ev.every(params, {}, body))) == 3  # every item
     assert len(list(lab_evaluator(domain).every(params, {}, body))) == 2  # items on a place
+
+
+def test_exists_takes_its_candidates_from_the_atom_with_the_fewest_facts(domain: Domain) -> None:
+    """?p is named by (edge ?p ?q) (3 edge facts) and (on b1 ?p) (2 on facts): its
+    candidates are those of on. A refutation covers those only: at p3, b1 is not there (an
+    absent fact), so (edge p3 p1), which would make the first part false, is not relied on."""
+    params = (Parameter("?p", "place"),)
+    body = And(
+        (
+            Not(Atom("edge", ("?p", "p1"))),
+            Atom("edge", ("?p", "?q")),
+            Atom("on", ("b1", "?p")),
+        )
+    )
+    ev = lab_evaluator(domain, explain=True)
+    assert [b["?p"] for b in ev.witnesses(params, body, {"?q": "p3"})] == ["p1", "p2"]
+    formula = Exists(params, body)
+    assert ev.support(formula, {"?q": "p3"}) is None
+    assert ev.refutation(formula, {"?q": "p3"}) == frozenset()
+    assert ev.support(Not(formula), {"?q": "p3"}) == frozenset()
+    # the first witness is the same as with every place tried
+    assert ev.support(formula, {"?q": "p2"}) == {
+        Atom("edge", ("p1", "p2")),
+        Atom("on", ("b1", "p1")),
+    }
