@@ -184,8 +184,13 @@ _GUARD = (
 )
 
 
-def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, object]:
-    """Run one example; returns its name, result, time [s] and details."""
+def run_example(
+    checkout: Path, example: Example, timeout: float, seed: int | None = None
+) -> dict[str, object]:
+    """Run one example; returns its name, result, time [s] and details (``solve_seconds``:
+    the time of the program's solve calls). ``seed``: Python's and NumPy's random generators
+    are seeded with it before the program starts (an unseeded example then runs the same way
+    each time)."""
     if example.needs and importlib.util.find_spec(example.needs) is None:
         return {
             "example": example.name,
@@ -195,12 +200,15 @@ def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, o
             "seconds": 0.0,
             "solve_calls": 0,
             "plans": 0,
+            "solve_seconds": 0.0,
         }
     with tempfile.TemporaryDirectory() as scratch:
         report = Path(scratch) / "report.json"
         guard = _GUARD.format(
             pkg=str(checkout / "pddlstream") + os.sep, numpy_aliases=NUMPY_ALIASES
         )
+        if seed is not None:
+            guard = f"import random, numpy\nrandom.seed({seed})\nnumpy.random.seed({seed})\n{guard}"
         command = [
             sys.executable,
             "-c",
@@ -262,6 +270,7 @@ def run_example(checkout: Path, example: Example, timeout: float) -> dict[str, o
         "seconds": round(seconds, 2),
         "solve_calls": len(calls),
         "plans": len(solved),
+        "solve_seconds": round(sum(float(c.get("seconds", 0.0)) for c in calls), 3),
     }
 
 

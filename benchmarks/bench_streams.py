@@ -23,8 +23,17 @@ on the collision test; every algorithm on ``--kitchen-seeds`` seeds each, a run 
 nothing) when every seed ends ``infeasible`` within ``INFEASIBLE_SECONDS`` with the failing
 collision test named in the diagnosis. ``--kitchen-seeds 0`` skips these rows.
 
+Then PDDLStream's own continuous_tamp (its ``tight`` problem, two blocks), unmodified, through
+the alias (``benchmarks/bench_pddlstream_compat.py`` runs it, one process a run, seeding Python's
+and NumPy's generators): every algorithm (``-a``) on ``--tamp-seeds`` seeds; a row is met when
+every seed finds a plan that passes the re-check within ``FEASIBLE_SECONDS`` of solve time (the
+example wraps its solve in its own profiler, as in PDDLStream). It needs a PDDLStream checkout
+(``--pddlstream PATH`` or ``$PDDLSTREAM_PATH``; without one the rows are skipped and the JSON
+says why); ``--tamp-seeds 0`` skips them.
+
 ``--quick`` changes only the defaults: every algorithm on kitchen, dual_arm_swap and infeasible
-(pick_place_2d, the slow one, left out), the 2-D kitchen on 2 seeds (3 s a run), a 0.2 s
+(pick_place_2d, the slow one, left out), the 2-D kitchen on 2 seeds (3 s a run),
+continuous_tamp on 1 seed, a 0.2 s
 overrun probe and 2,000 calls for the call overhead; the JSON keys are the same, plus
 ``"quick": true``.
 """
@@ -33,11 +42,15 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import itertools
 import json
 import logging
 import math
+import os
+import sys
 import time
+from pathlib import Path
 from typing import Any
 
 from domains.kitchen_2d import samplers as kitchen_2d
@@ -59,6 +72,7 @@ QUICK = {
     "overhead_calls": 2_000,
     "kitchen_seeds": 2,
     "kitchen_max_time": 3.0,
+    "tamp_seeds": 1,
 }
 #: The 2-D kitchen's variants: name -> (shelf width [m], pose sampler, negate the test)
 KITCHEN_VARIANTS: dict[str, tuple[float, str, bool]] = {
@@ -161,6 +175,53 @@ def kitchen_rows(algorithms: list[str], seeds: int, max_time: float) -> list[dic
                     "stream_calls": [r["stream_calls"] for r in runs],
                 }
             )
+    return rows
+
+
+def _compat_bench() -> Any:
+    """``bench_pddlstream_compat.py`` beside this file (the runner of PDDLStream's examples)."""
+    path = Path(__file__).with_name("bench_pddlstream_compat.py")
+    spec = importlib.util.spec_from_file_location("bench_pddlstream_compat", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # (its dataclasses look their module up)
+    spec.loader.exec_module(module)
+    return module
+
+
+#: [s] a continuous_tamp run's process is stopped after this (the example's own limit is 30 s)
+TAMP_TIMEOUT = 60.0
+
+
+def tamp_rows(checkout: Path, algorithms: list[str], seeds: int) -> list[dict[str, Any]]:
+    """PDDLStream's continuous_tamp through the alias: per algorithm, the seeds solved within
+    ``FEASIBLE_SECONDS`` of solve time (its plans re-checked by the runner)."""
+    bench = _compat_bench()
+    rows = []
+    for algorithm in algorithms:
+        example = bench.Example(
+            "continuous_tamp", "examples.continuous_tamp.run", args=("-a", algorithm)
+        )
+        runs = [
+            bench.run_example(checkout, example, TAMP_TIMEOUT, seed=seed) for seed in range(seeds)
+        ]
+        times = sorted(float(r["solve_seconds"]) for r in runs)
+        rows.append(
+            {
+                "variant": "continuous_tamp (alias)",
+                "algorithm": algorithm,
+                "expected": "solved",
+                "seeds": seeds,
+                "met": sum(
+                    bool(r["passed"]) and r["solve_seconds"] <= FEASIBLE_SECONDS for r in runs
+                ),
+                "statuses": [str(r["result"]) for r in runs],
+                "median_time": times[len(times) // 2],
+                "max_time": times[-1],
+                "rounds_per_s": None,
+                "solve_seconds": [r["solve_seconds"] for r in runs],
+            }
+        )
     return rows
 
 
@@ -269,6 +330,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--kitchen-max-time", type=float, default=10.0, help="[s] per 2-D kitchen run"
     )
+    parser.add_argument(
+        "--pddlstream",
+        default=os.environ.get("PDDLSTREAM_PATH"),
+        help="a PDDLStream checkout, for the continuous_tamp rows (default: $PDDLSTREAM_PATH)",
+    )
+    parser.add_argument(
+        "--tamp-seeds", type=int, default=8, help="seeds per continuous_tamp row; 0: skip them"
+    )
     parser.add_argument("--quick", action="store_true", help="the fast domains, short probes")
     args = parser.parse_args(argv)
     if args.quick:  # explicit options still win
@@ -289,6 +358,16 @@ def main(argv: list[str] | None = None) -> int:
     )
     if kitchen:
         print(kitchen_table(kitchen))
+    tamp: list[dict[str, Any]] = []
+    tamp_skipped = None
+    if args.tamp_seeds > 0:
+        checkout = Path(args.pddlstream) if args.pddlstream else None
+        if checkout is None or not (checkout / "examples" / "continuous_tamp").is_dir():
+            tamp_skipped = f"no PDDLStream checkout (--pddlstream or $PDDLSTREAM_PATH): {checkout}"
+            print(f"continuous_tamp rows skipped: {tamp_skipped}")
+        else:
+            tamp = tamp_rows(checkout.resolve(), args.algorithms, args.tamp_seeds)
+            print(kitchen_table(tamp))
     probes = (
         [limit_overrun(algorithm, args.limit_probe) for algorithm in args.algorithms]
         if args.limit_probe > 0
@@ -320,6 +399,10 @@ def main(argv: list[str] | None = None) -> int:
         "kitchen_2d": kitchen,
         "kitchen_2d_met": sum(r["met"] for r in kitchen),
         "kitchen_2d_runs": sum(r["seeds"] for r in kitchen),
+        "continuous_tamp": tamp,
+        "continuous_tamp_met": sum(r["met"] for r in tamp),
+        "continuous_tamp_runs": sum(r["seeds"] for r in tamp),
+        "continuous_tamp_skipped": tamp_skipped,
         "max_time_probes": probes,
         "max_time_overrun_max": max((p["overrun"] for p in probes), default=None),
         "quick": args.quick,

@@ -57,8 +57,9 @@ PLANNER_ALIASES: dict[str, tuple[str, str, float]] = {
     "ff-eager-tiebreak": ("gbfs", "ff", 1.0),
     "ff-lazy-tiebreak": ("gbfs", "ff", 1.0),
     "ff-ehc": ("gbfs", "ff", 1.0),
-    **{f"ff-wastar{w}": ("wastar", "ff", float(w)) for w in range(1, 6)},
-    **{f"cea-wastar{w}": ("wastar", "ff", float(w)) for w in range(1, 6)},
+    # Fast Downward's lazy_wastar with preferred operators, as PDDLStream configures them
+    **{f"ff-wastar{w}": ("lazy-wastar", "ff", float(w)) for w in range(1, 6)},
+    **{f"cea-wastar{w}": ("lazy-wastar", "ff", float(w)) for w in range(1, 6)},
     **{f"ff-astar{w}": ("wastar", "ff", float(w)) for w in range(1, 6)},
 }
 _APPROXIMATED = {

@@ -7,8 +7,13 @@ objects:
 * ``and``/``or``/``not``/``imply`` as in logic, ``(= a b)`` by name, ``And(())`` true and
   ``Or(())`` false;
 * ``exists`` looks for a witness: a parameter named by a positive atom of the body takes its
-  values from that atom's facts, any other ranges over the objects of its type; ``forall``
-  ranges over the objects of its types;
+  values from that atom's facts (the atom with the fewest), any other ranges over the objects
+  of its type (the first witness is the same whichever atom gave the values; a refutation
+  covers those bindings only: elsewhere an absent fact makes the body false); ``forall``
+  ranges over the objects of its types, but for a body ``(imply A C)`` a parameter that a
+  positive atom of ``A`` names takes its values from that atom's facts (a binding outside
+  them makes ``A`` false: the body holds, and relies on no fact when ``A`` is a conjunction
+  of atoms);
 * a type name used as a unary predicate holds for the objects of that type;
 * a derived predicate is evaluated on demand from its axioms (any axiom may derive it; an
   axiom variable that is not a parameter is existential), memoised per state; positive
@@ -113,7 +118,7 @@ class Evaluator:
                     return found
             return None
         collected: set[Atom] = set()
-        for extended in self.every(formula.parameters, binding):
+        for extended in self.every(formula.parameters, binding, formula.body):
             found = self.support(formula.body, extended)
             if found is None:
                 return None
@@ -149,7 +154,7 @@ class Evaluator:
                     for extended in self.witnesses(formula.parameters, formula.body, binding)
                 )
             )
-        for extended in self.every(formula.parameters, binding):
+        for extended in self.every(formula.parameters, binding, formula.body):
             if self.support(formula.body, extended) is None:
                 return self.refutation(formula.body, extended)
         return EMPTY
@@ -175,34 +180,53 @@ class Evaluator:
     ) -> Iterator[dict[str, str]]:
         """Candidate bindings of an existential's ``parameters`` (a superset of its witnesses):
         a parameter that a positive atom of ``body`` names takes the values of that atom's
-        facts (of the parameter's type), any other ranges over its type. In lexicographic order
-        of the parameters' values."""
+        facts (of the parameter's type; of the atom with the fewest facts), any other ranges
+        over its type. In lexicographic order of the parameters' values."""
         hints = _positive_atoms(body)
-        candidates: list[Sequence[str]] = []
-        for param in parameters:
-            values: Collection[tuple[str, ...]] | None = None
-            for atom in hints:
-                if param.name in atom.args and atom.predicate not in self._axioms:
-                    found = self.facts.args_of(atom.predicate)
-                    if found:
-                        position = atom.args.index(param.name)
-                        values = found
-                        break
-            if values is None:
-                candidates.append(self.objects.objects_of(param.type))
-            else:
-                candidates.append(
-                    sorted(
-                        v
-                        for v in {args[position] for args in values}
-                        if self.objects.has_type(v, param.type)
-                    )
-                )
-        return _extend(parameters, candidates, binding)
+        return _extend(parameters, [self._values(p, hints) for p in parameters], binding)
 
-    def every(self, parameters: Sequence[Parameter], binding: Binding) -> Iterator[dict[str, str]]:
-        """Every binding of ``parameters`` to objects of their types (universal quantifiers)."""
-        return _extend(parameters, [self.objects.objects_of(p.type) for p in parameters], binding)
+    def every(
+        self, parameters: Sequence[Parameter], binding: Binding, body: Formula | None = None
+    ) -> Iterator[dict[str, str]]:
+        """The bindings of a universal's ``parameters`` on which its ``body`` may be false or
+        rely on facts: every object of their types, but when ``body`` is ``(imply A C)`` (or
+        ``(or (not A) ...)``), a parameter that a positive atom of ``A`` names takes the
+        values of that atom's facts only (elsewhere ``A`` is false, so the body holds; with
+        ``explain``, only when ``A`` is a conjunction of atoms, whose refutation is empty)."""
+        guards = self._guards(body) if body is not None else []
+        return _extend(parameters, [self._values(p, guards) for p in parameters], binding)
+
+    def _guards(self, body: Formula) -> list[Atom]:
+        """The positive atoms of the antecedent of a universal's ``body`` (see :meth:`every`)."""
+        if isinstance(body, Imply):
+            antecedent = body.antecedent
+        elif isinstance(body, Or) and body.parts and isinstance(body.parts[0], Not):
+            antecedent = body.parts[0].formula
+        else:
+            return []
+        if self.explain:
+            parts = antecedent.parts if isinstance(antecedent, And) else (antecedent,)
+            if not all(isinstance(p, Atom) and p.predicate not in self._axioms for p in parts):
+                return []
+        return _positive_atoms(antecedent)
+
+    def _values(self, param: Parameter, hints: Sequence[Atom]) -> Sequence[str]:
+        """The values ``param`` takes: those of the (non-derived) atom of ``hints`` naming it
+        with the fewest facts, of the parameter's type, sorted; the objects of its type when
+        none names it or none has facts (a view may not list every atom it holds)."""
+        best: Collection[tuple[str, ...]] | None = None
+        position = 0
+        for atom in hints:
+            if param.name not in atom.args or atom.predicate in self._axioms:
+                continue
+            found = self.facts.args_of(atom.predicate)
+            if found and (best is None or len(found) < len(best)):
+                best, position = found, atom.args.index(param.name)
+        if best is None:
+            return self.objects.objects_of(param.type)
+        return sorted(
+            v for v in {args[position] for args in best} if self.objects.has_type(v, param.type)
+        )
 
     # -- derived predicates --------------------------------------------------------------------
     def _axiom_body(self, axiom: Axiom, atom: Atom) -> tuple[Formula, dict[str, str]]:

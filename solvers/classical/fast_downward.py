@@ -104,6 +104,13 @@ def search_engine(search: str, heuristic: str, weight: float = 2.0, options: str
         if weight != int(weight):
             raise ParameterError(f"weight must be an integer for Fast Downward; got {weight!r}")
         engine = f"eager_wastar([{hs}]{preferred},w={weight:g}{options})"
+    elif search == "lazy-wastar":
+        if weight != int(weight):
+            raise ParameterError(f"weight must be an integer for Fast Downward; got {weight!r}")
+        engine = (
+            f"lazy_wastar([{hs}]{preferred},reopen_closed=true,w={weight:g},"
+            f"cost_type=plusone{options})"
+        )
     elif search == "astar" and len(names) == 1:
         engine = f"astar({names[0]}{options})"
     else:

@@ -25,7 +25,7 @@ from solvers.classical.reachability import GroundingTimeout
 from solvers.classical.search import Evaluator, SearchOutcome, best_first_search
 from solvers.classical.task import GroundTask
 
-SEARCHES = ("gbfs", "astar", "wastar", "lazy-gbfs")
+SEARCHES = ("gbfs", "astar", "wastar", "lazy-gbfs", "lazy-wastar")
 logger = get_logger(__name__)
 
 
@@ -64,7 +64,9 @@ def plan(
 
     ``search``: ``"gbfs"`` (greedy best-first), ``"lazy-gbfs"`` (greedy best-first with lazy
     evaluation and unit action costs inside the heuristics, as LAMA's first iteration),
-    ``"astar"`` or ``"wastar"`` (f = g + weight·h).
+    ``"astar"`` or ``"wastar"`` (f = g + weight·h), ``"lazy-wastar"`` (weighted A* with lazy
+    evaluation and 1 added to every action cost inside the heuristic, as Fast Downward's
+    ``lazy_wastar`` in PDDLStream's ``ff-wastar`` planners).
     ``heuristic``: ``"ff"``, ``"add"``, ``"max"``, ``"blind"``, ``"lmcount"`` (landmark count,
     path-dependent and not admissible) or ``"ff-lmcount"`` (h_FF and landmark count in
     alternating queues, LAMA's guidance). Preferred operators (from the relaxed plan; not used
@@ -152,7 +154,7 @@ def _search(
     costs = compiled.costs
     if search == "lazy-gbfs":
         costs = [1.0] * len(costs)  # as LAMA's first iteration: distance to the goal in steps
-    elif search == "gbfs" and ground_task.source.use_costs:
+    elif search in ("gbfs", "lazy-wastar") and ground_task.source.use_costs:
         costs = [c + 1.0 for c in costs]  # "plusone": zero-cost actions still count
     relaxed_name = heuristic.removesuffix("-lmcount")
     relaxed = None if relaxed_name == "lmcount" else RelaxedHeuristic(compiled, relaxed_name, costs)
@@ -169,6 +171,7 @@ def _search(
         "lazy-gbfs": (0.0, 1.0),
         "astar": (1.0, 1.0),
         "wastar": (1.0, weight),
+        "lazy-wastar": (1.0, weight),
     }[search]
     outcome = best_first_search(
         compiled,
@@ -176,7 +179,7 @@ def _search(
         g_weight=g_weight,
         h_weight=h_weight,
         preferred=preferred and relaxed_name not in ("blind", "lmcount") and search != "astar",
-        lazy=lazy or search == "lazy-gbfs",
+        lazy=lazy or search in ("lazy-gbfs", "lazy-wastar"),
         reopen=search not in ("gbfs", "lazy-gbfs"),
         deadline=deadline,
         cost_bound=cost_bound,

@@ -33,6 +33,9 @@ from solvers.stream_planning.stream_plans import ActionEfforts
 
 LOG = get_logger(__name__)
 PlanSteps = list[tuple[str, tuple[str, ...]]]
+#: [s] the least time a drain of samplers may take before its time bound applies
+#: (:meth:`SolveContext.drain`)
+DRAIN_SECONDS = 0.5
 
 
 class SolveTimeout(Exception):
@@ -77,6 +80,7 @@ class SolveContext:
         self.deferred_calls = 0  # deferred tests and functions evaluated for candidate plans
         self.unreachable = False  # the last plan search found the goal relaxed-unreachable
         self.searched = 0  # facts the last plan search planned over
+        self.search_seconds = 0.0  # [s] the plan searches since the last drain took
         self._order = 0
 
     def next_order(self) -> int:
@@ -144,6 +148,7 @@ class SolveContext:
             cost_bound=self._cost_bound(),
         )
         self.stats.search_time += time.perf_counter() - start
+        self.search_seconds += time.perf_counter() - start
         statistics = result.statistics
         LOG.debug(
             "plan search: %s, %d facts, %d ground operators, %d expanded, %.3f s",
@@ -250,17 +255,26 @@ class SolveContext:
         left or the calls reach ``search_sample_ratio`` times the facts of the last search
         (the next search costs about that much). Without this, a focused algorithm calls an
         instance only when a plan needs it, so a finite sampler whose values no plan wants
-        keeps later calls on offer, and the world grows with every level, for ever. Returns
+        keeps later calls on offer, and the world grows with every level, for ever.
+
+        The calls also stop once they took ``search_sample_ratio`` times as long as the
+        searches since the last drain, and at least :data:`DRAIN_SECONDS` (after one call at
+        least): PDDLStream's balance of sampling and search time, for samplers that take
+        seconds a call (a motion planner), which would otherwise hold the next search back for
+        minutes. Fast samplers never reach it (a seeded run makes the same calls). Returns
         the calls made."""
         budget = self.options.search_sample_ratio * max(self.searched, 1)
+        seconds = max(self.options.search_sample_ratio * self.search_seconds, DRAIN_SECONDS)
+        self.search_seconds = 0.0
+        start = time.perf_counter()
         limit = level + self.options.complexity_step
         calls = 0
         progress = True
         while progress and calls < budget:
             progress = False
             for key in list(self.engine.instance_keys):
-                if calls >= budget:
-                    break
+                if calls >= budget or (calls and time.perf_counter() - start >= seconds):
+                    return calls
                 state = self.engine.instances[key]
                 instance = state.instance
                 external = instance.external

@@ -27,6 +27,8 @@ and their values are read when the search asks for them.
 
 from __future__ import annotations
 
+import heapq
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -141,24 +143,41 @@ class OptimisticBuilder:
         instantiator = Instantiator(queries, store)
         # functions on real facts alone: the engine evaluated them or holds them deferred
         functions = {q.name: q for q in queries if q.name in engine.functions}
-        pending = list(instantiator.initial(skip=functions))
+        # Instances and results are taken lowest level first (a level is never below the
+        # levels it rests on), so every fact enters at the lowest level any instance gives it:
+        # a shared placeholder made by instances on facts of several levels, and every
+        # instance on it, takes the lowest (in the order found, one on a late sample could
+        # fix it above the limit and leave out all that rests on it).
+        queue: list[tuple[int, int, OptResult | tuple[str, tuple[str, ...]]]] = []
+        order = itertools.count()
+
+        def push(level: int, item: OptResult | tuple[str, tuple[str, ...]]) -> None:
+            heapq.heappush(queue, (level, -next(order), item))  # (the latest first on ties)
+
+        for query, inputs, level in instantiator.initial(skip=functions):
+            push(level, (query.name, inputs))
         steps = 0
-        while pending:
+        while queue:
             steps += 1
             if check_time is not None and steps % 256 == 0:
                 check_time()
-            query, inputs, level = pending.pop()
-            results = self._results(query.name, inputs, level, limit, world, lazy)
+            level, _, item = heapq.heappop(queue)
+            if isinstance(item, OptResult):
+                for atom in item.certified:
+                    if store.add(atom, item.level):
+                        world.facts[atom] = item.level
+                        world.provenance[atom] = item
+                        for query, inputs, found in instantiator.new_fact(atom):
+                            push(found, (query.name, inputs))
+                continue
+            name, inputs = item
+            results = self._results(name, inputs, level, limit, world, lazy)
             more = self._further(results, limit, world, further)
             for result in results:  # what rests on a later call's output is "later" too
                 if any(n in self._later for n in result.inputs):
                     self._later.update(result.outputs)
             for result in [*results, *more]:
-                for atom in result.certified:
-                    if store.add(atom, result.level):
-                        world.facts[atom] = result.level
-                        world.provenance[atom] = result
-                        pending.extend(instantiator.new_fact(atom))
+                push(result.level, result)
         world.placeholders = sorted(
             {n for atom in world.provenance for n in atom.args if is_placeholder(n)}
         )

@@ -78,3 +78,38 @@ def test_hard_motion_set_without_ompl(
     bench.main(["--quick", "--hard", "1"])
     out = _last_line(capsys)
     assert out["quick"] is True and "OMPL is not installed" in str(out["skipped"])
+
+
+def test_stream_benchmark_without_a_pddlstream_checkout(
+    benchmark_script: Loader, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The continuous_tamp rows are skipped, and the summary says why; the rest runs."""
+    bench = benchmark_script("bench_streams")
+    argv = ["--quick", "--domains", "infeasible", "--algorithms", "adaptive"]
+    argv += ["--kitchen-seeds", "0", "--limit-probe", "0", "--pddlstream", str(tmp_path)]
+    assert bench.main(argv) == 0
+    out = _last_line(capsys)
+    assert out["continuous_tamp"] == [] and out["continuous_tamp_runs"] == 0
+    assert "no PDDLStream checkout" in str(out["continuous_tamp_skipped"])
+    assert out["runs"] and out["all_expected"] is True
+
+
+def test_a_seeded_example_draws_the_same_numbers(benchmark_script: Loader, tmp_path: Path) -> None:
+    """``run_example(..., seed=S)`` seeds Python's and NumPy's generators before the program:
+    two runs of an unseeded program draw the same numbers, another seed others."""
+    bench = benchmark_script("bench_pddlstream_compat")
+    checkout = tmp_path / "checkout"
+    (checkout / "examples").mkdir(parents=True)
+    (checkout / "examples" / "__init__.py").write_text("")
+    out = tmp_path / "drawn.txt"
+    (checkout / "examples" / "draw.py").write_text(
+        "import random, numpy\n"
+        f"with open({str(out)!r}, 'a') as f:\n"
+        "    f.write(f'{random.random()} {numpy.random.rand()}\\n')\n"
+    )
+    example = bench.Example("draw", "examples.draw")
+    for seed in (3, 3, 4):
+        row = bench.run_example(checkout, example, 60.0, seed=seed)
+        assert row["result"] == "no plan" and row["solve_seconds"] == 0.0
+    first, again, other = out.read_text().splitlines()
+    assert first == again and first != other

@@ -220,8 +220,12 @@ def test_grounded_backend_reports_missing_install(monkeypatch: pytest.MonkeyPatc
 
 
 def test_non_integer_weight_is_refused_for_fast_downward() -> None:
-    with pytest.raises(ParameterError, match="weight must be an integer"):
-        search_engine("wastar", "ff", weight=1.5)
+    for search in ("wastar", "lazy-wastar"):
+        with pytest.raises(ParameterError, match="weight must be an integer"):
+            search_engine(search, "ff", weight=1.5)
+    assert search_engine("lazy-wastar", "ff", weight=3.0).endswith(
+        "lazy_wastar([h0],preferred=[h0],reopen_closed=true,w=3,cost_type=plusone))"
+    )
     assert search_engine("lazy-gbfs", "ff-lmcount", options=",bound=3").endswith(
         "reopen_closed=false,bound=3)))"
     )

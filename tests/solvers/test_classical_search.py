@@ -169,7 +169,7 @@ def test_goal_true_initially_gives_the_empty_plan() -> None:
         assert result.status is PlanStatus.SOLVED and result.plan == () and result.cost == 0.0
 
 
-@pytest.mark.parametrize("search", ["gbfs", "wastar", "astar"])
+@pytest.mark.parametrize("search", ["gbfs", "wastar", "astar", "lazy-wastar"])
 @pytest.mark.parametrize("lazy", [False, True])
 def test_cost_bound_keeps_only_cheaper_plans(search: str, lazy: bool) -> None:
     task = load("delivery_costs", "detour")
@@ -209,3 +209,15 @@ def test_batched_greedy_queues_pop_in_per_successor_order() -> None:
         taken_batched.append(pair[:2])
     assert len(taken_single) > 200
     assert taken_batched == taken_single
+
+
+def test_lazy_weighted_astar_evaluates_only_the_states_it_expands() -> None:
+    """``lazy-wastar`` (PDDLStream's ff-wastar planners): the same weighted A*, its states
+    evaluated when taken from the queue, not when generated."""
+    task = load("blocksworld", "sussman")
+    eager = plan(task, search="wastar", weight=3.0)
+    lazy = plan(task, search="lazy-wastar", weight=3.0)
+    assert eager.status is lazy.status is PlanStatus.SOLVED
+    assert lazy.statistics.evaluated <= lazy.statistics.expanded + 1
+    assert eager.statistics.evaluated == eager.statistics.generated
+    assert lazy.cost >= 6.0  # (the optimum of sussman)

@@ -48,7 +48,7 @@ def test_our_planner_stays_the_default() -> None:
         ("fd", ("fd", "wastar", "ff", 2.0)),
         ("FD", ("fd", "wastar", "ff", 2.0)),
         ("fd:ff-astar", ("fd", "astar", "ff", 1.0)),
-        ("fd:ff-wastar3", ("fd", "wastar", "ff", 3.0)),
+        ("fd:ff-wastar3", ("fd", "lazy-wastar", "ff", 3.0)),
         ("fd:lazy-gbfs-ff-lmcount", ("fd", "lazy-gbfs", "ff-lmcount", 2.0)),
     ],
 )

@@ -123,3 +123,58 @@ def test_a_failing_negated_test_is_named() -> None:
     assert any(
         r.startswith("test 'test-cfree' (negate=True) was false on") for r in solution.diagnosis
     )
+
+
+def _slow_sampler_context(delay: float):  # type: ignore[no-untyped-def]
+    """A solve context whose pose sampler (20 instances: block x region) takes ``delay`` [s]
+    a call and never runs dry."""
+    import time
+
+    from solvers.stream_planning.context import SolveContext
+    from solvers.stream_planning.options import StreamOptions
+
+    def sample_pose(block: str, region: str):  # type: ignore[no-untyped-def]
+        k = 0
+        while True:
+            time.sleep(delay)
+            k += 1
+            yield (float(k),)
+
+    init: list[tuple[object, ...]] = [("handempty",)]
+    for r in range(10):
+        init.append(("region", f"r{r}"))
+    for block, x in (("A", -10.0), ("B", -20.0)):
+        init += [("block", block), ("pose", x), ("blockpose", block, x), ("atpose", block, x)]
+    problem = PDDLProblem(
+        (NARROW / "domain.pddl").read_text(encoding="utf-8"),
+        {},
+        (NARROW / "stream.pddl").read_text(encoding="utf-8"),
+        {"sample-pose": from_gen_fn(sample_pose), "test-cfree": from_test(lambda *a: True)},
+        init,
+        ("placed", "A"),
+    )
+    context = SolveContext(problem, StreamOptions(enforce_max_time=False))
+    context.engine.start()
+    context.searched = 100  # the call budget: 100 calls
+    return context
+
+
+def test_a_drain_of_slow_samplers_stops_at_its_time_bound() -> None:
+    """Samplers of 0.3 s a call, after a search of no measurable time: the drain stops once
+    its calls took DRAIN_SECONDS (0.5 s), after two calls, not after its budget of 100."""
+    from solvers.stream_planning.context import DRAIN_SECONDS
+
+    assert DRAIN_SECONDS == 0.5
+    context = _slow_sampler_context(0.3)
+    assert len(context.engine.instances) >= 20
+    assert 1 <= context.drain(0) <= 2
+    context.search_seconds = 1.0  # searches of 1 s: a second of calls (ratio 1)
+    assert 3 <= context.drain(1) <= 4
+    context.runner.close()
+
+
+def test_a_drain_of_fast_samplers_makes_its_counted_calls() -> None:
+    context = _slow_sampler_context(0.0)
+    context.searched = 15
+    assert context.drain(5) == 15  # the budget, however long the last search took
+    context.runner.close()

@@ -146,3 +146,71 @@ def test_a_shared_placeholder_fed_back_to_its_own_stream_is_refined() -> None:
         "next": StreamInfo(opt_gen_fn="shared")})  # fmt: skip
     assert solution.status is Status.SOLVED and solution.plan is not None
     assert solution.plan[0].args == (2,)
+
+
+LEVELS_DOMAIN = """(define (domain reach) (:requirements :strips)
+  (:predicates (item ?b) (pos ?b ?p) (conf ?q) (path ?q ?t) (done))
+  (:action go :parameters (?q ?t) :precondition (path ?q ?t) :effect (done)))"""
+LEVELS_STREAMS = """(define (stream reach)
+  (:stream sample-pos :inputs (?b) :domain (item ?b) :outputs (?p) :certified (pos ?b ?p))
+  (:stream ik :inputs (?b ?p) :domain (pos ?b ?p) :outputs (?q) :certified (conf ?q))
+  (:stream plan-path :inputs (?q) :domain (conf ?q) :outputs (?t) :certified (path ?q ?t)))"""
+
+
+def _levels_problem() -> PDDLProblem:
+    def positions(item: str):  # type: ignore[no-untyped-def]
+        for k in range(10):
+            yield (f"{item}-p{k}",)
+
+    return PDDLProblem(
+        LEVELS_DOMAIN,
+        {},
+        LEVELS_STREAMS,
+        {
+            "sample-pos": from_gen_fn(positions),
+            "ik": from_gen_fn(lambda b, p: iter([(f"q-{p}",)])),
+            "plan-path": from_gen_fn(lambda q: iter([(f"t-{q}",)])),
+        },
+        [("item", "a")],
+        ("done",),
+    )
+
+
+def test_a_shared_placeholder_takes_the_lowest_level_of_the_instances_that_make_it() -> None:
+    """Real positions from the 1st to the 5th call (levels 1 to 5) all feed one shared ik
+    placeholder: it enters at the level the first position gives it (2), not at that of the
+    instance met first, and plan-path on it (3) is in the world at limit 3."""
+    from solvers.stream_planning.engine import Engine
+    from solvers.stream_planning.optimistic import OptimisticBuilder, is_placeholder
+
+    engine = Engine(_levels_problem(), {"ik": StreamInfo(opt_gen_fn="shared")})
+    engine.start()
+    (state,) = engine.instances.values()  # sample-pos on the item
+    for _ in range(5):
+        assert engine.sample(state)
+    levels = engine.store.levels
+    positions = {a.args[1]: level for a, level in levels.items() if a.predicate == "pos"}
+    assert sorted(positions.values()) == [1, 2, 3, 4, 5]
+    world = OptimisticBuilder(engine, frozenset()).build(3)
+    confs = {a: level for a, level in world.facts.items() if a.predicate == "conf"}
+    assert len(confs) == 1 and all(is_placeholder(a.args[0]) for a in confs)
+    assert list(confs.values()) == [2]
+    assert [level for a, level in world.facts.items() if a.predicate == "path"] == [3]
+    first = next(p for p, level in positions.items() if level == 1)
+    assert world.provenance[next(iter(confs))].inputs[1] == first  # made on the first one
+
+
+def test_real_facts_of_later_samples_do_not_hide_the_plan_on_earlier_ones() -> None:
+    """A solve whose sampler has been called many times before a plan is searched for at the
+    level that the first samples allow finds that plan there."""
+    from solvers.stream_planning.engine import Engine
+    from solvers.stream_planning.optimistic import OptimisticBuilder
+
+    engine = Engine(_levels_problem(), {"ik": StreamInfo(opt_gen_fn="shared")})
+    engine.start()
+    (state,) = engine.instances.values()
+    for _ in range(8):
+        engine.sample(state)
+    for limit in range(3, 9):
+        world = OptimisticBuilder(engine, frozenset()).build(limit)
+        assert any(a.predicate == "path" for a in world.facts), limit
