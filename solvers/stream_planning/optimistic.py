@@ -27,6 +27,8 @@ and their values are read when the search asks for them.
 
 from __future__ import annotations
 
+import heapq
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -141,13 +143,33 @@ class OptimisticBuilder:
         instantiator = Instantiator(queries, store)
         # functions on real facts alone: the engine evaluated them or holds them deferred
         functions = {q.name: q for q in queries if q.name in engine.functions}
-        pending = list(instantiator.initial(skip=functions))
+        # Instances and the facts their results certify are taken lowest level first (as
+        # in Dijkstra's algorithm: a result's level is never below its inputs'), so that each
+        # fact is added at the lowest level any result gives it, and the instances on it are
+        # made at their lowest level too. (Taken in the order found, a fact first made at a
+        # high level, e.g. a shared placeholder's through the instance on the newest sample,
+        # would keep that level, and leave out every instance that rests on it.)
+        order = itertools.count()
+        pending: list[tuple[int, int, Query | None, tuple[str, ...], OptResult | None]] = [
+            (level, next(order), query, inputs, None)
+            for query, inputs, level in instantiator.initial(skip=functions)
+        ]
+        heapq.heapify(pending)
         steps = 0
         while pending:
             steps += 1
             if check_time is not None and steps % 256 == 0:
                 check_time()
-            query, inputs, level = pending.pop()
+            level, _, query, inputs, made = heapq.heappop(pending)
+            if made is not None:  # a fact: ``inputs`` is its atom's (predicate, *args)
+                atom = Atom(inputs[0], inputs[1:])
+                if store.add(atom, level):
+                    world.facts[atom] = level
+                    world.provenance[atom] = made
+                    for found, args, at in instantiator.new_fact(atom):
+                        heapq.heappush(pending, (at, next(order), found, args, None))
+                continue
+            assert query is not None
             results = self._results(query.name, inputs, level, limit, world, lazy)
             more = self._further(results, limit, world, further)
             for result in results:  # what rests on a later call's output is "later" too
@@ -155,10 +177,9 @@ class OptimisticBuilder:
                     self._later.update(result.outputs)
             for result in [*results, *more]:
                 for atom in result.certified:
-                    if store.add(atom, result.level):
-                        world.facts[atom] = result.level
-                        world.provenance[atom] = result
-                        pending.extend(instantiator.new_fact(atom))
+                    if atom not in store.levels:
+                        fact = (atom.predicate, *atom.args)
+                        heapq.heappush(pending, (result.level, next(order), None, fact, result))
         world.placeholders = sorted(
             {n for atom in world.provenance for n in atom.args if is_placeholder(n)}
         )
