@@ -358,3 +358,30 @@ def test_a_sweep_of_siblings_stops_after_the_time_of_a_search(
     cheap, expensive = run(0.0), run(1.0)
     assert len(expensive) < len(cheap)
     assert len(cheap) > 2 * len(OBSTACLES)  # the cheap test's sweeps called siblings
+
+
+def test_a_sweep_budget_leaves_out_the_facts_of_deferred_predicates(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Each sweep evaluates at most ``search_sample_ratio`` times the known facts other than
+    the deferred predicates' own (which the sweeps add: counted, each sweep's budget would grow
+    with the one before)."""
+    sweeps: list[tuple[int, int, int]] = []
+    original = SolveContext.sweep_deferred
+
+    def recording(self: SolveContext, name: str, inputs: tuple[str, ...]) -> int:
+        store = self.engine.store
+        known = store.count_except(self.engine.functions)
+        calls = original(self, name, inputs)
+        sweeps.append((calls, known, len(store)))  # the store after the sweep
+        return calls
+
+    monkeypatch.setattr(SolveContext, "sweep_deferred", recording)
+    calls: list[tuple[Any, ...]] = []
+    problem = slots_problem(calls, [], lambda *_a: 1.0)
+    info = {"test-cfree": StreamInfo(negate=True)}
+    solution = solve(problem, algorithm="adaptive", stream_info=info, verbose=False)
+    assert solution.solved and sweeps
+    assert all(made <= known for made, known, _ in sweeps)
+    # the sweeps' true results joined the store; a budget counting them would have grown
+    assert all(known < after for _, known, after in sweeps)
