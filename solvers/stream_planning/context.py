@@ -4,6 +4,7 @@ plan, forget failures when the complexity level rises (nothing here is global)."
 
 from __future__ import annotations
 
+import heapq
 import math
 import time
 from collections.abc import Collection, Mapping
@@ -250,8 +251,12 @@ class SolveContext:
         known = engine.store.count_except(engine.functions)
         budget = self.options.search_sample_ratio * max(known, 1)
         siblings = [k for k in engine.deferred if k[0] == name]
-        if len(siblings) > budget:
-            siblings.sort(key=lambda k: -sum(a == b for a, b in zip(k[1], inputs, strict=True)))
+        if len(siblings) > budget:  # the budget's worth that share the most inputs, in order
+            siblings = heapq.nsmallest(
+                int(budget) + 1,
+                siblings,
+                key=lambda k: -sum(a == b for a, b in zip(k[1], inputs, strict=True)),
+            )
         calls = 0
         start = time.perf_counter()
         for key in siblings:
