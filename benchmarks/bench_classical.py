@@ -213,6 +213,9 @@ def own_validation(domain: Path, problem: Path, plan_file: Path) -> bool:
     task = task_from_problem(parsed_domain, parse_problem(problem.read_text(), parsed_domain))
     steps = []
     for line in plan_file.read_text().splitlines():
+        timed = re.match(r"\s*[\d.]+\s*:\s*(\([^)]*\))", line)  # VAL's "0.000: (a b) [2.000]"
+        if timed is not None:
+            line = timed.group(1)
         if line.startswith("("):
             name, *args = line.strip().strip("()").lower().split()
             steps.append(GroundAction(name, tuple(args)))

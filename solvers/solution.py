@@ -16,6 +16,17 @@ class Action(NamedTuple):
     args: tuple[Any, ...]
 
 
+class DurativeAction(NamedTuple):
+    """One step of a plan of a domain with durative actions: it starts at ``start`` [time
+    units of the domain] and lasts ``duration`` (0 for an instantaneous action); steps run one
+    after the other."""
+
+    name: str
+    args: tuple[Any, ...]
+    start: float
+    duration: float
+
+
 class Certificate(NamedTuple):
     """Facts known at the end (``all_facts``) and those the plan relies on (``preimage_facts``)."""
 
@@ -64,7 +75,8 @@ class Solution:
     """A solver's result. ``plan, cost, certificate = solution`` works as in PDDLStream.
 
     Attributes:
-        plan: the actions, or None when there is no plan.
+        plan: the actions, or None when there is no plan (for a domain with durative actions,
+            :class:`DurativeAction` steps, which have an Action's ``name`` and ``args``).
         cost: the plan's cost (``inf`` without a plan).
         certificate: the facts behind the plan.
         status: why the solver stopped.
@@ -114,7 +126,10 @@ def format_solution(solution: Solution) -> str:
         return "\n".join(lines)
     lines.append(f"Length: {len(solution.plan)}")
     for step, action in enumerate(solution.plan, 1):
-        lines.append(f"{step:3d}) {action.name} {' '.join(format_value(a) for a in action.args)}")
+        text = f"{step:3d}) {action.name} {' '.join(format_value(a) for a in action.args)}"
+        if isinstance(action, DurativeAction):
+            text = f"{text} [start {action.start:g}, duration {action.duration:g}]"
+        lines.append(text)
     return "\n".join(lines)
 
 

@@ -4,11 +4,16 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sdar_tamp.arguments import SEARCH_WEIGHT, TIME_LIMIT
 from sdar_tamp.textfile import read_text
+
+if TYPE_CHECKING:
+    from sdar_tamp.language.domain_model import Domain, Problem
+    from solvers.classical import GroundAction
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -30,7 +35,20 @@ def cmd_plan(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    if args.planner == "fd":
+    if args.planner == "fd" and domain.temporal:  # Fast Downward reads no durative action
+        from solvers.classical.fast_downward import plan_task_with_fast_downward
+
+        if args.unit:
+            print("sdar: error: --unit is not available with --planner fd", file=sys.stderr)
+            return 2
+        result = plan_task_with_fast_downward(
+            task_from_problem(domain, problem),
+            search=args.search,
+            heuristic=args.heuristic,
+            weight=args.weight,
+            time_limit=args.time_limit,
+        )
+    elif args.planner == "fd":
         from solvers.classical.fast_downward import plan_with_fast_downward
 
         if args.unit:
@@ -55,7 +73,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
         )
     stats = result.statistics
     print(f"status: {result.status.value}")
-    if result.plan is not None:
+    if result.plan is not None and domain.temporal:
+        for line in timed_plan_lines(domain, problem, result.plan):
+            print(line)
+        print(f"length: {len(result.plan)}  cost: {result.cost:g}")
+    elif result.plan is not None:
         for step, action in enumerate(result.plan, 1):
             print(f"{step:3d}) {action}")
         print(f"length: {len(result.plan)}  cost: {result.cost:g}")
@@ -64,6 +86,22 @@ def cmd_plan(args: argparse.Namespace) -> int:
         f"grounding: {stats.grounding_time:.3f} s  search: {stats.search_time:.3f} s"
     )
     return 0 if result.status is PlanStatus.SOLVED else 1
+
+
+def timed_plan_lines(domain: Domain, problem: Problem, steps: Sequence[GroundAction]) -> list[str]:
+    """A plan of a domain with durative actions in VAL's format, ``START: (ACTION) [DURATION]``
+    a line (steps one after the other; durations from the problem's function values)."""
+    from sdar_tamp.language.formula_model import FunctionTerm
+    from sdar_tamp.language.plan_run import plan_timing
+
+    def value(term: FunctionTerm) -> float:
+        return problem.numeric_init[(term.name, term.args)]
+
+    timing = plan_timing(domain, [(a.name, a.args) for a in steps], value)
+    return [
+        f"{start:.3f}: ({' '.join((a.name, *a.args))}) [{length:.3f}]"
+        for a, (start, length) in zip(steps, timing, strict=True)
+    ]
 
 
 def add_plan_parser(sub: argparse._SubParsersAction[Any]) -> None:

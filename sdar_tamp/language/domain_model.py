@@ -11,6 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from sdar_tamp.errors import SourceLocation
+from sdar_tamp.language.durative import DurativeActionSchema
 from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Effect, Formula, Parameter
 from sdar_tamp.language.leniency import Leniency
 
@@ -83,6 +84,9 @@ class Domain:
     functions: Mapping[str, Function]
     actions: tuple[ActionSchema, ...]
     axioms: tuple[Axiom, ...]
+    durative_actions: tuple[DurativeActionSchema, ...] = ()
+    """The ``(:durative-action ...)`` as written; ``actions`` holds each one compiled into an
+    instantaneous action of the same name (:mod:`sdar_tamp.language.sequential`)."""
     source: str | None = field(default=None, compare=False)
     leniencies: tuple[Leniency, ...] = field(default=(), compare=False)
     """What was accepted although strict PDDL rejects it (see ``language.leniency``)."""
@@ -90,6 +94,18 @@ class Domain:
     @property
     def derived_predicates(self) -> frozenset[str]:
         return frozenset(axiom.predicate for axiom in self.axioms)
+
+    @property
+    def temporal(self) -> bool:
+        """True when the domain has durative actions (its plans are timed)."""
+        return bool(self.durative_actions)
+
+    def durative_action(self, name: str) -> DurativeActionSchema | None:
+        """The durative action called ``name``, or None (an instantaneous action, or none)."""
+        for action in self.durative_actions:
+            if action.name == name.lower():
+                return action
+        return None
 
     def action(self, name: str) -> ActionSchema:
         for action in self.actions:

@@ -20,6 +20,7 @@ from sdar_tamp.language.domain_model import (
     Predicate,
     TypeHierarchy,
 )
+from sdar_tamp.language.durative import DurativeActionSchema, read_durative_action
 from sdar_tamp.language.errors import ArityError, DuplicateError, PddlSyntaxError, UndeclaredError
 from sdar_tamp.language.formula_model import (
     OBJECT_TYPE,
@@ -46,6 +47,7 @@ from sdar_tamp.language.leniency import (
     note_glued_variables,
 )
 from sdar_tamp.language.pddl_sections import DOMAIN_SECTIONS, read_requirements, split_sections
+from sdar_tamp.language.sequential import compile_durative
 from sdar_tamp.language.sexpr import SExpr, SList, read_sexpr
 
 
@@ -125,14 +127,27 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
     )
     actions: list[ActionSchema] = []
     axioms: list[Axiom] = []
+    durative: list[DurativeActionSchema] = []
+
+    def read_condition(
+        reader: FormulaReader, node: SExpr, scope: Mapping[str, str], what: str
+    ) -> Formula:
+        return _existential_closure(reader, node, scope, what, log)
+
     for keyword, section in pending:
-        if keyword == ":action":
-            action = _action(section, reader, log)
+        if keyword in (":action", ":durative-action"):
+            if keyword == ":action":
+                action = _action(section, reader, log)
+            else:
+                durative.append(read_durative_action(section, reader, read_condition))
+                action = ActionSchema(durative[-1].name, (), TRUE, AndEffect(()))
             if any(existing.name == action.name for existing in actions):
                 raise DuplicateError(f"action {action.name!r} is defined twice", section.location)
             actions.append(action)
         else:
             axioms.append(_axiom(section, reader, predicates, log))
+    compiled = {a.name: compile_durative(a, tuple(axioms)) for a in durative}
+    actions = [compiled.get(a.name, a) for a in actions]
     for fname, (arity, location) in vocabulary.function_arity_uses.items():
         log.add(
             FUNCTION_ARITY,
@@ -154,6 +169,7 @@ def parse_domain(text: str, filename: str | None = None, *, strict: bool = False
         functions=dict(functions),
         actions=tuple(actions),
         axioms=tuple(axioms),
+        durative_actions=tuple(durative),
         source=filename,
         leniencies=log.finish(),
     )

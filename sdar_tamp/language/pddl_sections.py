@@ -3,7 +3,9 @@ keywords of each, and ``(define (KIND NAME) (:section ...) ...)`` split into its
 
 Supported requirements: ``:strips :typing :negative-preconditions :disjunctive-preconditions
 :equality :existential-preconditions :universal-preconditions :quantified-preconditions
-:conditional-effects :derived-predicates :action-costs :adl``. Names are case-insensitive.
+:conditional-effects :derived-predicates :action-costs :adl :durative-actions`` (durative
+actions run one after the other: :mod:`sdar_tamp.language.durative`). Names are
+case-insensitive.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ REQUIREMENTS = frozenset(
         ":derived-predicates",
         ":action-costs",
         ":adl",
+        ":durative-actions",
     }
 )
 DOMAIN_SECTIONS = (
@@ -37,6 +40,7 @@ DOMAIN_SECTIONS = (
     ":predicates",
     ":functions",
     ":action",
+    ":durative-action",
     ":derived",
 )
 PROBLEM_SECTIONS = (":domain", ":requirements", ":objects", ":init", ":goal", ":metric")

@@ -1,19 +1,26 @@
 """What a plan means: :func:`run_plan` executes a whole plan from the lifted action schemas
 (each step's precondition by :class:`~sdar_tamp.language.evaluator.Evaluator`, its effect by
 :func:`~sdar_tamp.language.state_changes.effect_changes`) and evaluates the goal at the end;
-:class:`PlanRun` is what it found."""
+:class:`PlanRun` is what it found.
+
+A durative action's step is run from the durative action as written, not from its compiled
+form (so the compilation is checked, not trusted): its at-start condition, its at-start
+effects, then its over-all and at-end conditions in the state they make, then its at-end
+effects; its cost is its duration plus any ``total-cost`` increases."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
+from sdar_tamp.errors import EvaluationError
 from sdar_tamp.language.domain_model import ActionSchema, Domain
+from sdar_tamp.language.durative import DurativeActionSchema
 from sdar_tamp.language.evaluator import Evaluator, Support
-from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Formula
+from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Formula, FunctionTerm
 from sdar_tamp.language.state_changes import Changes, CostOf, effect_changes
 from sdar_tamp.language.state_index import FactIndex, Facts, Objects
-from sdar_tamp.language.substitution import bind
+from sdar_tamp.language.substitution import Binding, bind, ground_args
 
 
 def check_arguments(action: ActionSchema, args: Sequence[str], objects: Objects) -> str | None:
@@ -99,10 +106,18 @@ def run_plan(
             return stop(step, problem)
         binding = bind(action, args)
         evaluator = Evaluator(domain, view(state), objects, explain=explain)
-        found = evaluator.support(action.precondition, binding)
-        if found is None:
-            return stop(step, f"the precondition of {shown} does not hold")
-        done = effect_changes(evaluator, action.effect, binding, cost_of)
+        durative = domain.durative_action(name)
+        if durative is not None:
+            staged = _run_durative(durative, evaluator, binding, cost_of, view, state)
+            if isinstance(staged, str):
+                return stop(step, f"the {staged} condition of {shown} does not hold")
+            found, done = staged
+        else:
+            support = evaluator.support(action.precondition, binding)
+            if support is None:
+                return stop(step, f"the precondition of {shown} does not hold")
+            found = support
+            done = effect_changes(evaluator, action.effect, binding, cost_of)
         states.append(state)
         supports.append(found | done.support)
         changes.append(done)
@@ -112,3 +127,70 @@ def run_plan(
     if goal_support is None:
         return stop(-1, "the goal does not hold at the end of the plan")
     return PlanRun(state, tuple(states), tuple(supports), tuple(changes), goal_support)
+
+
+def _run_durative(
+    action: DurativeActionSchema,
+    evaluator: Evaluator,
+    binding: Binding,
+    cost_of: CostOf | None,
+    view: Callable[[frozenset[Atom]], Facts],
+    state: frozenset[Atom],
+) -> tuple[Support, Changes] | str:
+    """``action`` run alone from ``state``: what its conditions relied on in ``state`` and
+    what it did, or which condition failed (``at-start``, ``over-all``, ``at-end``)."""
+    found = evaluator.support(action.at_start, binding)
+    if found is None:
+        return "at-start"
+    start = effect_changes(evaluator, action.start_effect, binding, cost_of)
+    middle = start.apply(state)
+    later = Evaluator(evaluator.domain, view(middle), evaluator.objects, explain=evaluator.explain)
+    over = later.support(action.over_all, binding)
+    if over is None:
+        return "over-all"
+    end_found = later.support(action.at_end, binding)
+    if end_found is None:
+        return "at-end"
+    end = effect_changes(later, action.end_effect, binding, cost_of)
+    final = end.apply(middle)
+    duration = action.duration
+    if isinstance(duration, FunctionTerm):
+        term = FunctionTerm(duration.name, ground_args(duration.args, binding))
+        length = cost_of(term) if cost_of is not None else 0.0
+    else:
+        length = duration if cost_of is not None else 0.0
+    # facts the start effects made are the action's own, not something it relies on
+    relied = found | start.support | ((over | end_found | end.support) - start.adds)
+    changes = Changes(
+        final - state, state - final, start.cost + end.cost + length, frozenset(relied)
+    )
+    return relied, changes
+
+
+def plan_timing(
+    domain: Domain, plan: Sequence[tuple[str, Sequence[str]]], cost_of: CostOf
+) -> tuple[tuple[float, float], ...]:
+    """The ``(start, duration)`` of each step of ``plan`` run one after the other from time 0:
+    a durative action lasts its duration (``cost_of`` gives a function term's value), an
+    instantaneous action 0.
+
+    Raises:
+        EvaluationError: a step names no action of ``domain`` or has the wrong arity.
+    """
+    timing: list[tuple[float, float]] = []
+    now = 0.0
+    for name, args in plan:
+        action = domain.durative_action(name)
+        length = 0.0
+        if action is not None:
+            if len(args) != len(action.parameters):
+                raise EvaluationError(f"({' '.join((name, *args))}) has the wrong arity")
+            duration = action.duration
+            if isinstance(duration, FunctionTerm):
+                binding = dict(zip((p.name for p in action.parameters), args, strict=True))
+                length = cost_of(FunctionTerm(duration.name, ground_args(duration.args, binding)))
+            else:
+                length = duration
+        timing.append((now, length))
+        now += length
+    return tuple(timing)

@@ -114,7 +114,7 @@ def _parse_problem(text: str, domain: Domain, filename: str | None, strict: bool
                 raise PddlSyntaxError("expected '(:goal formula)'", section.location)
             goal = reader.formula(section.items[1], {})
         elif keyword == ":metric":
-            minimize = _metric(section)
+            minimize = _metric(section, domain.temporal)
     if ":goal" not in seen:
         raise PddlSyntaxError(
             f"expected a '(:goal ...)' section in problem {name!r}", root.location
@@ -222,12 +222,15 @@ def _check_init_types(
             )
 
 
-def _metric(section: SList) -> bool:
+def _metric(section: SList, temporal: bool) -> bool:
+    """``(:metric minimize (total-cost))``, or for a domain with durative actions ``(:metric
+    minimize (total-time))`` (their plans run one action after another, so the makespan is
+    the sum of the durations, which is the cost)."""
     items = section.items[1:]
     text = " ".join(str(item) for item in items)
-    if text != f"minimize ({TOTAL_COST})":
+    allowed = [f"minimize ({TOTAL_COST})", *(["minimize (total-time)"] if temporal else [])]
+    if text not in allowed:
         location: SourceLocation = section.location
-        raise UnknownKeywordError(
-            f"unsupported metric {text!r}; expected 'minimize (total-cost)'", location
-        )
+        expected = " or ".join(repr(a) for a in allowed)
+        raise UnknownKeywordError(f"unsupported metric {text!r}; expected {expected}", location)
     return True

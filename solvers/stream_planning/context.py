@@ -4,6 +4,7 @@ plan, forget failures when the complexity level rises (nothing here is global)."
 
 from __future__ import annotations
 
+import heapq
 import math
 import time
 from collections.abc import Collection, Mapping
@@ -32,6 +33,9 @@ from solvers.stream_planning.statistics import SearchStatistics
 from solvers.stream_planning.stream_plans import ActionEfforts
 
 LOG = get_logger(__name__)
+
+MIN_SWEEP_SECONDS = 0.05
+"""A sweep of a failed test's siblings may always take this long [s] (for very fast searches)."""
 PlanSteps = list[tuple[str, tuple[str, ...]]]
 #: [s] the least time a drain of samplers may take before its time bound applies
 #: (:meth:`SolveContext.drain`)
@@ -81,6 +85,7 @@ class SolveContext:
         self.unreachable = False  # the last plan search found the goal relaxed-unreachable
         self.searched = 0  # facts the last plan search planned over
         self.search_seconds = 0.0  # [s] the plan searches since the last drain took
+        self.last_search_seconds = 0.0  # [s] the last plan search took
         self._order = 0
 
     def next_order(self) -> int:
@@ -147,8 +152,9 @@ class SolveContext:
             # with efforts, the bound applies to cost plus effort (as in PDDLStream)
             cost_bound=self._cost_bound(),
         )
-        self.stats.search_time += time.perf_counter() - start
-        self.search_seconds += time.perf_counter() - start
+        self.last_search_seconds = time.perf_counter() - start
+        self.stats.search_time += self.last_search_seconds
+        self.search_seconds += self.last_search_seconds
         statistics = result.statistics
         LOG.debug(
             "plan search: %s, %d facts, %d ground operators, %d expanded, %.3f s",
@@ -184,7 +190,8 @@ class SolveContext:
         """A test instance of a candidate plan failed: call the test's other uncalled real
         instances within the complexity level, in the order they were made, up to
         ``search_sample_ratio`` times the facts of the last plan search (the next search costs
-        about that much; each failure it is spared saves a search). Returns the calls made.
+        about that much; each failure it is spared saves a search), and within
+        ``search_sample_ratio`` times the last search's time. Returns the calls made.
 
         Without this, each search finds the next untested combination, one per search; a
         test is cheap next to a search, so a failed one has its siblings evaluated in a batch.
@@ -196,8 +203,9 @@ class SolveContext:
         budget = self.options.search_sample_ratio * max(self.searched, 1)
         level = self.stats.complexity
         calls = 0
+        start = time.perf_counter()
         for key in self.engine.instance_keys:
-            if calls >= budget:
+            if calls >= budget or self._sweep_spent(start):
                 break
             if key[0] != external.name:
                 continue
@@ -210,6 +218,16 @@ class SolveContext:
             if not self.sample(state) and disable:
                 self.failed(state)
         return calls
+
+    def _sweep_spent(self, start: float) -> bool:
+        """A sweep that began at ``start`` has taken ``search_sample_ratio`` times as long as
+        the last plan search (at least :data:`MIN_SWEEP_SECONDS`): it stops there, however few
+        calls it made (expensive tests: a collision test along a long trajectory), as the
+        search and the sampling are balanced in time."""
+        spent = time.perf_counter() - start
+        return spent > self.options.search_sample_ratio * max(
+            self.last_search_seconds, MIN_SWEEP_SECONDS
+        )
 
     def evaluate_deferred(self, name: str, inputs: tuple[str, ...]) -> bool:
         """Evaluate a deferred function or predicate instance a plan uses (False: it was not
@@ -227,18 +245,27 @@ class SolveContext:
     def sweep_deferred(self, name: str, inputs: tuple[str, ...]) -> int:
         """A deferred predicate a plan used came out false: evaluate other deferred instances
         of it, those sharing the most inputs with it first (the likeliest to fail too), up to
-        ``search_sample_ratio`` times the real facts known. (:meth:`sweep_test` allows as many
-        as the facts of the last search; here those include every deferred instance, so that
-        budget would call nearly all of them.) Returns the calls made."""
+        ``search_sample_ratio`` times the real facts known, those of deferred predicates left
+        out. (:meth:`sweep_test` allows as many as the facts of the last search; here those
+        include every deferred instance, so that budget would call nearly all of them.) It
+        stops, too, once it has taken
+        ``search_sample_ratio`` times the last search's time. Returns the calls made."""
         engine = self.engine
-        budget = self.options.search_sample_ratio * max(len(engine.store), 1)
+        # the facts of deferred predicates do not count: each sweep adds some, and the next
+        # sweep's budget would grow with them (without bound, on a test that is mostly true)
+        known = engine.store.count_except(engine.functions)
+        budget = self.options.search_sample_ratio * max(known, 1)
         siblings = [k for k in engine.deferred if k[0] == name]
-        if len(siblings) > budget:
-            siblings.sort(key=lambda k: -sum(a == b for a, b in zip(k[1], inputs, strict=True)))
+        if len(siblings) > budget:  # the budget's worth that share the most inputs, in order
+            siblings = heapq.nsmallest(
+                int(budget) + 1,
+                siblings,
+                key=lambda k: -sum(a == b for a, b in zip(k[1], inputs, strict=True)),
+            )
         calls = 0
         start = time.perf_counter()
         for key in siblings:
-            if calls >= budget:
+            if calls >= budget or self._sweep_spent(start):
                 break
             self.check_time()
             calls += engine.evaluate(*key)

@@ -44,6 +44,10 @@ class FactStore:
     def __contains__(self, atom: object) -> bool:
         return atom in self.levels
 
+    def count_except(self, predicates: Collection[str]) -> int:
+        """How many atoms are known, those of ``predicates`` left out."""
+        return sum(len(found) for p, found in self._by_predicate.items() if p not in predicates)
+
     def __len__(self) -> int:
         return len(self.levels)
 

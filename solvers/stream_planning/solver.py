@@ -17,12 +17,20 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, cast
 
 from sdar_tamp.language.formula_model import Atom
+from sdar_tamp.language.plan_run import plan_timing
 from sdar_tamp.language.problem import PDDLProblem
 from sdar_tamp.logs import get_logger
-from solvers.solution import Action, Certificate, Solution, Status, StreamStatistics
+from solvers.solution import (
+    Action,
+    Certificate,
+    DurativeAction,
+    Solution,
+    Status,
+    StreamStatistics,
+)
 from solvers.stream_planning.calls import CallTimeout
 from solvers.stream_planning.constraints import original_name
 from solvers.stream_planning.context import PlanSteps, SolveContext, SolveTimeout
@@ -325,6 +333,17 @@ class StreamSolver:
             Action(original_name(name), tuple(table.value(a) for a in args))
             for name, args in actions
         ]
+        domain = context.problem.domain
+        if domain.temporal:  # each step's start and duration, steps one after the other
+            numeric = engine.numeric
+            timing = plan_timing(
+                domain, actions, lambda term: numeric.get((term.name, term.args), 0.0)
+            )
+            timed = [
+                DurativeAction(a.name, a.args, start, length)
+                for a, (start, length) in zip(plan, timing, strict=True)
+            ]
+            plan = cast(list[Action], timed)  # read as Actions: name and args come first
         certificate = Certificate(
             tuple(fact(a) for a in real),
             tuple(fact(a) for a in sorted(needed, key=str) if not a.predicate.startswith("@")),

@@ -98,3 +98,22 @@ def test_own_validator_decides_where_val_cannot_read_the_domain(
     assert bench.validate(domain, problem, bad) == (False, "own")
     monkeypatch.setattr(bench, "_val_binary", lambda: None)  # VAL not installed
     assert bench.validate(domain, problem, good) == (True, "own")
+
+
+def test_the_own_validator_reads_plans_in_vals_temporal_format(
+    bench: ModuleType, tmp_path: Path
+) -> None:
+    domain, problem, plan = tmp_path / "d.pddl", tmp_path / "p.pddl", tmp_path / "plan"
+    domain.write_text(
+        "(define (domain lights) (:requirements :durative-actions) (:predicates (on ?l) (warm ?l))"
+        " (:durative-action heat :parameters (?l) :duration (= ?duration 2)"
+        " :condition (over all (on ?l))"
+        " :effect (and (at start (on ?l)) (at end (warm ?l)) (at end (not (on ?l))))))"
+    )
+    problem.write_text(
+        "(define (problem p) (:domain lights) (:objects a) (:init) (:goal (warm a)))"
+    )
+    plan.write_text("0.000: (heat a) [2.000]\n; makespan 2\n")
+    assert bench.own_validation(domain, problem, plan)
+    plan.write_text("; nothing\n")
+    assert not bench.own_validation(domain, problem, plan)

@@ -315,3 +315,73 @@ def test_the_plan_check_view_assumes_what_the_search_assumes() -> None:
     assert Atom("cfree", clash) not in view  # refuted
     assert Atom("cfree", (name("a"), "nowhere", name("b"), name(10))) not in view  # no domain
     assert view.args_of("cfree") == () and view.args_of("obj")
+
+
+def test_a_sweep_of_siblings_stops_after_the_time_of_a_search(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A failed deferred test has its siblings evaluated in a batch, but only for about as
+    long as a plan search takes: an expensive test (here each call takes 1 s of a clock the
+    solver reads, the searches none of it) gets far fewer sibling calls than a cheap one."""
+    import time
+
+    from solvers.stream_planning import context as context_module
+
+    def run(seconds_per_call: float) -> list[tuple[Any, ...]]:
+        calls: list[tuple[Any, ...]] = []
+        offset = [0.0]
+
+        class Clock:
+            @staticmethod
+            def perf_counter() -> float:
+                return time.perf_counter() + offset[0]
+
+        def cfree(o: str, p: int, o2: str, p2: int) -> bool:
+            calls.append((o, p, o2, p2))
+            offset[0] += seconds_per_call
+            return o == o2 or abs(p - p2) >= 2
+
+        monkeypatch.setattr(context_module, "time", Clock)
+        init: list[tuple[Any, ...]] = [("HandEmpty",), ("Obj", "a"), ("AtPose", "a", 0)]
+        init += [("Slot", p) for p in range(SLOTS)]
+        init += [("Shelf", p) for p in range(8, SLOTS)]
+        for obstacle, slot in OBSTACLES.items():
+            init += [("Obj", obstacle), ("AtPose", obstacle, slot)]
+        streams = {"test-cfree": from_test(cfree), "handling": lambda *_a: 1.0}
+        problem = PDDLProblem(DOMAIN, {}, STREAMS, streams, init, ("Done", "a"))
+        info = {"test-cfree": StreamInfo(negate=True)}
+        solution = solve(problem, algorithm="adaptive", stream_info=info, verbose=False)
+        assert solution.solved
+        check_plan(solution.plan or [])
+        return calls
+
+    cheap, expensive = run(0.0), run(1.0)
+    assert len(expensive) < len(cheap)
+    assert len(cheap) > 2 * len(OBSTACLES)  # the cheap test's sweeps called siblings
+
+
+def test_a_sweep_budget_leaves_out_the_facts_of_deferred_predicates(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Each sweep evaluates at most ``search_sample_ratio`` times the known facts other than
+    the deferred predicates' own (which the sweeps add: counted, each sweep's budget would grow
+    with the one before)."""
+    sweeps: list[tuple[int, int, int]] = []
+    original = SolveContext.sweep_deferred
+
+    def recording(self: SolveContext, name: str, inputs: tuple[str, ...]) -> int:
+        store = self.engine.store
+        known = store.count_except(self.engine.functions)
+        calls = original(self, name, inputs)
+        sweeps.append((calls, known, len(store)))  # the store after the sweep
+        return calls
+
+    monkeypatch.setattr(SolveContext, "sweep_deferred", recording)
+    calls: list[tuple[Any, ...]] = []
+    problem = slots_problem(calls, [], lambda *_a: 1.0)
+    info = {"test-cfree": StreamInfo(negate=True)}
+    solution = solve(problem, algorithm="adaptive", stream_info=info, verbose=False)
+    assert solution.solved and sweeps
+    assert all(made <= known for made, known, _ in sweeps)
+    # the sweeps' true results joined the store; a budget counting them would have grown
+    assert all(known < after for _, known, after in sweeps)

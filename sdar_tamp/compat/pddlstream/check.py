@@ -32,7 +32,16 @@ def _without_costs(effect: Effect) -> Effect:
 
 def _cost_free(domain: Domain) -> Domain:
     actions = tuple(replace(a, effect=_without_costs(a.effect)) for a in domain.actions)
-    return replace(domain, actions=actions)
+    durative = tuple(
+        replace(
+            a,
+            duration=0.0,
+            start_effect=_without_costs(a.start_effect),
+            end_effect=_without_costs(a.end_effect),
+        )
+        for a in domain.durative_actions
+    )
+    return replace(domain, actions=actions, durative_actions=durative)
 
 
 def check_solution(problem: PDDLProblem, solution: Solution) -> str | None:

@@ -14,6 +14,7 @@ from sdar_tamp.compat.pddlstream.utils import INF, read, str_from_object
 from sdar_tamp.language.formula_model import TOTAL_COST as TOTAL_COST
 from solvers.solution import Action as Action
 from solvers.solution import Certificate as Certificate
+from solvers.solution import DurativeAction as DurativeAction
 from solvers.solution import Solution as Solution
 
 __all__ = [
@@ -129,13 +130,6 @@ class OptPlan(NamedTuple):
 
 class Assignment(NamedTuple):
     args: Any
-
-
-class DurativeAction(NamedTuple):
-    name: str
-    args: tuple[Any, ...]
-    start: float
-    duration: float
 
 
 class StreamAction(NamedTuple):

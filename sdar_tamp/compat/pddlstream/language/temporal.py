@@ -1,6 +1,6 @@
-"""``pddlstream.language.temporal``: timing of sequential plans (durative plan display).
-
-Temporal planning itself (Temporal Fast Downward) is not provided."""
+"""``pddlstream.language.temporal``: timing of plans of ``DurativeAction`` steps (``solve``
+returns them for a domain with durative actions, which run one after the other) and of
+sequential plans. Temporal Fast Downward (``solve_tfd``) is not provided."""
 
 from __future__ import annotations
 
