@@ -136,9 +136,10 @@ def _repair_task(
     culprits = {n for n in re.findall(r"[A-Za-z0-9_.\-]+", why) if n in here} - set(goals)
     goals.update({n: known[n] for n in culprits if n in known})
     goals.update({n: Pose2D(*p) for n, p in here.items() if n not in goals and n in known})
-    fake = Instance(instance.name, instance.workspace,
-                    tuple(ObjectSpec(n, sizes[n], Pose2D(*here[n]), g) for n, g in goals.items()),
-                    instance.scene)  # fmt: skip
+    fake = dataclasses.replace(
+        instance,
+        objects=tuple(ObjectSpec(n, sizes[n], Pose2D(*here[n]), g) for n, g in goals.items()),
+    )
     mini, moved = continuation_instance(fake, here, sizes, config.seed, frozenset(culprits))
     head = prefix_plan(plan, begin)
     q0 = head.q[-1]

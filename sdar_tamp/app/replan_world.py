@@ -10,6 +10,7 @@ nearby as its goal: it is moved away like a buffered object. Objects gone are no
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 
@@ -51,7 +52,7 @@ def continuation_instance(
                     goal = free
                     moved.append(name)
         objects.append(ObjectSpec(name, sizes[name], here, goal))
-    return Instance(instance.name, instance.workspace, tuple(objects), instance.scene), tuple(moved)
+    return dataclasses.replace(instance, objects=tuple(objects)), tuple(moved)
 
 
 def _rect(pose: Pose2D, size: tuple[float, ...], margin: float = 0.0) -> FloatArray:

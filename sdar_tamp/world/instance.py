@@ -19,7 +19,7 @@ overlapping footprints at start or at goal (touching is allowed).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -68,6 +68,8 @@ class Instance:
     scene: str | None = None  # scene file as written (relative to the instance file)
     family: str | None = None
     seed: int | None = None
+    #: the file the instance was read from (None: built in memory); not part of its value
+    source: Path | None = field(default=None, compare=False, repr=False)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -86,11 +88,14 @@ class Instance:
         return np.array([o.size for o in self.objects]).reshape(-1, 3)
 
     def scene_path(self, instance_file: Path | None = None) -> Path | None:
-        """The scene file, resolved against the instance file's folder (None: default)."""
+        """The scene file, resolved against the folder of ``instance_file`` (default: the file
+        the instance was read from; relative to the working folder for an instance built in
+        memory); None: the default scene."""
         if self.scene is None:
             return None
         p = Path(self.scene)
-        return p if p.is_absolute() or instance_file is None else instance_file.parent / p
+        folder_of = instance_file if instance_file is not None else self.source
+        return p if p.is_absolute() or folder_of is None else folder_of.parent / p
 
 
 def validate_instance(
@@ -142,7 +147,8 @@ def validate_instance(
 
 def load_instance(path: Path, grasp: GraspLimits | None = SHIPPED_GRASP) -> Instance:
     """Read and validate an instance file."""
-    return _from_node(read_yaml(Path(path), InstanceError), grasp)
+    instance = _from_node(read_yaml(Path(path), InstanceError), grasp)
+    return replace(instance, source=Path(path))
 
 
 def parse_instance(

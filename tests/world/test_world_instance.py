@@ -142,3 +142,34 @@ def test_bad_object_name() -> None:
     text = HEAD + _obj("'a b'", "[0, 0, 0]", "[0, 0, 0]")
     with pytest.raises(InstanceError, match="object 'a b': expected a name of letters"):
         parse_instance(text, "inst.yaml")
+
+
+def test_a_relative_scene_resolves_against_the_file_read_whatever_the_working_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An instance read from a file finds its cell next to that file, also where a caller
+    does not pass the file again (the validator's default scene)."""
+    import os
+
+    from sdar_tamp.plan_reading import load_plan
+    from sdar_tamp.replay import validate_plan
+
+    root = Path(__file__).parents[2]
+    cell = root / "domains" / "dual_arm_rearrangement" / "cells" / "ur5e_facing.yaml"
+    folder = tmp_path / "made" / "here"
+    folder.mkdir(parents=True)
+    text = (
+        root / "domains" / "dual_arm_rearrangement" / "suites" / "paper" / "D5.yaml"
+    ).read_text()
+    key = os.path.relpath(cell, folder)
+    (folder / "D5.yaml").write_text(f"scene: {key}\n{text}")
+    elsewhere = tmp_path / "a" / "b" / "c" / "d"
+    elsewhere.mkdir(parents=True)
+    monkeypatch.chdir(elsewhere)  # the key read from the working folder names no file
+    instance = load_instance(folder / "D5.yaml")
+    assert instance.scene == key and instance.source == folder / "D5.yaml"
+    assert instance.scene_path() == folder / key and instance.scene_path().is_file()
+    assert not Path(key).is_file()
+    plan = load_plan(root / "tests" / "plan" / "solved" / "D5.plan.json")
+    assert validate_plan(instance, plan).ok
+    assert instance == load_instance(folder / "D5.yaml")  # the source is not part of the value
