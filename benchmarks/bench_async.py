@@ -31,18 +31,15 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import re
 import statistics
 import time
 from pathlib import Path
 
-from sdar_tamp.app import PlannerCache, solve_instance
+from _suites import shipped_suite_files, stored_or_solved
+
+from sdar_tamp.app import PlannerCache, PlannerConfig
 from sdar_tamp.app.execution import execution_options
-from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.plan_reading import load_plan
-from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.replay import validate_plan
-from sdar_tamp.resources import domain_file
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule.pieces import arm_blocks
 from sdar_tamp.schedule.scheduler import retimer
@@ -50,29 +47,6 @@ from sdar_tamp.schedule.timelines import schedule_timelines
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.scene import load_scene
 from sdar_tamp.world.suites import CELL_SUITES, SUITES
-
-
-def _suite_files(suite: str) -> list[Path]:
-    folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
-
-    def key(p: Path) -> tuple[str, int]:
-        digits = re.sub(r"\D", "", p.stem)
-        return (p.stem[0], int(digits) if digits else 0)
-
-    return sorted(folder.glob("*.yaml"), key=key)
-
-
-def _plan(path: Path, args: argparse.Namespace, cache: PlannerCache) -> PlanFile | None:
-    stored = args.plans / f"{path.stem}.json" if args.plans else None
-    if stored is not None and stored.exists() and not args.save:
-        return load_plan(stored)
-    outcome = solve_instance(path, time_limit=args.time_limit, execution="sync", cache=cache)
-    if not outcome.success or outcome.plan is None:
-        return None
-    if stored is not None and args.save:
-        save_plan(outcome.plan, stored)
-    return outcome.plan
-
 
 #: ``--quick``'s defaults
 QUICK = {"only": "R4", "time_limit": 30.0}
@@ -97,15 +71,18 @@ def main(argv: list[str] | None = None) -> None:
         ap.set_defaults(**QUICK)
         args = ap.parse_args(argv)
     only = {s for s in args.only.split(",") if s}
-    files = [p for p in _suite_files(args.suite) if not only or p.stem in only]
+    files = [p for p in shipped_suite_files(args.suite) if not only or p.stem in only]
     cache = PlannerCache()
+    solve_config = PlannerConfig(max_time=args.time_limit, execution="sync")
     rows = []
     print(f"{'instance':>8} {'sync [s]':>9} {'retime':>7} {'lines':>7} {'best':>7} {'ratio':>6} "
           f"{'valid':>5} {'bound':>6} {'dep':>5} {'arms':>5} {'tog':>3} {'cut':>5} "
           f"{'time [s]':>8}  note")  # fmt: skip
     for path in files:
         instance = load_instance(path)
-        plan = _plan(path, args, cache)
+        plan = stored_or_solved(
+            path, args.plans, solve_config, cache, save=args.save, refresh=args.save
+        )
         if plan is None:
             print(f"{path.stem:>8} not solved")
             continue

@@ -38,21 +38,18 @@ import argparse
 import json
 import math
 import os
-import re
 import statistics
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from _suites import shipped_suite_files, stored_or_solved
 
-from sdar_tamp.app import PlannerCache, PlannerConfig, solve_instance
+from sdar_tamp.app import PlannerCache, PlannerConfig
 from sdar_tamp.app.replanning import replan
 from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.plan_reading import load_plan
 from sdar_tamp.plan_state import state_at
-from sdar_tamp.plan_writing import save_plan
-from sdar_tamp.resources import domain_file
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.errors import ObservedStateError
 from sdar_tamp.world.instance import Instance, Pose2D, load_instance
@@ -66,29 +63,6 @@ from sdar_tamp.world.observed import (
 from sdar_tamp.world.scene import Scene, load_scene
 
 KINDS = ("nudge", "remove", "add")
-
-
-def _suite_files(suite: str) -> list[Path]:
-    folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
-
-    def key(p: Path) -> tuple[str, int]:
-        digits = re.sub(r"\D", "", p.stem)
-        return (p.stem[0], int(digits) if digits else 0)
-
-    return sorted(folder.glob("*.yaml"), key=key)
-
-
-def _plan(path: Path, args: argparse.Namespace, cache: PlannerCache) -> PlanFile | None:
-    stored = args.plans / f"{path.stem}.json" if args.plans is not None else None
-    if stored is not None and stored.exists():
-        return load_plan(stored)
-    config = PlannerConfig(max_time=args.solve_time_limit, execution="sync")
-    outcome = solve_instance(path, config, cache=cache)
-    if not outcome.success or outcome.plan is None:
-        return None
-    if stored is not None and args.save:
-        save_plan(outcome.plan, stored)
-    return outcome.plan
 
 
 @dataclass(frozen=True)
@@ -157,17 +131,22 @@ def main() -> None:
     only = args.only or ("R4" if args.quick else None)
     per = args.per_instance or (3 if args.quick else 6)
     args.time_limit = args.time_limit or (30.0 if args.quick else 60.0)
-    files = [p for p in _suite_files(args.suite) if only is None or p.stem in only.split(",")]
+    files = [
+        p for p in shipped_suite_files(args.suite) if only is None or p.stem in only.split(",")
+    ]
     cache = PlannerCache()
     scene = load_scene()
     world = CollisionWorld(scene)
     config = PlannerConfig(max_time=args.time_limit, seed=args.seed)
+    solve_config = PlannerConfig(max_time=args.solve_time_limit, execution="sync")
     rows: list[dict[str, object]] = []
     unsolved: list[str] = []
     started = time.perf_counter()
     for path in files:
         instance = load_instance(path)
-        plan = _plan(path, args, cache)
+        plan = stored_or_solved(
+            path, args.plans, solve_config, cache, save=args.save, refresh=False
+        )
         if plan is None:
             unsolved.append(path.stem)
             continue

@@ -35,37 +35,22 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import statistics
 import time
 from pathlib import Path
 
+from _suites import shipped_suite_files, suite_order
+
 from sdar_tamp.app.cache import PlannerCache
 from sdar_tamp.app.pipeline import solve_instance
 from sdar_tamp.app.records import SolveOutcome
-from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import load_instance
 from sdar_tamp.world.suites import CELL_SUITES, SUITES
 
 
-def _order(p: Path) -> tuple[str, int]:
-    digits = re.sub(r"\D", "", p.stem)
-    return (p.stem[0], int(digits) if digits else 0)
-
-
-def _suite_files(suite: str) -> list[Path]:
-    folder = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / suite
-    if not folder.is_dir():
-        raise SystemExit(
-            f"--suite {suite}: not shipped; generate it in a cell (sdar generate --scene CELL "
-            f"--suite {suite} -o DIR) and pass --folder DIR"
-        )
-    return sorted(folder.glob("*.yaml"), key=_order)
-
-
 def _folder_files(folder: Path) -> list[Path]:
     """The instance files of ``folder``, by family then object count."""
-    return sorted(Path(folder).glob("*.yaml"), key=_order)
+    return sorted(Path(folder).glob("*.yaml"), key=suite_order)
 
 
 #: ``--quick``'s defaults
@@ -102,7 +87,7 @@ def main(argv: list[str] | None = None) -> None:
     if args.compare_adaptive:
         compare_adaptive(args.time_limit, args.quick)
         return
-    files = _suite_files(args.suite) if args.folder is None else _folder_files(args.folder)
+    files = shipped_suite_files(args.suite) if args.folder is None else _folder_files(args.folder)
     files = [p for p in files if _wanted(p, args)]
     if args.bound_only:
         bounds_only(files, args)
