@@ -14,7 +14,9 @@ checkout's own ``pddlstream`` package is never imported; the runner fails the ex
 is), and every plan the program obtains is re-checked by simulation
 (:mod:`sdar_tamp.compat.pddlstream.check`). An example passes when it found at least one plan
 and every plan it found is valid; an error raised after a valid plan was found is reported but
-does not fail the example.
+does not fail the example, nor does the runner's time limit ending a program that plans again
+after executing each plan (pr2_belief) once it has found a plan (the record is written after
+every solve call).
 
 The runner fixes the environment, never the examples: without a display (no ``$DISPLAY``) the
 examples' tkinter viewers get a do-nothing stand-in and the pybullet ones connect in DIRECT mode
@@ -33,8 +35,15 @@ or add ``import sdar_tamp.compat.pddlstream.install`` as its first import.
 
 Three examples find no plan in PDDLStream itself either (run locally with Fast Downward, as
 written): ``continuous_tamp_unfactored`` (not within its own 30 s), ``continuous_tamp_ffrob``
-(unsolvable as written) and ``discrete_belief`` (its own ``opt_gen_fn`` raises); the table
-says so under their rows, and the summary lists them as ``fail_in_pddlstream_too``.
+(unsolvable as written) and ``discrete_belief`` (its own ``opt_gen_fn`` raises); nor does
+``turtlebots`` (read from its source: it needs Temporal Fast Downward, and its own collision
+predicate raises a ``TypeError`` on Python 3); the table says so under their rows, and the
+summary lists them as ``fail_in_pddlstream_too``.
+
+Each example runs within its own time limit (the ``max_time`` it passes to ``solve``) plus
+60 s for loading its world and re-checking its plans; one with no limit of its own (kuka, pr2,
+pr2_belief) gets ``--unlimited`` (600 s), and one that states none 120 s; ``--timeout``
+replaces all three.
 
 Prints a table example -> result -> time [s]; the last line is one JSON object. Without a
 checkout it prints ``{"skipped": "<why>", ...}`` as its last line and exits 0.
@@ -51,6 +60,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import json
+import math
 import os
 import subprocess
 import sys
@@ -61,6 +71,17 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
+#: [s] the runner's limit for an example that states none
+DEFAULT_TIMEOUT = 120.0
+
+#: what PDDLStream does with turtlebots here (it cannot be run: see the module docstring)
+TURTLEBOTS_UPSTREAM = (
+    "hands its durative actions and numeric fluents to Temporal Fast Downward (TFD_PATH; not "
+    "here), and once its streams reach complexity 1 its own collision predicate raises a "
+    "TypeError on Python 3 (get_turtle_traj_aabb passes a map to aabb_union, which calls len() "
+    "on it; PDDLStream calls predicates with no try)"
+)
+
 
 @dataclass(frozen=True)
 class Example:
@@ -68,10 +89,13 @@ class Example:
     module: str
     args: tuple[str, ...] = ()
     #: set when PDDLStream itself finds no plan for the example as written (run locally with
-    #: Fast Downward): what happens there
+    #: Fast Downward, or, for turtlebots, read from its source): what happens there
     upstream: str = ""
     #: a module the example needs that is not a dependency of this project (an optional extra)
     needs: str = ""
+    #: the example's own time limit [s] (the ``max_time`` it passes to ``solve``; ``math.inf``:
+    #: it passes none); None: the runner's ``--timeout`` applies
+    limit: float | None = None
 
 
 EXAMPLES = (
@@ -117,18 +141,44 @@ EXAMPLES = (
     Example("satellites", "examples.ipc.satellites.run"),
     # the robot programs: PyBullet (``pip install sdar-tamp[pybullet]``) in DIRECT mode (no
     # $DISPLAY, so their ``connect`` opens no window)
-    Example("kuka", "examples.pybullet.kuka.run", needs="pybullet"),
-    Example("pr2", "examples.pybullet.pr2.run", needs="pybullet"),
-    Example("namo", "examples.pybullet.namo.run", needs="pybullet"),
-    Example("pr2_rovers", "examples.pybullet.pr2_rovers.run", needs="pybullet"),
-    Example("pr2_belief", "examples.pybullet.pr2_belief.run", needs="pybullet"),
-    Example("tamp", "examples.pybullet.tamp.run", needs="pybullet"),
-    Example("turtlebot_rovers", "examples.pybullet.turtlebot_rovers.run", needs="pybullet"),
-    Example("turtlebots", "examples.pybullet.turtlebots.run", needs="pybullet"),
+    Example("kuka", "examples.pybullet.kuka.run", needs="pybullet", limit=math.inf),
+    Example("pr2", "examples.pybullet.pr2.run", needs="pybullet", limit=math.inf),
+    Example("namo", "examples.pybullet.namo.run", needs="pybullet", limit=120.0),
+    Example("pr2_rovers", "examples.pybullet.pr2_rovers.run", needs="pybullet", limit=120.0),
+    Example("pr2_belief", "examples.pybullet.pr2_belief.run", needs="pybullet", limit=math.inf),
+    Example("tamp", "examples.pybullet.tamp.run", needs="pybullet", limit=120.0),
+    Example(
+        "turtlebot_rovers", "examples.pybullet.turtlebot_rovers.run", needs="pybullet", limit=120.0
+    ),
+    Example(
+        "turtlebots",
+        "examples.pybullet.turtlebots.run",
+        needs="pybullet",
+        limit=300.0,
+        upstream=TURTLEBOTS_UPSTREAM,
+    ),
 )
 
 #: ``--quick``'s defaults
 QUICK: dict[str, object] = {"only": ["blocksworld"], "timeout": 60.0}
+
+#: [s] the runner's allowance, beyond an example's own time limit, for loading its world
+#: (pybullet scenes, sampled roadmaps) and re-checking its plans
+SETUP_SECONDS = 60.0
+
+
+def allowed_seconds(example: Example, timeout: float | None, unlimited: float) -> float:
+    """How long the runner lets ``example`` run [s]: ``timeout`` when given, else its own time
+    limit plus :data:`SETUP_SECONDS`, ``unlimited`` when it has none, 120 s when it states
+    nothing."""
+    if timeout is not None:
+        return timeout
+    if example.limit is None:
+        return DEFAULT_TIMEOUT
+    if math.isinf(example.limit):
+        return unlimited
+    return example.limit + SETUP_SECONDS
+
 
 #: PDDLStream's examples predate NumPy 2 and use names it removed; the runner puts those
 #: aliases back in the example's process (an environment fix, the examples stay unmodified),
@@ -252,7 +302,9 @@ def run_example(
         result = f"INVALID plan: {invalid[0].get('error')}"
     elif solved:
         result = "solved"
-        if returncode not in (0, None) and record.get("exception"):
+        if returncode is None:  # a closed-loop program (plan, execute, plan again) still going
+            result = f"solved, {len(solved)} plan(s) (then: stopped at {timeout:g} s)"
+        elif returncode != 0 and record.get("exception"):
             result = f"solved (then: {str(record['exception'])[:60]})"
     elif returncode is None:
         result = f"timeout ({timeout:g} s)"
@@ -277,7 +329,18 @@ def run_example(
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("checkout", nargs="?", default=os.environ.get("PDDLSTREAM_PATH"))
-    parser.add_argument("--timeout", type=float, default=120.0, help="[s] per example")
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=None,
+        help="[s] per example (default: its own time limit + 60 s; 120 s when it states none)",
+    )
+    parser.add_argument(
+        "--unlimited",
+        type=float,
+        default=600.0,
+        help="[s] for an example with no time limit of its own (kuka, pr2, pr2_belief)",
+    )
     parser.add_argument("--only", nargs="*", default=None, help="example names to run")
     parser.add_argument(
         "--repeat", type=int, default=1, help="runs per example (unseeded ones vary: pass rates)"
@@ -304,7 +367,8 @@ def main(argv: list[str] | None = None) -> int:
     for example in chosen:
         runs = []
         for _ in range(args.repeat):
-            row = run_example(checkout, example, args.timeout)
+            allowed = allowed_seconds(example, args.timeout, args.unlimited)
+            row = run_example(checkout, example, allowed)
             runs.append(row)
             print(f"{row['example']:28} {row['result']!s:60} {row['seconds']:8.2f}", flush=True)
             if not row["passed"] and example.upstream:

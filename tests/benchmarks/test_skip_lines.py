@@ -56,6 +56,18 @@ def test_pddlstream_robot_example_without_its_simulator(
     }
 
 
+def test_pddlstream_examples_run_within_their_own_time_limits(benchmark_script: Loader) -> None:
+    bench = benchmark_script("bench_pddlstream_compat")
+    by_name = {e.name: e for e in bench.EXAMPLES}
+    allowed = {name: bench.allowed_seconds(e, None, 600.0) for name, e in by_name.items()}
+    assert allowed["namo"] == 120.0 + bench.SETUP_SECONDS  # its own max_time, plus loading
+    assert allowed["turtlebots"] == 300.0 + bench.SETUP_SECONDS
+    assert allowed["kuka"] == allowed["pr2_belief"] == 600.0  # no limit of its own
+    assert allowed["blocksworld"] == bench.DEFAULT_TIMEOUT  # states none
+    assert all(bench.allowed_seconds(e, 5.0, 600.0) == 5.0 for e in bench.EXAMPLES)
+    assert "turtlebots" in {e.name for e in bench.EXAMPLES if e.upstream}
+
+
 def test_classical_without_its_problem_folder(
     benchmark_script: Loader, capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:

@@ -205,3 +205,37 @@ def test_runner_runs_an_unmodified_program_and_rechecks_its_plan(tmp_path: Path)
     assert "Solved: True" in done.stdout
     calls = json.loads(report.read_text())["calls"]
     assert [(c["algorithm"], c["solved"], c["valid"]) for c in calls] == [("focused", True, True)]
+
+
+def test_the_record_holds_each_call_when_the_program_is_killed(tmp_path: Path) -> None:
+    import json
+
+    program = tmp_path / "program.py"
+    killed = PROGRAM.replace(
+        "args = create_parser().parse_args()", "import os, signal\nargs = None"
+    )
+    killed = killed.replace("algorithm=args.algorithm", "algorithm='focused'")
+    program.write_text(killed + "os.kill(os.getpid(), signal.SIGKILL)\n")
+    report = tmp_path / "report.json"
+    env = {"PYTHONPATH": f"{ROOT}:{Path(__file__).parent}", "PATH": "/usr/bin:/bin"}
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sdar_tamp.compat.pddlstream",
+            "--report",
+            str(report),
+            str(program),
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=120,
+    )
+    assert done.returncode == -9  # killed: the final write never happened
+    record = json.loads(report.read_text())
+    assert record["finished"] is False
+    assert [(c["algorithm"], c["solved"], c["valid"]) for c in record["calls"]] == [
+        ("focused", True, True)
+    ]

@@ -31,9 +31,14 @@ USAGE = (
 
 
 class _Recorder:
-    """Wraps the solver entry points of this process to record and re-check each result."""
+    """Wraps the solver entry points of this process to record and re-check each result.
 
-    def __init__(self) -> None:
+    The record is written to ``path`` after every call (``"finished": false``) and once more
+    when the program ends, so a program stopped from outside (a closed-loop program that plans
+    again after each execution, killed at a time limit) still leaves the calls it made."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
         self.calls: list[dict[str, Any]] = []
 
     def install(self) -> None:
@@ -61,6 +66,7 @@ class _Recorder:
                     "seconds": round(seconds, 4),
                 }
             )
+            self.write(None, finished=False)
             return solution
 
         def recorded_plan(task: Any, *args: Any, **kwargs: Any) -> Any:
@@ -77,18 +83,23 @@ class _Recorder:
                     "seconds": round(time.perf_counter() - start, 4),
                 }
             )
+            self.write(None, finished=False)
             return result
 
         setattr(meta, "core_solve", recorded_solve)  # noqa: B010
         setattr(search, "plan", recorded_plan)  # noqa: B010
 
-    def write(self, path: str, failure: BaseException | None) -> None:
+    def write(self, failure: BaseException | None, finished: bool = True) -> None:
+        """Write the record (whole or not at all: a new file replaces the old one)."""
         record = {
             "calls": self.calls,
             "exception": None if failure is None else f"{type(failure).__name__}: {failure}",
+            "finished": finished,
         }
-        with open(path, "w", encoding="utf-8") as handle:
+        partial = f"{self.path}.partial"
+        with open(partial, "w", encoding="utf-8") as handle:
             json.dump(record, handle, default=str)
+        os.replace(partial, self.path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -107,7 +118,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     install_alias()
     if report is None:
         return _run(args)
-    recorder = _Recorder()
+    recorder = _Recorder(report)
     recorder.install()
     failure: BaseException | None = None
     try:
@@ -116,7 +127,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         failure = error
         raise
     finally:
-        recorder.write(report, None if isinstance(failure, SystemExit) else failure)
+        recorder.write(None if isinstance(failure, SystemExit) else failure)
 
 
 def _run(args: list[str]) -> int:
