@@ -164,6 +164,7 @@ def main() -> None:
                 "redrawn": p.redrawn, "status": out.status, "valid": out.valid,
                 "latency": out.latency, "cpu": cpu, "cut": out.cut,
                 "cannot_stop": any("before the arms can stop" in r for r in out.reasons),
+                "why": out.violation or "; ".join(out.reasons),
             }  # fmt: skip
             if kind == "nudge" and out.plan is not None:
                 fresh = replan(instance, plan, p.at, p.observed, config=config, cache=cache,
@@ -178,6 +179,8 @@ def main() -> None:
             print(f"{path.stem:4s} {kind:6s} t={p.at:6.2f} {p.what:28s} {out.status:10s} "
                   f"valid={out.valid} {out.latency:6.3f} s (cpu {cpu:.3f} s){ratio}",
                   flush=True)  # fmt: skip
+            if out.valid is not True:
+                print(f"     why: {row['why']}", flush=True)
     solvable = [r for r in rows if not r["cannot_stop"]]
     ok = [r for r in solvable if r["valid"] is True]
     latencies = [float(r["latency"]) for r in solvable]  # type: ignore[arg-type]
