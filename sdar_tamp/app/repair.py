@@ -9,7 +9,9 @@ no longer where the grasp expects it, a removed object, an added object in the w
 it falls in is planned again by SDAR for its own objects only, from the arms' configuration at
 the task's start to the placements the old plan gave them (a removed object's part is
 dropped, an added object that blocks those placements is moved away); one motion then joins
-the arms to the old plan's next grasp, and the old plan goes on from there. The result is
+the arms to the old plan's next grasp, and the old plan goes on from there. A violation that
+no task holds, an object left off its goal at the end (one at its goal, nudged), is repaired
+by one more task after the old plan's end. The result is
 kept when it replays without violation from the cut; after a few tasks repaired in turn (or a
 failed step) the caller solves afresh.
 """
@@ -124,7 +126,9 @@ def _repair_task(
     scene = world.ctx.scene
     task = next((k for k in tasks_of(plan, state.t) if k.start <= bad < k.end), None)
     if task is None:
-        return None
+        if bad < float(plan.t[-1]) - 1e-9:
+            return None
+        return _append_task(world, config, instance, plan, sizes)
     begin = cut_at(plan, task.start)
     walk = walk_from(instance, plan, scene, kins, collision, state)
     if walk.walk(begin.t, state.t) is not None:
@@ -177,6 +181,33 @@ def _repair_task(
     middle = build_plan_file(scene, instance.name, here, sizes_here, items, {},
                              gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
     return splice(splice(head, middle), tail(plan, join)), moved, restart
+
+
+def _append_task(
+    world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile,
+    sizes: Mapping[str, tuple[float, float, float]],
+) -> tuple[PlanFile, tuple[str, ...], PlanState] | None:  # fmt: skip
+    """``plan`` followed by one more task that brings the objects it leaves off their goals
+    there (an object at its goal nudged off it, which no task of the old plan touches), and
+    the state where that task begins; the added objects in the way are moved away."""
+    scene = world.ctx.scene
+    here = dict(plan.final_poses)
+    mini, moved = continuation_instance(instance, here, sizes, config.seed)
+    if all(o.start == o.goal for o in mini.objects):
+        return None  # nothing off its goal: the violation is another one
+    q0 = plan.q[-1]
+    start = start_configuration(
+        _home(world), q0, {a: scene.layout.slice(a) for a in scene.arm_names}
+    )
+    r = rearrangement_problem(mini, world.ctx, config=config, planner=world.planner, start=start)
+    solution = solve_rearrangement(r, prove=False)
+    if solution.plan is None:
+        return None
+    items = timeline(solution.plan, task_records(solution), decoder_of(r))
+    more = build_plan_file(scene, instance.name, here, {n: sizes[n] for n in here}, items, {},
+                           gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
+    end = PlanState(float(plan.t[-1]), q0, {}, here)
+    return splice(plan, more), moved, end
 
 
 def _last_actors(items: list[MotionSegment | GripperEvent]) -> set[str]:

@@ -101,6 +101,29 @@ def test_a_nudged_object_is_regrasped_at_its_new_pose(
     assert not report.ok and report.violation is not None and report.violation.t > AT
 
 
+@pytest.mark.parametrize("repair", [True, False])
+def test_a_nudged_object_at_its_goal_is_put_back(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, repair: bool
+) -> None:
+    """o3 rests at its goal from 3.59 s on and no task of the old plan touches it again: the
+    repair appends one that puts it back; a fresh continuation does the same within its plan.
+    Neither moves o0, at its goal to rounding (the continuation takes it as there)."""
+    goal = _obj(d5[0], "o3").goal
+    new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
+    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]",
+                  repair=repair)  # fmt: skip
+    assert out.status == ("repaired" if repair else "replanned")
+    plan = _assert_valid_whole(d5, out)
+    grasps = _grasp_poses(plan, "o3", out.cut)
+    assert len(grasps) == 1 and math.hypot(grasps[0][0] - new[0], grasps[0][1] - new[1]) < 1e-3
+    assert np.allclose(plan.final_poses["o3"][:2], (goal.x, goal.y), atol=1e-3)
+    assert not [e for e in plan.events if e.object == "o0" and e.t > out.cut]
+    if repair:  # the old plan's rest is kept whole, the new task after it
+        kept = [(e.type, e.object) for e in d5[1].events if e.t > AT]
+        after = [(e.type, e.object) for e in plan.events if e.t > AT]
+        assert after == [*kept, ("grasp", "o3"), ("release", "o3")]
+
+
 def test_a_removed_object_loses_its_remaining_tasks(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
