@@ -119,13 +119,18 @@ def _free_pose(
     return None
 
 
-def start_configuration(home: CellConf, q: FloatArray, arm_slices: Mapping[str, slice]) -> CellConf:
+def start_configuration(
+    home: CellConf, q: FloatArray, arm_slices: Mapping[str, slice],
+    free: frozenset[str] = frozenset(),
+) -> CellConf:  # fmt: skip
     """The cell configuration at ``q`` ``(dof,)`` [rad]: an arm at home keeps its home
     configuration; an arm elsewhere (over the table, at a grasp or a placement) gets a
-    pre-grasp mark, so that its first motion leaves by a straight lift."""
+    pre-grasp mark, so that its first motion leaves by a straight lift, unless it is in
+    ``free`` (stopped in the middle of a motion, clear of the objects: it leaves directly)."""
     arms = []
     for conf in home.arms:
         q_arm = tuple(float(v) for v in q[arm_slices[conf.arm]])
         at_home = math.dist(q_arm, conf.q) <= 1e-9
-        arms.append(conf if at_home else ArmConf(conf.arm, q_arm, pre=q_arm))
+        mark = None if conf.arm in free else q_arm
+        arms.append(conf if at_home else ArmConf(conf.arm, q_arm, pre=mark))
     return CellConf(*arms)

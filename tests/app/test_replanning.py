@@ -169,18 +169,41 @@ def test_nothing_changed_keeps_the_old_plan(
     assert len(plan.events) == len(d5[1].events)
 
 
+def _o1_nudged(instance: Instance) -> str:
+    o1 = _obj(instance, "o1")  # the right arm is on its way to grasp it at 5.71 s
+    return (f"poses: [{{name: o1, pose: [{o1.start.x + 0.015}, {o1.start.y - 0.01}, "
+            f"{o1.start.yaw + 0.15}]}}]")  # fmt: skip
+
+
+def test_the_arms_brake_short_of_a_change_on_their_way(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """The right arm would touch the nudged o1 at 5.414 s, before the plan's next cut (its
+    grasp at 5.71 s): the arms brake on their way from 4.5 s, on the old plan's path, and a
+    fresh continuation re-grasps o1 at its new pose."""
+    out = _replan(d5, cache, _o1_nudged(d5[0]))
+    assert out.status == "replanned" and out.plan is not None and out.valid is True
+    assert validate_plan(d5[0], out.plan, load_scene()).ok
+    assert AT < out.cut < 5.414
+    old = d5[1]
+    dense = np.linspace(AT - 0.05, out.cut + 0.05, 4000)
+    path = np.stack([np.interp(dense, old.t, old.q[:, j]) for j in range(old.q.shape[1])], 1)
+    braked = out.plan.q[(out.plan.t >= AT) & (out.plan.t <= out.cut)]
+    gap = np.linalg.norm(braked[:, None] - path[None], axis=2).min(axis=1)
+    assert gap.max() < 2e-3  # configurations of the old path (to the density of ``dense``)
+    assert np.array_equal(out.plan.q[out.plan.t <= AT], old.q[old.t <= AT])
+    assert len(_grasp_poses(out.plan, "o1", out.cut)) == 1
+
+
 def test_the_running_plan_meeting_the_change_is_infeasible_with_the_object(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
-    o1 = _obj(d5[0], "o1")  # the right arm is on its way to grasp it at 5.71 s
-    out = _replan(
-        d5, cache,
-        f"poses: [{{name: o1, pose: [{o1.start.x + 0.015}, {o1.start.y - 0.01}, "
-        f"{o1.start.yaw + 0.15}]}}]",
-    )  # fmt: skip
+    """At 5.4 s the right arm is 14 ms from touching o1: too late to brake."""
+    out = _replan(d5, cache, _o1_nudged(d5[0]), at=5.4)
     assert out.status == "infeasible" and out.plan is None and not out.success
     assert out.blocking == ("o1",)
     assert "before the arms can stop" in out.reasons[0]
+    assert "nor braking on their way" in out.reasons[0]
 
 
 @pytest.mark.parametrize(
