@@ -9,9 +9,10 @@ no longer where the grasp expects it, a removed object, an added object in the w
 it falls in is planned again by SDAR for its own objects only, from the arms' configuration at
 the task's start to the placements the old plan gave them (a removed object's part is
 dropped, an added object that blocks those placements is moved away); one motion then joins
-the arms to the old plan's next grasp, and the old plan goes on from there. A violation that
-no task holds, an object left off its goal at the end (one at its goal, nudged), is repaired
-by one more task after the old plan's end. The result is
+the arms to the old plan's next grasp, and the old plan goes on from there. An object left off
+its goal at the end (one at its goal, nudged: no task of the old plan touches it) joins the
+last task, planned again with it (the arms may share the work), or, when no task is left, one
+more task after the old plan's end brings it back. The result is
 kept when it replays without violation from the cut; after a few tasks repaired in turn (or a
 failed step) the caller solves afresh.
 """
@@ -124,11 +125,14 @@ def _repair_task(
     ``why``: the replay's violation there; an object it names outside the task (a nudged or
     added object in the task's way) is moved too: to its goal, or away (added objects)."""
     scene = world.ctx.scene
-    task = next((k for k in tasks_of(plan, state.t) if k.start <= bad < k.end), None)
+    tasks = tasks_of(plan, state.t)
+    task = next((k for k in tasks if k.start <= bad < k.end), None)
     if task is None:
         if bad < float(plan.t[-1]) - 1e-9:
             return None
-        return _append_task(world, config, instance, plan, sizes)
+        if not tasks:
+            return _append_task(world, config, instance, plan, sizes)
+        task = tasks[-1]  # an object off its goal at the end: joins the last task
     begin = cut_at(plan, task.start)
     walk = walk_from(instance, plan, scene, kins, collision, state)
     if walk.walk(begin.t, state.t) is not None:

@@ -106,7 +106,8 @@ def test_a_nudged_object_at_its_goal_is_put_back(
     d5: tuple[Instance, PlanFile], cache: PlannerCache, repair: bool
 ) -> None:
     """o3 rests at its goal from 3.59 s on and no task of the old plan touches it again: the
-    repair appends one that puts it back; a fresh continuation does the same within its plan.
+    repair plans the last task (o2's) again with o3 put back; a fresh continuation puts it back
+    within its plan.
     Neither moves o0, at its goal to rounding (the continuation takes it as there)."""
     goal = _obj(d5[0], "o3").goal
     new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
@@ -118,10 +119,30 @@ def test_a_nudged_object_at_its_goal_is_put_back(
     assert len(grasps) == 1 and math.hypot(grasps[0][0] - new[0], grasps[0][1] - new[1]) < 1e-3
     assert np.allclose(plan.final_poses["o3"][:2], (goal.x, goal.y), atol=1e-3)
     assert not [e for e in plan.events if e.object == "o0" and e.t > out.cut]
-    if repair:  # the old plan's rest is kept whole, the new task after it
-        kept = [(e.type, e.object) for e in d5[1].events if e.t > AT]
+    if repair:  # the old plan's rest is kept up to its last task (o2's), which o3 joins
+        kept = [(e.type, e.object) for e in d5[1].events if AT < e.t < 10.0]
         after = [(e.type, e.object) for e in plan.events if e.t > AT]
-        assert after == [*kept, ("grasp", "o3"), ("release", "o3")]
+        assert after[: len(kept)] == kept
+        assert sorted(after[len(kept) :]) == sorted(
+            [("grasp", "o2"), ("release", "o2"), ("grasp", "o3"), ("release", "o3")]
+        )
+
+
+def test_a_nudged_object_at_its_goal_after_the_last_task_gets_one_more(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """At 12.3 s every task is done (the last release, at 12.03 s, in its dwell): one more
+    task after the old plan's end puts o3 back."""
+    goal = _obj(d5[0], "o3").goal
+    new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
+    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]",
+                  at=12.3)  # fmt: skip
+    assert out.status == "repaired" and out.plan is not None and out.valid is True
+    assert validate_plan(d5[0], out.plan, load_scene()).ok
+    assert out.cut == pytest.approx(12.3, abs=0.03)  # in the dwell: still and empty
+    after = [(e.type, e.object) for e in out.plan.events if e.t > 12.3]
+    assert after == [("grasp", "o3"), ("release", "o3")]
+    assert np.allclose(out.plan.final_poses["o3"][:2], (goal.x, goal.y), atol=1e-3)
 
 
 def test_a_removed_object_loses_its_remaining_tasks(
