@@ -11,8 +11,9 @@ the task's start to the placements the old plan gave them (a removed object's pa
 dropped, an added object that blocks those placements is moved away); one motion then joins
 the arms to the old plan's next grasp, and the old plan goes on from there. An object left off
 its goal at the end (one at its goal, nudged: no task of the old plan touches it) joins the
-last task, planned again with it (the arms may share the work), or, when no task is left, one
-more task after the old plan's end brings it back. The result is
+last task, planned again with it (the arms may share the work), or, when that fails within
+half the budget or no task is left, one more task after the old plan's end brings it back.
+The result is
 kept when it replays without violation from the cut; after a few tasks repaired in turn (or a
 failed step) the caller solves afresh.
 """
@@ -124,15 +125,35 @@ def _repair_task(
     docstring), the added objects moved away, and the state where the new task begins.
     ``why``: the replay's violation there; an object it names outside the task (a nudged or
     added object in the task's way) is moved too: to its goal, or away (added objects)."""
-    scene = world.ctx.scene
     tasks = tasks_of(plan, state.t)
     task = next((k for k in tasks if k.start <= bad < k.end), None)
-    if task is None:
-        if bad < float(plan.t[-1]) - 1e-9:
-            return None
-        if not tasks:
-            return _append_task(world, config, instance, plan, sizes)
-        task = tasks[-1]  # an object off its goal at the end: joins the last task
+    if task is not None:
+        return _replan_task(world, config, instance, plan, state, kins, collision, sizes, task,
+                            why)  # fmt: skip
+    if bad < float(plan.t[-1]) - 1e-9:
+        return None
+    # an object off its goal at the end: it joins the last task (half the budget), else one
+    # more task after the plan's end brings it back
+    started = time.perf_counter()
+    if tasks:
+        half = config.replace(max_time=0.5 * config.max_time)
+        joined = _replan_task(world, half, instance, plan, state, kins, collision, sizes,
+                              tasks[-1], why)  # fmt: skip
+        if joined is not None:
+            return joined
+    left = config.max_time - (time.perf_counter() - started)
+    if left <= 0.0:
+        return None
+    return _append_task(world, config.replace(max_time=left), instance, plan, sizes)
+
+
+def _replan_task(
+    world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile,
+    state: PlanState, kins: Mapping[str, ArmKinematics], collision: CollisionWorld,
+    sizes: Mapping[str, tuple[float, float, float]], task: Task, why: str,
+) -> tuple[PlanFile, tuple[str, ...], PlanState] | None:  # fmt: skip
+    """``task`` of ``plan`` planned again (see :func:`_repair_task`)."""
+    scene = world.ctx.scene
     begin = cut_at(plan, task.start)
     walk = walk_from(instance, plan, scene, kins, collision, state)
     if walk.walk(begin.t, state.t) is not None:

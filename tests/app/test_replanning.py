@@ -128,6 +128,24 @@ def test_a_nudged_object_at_its_goal_is_put_back(
         )
 
 
+def test_a_nudged_object_at_its_goal_gets_one_more_task_when_the_last_cannot_take_it(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When the last task cannot be planned again with o3 (made to fail here), the old plan's
+    rest is kept whole and one more task after it puts o3 back."""
+    from sdar_tamp.app import repair as repair_module
+
+    monkeypatch.setattr(repair_module, "_replan_task", lambda *args: None)
+    goal = _obj(d5[0], "o3").goal
+    new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
+    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]")
+    assert out.status == "repaired"
+    plan = _assert_valid_whole(d5, out)
+    kept = [(e.type, e.object) for e in d5[1].events if e.t > AT]
+    after = [(e.type, e.object) for e in plan.events if e.t > AT]
+    assert after == [*kept, ("grasp", "o3"), ("release", "o3")]
+
+
 def test_a_nudged_object_at_its_goal_after_the_last_task_gets_one_more(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
