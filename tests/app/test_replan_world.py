@@ -53,4 +53,3 @@ def test_objects_at_their_goals_are_not_moved_again(d5: Instance) -> None:
     assert objs["o0"].goal.as_tuple() == resting["o0"] == objs["o0"].start.as_tuple()
     assert objs["o3"].goal.as_tuple() == resting["o3"]
     assert objs["o1"].goal == o1.goal and objs["o2"].goal == o2.goal
-
