@@ -12,7 +12,9 @@ by the independent replay.
 
 Counted apart (not solvable by any re-plan from ``T``): ``cannot_stop``, where the running
 plan meets the observed world before its arms reach the next point at which they are at rest
-with empty grippers (the cut). ``success_rate``: valid new plans over the other perturbed
+with empty grippers (the cut), and braking on their way does not stop them short of it
+either (an arm holds an object, a gripper acts first, or the change is too close).
+``success_rate``: valid new plans over the other perturbed
 states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
 time of ``replan`` without the final validation (``cpu_median_s``: the process's CPU time
 of the call, the validation included: on a loaded machine the wall time grows, the CPU time
@@ -164,6 +166,7 @@ def main() -> None:
                 "redrawn": p.redrawn, "status": out.status, "valid": out.valid,
                 "latency": out.latency, "cpu": cpu, "cut": out.cut,
                 "cannot_stop": any("before the arms can stop" in r for r in out.reasons),
+                "why": out.violation or "; ".join(out.reasons),
             }  # fmt: skip
             if kind == "nudge" and out.plan is not None:
                 fresh = replan(instance, plan, p.at, p.observed, config=config, cache=cache,
@@ -178,6 +181,8 @@ def main() -> None:
             print(f"{path.stem:4s} {kind:6s} t={p.at:6.2f} {p.what:28s} {out.status:10s} "
                   f"valid={out.valid} {out.latency:6.3f} s (cpu {cpu:.3f} s){ratio}",
                   flush=True)  # fmt: skip
+            if out.valid is not True:
+                print(f"     why: {row['why']}", flush=True)
     solvable = [r for r in rows if not r["cannot_stop"]]
     ok = [r for r in solvable if r["valid"] is True]
     latencies = [float(r["latency"]) for r in solvable]  # type: ignore[arg-type]

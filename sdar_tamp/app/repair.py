@@ -9,7 +9,11 @@ no longer where the grasp expects it, a removed object, an added object in the w
 it falls in is planned again by SDAR for its own objects only, from the arms' configuration at
 the task's start to the placements the old plan gave them (a removed object's part is
 dropped, an added object that blocks those placements is moved away); one motion then joins
-the arms to the old plan's next grasp, and the old plan goes on from there. The result is
+the arms to the old plan's next grasp, and the old plan goes on from there. An object left off
+its goal at the end (one at its goal, nudged: no task of the old plan touches it) joins the
+last task, planned again with it (the arms may share the work), or, when that fails within
+half the budget or no task is left, one more task after the old plan's end brings it back.
+The result is
 kept when it replays without violation from the cut; after a few tasks repaired in turn (or a
 failed step) the caller solves afresh.
 """
@@ -45,7 +49,16 @@ from streams.stream_types import ArmConf, CellConf
 
 Pose3 = tuple[float, float, float]
 MAX_TASKS = 3  #: tasks repaired in turn before the caller solves afresh
-BUDGET = 3.0  #: [s] of planning the repair may take before the caller solves afresh
+BUDGET = 3.0  #: [s] of planning the repair may take at least before the caller solves afresh
+#: Share of the re-plan's time limit the repair may take, when more than :data:`BUDGET`: on a
+#: loaded machine (wall time several times the CPU time) a repair that needs 1 s of CPU
+#: still fits, rather than falling back on a fresh solve that needs several times more.
+BUDGET_SHARE = 0.25
+
+
+def repair_budget(max_time: float) -> float:
+    """The repair's planning budget [s] (wall time) within a re-plan's ``max_time`` [s]."""
+    return min(max_time, max(BUDGET, BUDGET_SHARE * max_time))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,7 +107,7 @@ def repair(
     the repair fails."""
     scene = world.ctx.scene
     moved: tuple[str, ...] = ()
-    deadline = time.perf_counter() + min(BUDGET, config.max_time)
+    deadline = time.perf_counter() + repair_budget(config.max_time)
     for _ in range(MAX_TASKS + 1):
         plan, bad, why = check_from(instance, plan, scene, kins, collision, state)
         if bad is None:
@@ -121,10 +134,35 @@ def _repair_task(
     docstring), the added objects moved away, and the state where the new task begins.
     ``why``: the replay's violation there; an object it names outside the task (a nudged or
     added object in the task's way) is moved too: to its goal, or away (added objects)."""
-    scene = world.ctx.scene
-    task = next((k for k in tasks_of(plan, state.t) if k.start <= bad < k.end), None)
-    if task is None:
+    tasks = tasks_of(plan, state.t)
+    task = next((k for k in tasks if k.start <= bad < k.end), None)
+    if task is not None:
+        return _replan_task(world, config, instance, plan, state, kins, collision, sizes, task,
+                            why)  # fmt: skip
+    if bad < float(plan.t[-1]) - 1e-9:
         return None
+    # an object off its goal at the end: it joins the last task (half the budget), else one
+    # more task after the plan's end brings it back
+    started = time.perf_counter()
+    if tasks:
+        half = config.replace(max_time=0.5 * config.max_time)
+        joined = _replan_task(world, half, instance, plan, state, kins, collision, sizes,
+                              tasks[-1], why)  # fmt: skip
+        if joined is not None:
+            return joined
+    left = config.max_time - (time.perf_counter() - started)
+    if left <= 0.0:
+        return None
+    return _append_task(world, config.replace(max_time=left), instance, plan, sizes)
+
+
+def _replan_task(
+    world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile,
+    state: PlanState, kins: Mapping[str, ArmKinematics], collision: CollisionWorld,
+    sizes: Mapping[str, tuple[float, float, float]], task: Task, why: str,
+) -> tuple[PlanFile, tuple[str, ...], PlanState] | None:  # fmt: skip
+    """``task`` of ``plan`` planned again (see :func:`_repair_task`)."""
+    scene = world.ctx.scene
     begin = cut_at(plan, task.start)
     walk = walk_from(instance, plan, scene, kins, collision, state)
     if walk.walk(begin.t, state.t) is not None:
@@ -177,6 +215,33 @@ def _repair_task(
     middle = build_plan_file(scene, instance.name, here, sizes_here, items, {},
                              gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
     return splice(splice(head, middle), tail(plan, join)), moved, restart
+
+
+def _append_task(
+    world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile,
+    sizes: Mapping[str, tuple[float, float, float]],
+) -> tuple[PlanFile, tuple[str, ...], PlanState] | None:  # fmt: skip
+    """``plan`` followed by one more task that brings the objects it leaves off their goals
+    there (an object at its goal nudged off it, which no task of the old plan touches), and
+    the state where that task begins; the added objects in the way are moved away."""
+    scene = world.ctx.scene
+    here = dict(plan.final_poses)
+    mini, moved = continuation_instance(instance, here, sizes, config.seed)
+    if all(o.start == o.goal for o in mini.objects):
+        return None  # nothing off its goal: the violation is another one
+    q0 = plan.q[-1]
+    start = start_configuration(
+        _home(world), q0, {a: scene.layout.slice(a) for a in scene.arm_names}
+    )
+    r = rearrangement_problem(mini, world.ctx, config=config, planner=world.planner, start=start)
+    solution = solve_rearrangement(r, prove=False)
+    if solution.plan is None:
+        return None
+    items = timeline(solution.plan, task_records(solution), decoder_of(r))
+    more = build_plan_file(scene, instance.name, here, {n: sizes[n] for n in here}, items, {},
+                           gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
+    end = PlanState(float(plan.t[-1]), q0, {}, here)
+    return splice(plan, more), moved, end
 
 
 def _last_actors(items: list[MotionSegment | GripperEvent]) -> set[str]:

@@ -2,7 +2,8 @@
 begin (:mod:`sdar_tamp.app.replanning`).
 
 The continuation's instance holds the objects resting at the cut: an instance object keeps
-its goal; an object the instance does not know (added by an observation) has none, so it
+its goal (one already there, to rounding or turned half a turn, has its pose as goal: no task
+moves it again); an object the instance does not know (added by an observation) has none, so it
 stays where it is, unless it blocks a goal of the objects still to place (its footprint,
 grown by the fingers' clearance, meets such a goal), in which case it is given a free pose
 nearby as its goal: it is moved away like a buffered object. Objects gone are not in it.
@@ -22,6 +23,9 @@ from sdar_tamp.world.transforms import FloatArray
 from streams.stream_types import ArmConf, CellConf
 
 CLEARANCE = 0.03  #: [m] room kept around an added object for the fingers of a goal's grasp
+#: [m], [rad]: an object this close to its goal rests at it (half the validator's tolerances of a
+#: goal); its goal is its pose, so no task moves it again.
+AT_GOAL = (5e-4, math.radians(0.5))
 Pose3 = tuple[float, float, float]
 
 
@@ -37,6 +41,9 @@ def continuation_instance(
     object for which no free pose is found keeps its pose as goal (the solve then names it as
     blocking)."""
     goals = {o.name: o.goal for o in instance.objects}
+    for name, pose in resting.items():
+        if name in goals and at_goal(pose, goals[name]):
+            goals[name] = Pose2D(*pose)
     objects: list[ObjectSpec] = []
     names = sorted(resting, key=lambda n: (n not in goals, n))
     todo = [n for n in names if n in goals and goals[n].as_tuple() != tuple(resting[n])]
@@ -53,6 +60,14 @@ def continuation_instance(
                     moved.append(name)
         objects.append(ObjectSpec(name, sizes[name], here, goal))
     return dataclasses.replace(instance, objects=tuple(objects)), tuple(moved)
+
+
+def at_goal(pose: Pose3, goal: Pose2D) -> bool:
+    """Whether an object resting at ``pose`` is at ``goal`` within :data:`AT_GOAL` (yaw modulo
+    pi: a cuboid turned half a turn is the same)."""
+    turn = (pose[2] - goal.yaw) % math.pi
+    near = math.hypot(pose[0] - goal.x, pose[1] - goal.y) <= AT_GOAL[0]
+    return near and min(turn, math.pi - turn) <= AT_GOAL[1]
 
 
 def _rect(pose: Pose2D, size: tuple[float, ...], margin: float = 0.0) -> FloatArray:
@@ -104,13 +119,18 @@ def _free_pose(
     return None
 
 
-def start_configuration(home: CellConf, q: FloatArray, arm_slices: Mapping[str, slice]) -> CellConf:
+def start_configuration(
+    home: CellConf, q: FloatArray, arm_slices: Mapping[str, slice],
+    free: frozenset[str] = frozenset(),
+) -> CellConf:  # fmt: skip
     """The cell configuration at ``q`` ``(dof,)`` [rad]: an arm at home keeps its home
     configuration; an arm elsewhere (over the table, at a grasp or a placement) gets a
-    pre-grasp mark, so that its first motion leaves by a straight lift."""
+    pre-grasp mark, so that its first motion leaves by a straight lift, unless it is in
+    ``free`` (stopped in the middle of a motion, clear of the objects: it leaves directly)."""
     arms = []
     for conf in home.arms:
         q_arm = tuple(float(v) for v in q[arm_slices[conf.arm]])
         at_home = math.dist(q_arm, conf.q) <= 1e-9
-        arms.append(conf if at_home else ArmConf(conf.arm, q_arm, pre=q_arm))
+        mark = None if conf.arm in free else q_arm
+        arms.append(conf if at_home else ArmConf(conf.arm, q_arm, pre=mark))
     return CellConf(*arms)

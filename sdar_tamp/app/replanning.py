@@ -11,7 +11,10 @@ camera sees -> one new plan, the executed prefix spliced with a continuation.
 2. The arms cannot jump: the plan runs on to its next cut point (:func:`~sdar_tamp.plan_state.
    cut_point`: every arm at rest with an empty gripper, the events of that instant left to
    the continuation); the stretch from ``at`` to the cut is replayed in the observed world
-   (the validator's walk) and a contact there ends the re-plan as ``infeasible``. When the
+   (the validator's walk). Where it meets the change, the arms brake on their way instead
+   (:mod:`sdar_tamp.app.braking`: empty grippers, no gripper acting before they stand still)
+   and a fresh continuation starts there; when that stretch meets it too, or an arm holds an
+   object, the re-plan ends as ``infeasible``. When the
    cut falls on grasps about to happen and the plan's next cut is reached without violation
    through them, that later cut is taken: the arms then stop clear of the objects rather than
    with open fingers around them.
@@ -37,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sdar_tamp.app.braking import brake
 from sdar_tamp.app.cache import PlannerCache, PlanningWorld
 from sdar_tamp.app.config import PlannerConfig
 from sdar_tamp.app.plan_export import plan_file_from_solution
@@ -48,6 +52,7 @@ from sdar_tamp.app.splicing import cut_at, splice, tail, walk_from
 from sdar_tamp.plan_file import PlanFile, PlanObservation
 from sdar_tamp.plan_state import Cut, PlanState, cut_point, prefix_plan, state_at
 from sdar_tamp.replay import validate_plan
+from sdar_tamp.replay_walk import ReplayWalk
 from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.instance import Instance, Pose2D
 from sdar_tamp.world.kinematics import ArmKinematics
@@ -147,14 +152,20 @@ def replan(
     prefix = prefix_plan(old, cut)
     walk = walk_from(instance, prefix, scene, kins, collision, state)
     found = walk.walk(float(prefix.t[-1]), at)
-    if found is not None:
-        return ReplanOutcome(
-            "infeasible", None, cut.t, time.perf_counter() - started,
-            (f"the running plan meets the observed world at t = {found.t:.3f} s before the "
-             f"arms can stop at t = {cut.t:.3f} s: {found.kind}: {found.message}",),
-            _objects_in(found.message, sizes),
-        )  # fmt: skip
-    if any(abs(e.t - cut.t) <= 1e-9 for e in old.events):
+    braked = False
+    if found is not None:  # the arms meet the change on their way: stop them short of it
+        short = _stop_short(instance, old, at, scene, kins, collision, state)
+        if short is None:
+            return ReplanOutcome(
+                "infeasible", None, cut.t, time.perf_counter() - started,
+                (f"the running plan meets the observed world at t = {found.t:.3f} s before the "
+                 f"arms can stop at t = {cut.t:.3f} s (nor braking on their way): "
+                 f"{found.kind}: {found.message}",),
+                _objects_in(found.message, sizes),
+            )  # fmt: skip
+        cut, prefix, walk = short
+        braked = True
+    elif any(abs(e.t - cut.t) <= 1e-9 for e in old.events):
         # the arms stop at grasps about to happen: when those still hold in the observed
         # world, the plan runs on through them to its next cut (its grippers clear again)
         later = cut_point(old, cut.t + 1e-6)
@@ -164,16 +175,17 @@ def replan(
             cut, prefix, walk = later, longer, ahead
     at_cut = dict(walk.rest)
     t_hold = float(prefix.t[-1])
-    if repair:
+    if repair and not braked:  # braked off the plan's timeline, its rest cannot resume
         rest = splice(prefix, tail(old, _resume(old, cut, float(prefix.t[-1]))))
         empty = PlanState(t_hold, prefix.q[-1], {}, at_cut)
         fixed = repair_plan(world, config, instance, rest, empty, kins, collision, sizes)
         if fixed is not None:
             return _finish("repaired", fixed[0], instance, scene, cut, started, validate, fixed[1])
     cont_instance, moved = continuation_instance(instance, at_cut, sizes, config.seed)
-    start = start_configuration(
-        _home(world), prefix.q[-1], {a: scene.layout.slice(a) for a in scene.arm_names}
-    )
+    slices = {a: scene.layout.slice(a) for a in scene.arm_names}
+    moving = prefix.q[prefix.t >= at - 1e-9]  # braked arms leave directly, not by a lift
+    free = frozenset(a for a, sl in slices.items() if braked and np.ptp(moving[:, sl], 0).max() > 0)
+    start = start_configuration(_home(world), prefix.q[-1], slices, free)
     r = rearrangement_problem(cont_instance, world.ctx, config=config, planner=world.planner,
                               start=start)  # fmt: skip
     solution = solve_rearrangement(r)
@@ -193,6 +205,24 @@ def replan(
         if again.valid:
             return dataclasses.replace(again, latency=time.perf_counter() - started)
     return out
+
+
+def _stop_short(
+    instance: Instance, plan: PlanFile, at: float, scene: Scene,
+    kins: dict[str, ArmKinematics], collision: CollisionWorld, state: PlanState,
+) -> tuple[Cut, PlanFile, ReplayWalk] | None:  # fmt: skip
+    """The arms braked on their way from ``at`` (:func:`~sdar_tamp.app.braking.brake`): the
+    cut where they stand still, the prefix with its hold and its walk from ``state``, when
+    the braked stretch meets nothing in the observed world; else None."""
+    v_max, a_max = scene.joint_array("velocity_limit"), scene.joint_array("acceleration_limit")
+    stop = brake(plan, at, v_max, a_max)
+    if stop is None:
+        return None
+    prefix = prefix_plan(stop.plan, stop.cut)
+    walk = walk_from(instance, prefix, scene, kins, collision, state)
+    if walk.walk(float(prefix.t[-1]), at) is not None:
+        return None
+    return stop.cut, prefix, walk
 
 
 def _resume(plan: PlanFile, cut: Cut, t_hold: float) -> Cut:

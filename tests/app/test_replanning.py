@@ -101,6 +101,68 @@ def test_a_nudged_object_is_regrasped_at_its_new_pose(
     assert not report.ok and report.violation is not None and report.violation.t > AT
 
 
+@pytest.mark.parametrize("repair", [True, False])
+def test_a_nudged_object_at_its_goal_is_put_back(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, repair: bool
+) -> None:
+    """o3 rests at its goal from 3.59 s on and no task of the old plan touches it again: the
+    repair plans the last task (o2's) again with o3 put back; a fresh continuation puts it back
+    within its plan.
+    Neither moves o0, at its goal to rounding (the continuation takes it as there)."""
+    goal = _obj(d5[0], "o3").goal
+    new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
+    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]",
+                  repair=repair)  # fmt: skip
+    assert out.status == ("repaired" if repair else "replanned")
+    plan = _assert_valid_whole(d5, out)
+    grasps = _grasp_poses(plan, "o3", out.cut)
+    assert len(grasps) == 1 and math.hypot(grasps[0][0] - new[0], grasps[0][1] - new[1]) < 1e-3
+    assert np.allclose(plan.final_poses["o3"][:2], (goal.x, goal.y), atol=1e-3)
+    assert not [e for e in plan.events if e.object == "o0" and e.t > out.cut]
+    if repair:  # the old plan's rest is kept up to its last task (o2's), which o3 joins
+        kept = [(e.type, e.object) for e in d5[1].events if AT < e.t < 10.0]
+        after = [(e.type, e.object) for e in plan.events if e.t > AT]
+        assert after[: len(kept)] == kept
+        assert sorted(after[len(kept) :]) == sorted(
+            [("grasp", "o2"), ("release", "o2"), ("grasp", "o3"), ("release", "o3")]
+        )
+
+
+def test_a_nudged_object_at_its_goal_gets_one_more_task_when_the_last_cannot_take_it(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When the last task cannot be planned again with o3 (made to fail here), the old plan's
+    rest is kept whole and one more task after it puts o3 back."""
+    from sdar_tamp.app import repair as repair_module
+
+    monkeypatch.setattr(repair_module, "_replan_task", lambda *args: None)
+    goal = _obj(d5[0], "o3").goal
+    new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
+    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]")
+    assert out.status == "repaired"
+    plan = _assert_valid_whole(d5, out)
+    kept = [(e.type, e.object) for e in d5[1].events if e.t > AT]
+    after = [(e.type, e.object) for e in plan.events if e.t > AT]
+    assert after == [*kept, ("grasp", "o3"), ("release", "o3")]
+
+
+def test_a_nudged_object_at_its_goal_after_the_last_task_gets_one_more(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """At 12.3 s every task is done (the last release, at 12.03 s, in its dwell): one more
+    task after the old plan's end puts o3 back."""
+    goal = _obj(d5[0], "o3").goal
+    new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
+    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]",
+                  at=12.3)  # fmt: skip
+    assert out.status == "repaired" and out.plan is not None and out.valid is True
+    assert validate_plan(d5[0], out.plan, load_scene()).ok
+    assert out.cut == pytest.approx(12.3, abs=0.03)  # in the dwell: still and empty
+    after = [(e.type, e.object) for e in out.plan.events if e.t > 12.3]
+    assert after == [("grasp", "o3"), ("release", "o3")]
+    assert np.allclose(out.plan.final_poses["o3"][:2], (goal.x, goal.y), atol=1e-3)
+
+
 def test_a_removed_object_loses_its_remaining_tasks(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
@@ -146,18 +208,41 @@ def test_nothing_changed_keeps_the_old_plan(
     assert len(plan.events) == len(d5[1].events)
 
 
+def _o1_nudged(instance: Instance) -> str:
+    o1 = _obj(instance, "o1")  # the right arm is on its way to grasp it at 5.71 s
+    return (f"poses: [{{name: o1, pose: [{o1.start.x + 0.015}, {o1.start.y - 0.01}, "
+            f"{o1.start.yaw + 0.15}]}}]")  # fmt: skip
+
+
+def test_the_arms_brake_short_of_a_change_on_their_way(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """The right arm would touch the nudged o1 at 5.414 s, before the plan's next cut (its
+    grasp at 5.71 s): the arms brake on their way from 4.5 s, on the old plan's path, and a
+    fresh continuation re-grasps o1 at its new pose."""
+    out = _replan(d5, cache, _o1_nudged(d5[0]))
+    assert out.status == "replanned" and out.plan is not None and out.valid is True
+    assert validate_plan(d5[0], out.plan, load_scene()).ok
+    assert AT < out.cut < 5.414
+    old = d5[1]
+    dense = np.linspace(AT - 0.05, out.cut + 0.05, 4000)
+    path = np.stack([np.interp(dense, old.t, old.q[:, j]) for j in range(old.q.shape[1])], 1)
+    braked = out.plan.q[(out.plan.t >= AT) & (out.plan.t <= out.cut)]
+    gap = np.linalg.norm(braked[:, None] - path[None], axis=2).min(axis=1)
+    assert gap.max() < 2e-3  # configurations of the old path (to the density of ``dense``)
+    assert np.array_equal(out.plan.q[out.plan.t <= AT], old.q[old.t <= AT])
+    assert len(_grasp_poses(out.plan, "o1", out.cut)) == 1
+
+
 def test_the_running_plan_meeting_the_change_is_infeasible_with_the_object(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
-    o1 = _obj(d5[0], "o1")  # the right arm is on its way to grasp it at 5.71 s
-    out = _replan(
-        d5, cache,
-        f"poses: [{{name: o1, pose: [{o1.start.x + 0.015}, {o1.start.y - 0.01}, "
-        f"{o1.start.yaw + 0.15}]}}]",
-    )  # fmt: skip
+    """At 5.4 s the right arm is 14 ms from touching o1: too late to brake."""
+    out = _replan(d5, cache, _o1_nudged(d5[0]), at=5.4)
     assert out.status == "infeasible" and out.plan is None and not out.success
     assert out.blocking == ("o1",)
     assert "before the arms can stop" in out.reasons[0]
+    assert "nor braking on their way" in out.reasons[0]
 
 
 @pytest.mark.parametrize(

@@ -47,12 +47,13 @@ def test_replan_writes_a_valid_plan(tmp_path: Path, capsys: pytest.CaptureFixtur
 
 
 def test_replan_json_and_infeasible(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """o1 nudged at 5.4 s, when the right arm is too close to brake before touching it."""
     obs = _observed(tmp_path, "poses: [{name: o1, pose: [-0.045, -0.064, 1.19]}]\n")
-    code, out, _ = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs, "--json"], capsys)
+    code, out, _ = _run(["replan", D5, PLAN, "--at", "5.4", "--observed", obs, "--json"], capsys)
     record = json.loads(out)
     assert code == 1 and record["status"] == "infeasible" and record["blocking"] == ["o1"]
     assert record["plan_file"] is None and "before the arms can stop" in record["reasons"][0]
-    code, out, _ = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs], capsys)
+    code, out, _ = _run(["replan", D5, PLAN, "--at", "5.4", "--observed", obs], capsys)
     assert code == 1 and out.startswith("infeasible:") and "blocking: o1" in out
 
 
