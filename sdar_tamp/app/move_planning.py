@@ -8,7 +8,8 @@ it). :meth:`StreamMovePlanner.estimate` ranks the pairs of inverse-kinematics br
 grasp by the rest-to-rest times (each joint at its velocity and acceleration limits) from where
 the arm stands to the grasp and on to the release, collisions ignored; :meth:`~.plan` checks the
 best pairs against the resting objects and plans the two motions (retreat, transfer, approach)
-with the motion planner (its first rung, then its whole ladder), the other arms at home.
+with the motion planner (its first rung, then its whole ladder), the other arms at home (on the
+way home, :meth:`~.park`, where they stand).
 :meth:`~.buffer` is the buffer stream's first pose clear of every pose the plan's moves use.
 """
 
@@ -147,12 +148,13 @@ class StreamMovePlanner:
         return None if found is None else found[0].as_tuple()
 
     def park(
-        self, arm: int, stand: Stand, resting: Mapping[str, Pose]
+        self, arm: int, stand: Stand, resting: Mapping[str, Pose], others: Sequence[FloatArray]
     ) -> tuple[FloatArray, FloatArray] | None:
         name = self.names[arm]
         home = ArmConf(name, tuple(float(x) for x in self.ctx.home(name)))
         fluents = [("atpose", o, Pose2D(*p)) for o, p in resting.items()]
-        return self.motion(name, self.conf(name, stand), home, fluents)
+        standing = {a: q for a, q in zip(self.names, others, strict=True) if a != name}
+        return self.motion(name, self.conf(name, stand), home, fluents, standing)
 
     @staticmethod
     def conf(name: str, stand: Stand) -> ArmConf:
@@ -160,10 +162,18 @@ class StreamMovePlanner:
         return ArmConf(name, tuple(map(float, stand.q)), pre)
 
     def motion(
-        self, name: str, q1: ArmConf, q2: ArmConf, fluents: Sequence[tuple[Any, ...]]
+        self,
+        name: str,
+        q1: ArmConf,
+        q2: ArmConf,
+        fluents: Sequence[tuple[Any, ...]],
+        standing: Mapping[str, FloatArray] | None = None,
     ) -> tuple[FloatArray, FloatArray] | None:
-        """The arm's motion ``q1 -> q2`` (times, its configurations), the other arms at home."""
-        others = {a: ArmConf(a, tuple(float(x) for x in self.ctx.home(a))) for a in self.names}
+        """The arm's motion ``q1 -> q2`` (times, its configurations), the other arms at home
+        or where ``standing`` says."""
+        where = {a: self.ctx.home(a) for a in self.names}
+        where.update(standing or {})
+        others = {a: ArmConf(a, tuple(float(x) for x in where[a])) for a in self.names}
         c1 = CellConf(*(q1 if a == name else others[a] for a in self.names))
         c2 = CellConf(*(q2 if a == name else others[a] for a in self.names))
         key = (c1, c2, frozenset(fluents))

@@ -117,10 +117,11 @@ class MovePlanner(Protocol):
         ...
 
     def park(
-        self, arm: int, stand: Stand, resting: Mapping[str, Pose]
+        self, arm: int, stand: Stand, resting: Mapping[str, Pose], others: Sequence[FloatArray]
     ) -> tuple[FloatArray, FloatArray] | None:
         """The arm's motion (times ``(m,)``, configurations ``(m, k)``) from ``stand`` to its
-        home configuration, or None."""
+        home configuration, the other arms standing at ``others`` (per arm, scene order; the
+        arm's own entry is ignored), or None."""
         ...
 
 
@@ -308,7 +309,8 @@ class Assignment(Placement):
 
     def park(self, arm: int) -> bool:
         """Send ``arm`` home from where it stands; False when that cannot be committed."""
-        motion = self.planner.park(arm, self.stand[arm], self.rest)
+        ends = [np.array(self.traj[a][-1]) for a in self.arms]
+        motion = self.planner.park(arm, self.stand[arm], self.rest, ends)
         self.plans += 1
         if motion is None:
             return False

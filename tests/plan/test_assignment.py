@@ -53,7 +53,12 @@ class StraightMoves(StreamMovePlanner):
         return None if arm in self.unable else super().estimate(arm, stand, move)
 
     def motion(
-        self, name: str, q1: ArmConf, q2: ArmConf, fluents: Sequence[tuple[Any, ...]]
+        self,
+        name: str,
+        q1: ArmConf,
+        q2: ArmConf,
+        fluents: Sequence[tuple[Any, ...]],
+        standing: Mapping[str, FloatArray] | None = None,
     ) -> tuple[FloatArray, FloatArray] | None:
         points = [q1.q, *(() if q1.pre is None else (q1.pre,)), tuple(self.ctx.home(name))]
         points += [*(() if q2.pre is None else (q2.pre,)), q2.q]
