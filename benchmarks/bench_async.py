@@ -5,7 +5,11 @@ Every instance is solved by ``sdar solve``'s code path (or its plan is read from
 executed three ways side by side: synchronously, re-timed step by step
 (:func:`sdar_tamp.schedule.schedule_async`, ``--execution async``) and with one timeline per
 arm (:func:`sdar_tamp.schedule.timelines.schedule_timelines`; ``best`` is what ``--execution
-timelines`` returns: the shorter of the two that the replay accepts). Every plan is checked by
+timelines`` returns: the shorter of the two that the replay accepts) and with the moves assigned
+anew to whichever arm is free (:func:`sdar_tamp.schedule.assignment.schedule_assigned`;
+``assign`` is its own schedule, nan when none is found; the ratio after it is what
+``--execution assigned`` returns: the shortest of the three the replay accepts; ``--no-assigned``
+leaves it out). Every plan is checked by
 the independent replay. Execution time is the plan's duration; a scheduler that finds no
 shorter schedule returns the synchronous plan, so every ratio is at most 1. Where the time goes
 on the timelines: ``dep`` and ``arms``, the waits [s] (summed over the arms) for the task
@@ -39,8 +43,10 @@ from _suites import shipped_suite_files, stored_or_solved
 
 from sdar_tamp.app import PlannerCache, PlannerConfig
 from sdar_tamp.app.execution import execution_options
+from sdar_tamp.app.move_planning import StreamMovePlanner
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
+from sdar_tamp.schedule.assignment import schedule_assigned
 from sdar_tamp.schedule.pieces import arm_blocks
 from sdar_tamp.schedule.scheduler import retimer
 from sdar_tamp.schedule.timelines import schedule_timelines
@@ -65,6 +71,9 @@ def main(argv: list[str] | None = None) -> None:
         action="store_true",
         help="re-time each arm's motions uniformly faster (no time-optimal path timing)",
     )
+    ap.add_argument(
+        "--no-assigned", action="store_true", help="leave out the moves assigned anew (slow)"
+    )
     ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
     args = ap.parse_args(argv)
     if args.quick:  # explicit options still win
@@ -76,8 +85,8 @@ def main(argv: list[str] | None = None) -> None:
     solve_config = PlannerConfig(max_time=args.time_limit, execution="sync")
     rows = []
     print(f"{'instance':>8} {'sync [s]':>9} {'retime':>7} {'lines':>7} {'best':>7} {'ratio':>6} "
-          f"{'valid':>5} {'bound':>6} {'dep':>5} {'arms':>5} {'tog':>3} {'cut':>5} "
-          f"{'time [s]':>8}  note")  # fmt: skip
+          f"{'assign':>7} {'ratio':>6} {'valid':>5} {'bound':>6} {'dep':>5} {'arms':>5} "
+          f"{'tog':>3} {'cut':>5} {'time [s]':>8}  note")  # fmt: skip
     for path in files:
         instance = load_instance(path)
         plan = stored_or_solved(
@@ -95,12 +104,22 @@ def main(argv: list[str] | None = None) -> None:
         today = schedule_async(plan, instance, scene, options)
         middle = time.perf_counter()
         lines = schedule_timelines(plan, instance, scene, options)
-        elapsed = (middle - start, time.perf_counter() - middle)
+        after = time.perf_counter()
+        assigned = None
+        if not args.no_assigned:
+            assigned = schedule_assigned(
+                plan, instance, scene, options, StreamMovePlanner(instance, scene)
+            )
+        elapsed = (middle - start, after - middle, time.perf_counter() - after)
         valid_today = validate_plan(instance, today.plan, scene).ok
         valid_lines = validate_plan(instance, lines.plan, scene).ok
+        valid_assigned = assigned is None or validate_plan(instance, assigned.plan, scene).ok
         # what `--execution timelines` returns: the shorter of the two the replay accepts
         kept = [r.plan for r, ok in ((today, valid_today), (lines, valid_lines)) if ok]
         best = min((p.duration for p in kept), default=plan.duration)
+        # and `--execution assigned`: the shortest of the three
+        moved = assigned.plan.duration if assigned is not None and valid_assigned else plan.duration
+        best_assigned = min(best, moved)
         # no schedule of these motions beats the busier arm's motions plus its dwells
         bound = max(
             sum(b.motion_ticks * options.tick + options.dwell * (b.event is not None) for b in bs)
@@ -123,20 +142,35 @@ def main(argv: list[str] | None = None) -> None:
                 "asynchronous": today.asynchronous,
                 "timelines_kept": lines.asynchronous,
                 "order": today.order,
-                "valid": valid_today and valid_lines,
+                "assigned": None if assigned is None else round(assigned.plan.duration, 3),
+                "assigned_found": None if assigned is None else assigned.async_duration,
+                "assigned_kept": assigned is not None and assigned.asynchronous,
+                "assigned_reason": "" if assigned is None else assigned.reason,
+                "best_assigned": round(best_assigned, 3),
+                "ratio_assigned": round(best_assigned / plan.duration, 4),
+                "valid": valid_today and valid_lines and valid_assigned,
                 "schedule_time": round(elapsed[0], 2),
                 "timelines_time": round(elapsed[1], 2),
+                "assigned_time": round(elapsed[2], 2),
+                "assigned_checks": None if assigned is None else assigned.checks,
+                **(
+                    {}
+                    if assigned is None
+                    else {f"assigned_{k}": round(v, 3) for k, v in assigned.figures}
+                ),
                 "checks": today.checks,
                 "timelines_checks": lines.checks,
                 **{k: round(v, 3) for k, v in figures.items()},
             }
         )
-        note = lines.reason[:60]
+        note = lines.reason[:40] + (" | " + assigned.reason[:40] if assigned is not None else "")
+        found = assigned.async_duration if assigned is not None else None
         dep, arms = figures.get("wait_dependencies", 0.0), figures.get("wait_other_arms", 0.0)
         tog, cut = int(figures.get("together", 0)), figures.get("shortcut_saved", 0.0)
         print(f"{path.stem:>8} {plan.duration:9.2f} {today.plan.duration:7.2f} "
               f"{lines.plan.duration:7.2f} {best:7.2f} {best / plan.duration:6.3f} "
-              f"{valid_today and valid_lines!s:>5} {bound:6.2f} {dep:5.1f} {arms:5.1f} {tog:3d} "
+              f"{found or float('nan'):7.2f} {best_assigned / plan.duration:6.3f} "
+              f"{rows[-1]['valid']!s:>5} {bound:6.2f} {dep:5.1f} {arms:5.1f} {tog:3d} "
               f"{cut:5.2f} {sum(elapsed):8.1f}  {note}", flush=True)  # fmt: skip
 
     def median(key: str) -> float | None:
@@ -156,6 +190,9 @@ def main(argv: list[str] | None = None) -> None:
         "median_bound": median("bound"),
         "median_ratio": median("ratio"),
         "median_ratio_timelines": median("ratio_timelines"),
+        "median_assigned": median("best_assigned"),
+        "median_ratio_assigned": median("ratio_assigned"),
+        "assigned_kept": sum(r["assigned_kept"] for r in rows),
         "mean_ratio": round(statistics.fmean(ratios), 4) if ratios else None,
         "timelines_kept": sum(r["timelines_kept"] for r in rows),
         "all_valid": all(r["valid"] for r in rows),
@@ -164,7 +201,8 @@ def main(argv: list[str] | None = None) -> None:
     }
     if ratios:
         print(f"median execution [s]: sync {summary['median_sync']}, async (re-timed) "
-              f"{summary['median_async']}, timelines {summary['median_timelines']}")  # fmt: skip
+              f"{summary['median_async']}, timelines {summary['median_timelines']}, "
+              f"assigned {summary['median_assigned']}")  # fmt: skip
     print(json.dumps(summary))
 
 

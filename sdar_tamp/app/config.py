@@ -38,8 +38,9 @@ MOTION_PLANNERS = ("sdar", "plain", "sequential")
 #: How the plan is executed: one synchronous timeline, or each arm on its own
 #: (:mod:`sdar_tamp.schedule`, kept only when shorter and valid): ``async`` re-times the
 #: synchronous steps, ``timelines`` gives each arm its own timeline (prioritised planning in
-#: time) and keeps the shorter of the two.
-EXECUTIONS = ("sync", "async", "timelines")
+#: time) and keeps the shorter of the two; ``assigned`` assigns the plan's moves anew to
+#: whichever arm is free, with motions planned for it, and keeps the shortest of the three.
+EXECUTIONS = ("sync", "async", "timelines", "assigned")
 GRIPPER_TIME = GRIPPER_DWELL  # [s] one gripper action (both grippers at once take as long)
 _DURATION = Real(0.0, closed=True, unit="s")  # gripper_time
 

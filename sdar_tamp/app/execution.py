@@ -3,11 +3,15 @@ motions re-timed by the same time-optimal path timing the motion planner uses
 (:func:`streams.motion.timing.time_parameterize`) and the same slow tool travel at gripper
 events.
 
-Two schedules (:data:`SCHEDULERS`): ``"retime"``, the synchronous plan's steps re-timed
-(:func:`sdar_tamp.schedule.schedule_async`), and ``"timelines"``, one timeline per arm by
+Three schedules (:data:`SCHEDULERS`): ``"retime"``, the synchronous plan's steps re-timed
+(:func:`sdar_tamp.schedule.schedule_async`); ``"timelines"``, one timeline per arm by
 prioritised planning in time (:func:`sdar_tamp.schedule.timelines.schedule_timelines`), which
-also computes the re-timing and keeps the shorter of the two. Either way the result is replayed
-by the independent validator and the synchronous plan kept when the replay rejects it."""
+also computes the re-timing and keeps the shorter of the two; and ``"assigned"``, the plan's
+moves assigned anew to whichever arm is free, with motions planned for it by the streams
+(:func:`sdar_tamp.schedule.assignment.schedule_assigned`,
+:class:`sdar_tamp.app.move_planning.StreamMovePlanner`), which also computes the other two and
+keeps the shortest. Either way the result is replayed by the independent validator and the
+synchronous plan kept when the replay rejects every schedule."""
 
 from __future__ import annotations
 
@@ -19,6 +23,7 @@ from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.replay import ReplayReport, validate_plan
 from sdar_tamp.schedule import Schedule, ScheduleOptions, schedule_async
+from sdar_tamp.schedule.assignment import schedule_assigned
 from sdar_tamp.schedule.retiming import PathTimer
 from sdar_tamp.schedule.timelines import schedule_timelines
 from sdar_tamp.world.instance import Instance
@@ -29,8 +34,9 @@ from streams.motion.timing import time_parameterize
 
 _log = logging.getLogger(__name__)
 
-#: The asynchronous schedules: the synchronous steps re-timed, or one timeline per arm.
-SCHEDULERS = ("retime", "timelines")
+#: The asynchronous schedules: the synchronous steps re-timed, one timeline per arm, or the
+#: moves assigned anew to whichever arm is free.
+SCHEDULERS = ("retime", "timelines", "assigned")
 
 
 def path_timer(safety: float) -> PathTimer:
@@ -104,13 +110,19 @@ def _checked_schedule(
 ) -> tuple[Schedule, ReplayReport | None]:
     """The schedule with the replay's report when the schedule is kept; the synchronous plan
     and None (not replayed) when there is none or the replay rejects it. With
-    ``"timelines"``, the shorter of the two schedules that the replay accepts."""
+    ``"timelines"``, the shorter of the two schedules that the replay accepts; with
+    ``"assigned"``, the shortest of the three."""
     if scheduler not in SCHEDULERS:
         raise ParameterError(f"scheduler must be one of {', '.join(SCHEDULERS)}; got {scheduler!r}")
     options = options or execution_options(scene, shape)
     candidates = [schedule_async(plan, instance, scene, options)]
-    if scheduler == "timelines":
+    if scheduler in ("timelines", "assigned"):
         candidates.insert(0, schedule_timelines(plan, instance, scene, options))
+    if scheduler == "assigned":
+        from sdar_tamp.app.move_planning import StreamMovePlanner
+
+        planner = StreamMovePlanner(instance, scene)
+        candidates.insert(0, schedule_assigned(plan, instance, scene, options, planner))
     if stage is not None:
         stage("validating")
     kept = [c for c in candidates if c.asynchronous]

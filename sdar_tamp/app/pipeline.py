@@ -195,7 +195,7 @@ def finish_solve(
         plan = plan_file_from_solution(rearrangement, solution, metrics)
     else:
         plan = builder.finish(instance.name, plan_metrics(solution, metrics))
-    if config.execution in ("async", "timelines"):
+    if config.execution in ("async", "timelines", "assigned"):
         if stage is not None:
             stage("scheduling")
         started = time.perf_counter()
@@ -205,7 +205,7 @@ def finish_solve(
             rearrangement.ctx.scene,
             world.planner.shape,
             stage=stage,
-            scheduler="timelines" if config.execution == "timelines" else "retime",
+            scheduler="retime" if config.execution == "async" else config.execution,
         )
         plan = schedule.plan
         figures = dataclasses.replace(figures, schedule_time=time.perf_counter() - started)

@@ -172,7 +172,9 @@ def add_solve_parser(sub: argparse._SubParsersAction[Any]) -> None:
         help="sync: every arm on one synchronous timeline; async: each arm on its own, "
         "the synchronous steps re-timed for itself; timelines: one timeline per arm, each "
         "arm's next motion started as soon as it is done, against the other arms' committed "
-        "motions (the shorter of it and async); async modes are kept only when shorter and "
+        "motions (the shorter of it and async); assigned: the plan's moves assigned anew to "
+        "whichever arm is free, each with a motion planned for it (the shortest of the three); "
+        "async modes are kept only when shorter and "
         "valid (default: async, sync with --stream; see docs/execution.md)",
     )
     solve.add_argument("--json", action="store_true", help=JSON_HELP + " (implies -q)")

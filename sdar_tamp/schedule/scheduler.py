@@ -219,6 +219,11 @@ class Placement:
         self.events: list[TimedEvent] = []
         self.event_tick: dict[int, int] = {}  # id(sync event) -> tick
         self.steps: list[StepRecord] = []
+        #: ticks between the starts tried by :meth:`place`
+        self.stride = 1
+        #: :meth:`place` gives up at a conflict after every other arm's timeline has ended
+        #: (those arms stand still from then on: a later start meets the same conflict)
+        self.give_up_standing = False
 
     def horizon(self, arm: int) -> int:
         return len(self.traj[arm]) - 1
@@ -337,7 +342,7 @@ class Placement:
         before = [e for e in self.events if e.tick < k0]
         later = [e for e in self.events if e.tick >= k0]
         conflict: Conflict | None = None
-        for s in range(start, stop + 1):
+        for s in range(start, stop + 1, self.stride):
             ends = [s + e.offset + self.length(e) for e in entries]
             k1 = max(*ends, *(self.horizon(a) for a in self.arms))
             q = np.concatenate([self.rows(a, k0, k1) for a in self.arms], axis=1)
@@ -358,6 +363,9 @@ class Placement:
                     self.commit(e, s + e.offset, q[: end - k0 + 1, self.columns[e.arm]], k0, timed)
                 return
             if conflict.tick < s:  # while an arm waits for its start: later is no better
+                break
+            others = [self.horizon(a) for a in self.arms if a not in arms]
+            if self.give_up_standing and conflict.tick >= max(others, default=0):
                 break
             if all(s > self.horizon(a) for a in self.arms if a not in arms):
                 break  # the other arms stand still from now on: nothing changes

@@ -395,3 +395,33 @@ def test_a_timelines_run_keeps_the_shorter_schedule_and_replays_it(
     metrics = outcome.plan.metrics
     if metrics.execution == "async":
         assert float(metrics.execution_time) < float(metrics.execution_time_sync)
+
+
+def test_an_assigned_run_makes_every_schedule_and_keeps_a_valid_one_never_longer(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``execution="assigned"``: the moves are assigned anew (with motions planned for the
+    arms), the other two schedules are made too, and the plan kept is valid and never longer
+    than the synchronous one."""
+    from sdar_tamp.app import execution
+    from sdar_tamp.app.pipeline import solve_instance
+    from sdar_tamp.world.instance import save_instance
+
+    a = ObjectSpec("a", SQUARE, Pose2D(-0.1, 0.15, 0.0), Pose2D(0.1, -0.15, 0.3))
+    b = ObjectSpec("b", SQUARE, Pose2D(0.1, 0.15, 0.0), Pose2D(-0.1, -0.15, 0.0))
+    path = save_instance(Instance("two", WORKSPACE, (a, b)), tmp_path / "two.yaml")
+    made: list[str] = []
+    for name in ("schedule_timelines", "schedule_assigned"):
+        real = getattr(execution, name)
+
+        def counting(*args: Any, _real: Any = real, _name: str = name, **kwargs: Any) -> Any:
+            made.append(_name)
+            return _real(*args, **kwargs)
+
+        monkeypatch.setattr(f"sdar_tamp.app.execution.{name}", counting)
+    outcome = solve_instance(path, PlannerConfig(execution="assigned"), time_limit=BUDGET)
+    assert outcome.plan is not None and outcome.valid, outcome.violation
+    assert sorted(made) == ["schedule_assigned", "schedule_timelines"]
+    metrics = outcome.plan.metrics
+    if metrics.execution in ("async", "assigned"):
+        assert float(metrics.execution_time) < float(metrics.execution_time_sync)

@@ -56,6 +56,11 @@ def _async(out: Summary) -> None:
     assert out["instances"] == 1 and out["all_valid"] is True
     assert out["median_ratio"] <= 1.0  # the scheduler never returns a longer plan
     assert out["median_ratio_timelines"] <= out["median_ratio"]  # the shorter of the two
+    assert out["median_ratio_assigned"] <= out["median_ratio_timelines"]  # the shortest of three
+    row = out["rows"][0]
+    assert row["assigned_kept"] == (
+        row["assigned_found"] is not None and row["assigned"] < row["sync"]
+    )
 
 
 def _cells(out: Summary) -> None:

@@ -1,0 +1,226 @@
+"""Moves assigned anew to the arms (:mod:`sdar_tamp.schedule.assignment`): a free arm takes
+the next ready move, the moves' order is kept, a contact forces a wait, rotations go through a
+buffer, and every schedule replays.
+
+The motions come from :class:`StraightMoves`: the streams' grasps and inverse kinematics
+(:class:`~sdar_tamp.app.move_planning.StreamMovePlanner`) with straight joint-space segments
+through the pre-grasps and the arm's home in place of the motion planner (fast, clear of the
+resting objects; the sweep still checks them)."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from sdar_tamp.app.execution import SCHEDULERS, execution_options
+from sdar_tamp.app.move_planning import StreamMovePlanner
+from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.replay import validate_plan
+from sdar_tamp.schedule.assignment import (
+    FINGER_ROOM,
+    Assignment,
+    AssignmentOptions,
+    PlannedMove,
+    Stand,
+    schedule_assigned,
+)
+from sdar_tamp.schedule.moves import CyclicMoves, Move, break_cycles, plan_moves, stuck_moves
+from sdar_tamp.schedule.scheduler import retimer
+from sdar_tamp.schedule.sweep import WorldSweep
+from sdar_tamp.world.instance import Instance, load_instance
+from sdar_tamp.world.suites import shipped_suite_dir
+from sdar_tamp.world.transforms import FloatArray
+from streams.context import WorldContext
+from streams.stream_types import ArmConf
+
+SOLVED = Path(__file__).resolve().parent / "solved"
+
+
+class StraightMoves(StreamMovePlanner):
+    """The streams' grasps and IK, straight joint-space motions (see the module docstring);
+    ``unable``: arms that can do no move."""
+
+    unable: frozenset[int] = frozenset()
+
+    def estimate(self, arm: int, stand: Stand, move: Move) -> float | None:
+        return None if arm in self.unable else super().estimate(arm, stand, move)
+
+    def motion(
+        self,
+        name: str,
+        q1: ArmConf,
+        q2: ArmConf,
+        fluents: Sequence[tuple[Any, ...]],
+        standing: Mapping[str, FloatArray] | None = None,
+    ) -> tuple[FloatArray, FloatArray] | None:
+        points = [q1.q, *(() if q1.pre is None else (q1.pre,)), tuple(self.ctx.home(name))]
+        points += [*(() if q2.pre is None else (q2.pre,)), q2.q]
+        rows = [np.array(points[0])]
+        for a, b in itertools.pairwise(points):
+            n = max(2, int(np.ceil(np.abs(np.subtract(b, a)).max() / 0.01)))
+            rows.extend(np.linspace(a, b, n + 1)[1:])
+        q = np.array(rows)
+        return np.linspace(0.0, 0.05 * len(q), len(q)), q  # slow: the re-timing takes over
+
+
+def _solved(name: str) -> tuple[Instance, PlanFile]:
+    return load_instance(shipped_suite_dir("paper") / f"{name}.yaml"), load_plan(
+        SOLVED / f"{name}.plan.json"
+    )
+
+
+def _search(
+    ctx: WorldContext, instance: Instance, plan: PlanFile, planner: StraightMoves
+) -> Assignment:
+    options = execution_options(ctx.scene)
+    sweep = WorldSweep(instance, ctx.scene, options.max_tcp_step)
+    moves = break_cycles(plan_moves(plan, instance, sweep, FINGER_ROOM), planner.buffer)
+    retimers = [retimer(ctx.scene, i, options) for i in range(len(ctx.scene.arms))]
+    return Assignment(plan, sweep, options, moves, planner, retimers, AssignmentOptions())
+
+
+@pytest.fixture(scope="module")
+def r5(ctx: WorldContext) -> tuple[Instance, PlanFile, StraightMoves]:
+    instance, plan = _solved("R5")
+    return instance, plan, StraightMoves(instance, ctx.scene)
+
+
+def test_the_moves_of_a_plan_chain_each_object_from_start_to_goal(ctx: WorldContext) -> None:
+    instance, plan = _solved("M2")
+    moves = plan_moves(plan, instance, WorldSweep(instance, ctx.scene, 0.005))
+    assert [m.index for m in moves] == list(range(len(moves)))
+    for o in instance.objects:
+        chain = [m for m in moves if m.obj == o.name]
+        if not chain:
+            continue
+        assert np.allclose(chain[0].start, o.start.as_tuple(), atol=1e-6)
+        assert np.allclose(chain[-1].end[:2], o.goal.as_tuple()[:2], atol=1e-3)
+        assert chain[0].previous is None
+        assert [m.previous for m in chain[1:]] == [m.index for m in chain[:-1]]
+    assert any(m.blockers for m in moves) and not stuck_moves(moves)
+    for m in moves:  # a blocker is lifted from a pose the released object covers
+        assert all(moves[b].obj != m.obj for b in m.blockers)
+
+
+def test_a_rotation_goes_through_a_buffer_and_without_one_is_refused(ctx: WorldContext) -> None:
+    instance, plan = _solved("D5")
+    moves = plan_moves(plan, instance, WorldSweep(instance, ctx.scene, 0.005))
+    assert stuck_moves(moves)  # objects trading places, held at once
+    with pytest.raises(CyclicMoves, match="no buffer"):
+        break_cycles(moves, lambda m, ms: None)
+    spot = (0.0, -0.3, 0.0)
+    broken = break_cycles(moves, lambda m, ms: spot)
+    assert not stuck_moves(broken)
+    split = [m for m in broken if m.end == spot]
+    assert split and len(broken) == len(moves) + len(split)
+    for first in split:
+        (second,) = (m for m in broken if m.previous == first.index)
+        assert second.start == spot and not first.blockers
+        assert second.end == next(m.end for m in moves if m.index == first.index)
+
+
+def test_a_free_arm_takes_the_next_ready_move_in_the_moves_order(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    instance, plan, planner = r5
+    alone = planner
+    alone.unable = frozenset({1})  # the right arm can do nothing: the left takes every move
+    try:
+        search = _search(ctx, instance, plan, alone)
+        result = search.run()
+    finally:
+        alone.unable = frozenset()
+    assert set(search.carrier.values()) == {0}
+    figures = dict(search.figures())
+    assert figures["moves"] == len(search.moves)
+    assert figures["reassigned"] == sum(m.arm == 1 for m in search.moves) > 0
+    report = validate_plan(instance, result, ctx.scene)
+    assert report.ok, report.violation
+    # one arm after the other: each grasp follows the previous release by a dwell at least
+    ticks = sorted((search.grasp_tick[i], search.release_tick[i]) for i in search.carrier)
+    assert all(g >= r + search.dwell for (_, r), (g, _) in itertools.pairwise(ticks))
+    # the moves' order: a release after the blockers' grasps and the earlier neighbours'
+    # releases, a move after its object's previous one
+    assert any(m.blockers for m in search.moves)
+    for m in search.moves:
+        grasp, release = search.grasp_tick[m.index], search.release_tick[m.index]
+        assert release > grasp
+        if m.previous is not None:
+            assert grasp >= search.release_tick[m.previous] + search.dwell
+        for b in m.blockers:
+            assert release >= search.grasp_tick[b] + search.dwell
+        for b in m.placed_after:
+            assert release >= search.release_tick[b] + search.dwell
+
+
+def test_a_contact_forces_a_wait(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    """The left arm releases an object and stands there; the right arm, sent to take the same
+    object back, finds no start while the left arm's gripper is round it, and one after the
+    left arm has gone home."""
+    instance, plan, planner = r5
+    search = _search(ctx, instance, plan, planner)
+    stand = Stand(np.array(plan.q[0, search.columns[1]]))
+    first = next(
+        m
+        for m in search.moves
+        if not m.blockers
+        and planner.estimate(0, stand, m) is not None
+        and planner.estimate(1, stand, dataclasses.replace(m, start=m.end, end=m.start)) is not None
+    )
+    assert search.take(0, first)
+    back = Move(99, first.obj, first.end, first.start, 1, 0.0, first.index, ())
+    search.moves = (*search.moves, back)
+    assert not search.take(1, back)  # the left gripper stands round the object
+    left_done = search.horizon(0)
+    assert search.park(0)
+    assert search.take(1, back)
+    assert search.grasp_tick[99] > left_done  # waited for the left arm to leave
+    report = validate_plan(instance, search.assemble(), ctx.scene)
+    # the object is back at its start: not the goal, but no contact and no broken event
+    assert report.violation is None or report.violation.kind == "goal", report.violation
+
+
+def test_a_schedule_is_kept_only_when_shorter(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    instance, plan, planner = r5
+    s = schedule_assigned(plan, instance, ctx.scene, execution_options(ctx.scene), planner)
+    assert s.order == "assigned"
+    if s.asynchronous:
+        assert s.async_duration is not None and s.plan.duration < plan.duration
+        assert validate_plan(instance, s.plan, ctx.scene).ok
+    else:  # the motions through home are slow: the synchronous plan is kept, with the reason
+        assert s.plan is plan and s.reason
+        assert s.async_duration is None or s.async_duration >= plan.duration
+    assert "assigned" in SCHEDULERS
+
+
+def test_a_planner_that_finds_no_motion_gives_no_schedule(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    instance, plan, _ = r5
+
+    class Nothing(StraightMoves):
+        def plan(
+            self,
+            arm: int,
+            stand: Stand,
+            move: Move,
+            resting: Mapping[str, tuple[float, float, float]],
+        ) -> Iterator[PlannedMove]:
+            return iter(())
+
+    s = schedule_assigned(
+        plan, instance, ctx.scene, execution_options(ctx.scene), Nothing(instance, ctx.scene)
+    )
+    assert not s.asynchronous and s.plan is plan
+    assert "no move can be committed" in s.reason
