@@ -2,24 +2,28 @@
 
 A grounding of a step fails for reasons that often outlive the decision that found them: two
 grippers that always meet at two goals, an assignment of arms whose arms meet at the objects
-whatever the grasps. Re-testing them at every decision (and, for the reasons that do not
-depend on the arms, once per assignment of arms) is wasted work, so :class:`FailureMemo`
-keeps each failure with the part of the arrangement it depends on, its *world*: the poses of
-the objects involved (object -> pose). A failure is recalled only while every object of its
-world rests at the same pose; the first time one has moved (or been lifted) it is forgotten
-and the grounding is tested again.
+whatever the grasps. Re-testing them at every decision (and, for the reasons that do not depend
+on the arms, once per assignment of arms) is wasted work, so :class:`FailureMemo` keeps each
+failure with the part of the arrangement it depends on, its *world*: the poses of the objects
+involved (object -> pose). A failure is recalled only while every object of its world rests at
+the same pose; the first time one has moved (or been lifted) it is forgotten and the grounding
+is tested again.
 
-Two kinds of keys are used by :mod:`~solvers.sdar.grounding`: a key without arms, for
-failures that hold whatever arms do the moves (``("grippers", moves)``: no choice of grasps
-keeps every pair of grippers clear of the other objects at their goals), and a key with the
-arms, for failures of one assignment (``("arms", moves, arms)``). Remembering a failure only
-prunes candidates; a plan never depends on it being right (every executed step is checked by
-the solver's state and the plan by the validator's replay).
+Two kinds of keys are used: a key without arms, for failures that hold whatever arms do the
+moves (``("step", moves)`` in :mod:`~solvers.sdar.grounding`: no assignment of arms grounds a
+step of goal moves; its world is :func:`neighbourhood`, the poses of the step's objects and of
+the objects resting near their poses and goals), and keys with the arms, for failures of one
+assignment (two arms that meet whatever their options, :mod:`~solvers.sdar.arm_pairs`; its world
+the poses of the two objects). A world is an approximation: IK and buffers see every object on
+the table, the world only the near ones, so a failure may outlive a change far away. Remembering
+a failure only prunes candidates; a plan never depends on it being right (every executed step is
+checked by the solver's state and the plan by the validator's replay).
 """
 
 from __future__ import annotations
 
-from collections.abc import Hashable, Mapping
+import math
+from collections.abc import Callable, Hashable, Iterable, Mapping
 from dataclasses import dataclass
 
 
@@ -62,3 +66,32 @@ class FailureMemo:
         """Keep the failure ``reason`` under ``key`` while the objects of ``world`` (object ->
         pose) rest at those poses."""
         self._failures[key] = Remembered(reason, frozenset(world.items()))
+
+
+def neighbourhood(
+    objects: Iterable[str],
+    poses: Mapping[str, str],
+    goals: Mapping[str, str],
+    locate: Callable[[str], tuple[float, float] | None],
+    radius: float,
+) -> dict[str, str] | None:
+    """The poses (object -> pose) of ``objects`` and of every object resting within ``radius``
+    [m] of a pose or a goal of one of them (``locate``: a pose's ``(x, y)``); None when a pose
+    is not located."""
+    mine = set(objects)
+    spots: list[tuple[float, float]] = []
+    for obj in mine:
+        for pose in (poses.get(obj), goals.get(obj)):
+            xy = None if pose is None else locate(pose)
+            if pose is not None and xy is None:
+                return None
+            if xy is not None:
+                spots.append(xy)
+    world: dict[str, str] = {}
+    for obj, pose in poses.items():
+        xy = locate(pose)
+        if xy is None:
+            return None
+        if obj in mine or any(math.dist(xy, spot) <= radius for spot in spots):
+            world[obj] = pose
+    return world

@@ -5,12 +5,15 @@ For a candidate step and an assignment of arms, :class:`Grounder` asks the strea
 configurations (every arm; an arm without a move waits at home), or, for the one-arm-at-a-time
 motion planner, a sequence of gripper events with the other arms at home, and ranks the
 groundings by the task planner's rank and then by the estimated motion time. Groundings that
-failed before are skipped (see :class:`~solvers.sdar.attempts.TabuLists`).
+failed before are skipped (see :class:`~solvers.sdar.attempts.TabuLists`); with more than two
+arms, a step of goal moves that no assignment grounded is skipped while the objects near it rest
+where they were (:mod:`~solvers.sdar.failure_memo`).
 
 The assignments of arms to a step's moves are :mod:`~solvers.sdar.assignment`'s. The
 options of a step of ``m > 2`` moves are cut so that their combinations stay within
-:data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
-those bringing more objects to their goals come first (then the estimated motion time).
+:data:`MAX_COMBINATIONS` per stage (:data:`PAIRED_COMBINATIONS` in the expanded stage when they
+are checked in pairs: more than two arms), and with more than two arms, among groundings of one
+rank, those bringing more objects to their goals come first (then the estimated motion time).
 """
 
 from __future__ import annotations
@@ -27,8 +30,9 @@ from solvers.sdar.assignment import ArmAssigner
 from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
-from solvers.sdar.failure_memo import FailureMemo
+from solvers.sdar.failure_memo import FailureMemo, neighbourhood
 from solvers.sdar.move_option import Option
+from solvers.sdar.one_arm import one_arm_order
 from solvers.sdar.report import Failures
 from solvers.sdar.tasks import Layout, Move, Step
 
@@ -92,6 +96,8 @@ class Grounder:
         self.memo = FailureMemo()
         """Failures kept across assignments and decisions (:mod:`~solvers.sdar.failure_memo`)."""
         self.pairs = ArmPairs(self._combine, self.memo)
+        self._located: dict[str, tuple[float, float] | None] = {}  # pose -> (x, y) on the plane
+        self._tabu_met = False  # a combination was skipped as tried before
         self.assigner = ArmAssigner(
             cache, options, home, failures, lambda *args: self._move_options(*args)
         )
@@ -118,13 +124,40 @@ class Grounder:
                 ):
                     break
                 peers += peer
+            world = self._step_world(step)
+            if world is not None:
+                why = self.memo.recall(("step", step.moves), self.cache.current_poses())
+                if why is not None:  # no arms grounded it, and nothing near it has moved
+                    self.failures.unassigned(step, f"{why} (remembered)")
+                    continue
+            self._tabu_met = False
+            grounded = len(found)
             for arms in self._assignments(step):
                 found.extend(self._ground(step, arms, mode))
+            done = len(found) > grounded or self._tabu_met or self.deadline.passed()
+            if world is not None and not done:
+                self.memo.remember(("step", step.moves), _NO_ARMS, world)
             if len(self.home) > 2:
                 found.sort(key=lambda g: (g.step.rank, -g.step.progress, g.estimate))
             else:
                 found.sort(key=lambda g: (g.step.rank, g.estimate))
         return found
+
+    def _step_world(self, step: Step) -> dict[str, str] | None:
+        """With more than two arms and a plane, for a step of goal moves: what its failure to
+        ground depends on (:func:`~solvers.sdar.failure_memo.neighbourhood` within
+        :data:`NEAR`); None otherwise (such a failure is not remembered)."""
+        plane = self.options.plane
+        if len(self.home) <= 2 or plane is None or any(m.to_buffer for m in step.moves):
+            return None
+        value = self.cache.table.value
+
+        def locate(pose: str) -> tuple[float, float] | None:
+            if pose not in self._located:
+                self._located[pose] = plane.locate(value(pose))
+            return self._located[pose]
+
+        return neighbourhood(step.objects, self.cache.current_poses(), self.goals, locate, NEAR)
 
     def _assignments(self, step: Step) -> list[tuple[str, ...]]:
         """Arms for the step's moves, in order (:mod:`~solvers.sdar.assignment`)."""
@@ -144,8 +177,10 @@ class Grounder:
         first, more = opt.options_per_move, opt.more_options
         size = len(step.moves)
         if size > 2:  # keep the combinations of a stage within MAX_COMBINATIONS
-            cut = max(1, int(MAX_COMBINATIONS ** (1.0 / size) + 1e-9))
-            first, more = min(first, cut), min(more, cut)
+            first = min(first, _cut(MAX_COMBINATIONS, size))
+            # checked in pairs, the expanded stage's combinations are table look-ups
+            wide = PAIRED_COMBINATIONS if self._pairwise(step) else MAX_COMBINATIONS
+            more = min(more, _cut(wide, size))
         stages = [(first, opt.grasps)]
         if step.kind in opt.expand_kinds and more > first:
             stages.append((more, opt.grasps))
@@ -314,6 +349,7 @@ class Grounder:
             combo = tuple(o[k] for o, k in zip(per_move, chosen, strict=True))
             if self.tabu.blocked(self.key(step, arms, combo), mode):
                 misses[_TRIED] += 1
+                self._tabu_met = True
                 continue
             why = table.why_not(chosen) if table is not None else None
             if why is not None:
@@ -396,7 +432,7 @@ class Grounder:
         """The baseline motion planner's grounding: every gripper action happens with the
         acting arm at its configuration and the other arm at home (its retract pose)."""
         sequence: list[Event] = []
-        for index, pick in self._one_arm_order(step, [o.target for o in combo]):
+        for index, pick in one_arm_order(self.cache, step, [o.target for o in combo]):
             arm = arms[index]
             option = combo[index]
             confs = dict(self.home)
@@ -412,75 +448,31 @@ class Grounder:
         first, last = sequence[0].conf, sequence[-1].conf
         return Grounding(step, arms, combo, first, last, estimate, tuple(sequence))
 
-    def _one_arm_order(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
-        """``(move index, pick?)`` in execution order. A move whose target is clear of every
-        other resting object goes first, alone, then the other; otherwise (a swap) the first
-        arm picks and waits at home holding its object while the second arm works. More than
-        two moves: :meth:`_one_arm_order_k`."""
-        if len(step.moves) == 1:
-            return [(0, True), (0, False)]
-        if len(step.moves) > 2:
-            return self._one_arm_order_k(step, targets)
-        current = self.cache.current_poses()
-        for k, (obj, target) in enumerate(zip(step.objects, targets, strict=True)):
-            if all(
-                self.cache.test(self.cache.voc.cfree, (obj, target, other, pose))
-                for other, pose in current.items()
-                if other != obj
-            ):
-                return [(k, True), (k, False), (1 - k, True), (1 - k, False)]
-        return [(0, True), (1, True), (1, False), (0, False)]
-
-    def _one_arm_order_k(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
-        """One arm at a time for a step of more than two moves: a held object whose target is
-        clear of the resting objects is placed (the last picked first); else an object whose
-        target is clear is picked (to be placed next); else the first object left is picked
-        and held (its arm waits at home holding it); when nothing held can be placed and
-        nothing is left to pick, the last picked is placed anyway (the placement check of the
-        execution then refuses the grounding)."""
-        cache, cfree = self.cache, self.cache.voc.cfree
-        resting = dict(cache.current_poses())
-
-        def clear(k: int) -> bool:
-            obj = step.objects[k]
-            return all(
-                cache.test(cfree, (obj, targets[k], other, pose))
-                for other, pose in resting.items()
-                if other != obj
-            )
-
-        order: list[tuple[int, bool]] = []
-        todo = list(range(len(step.moves)))
-        held: list[int] = []
-        while todo or held:
-            place = next((k for k in reversed(held) if clear(k)), None)
-            if place is None and not todo:
-                place = held[-1]
-            if place is not None:
-                held.remove(place)
-                resting[step.objects[place]] = targets[place]
-                order.append((place, False))
-                continue
-            pick = next((k for k in todo if clear(k)), todo[0])
-            todo.remove(pick)
-            resting.pop(step.objects[pick])
-            held.append(pick)
-            order.append((pick, True))
-        return order
-
 
 #: The most combinations of options per stage grounded for a step of more than two moves (the
 #: two-arm expanded stage's 6 x 6).
 MAX_COMBINATIONS = 36
+#: [m] Objects resting this close to a pose or goal of a step belong to the world of its
+#: remembered failure to ground (:meth:`Grounder._step_world`).
+NEAR = 0.2
+#: The same for the expanded stage of a step whose options are checked in pairs (more than two
+#: arms: :mod:`~solvers.sdar.arm_pairs`): 6 options per move for three moves, 4 for four.
+PAIRED_COMBINATIONS = 256
 #: IK solutions asked per grasp and pose when no other object is on the table (every branch,
 #: and every branch of the half-turn twin where the IK stream offers it).
 _BRANCHES = 16
 _NO_FREE_PAIR = "no pair of grasps keeps the arms apart, whatever the other objects"
 _TRIED = "tried before"
+_NO_ARMS = "no assignment of arms grounds it"
 _GRIPPERS = "a gripper meets the other object at its target"
 _ONE_ARM = "an arm collides with the other arm at home"
 _AT_PICK = AT_PICK
 _AT_PLACE = AT_PLACE
+
+
+def _cut(combinations: int, moves: int) -> int:
+    """The most options per move whose product stays within ``combinations``."""
+    return max(1, int(combinations ** (1.0 / moves) + 1e-9))
 
 
 def _no_grounding(misses: Counter[str]) -> str:

@@ -6,12 +6,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from sdar_tamp.app.problem import rearrangement_problem
+import pytest
+
+from sdar_tamp.app.problem import rearrangement_problem, table_plane
 from sdar_tamp.world.instance import load_instance
 from solvers.sdar.arm_pairs import AT_PICK, AT_PLACE, ArmPairs, PairTable
 from solvers.sdar.attempts import MotionMode
-from solvers.sdar.failure_memo import FailureMemo
-from solvers.sdar.grounding import Option
+from solvers.sdar.failure_memo import FailureMemo, neighbourhood
+from solvers.sdar.grounding import Grounding, Option
 from solvers.sdar.options import SdarOptions
 from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
@@ -133,8 +135,62 @@ def test_the_grounder_reuses_a_meeting_across_assignments_and_decisions() -> Non
     grounder.pairs.combine = blocked
     assert grounder.select([rotate], MotionMode.FULL) == []  # both assignments use both
     first = len(checks)
-    assert grounder.memo.hits == 1  # found at the first assignment, recalled at the second
+    # found at the first assignment, recalled at the second: once per stage (2 and 4 options)
+    assert grounder.memo.hits == 2
     assert any("the arms collide at the objects (remembered)" in r for r in solver.failures.reasons)
     # the next decision in the same arrangement: nothing checked in pairs again
     assert grounder.select([rotate], MotionMode.FULL) == []
     assert len(checks) == first
+
+
+def test_the_neighbourhood_of_a_step_holds_its_objects_and_those_resting_near() -> None:
+    where = {"pa": (0.0, 0.0), "ga": (1.0, 0.0), "pc": (0.1, 0.0), "pd": (0.5, 0.5)}
+    where |= {"pe": (1.0, 0.15)}
+    poses = {"a": "pa", "c": "pc", "d": "pd", "e": "pe"}
+    found = neighbourhood(["a"], poses, {"a": "ga"}, where.get, 0.2)
+    assert found == {"a": "pa", "c": "pc", "e": "pe"}  # c near its pose, e near its goal
+    assert neighbourhood(["a"], {**poses, "d": "lost"}, {"a": "ga"}, where.get, 0.2) is None
+    assert neighbourhood(["a"], poses, {"a": "lost"}, where.get, 0.2) is None
+
+
+def test_a_step_no_arms_ground_is_skipped_until_an_object_near_it_moves(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    path = DATA / "four_arm_cycle.yaml"
+    instance = load_instance(path)
+    ctx = WorldContext.load(instance.scene_path(path))
+    r = rearrangement_problem(instance, ctx)
+    solver = SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions(plane=table_plane(ctx)))
+    grounder = solver.grounder
+    rotate = solver.planner.candidates(solver.view())[0]
+    grounded: list[tuple[str, ...]] = []
+
+    def nothing(step: Step, arms: tuple[str, ...], mode: MotionMode) -> list[Grounding]:
+        grounded.append(arms)
+        return []
+
+    monkeypatch.setattr(grounder, "_ground", nothing)
+    assert grounder.select([rotate], MotionMode.FULL) == []
+    tried = len(grounded)
+    assert tried > 0
+    assert grounder.select([rotate], MotionMode.FULL) == []  # the next decision: remembered
+    assert len(grounded) == tried
+    assert solver.failures.reasons[-1].endswith("no assignment of arms grounds it (remembered)")
+    # one of its objects moves: tested again
+    poses = solver.cache.current_poses()
+    moved = {**poses, rotate.objects[0]: solver.goals[rotate.objects[0]]}
+    monkeypatch.setattr(solver.cache, "current_poses", lambda: dict(moved))
+    assert grounder.select([rotate], MotionMode.FULL) == []
+    assert len(grounded) == 2 * tried
+    # a step whose groundings were all tried before (tabu) is not remembered as failing
+    monkeypatch.setattr(solver.cache, "current_poses", lambda: dict(poses))
+    grounder.memo = FailureMemo()
+    grounder.pairs.memo = grounder.memo
+
+    def tabu(step: Step, arms: tuple[str, ...], mode: MotionMode) -> list[Grounding]:
+        grounder._tabu_met = True
+        return []
+
+    monkeypatch.setattr(grounder, "_ground", tabu)
+    assert grounder.select([rotate], MotionMode.FULL) == []
+    assert len(grounder.memo) == 0
