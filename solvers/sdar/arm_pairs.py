@@ -136,3 +136,33 @@ class ArmPairs:
     def _alone(self, arm: str, q: str) -> bool:
         """``arm`` at ``q`` is clear of the other arms at home."""
         return self.combine({arm: q}) is not None
+
+
+def grippers_can_clear(
+    targets: Sequence[tuple[str, str]],
+    grasps: Sequence[Sequence[str]],
+    clear: Callable[[str, str, str, str, str], bool],
+) -> bool:
+    """Some choice of one grasp per object (``grasps[i]`` for the object and target
+    ``targets[i]``) keeps every gripper clear of every other object at its target (``clear(o,
+    p, g, o2, p2)``: the gripper holding ``o`` at ``p`` with ``g`` is clear of ``o2`` at
+    ``p2``): a backtracking search over the objects in order. Whatever arms place them, objects
+    placed at once with no such choice never ground; that depends on neither arms nor poses."""
+
+    def pair_ok(i: int, gi: str, j: int, gj: str) -> bool:
+        (oi, ti), (oj, tj) = targets[i], targets[j]
+        return clear(oi, ti, gi, oj, tj) and clear(oj, tj, gj, oi, ti)
+
+    def extend(chosen: list[str]) -> bool:
+        i = len(chosen)
+        if i == len(targets):
+            return True
+        for g in grasps[i]:
+            if all(pair_ok(j, chosen[j], i, g) for j in range(i)):
+                chosen.append(g)
+                if extend(chosen):
+                    return True
+                chosen.pop()
+        return False
+
+    return extend([])

@@ -6,8 +6,8 @@ configurations (every arm; an arm without a move waits at home), or, for the one
 motion planner, a sequence of gripper events with the other arms at home, and ranks the
 groundings by the task planner's rank and then by the estimated motion time. Groundings that
 failed before are skipped (see :class:`~solvers.sdar.attempts.TabuLists`); with more than two
-arms, a step of goal moves that no assignment grounded is skipped while the objects near it rest
-where they were (:mod:`~solvers.sdar.failure_memo`).
+arms, options are checked in pairs of arms and steps known not to ground are skipped
+(:mod:`~solvers.sdar.k_grounding`).
 
 The assignments of arms to a step's moves are :mod:`~solvers.sdar.assignment`'s. The
 options of a step of ``m > 2`` moves are cut so that their combinations stay within
@@ -25,12 +25,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from sdar_tamp.language.formula_model import Atom
-from solvers.sdar.arm_pairs import AT_PICK, AT_PLACE, ArmPairs, PairTable
+from solvers.sdar.arm_pairs import AT_PICK, AT_PLACE
 from solvers.sdar.assignment import ArmAssigner
 from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
-from solvers.sdar.failure_memo import FailureMemo, neighbourhood
+from solvers.sdar.k_grounding import KArmChecks
 from solvers.sdar.move_option import Option
 from solvers.sdar.one_arm import one_arm_order
 from solvers.sdar.report import Failures
@@ -93,10 +93,8 @@ class Grounder:
         self.layout: Layout | None = None
         """With more than two arms: the current view's layout; assignments whose arms cross
         (:meth:`~solvers.sdar.tasks.Layout.conflicts`) come after the others."""
-        self.memo = FailureMemo()
-        """Failures kept across assignments and decisions (:mod:`~solvers.sdar.failure_memo`)."""
-        self.pairs = ArmPairs(self._combine, self.memo)
-        self._located: dict[str, tuple[float, float] | None] = {}  # pose -> (x, y) on the plane
+        self.k = KArmChecks(cache, options, goals, len(home), self._combine)
+        """With more than two arms: pairwise checks and remembered failures."""
         self._tabu_met = False  # a combination was skipped as tried before
         self.assigner = ArmAssigner(
             cache, options, home, failures, lambda *args: self._move_options(*args)
@@ -124,40 +122,21 @@ class Grounder:
                 ):
                     break
                 peers += peer
-            world = self._step_world(step)
-            if world is not None:
-                why = self.memo.recall(("step", step.moves), self.cache.current_poses())
-                if why is not None:  # no arms grounded it, and nothing near it has moved
-                    self.failures.unassigned(step, f"{why} (remembered)")
-                    continue
+            why = self.k.skip(step)
+            if why is not None:
+                self.failures.unassigned(step, why)
+                continue
             self._tabu_met = False
             grounded = len(found)
             for arms in self._assignments(step):
                 found.extend(self._ground(step, arms, mode))
-            done = len(found) > grounded or self._tabu_met or self.deadline.passed()
-            if world is not None and not done:
-                self.memo.remember(("step", step.moves), _NO_ARMS, world)
+            if not (len(found) > grounded or self._tabu_met or self.deadline.passed()):
+                self.k.failed(step)
             if len(self.home) > 2:
                 found.sort(key=lambda g: (g.step.rank, -g.step.progress, g.estimate))
             else:
                 found.sort(key=lambda g: (g.step.rank, g.estimate))
         return found
-
-    def _step_world(self, step: Step) -> dict[str, str] | None:
-        """With more than two arms and a plane, for a step of goal moves: what its failure to
-        ground depends on (:func:`~solvers.sdar.failure_memo.neighbourhood` within
-        :data:`NEAR`); None otherwise (such a failure is not remembered)."""
-        plane = self.options.plane
-        if len(self.home) <= 2 or plane is None or any(m.to_buffer for m in step.moves):
-            return None
-        value = self.cache.table.value
-
-        def locate(pose: str) -> tuple[float, float] | None:
-            if pose not in self._located:
-                self._located[pose] = plane.locate(value(pose))
-            return self._located[pose]
-
-        return neighbourhood(step.objects, self.cache.current_poses(), self.goals, locate, NEAR)
 
     def _assignments(self, step: Step) -> list[tuple[str, ...]]:
         """Arms for the step's moves, in order (:mod:`~solvers.sdar.assignment`)."""
@@ -179,7 +158,7 @@ class Grounder:
         if size > 2:  # keep the combinations of a stage within MAX_COMBINATIONS
             first = min(first, _cut(MAX_COMBINATIONS, size))
             # checked in pairs, the expanded stage's combinations are table look-ups
-            wide = PAIRED_COMBINATIONS if self._pairwise(step) else MAX_COMBINATIONS
+            wide = PAIRED_COMBINATIONS if self.k.pairwise(step) else MAX_COMBINATIONS
             more = min(more, _cut(wide, size))
         stages = [(first, opt.grasps)]
         if step.kind in opt.expand_kinds and more > first:
@@ -197,8 +176,8 @@ class Grounder:
                     misses[_NO_FREE_PAIR] += 1
                     break
                 allowed = free or allowed
-            if self._pairwise(step):
-                remembered = self.pairs.meets(step, arms, (limit, grasps), poses)
+            if self.k.pairwise(step):
+                remembered = self.k.pairs.meets(step, arms, (limit, grasps), poses)
                 if remembered is not None:  # found at an earlier assignment or decision
                     misses[f"{remembered} (remembered)"] += 1
                     continue
@@ -342,7 +321,7 @@ class Grounder:
         current = self.cache.current_dualconf()
         found: list[Grounding] = []
         misses = Counter() if misses is None else misses
-        table = self._pair_table(step, arms, per_move, misses, stage)
+        table = self.k.pair_table(step, arms, per_move, misses, stage)
         if isinstance(table, str):
             return found
         for chosen in itertools.product(*(range(len(o)) for o in per_move)):
@@ -381,28 +360,6 @@ class Grounder:
             estimate = distance(current, d_pick) + distance(d_pick, d_place)
             found.append(Grounding(step, arms, combo, d_pick, d_place, estimate))
         return found
-
-    def _pair_table(
-        self,
-        step: Step,
-        arms: tuple[str, ...],
-        per_move: Sequence[Sequence[Option]],
-        misses: Counter[str],
-        stage: Hashable,
-    ) -> PairTable | str | None:
-        """With more than two arms, for a step of several moves moved at once: the option pairs
-        whose arms are clear (:mod:`~solvers.sdar.arm_pairs`), or why two of its arms meet
-        whatever their options (counted in ``misses``); None otherwise."""
-        if not self._pairwise(step):
-            return None
-        table = self.pairs.table(step, arms, per_move, self.cache.current_poses(), stage)
-        if isinstance(table, str):
-            misses[table] += 1
-        return table
-
-    def _pairwise(self, step: Step) -> bool:
-        """Options of ``step`` are checked in pairs: more than two arms, moves at once."""
-        return len(self.home) > 2 and len(step.moves) > 1 and not self.options.one_arm_at_a_time
 
     def _grippers_clear(self, step: Step, combo: tuple[Option, ...]) -> bool:
         """Objects placed at once: each gripper is clear of every other object at its target
@@ -452,9 +409,6 @@ class Grounder:
 #: The most combinations of options per stage grounded for a step of more than two moves (the
 #: two-arm expanded stage's 6 x 6).
 MAX_COMBINATIONS = 36
-#: [m] Objects resting this close to a pose or goal of a step belong to the world of its
-#: remembered failure to ground (:meth:`Grounder._step_world`).
-NEAR = 0.2
 #: The same for the expanded stage of a step whose options are checked in pairs (more than two
 #: arms: :mod:`~solvers.sdar.arm_pairs`): 6 options per move for three moves, 4 for four.
 PAIRED_COMBINATIONS = 256
@@ -463,7 +417,6 @@ PAIRED_COMBINATIONS = 256
 _BRANCHES = 16
 _NO_FREE_PAIR = "no pair of grasps keeps the arms apart, whatever the other objects"
 _TRIED = "tried before"
-_NO_ARMS = "no assignment of arms grounds it"
 _GRIPPERS = "a gripper meets the other object at its target"
 _ONE_ARM = "an arm collides with the other arm at home"
 _AT_PICK = AT_PICK

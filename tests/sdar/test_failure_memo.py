@@ -10,7 +10,7 @@ import pytest
 
 from sdar_tamp.app.problem import rearrangement_problem, table_plane
 from sdar_tamp.world.instance import load_instance
-from solvers.sdar.arm_pairs import AT_PICK, AT_PLACE, ArmPairs, PairTable
+from solvers.sdar.arm_pairs import AT_PICK, AT_PLACE, ArmPairs, PairTable, grippers_can_clear
 from solvers.sdar.attempts import MotionMode
 from solvers.sdar.failure_memo import FailureMemo, neighbourhood
 from solvers.sdar.grounding import Grounding, Option
@@ -115,7 +115,7 @@ def test_the_grounder_reuses_a_meeting_across_assignments_and_decisions() -> Non
     grounder = solver.grounder
     rotate = solver.planner.candidates(solver.view())[0]
     assert rotate.kind == "rotate" and len(rotate.moves) == 4
-    combine = grounder.pairs.combine
+    combine = grounder.k.pairs.combine
     by_name = {solver.cache.show(a): a for a in grounder.home}
     meet = {by_name["north"], by_name["south"]}
     # two assignments that share north on the first move and south on the second
@@ -132,11 +132,11 @@ def test_the_grounder_reuses_a_meeting_across_assignments_and_decisions() -> Non
         active = {a for a, q in confs.items() if q not in homes}
         return None if meet <= active else combine(confs)
 
-    grounder.pairs.combine = blocked
+    grounder.k.pairs.combine = blocked
     assert grounder.select([rotate], MotionMode.FULL) == []  # both assignments use both
     first = len(checks)
     # found at the first assignment, recalled at the second: once per stage (2 and 4 options)
-    assert grounder.memo.hits == 2
+    assert grounder.k.memo.hits == 2
     assert any("the arms collide at the objects (remembered)" in r for r in solver.failures.reasons)
     # the next decision in the same arrangement: nothing checked in pairs again
     assert grounder.select([rotate], MotionMode.FULL) == []
@@ -184,8 +184,7 @@ def test_a_step_no_arms_ground_is_skipped_until_an_object_near_it_moves(
     assert len(grounded) == 2 * tried
     # a step whose groundings were all tried before (tabu) is not remembered as failing
     monkeypatch.setattr(solver.cache, "current_poses", lambda: dict(poses))
-    grounder.memo = FailureMemo()
-    grounder.pairs.memo = grounder.memo
+    grounder.k.memo = grounder.k.pairs.memo = FailureMemo()
 
     def tabu(step: Step, arms: tuple[str, ...], mode: MotionMode) -> list[Grounding]:
         grounder._tabu_met = True
@@ -193,4 +192,52 @@ def test_a_step_no_arms_ground_is_skipped_until_an_object_near_it_moves(
 
     monkeypatch.setattr(grounder, "_ground", tabu)
     assert grounder.select([rotate], MotionMode.FULL) == []
-    assert len(grounder.memo) == 0
+    assert len(grounder.k.memo) == 0
+
+
+def test_grasps_for_objects_placed_at_once_are_searched_whatever_the_arms() -> None:
+    targets = [("a", "ta"), ("b", "tb"), ("c", "tc")]
+    # b's gripper with grasp b1 meets a at its goal; c's gripper meets b at its goal unless c2
+    bad = {("b", "b1", "a"), ("c", "c1", "b")}
+
+    def clear(o: str, p: str, g: str, o2: str, p2: str) -> bool:
+        return (o, g, o2) not in bad
+
+    assert grippers_can_clear(targets, [["a1"], ["b1", "b2"], ["c1", "c2"]], clear)
+    assert not grippers_can_clear(targets, [["a1"], ["b1"], ["c1", "c2"]], clear)
+    assert not grippers_can_clear(targets, [["a1"], ["b2"], ["c1"]], clear)
+    assert grippers_can_clear([], [], clear)
+
+
+def test_a_step_whose_grippers_always_meet_is_skipped_for_good(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    path = DATA / "four_arm_cycle.yaml"
+    instance = load_instance(path)
+    r = rearrangement_problem(instance, WorldContext.load(instance.scene_path(path)))
+    solver = SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions())
+    grounder = solver.grounder
+    rotate = solver.planner.candidates(solver.view())[0]
+    cache = solver.cache
+    asked: list[tuple[str, ...]] = []
+    test = cache.test
+
+    def never(stream: str, inputs: tuple[str, ...]) -> bool:
+        if stream == cache.voc.grasp_cfree:
+            asked.append(inputs)
+            return False
+        return test(stream, inputs)
+
+    monkeypatch.setattr(cache, "test", never)
+    monkeypatch.setattr(grounder, "_assignments", lambda step: pytest.fail("no arms needed"))
+    assert grounder.select([rotate], MotionMode.FULL) == []
+    assert solver.failures.reasons[-1].endswith(
+        "keeps every gripper clear of the other objects at their goals"
+    )
+    n = len(asked)
+    assert n > 0
+    assert grounder.select([rotate], MotionMode.FULL) == []  # remembered: nothing asked
+    assert len(asked) == n
+    # a step of two moves is left to its stages (its swap stage searches more grasps)
+    two = Step(rotate.moves[:2], "swap", 1)
+    assert grounder.k.skip(two) is None
