@@ -11,9 +11,8 @@ arms, options are checked in pairs of arms and steps known not to ground are ski
 
 The assignments of arms to a step's moves are :mod:`~solvers.sdar.assignment`'s. The
 options of a step of ``m > 2`` moves are cut so that their combinations stay within
-:data:`MAX_COMBINATIONS` per stage (:data:`PAIRED_COMBINATIONS` in the expanded stage when they
-are checked in pairs: more than two arms), and with more than two arms, among groundings of one
-rank, those bringing more objects to their goals come first (then the estimated motion time).
+:data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
+those bringing more objects to their goals come first (then the estimated motion time).
 """
 
 from __future__ import annotations
@@ -156,10 +155,8 @@ class Grounder:
         first, more = opt.options_per_move, opt.more_options
         size = len(step.moves)
         if size > 2:  # keep the combinations of a stage within MAX_COMBINATIONS
-            first = min(first, _cut(MAX_COMBINATIONS, size))
-            # checked in pairs, the expanded stage's combinations are table look-ups
-            wide = PAIRED_COMBINATIONS if self.k.pairwise(step) else MAX_COMBINATIONS
-            more = min(more, _cut(wide, size))
+            cut = max(1, int(MAX_COMBINATIONS ** (1.0 / size) + 1e-9))
+            first, more = min(first, cut), min(more, cut)
         stages = [(first, opt.grasps)]
         if step.kind in opt.expand_kinds and more > first:
             stages.append((more, opt.grasps))
@@ -409,9 +406,6 @@ class Grounder:
 #: The most combinations of options per stage grounded for a step of more than two moves (the
 #: two-arm expanded stage's 6 x 6).
 MAX_COMBINATIONS = 36
-#: The same for the expanded stage of a step whose options are checked in pairs (more than two
-#: arms: :mod:`~solvers.sdar.arm_pairs`): 6 options per move for three moves, 4 for four.
-PAIRED_COMBINATIONS = 256
 #: IK solutions asked per grasp and pose when no other object is on the table (every branch,
 #: and every branch of the half-turn twin where the IK stream offers it).
 _BRANCHES = 16
@@ -421,11 +415,6 @@ _GRIPPERS = "a gripper meets the other object at its target"
 _ONE_ARM = "an arm collides with the other arm at home"
 _AT_PICK = AT_PICK
 _AT_PLACE = AT_PLACE
-
-
-def _cut(combinations: int, moves: int) -> int:
-    """The most options per move whose product stays within ``combinations``."""
-    return max(1, int(combinations ** (1.0 / moves) + 1e-9))
 
 
 def _no_grounding(misses: Counter[str]) -> str:
