@@ -45,6 +45,11 @@ class StreamCache:
         init = set(problem.facts.init) | type_facts(problem.facts.objects, hierarchy)
         self.state = LiftedState(problem.domain, (), init, self.of_type, self._cost)
         self._instances: dict[InstanceKey, StreamInstance] = {}
+        # the current arrangement, read once per state version (see LiftedState.version)
+        self._fluents: dict[tuple[tuple[str, ...], frozenset[str]], tuple[Atom, ...]] = {}
+        self._poses: dict[str, str] = {}
+        self._version: tuple[int, int] = (0, -1)  # (id of the state, its version)
+        self._arm_confs: dict[str, dict[str, str]] = {}  # cell configuration -> arm -> conf
 
     # -- objects and costs ---------------------------------------------------------------
     def of_type(self, type_name: str) -> Sequence[str]:
@@ -117,14 +122,30 @@ class StreamCache:
     # -- the current arrangement ---------------------------------------------------------
     def fluents(self, *predicates: str, without: frozenset[str] = frozenset()) -> tuple[Atom, ...]:
         """The current atoms of ``predicates``, sorted; objects in ``without`` are lifted
-        (their ``atpose`` atoms left out)."""
+        (their ``atpose`` atoms left out). Fluent predicates are read once per state version."""
+        self._sync()
+        key = (predicates, without)
+        known = self._fluents.get(key)
+        if known is not None:
+            return known
         out = [
             Atom(p, args)
             for p in predicates
             for args in self.state.atoms(p)
             if not (p == self.voc.atpose and args[0] in without)
         ]
-        return tuple(sorted(out, key=str))
+        atoms = tuple(sorted(out, key=str))
+        if all(p in self.state.fluent_names for p in predicates):
+            self._fluents[key] = atoms
+        return atoms
+
+    def _sync(self) -> None:
+        """Forget the arrangement read at an earlier state version."""
+        version = (id(self.state), self.state.version)
+        if self._version != version:
+            self._version = version
+            self._fluents.clear()
+            self._poses = {}
 
     def current_dualconf(self) -> str:
         (d,) = next(self.state.atoms(self.voc.atdualconf))
@@ -133,10 +154,20 @@ class StreamCache:
     def current_arm_conf(self, arm: str) -> str:
         """The configuration of ``arm`` in the current cell configuration (its ``confin``)."""
         d = self.current_dualconf()
-        for d2, a, q in self.state.atoms(self.voc.confin):
-            if d2 == d and a == arm:
-                return q
+        confs = self._arm_confs.get(d)
+        if confs is None or arm not in confs:  # a cell configuration's confin facts, once
+            confs = {}
+            for d2, a, q in self.state.args_of(self.voc.confin):
+                if d2 == d and (a not in confs or q < confs[a]):
+                    confs[a] = q
+            self._arm_confs[d] = confs
+        if arm in confs:
+            return confs[arm]
         raise ParameterError(f"no ({self.voc.confin} {d} {arm} ?q) fact for the current state")
 
     def current_poses(self) -> dict[str, str]:
-        return {o: p for o, p in self.state.atoms(self.voc.atpose)}
+        """Object -> pose now (a copy; read once per state version)."""
+        self._sync()
+        if not self._poses:
+            self._poses = {o: p for o, p in self.state.atoms(self.voc.atpose)}
+        return dict(self._poses)

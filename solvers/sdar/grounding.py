@@ -5,13 +5,11 @@ For a candidate step and an assignment of arms, :class:`Grounder` asks the strea
 configurations (every arm; an arm without a move waits at home), or, for the one-arm-at-a-time
 motion planner, a sequence of gripper events with the other arms at home, and ranks the
 groundings by the task planner's rank and then by the estimated motion time. Groundings that
-failed before are skipped (see :class:`~solvers.sdar.attempts.TabuLists`).
+failed before are skipped (see :class:`~solvers.sdar.attempts.TabuLists`); with more than two
+arms, options are checked in pairs of arms and steps known not to ground are skipped
+(:mod:`~solvers.sdar.k_grounding`).
 
-Assignments of moves to arms: with two arms every one (two at most). With more, bounded: for
-each move the arms that reach its object and target (the first grasp option of that arm), by
-the estimated time of that arm's pick and transfer, the ``moves + 1`` soonest; of their
-combinations with distinct arms the ``SdarOptions.assignments`` of least total estimate (with
-the view's :class:`~solvers.sdar.tasks.Layout`, fewest crossing pairs of arms first). The
+The assignments of arms to a step's moves are :mod:`~solvers.sdar.assignment`'s. The
 options of a step of ``m > 2`` moves are cut so that their combinations stay within
 :data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
 those bringing more objects to their goals come first (then the estimated motion time).
@@ -26,9 +24,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from sdar_tamp.language.formula_model import Atom
+from solvers.sdar.arm_pairs import AT_PICK, AT_PLACE
+from solvers.sdar.assignment import ArmAssigner
 from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
+from solvers.sdar.k_grounding import KArmChecks
+from solvers.sdar.move_option import Option
+from solvers.sdar.one_arm import one_arm_order
 from solvers.sdar.report import Failures
 from solvers.sdar.tasks import Layout, Move, Step
 
@@ -37,14 +40,6 @@ if TYPE_CHECKING:
 
 
 BufferCheck = Callable[[tuple[Move, ...], str, str], bool]
-
-
-@dataclass(frozen=True)
-class Option:
-    grasp: str
-    pick: str  # arm configuration at the current pose
-    target: str  # pose
-    place: str  # arm configuration at the target
 
 
 @dataclass(frozen=True)
@@ -97,6 +92,12 @@ class Grounder:
         self.layout: Layout | None = None
         """With more than two arms: the current view's layout; assignments whose arms cross
         (:meth:`~solvers.sdar.tasks.Layout.conflicts`) come after the others."""
+        self.k = KArmChecks(cache, options, goals, len(home), self._combine)
+        """With more than two arms: pairwise checks and remembered failures."""
+        self._tabu_met = False  # a combination was skipped as tried before
+        self.assigner = ArmAssigner(
+            cache, options, home, failures, lambda *args: self._move_options(*args)
+        )
 
     def key(self, step: Step, arms: tuple[str, ...], combo: tuple[Option, ...]) -> Hashable:
         """The tabu key of a grounding in the current arrangement."""
@@ -120,8 +121,16 @@ class Grounder:
                 ):
                     break
                 peers += peer
+            why = self.k.skip(step)
+            if why is not None:
+                self.failures.unassigned(step, why)
+                continue
+            self._tabu_met = False
+            grounded = len(found)
             for arms in self._assignments(step):
                 found.extend(self._ground(step, arms, mode))
+            if not (len(found) > grounded or self._tabu_met or self.deadline.passed()):
+                self.k.failed(step)
             if len(self.home) > 2:
                 found.sort(key=lambda g: (g.step.rank, -g.step.progress, g.estimate))
             else:
@@ -129,51 +138,8 @@ class Grounder:
         return found
 
     def _assignments(self, step: Step) -> list[tuple[str, ...]]:
-        """Arms for the step's moves, in order (see the module docstring)."""
-        arms = sorted(self.home)
-        m = len(step.moves)
-        if len(arms) <= 2:
-            return list(itertools.permutations(arms, m))
-        lifted = frozenset(step.objects)
-        cost: dict[tuple[str, int], float] = {}
-        for i, move in enumerate(step.moves):
-            for a in arms:
-                options = self._move_options(a, move, lifted, 1, self.options.grasps,
-                                             None, step.moves)  # fmt: skip
-                if options:
-                    here = self.cache.current_arm_conf(a)
-                    pick, place = options[0].pick, options[0].place
-                    cost[a, i] = self.cache.arm_distance(here, pick) + self.cache.arm_distance(
-                        pick, place
-                    )
-        per_move = [
-            [a for _, a in sorted((cost[a, i], a) for a in arms if (a, i) in cost)][: m + 1]
-            for i in range(m)
-        ]
-        alone = [step.moves[i] for i, reach in enumerate(per_move) if not reach]
-        if alone:
-            show = self.cache.show
-            self.failures.unassigned(step, "no arm has a grasp with IK at " + ", ".join(
-                f"{show(mv.obj)} and at {'a buffer' if mv.to_buffer else 'its goal'}"
-                for mv in alone
-            ))  # fmt: skip
-            return []
-        tuples = [t for t in itertools.product(*per_move) if len(set(t)) == m]
-        if not tuples:
-            self.failures.unassigned(
-                step, "no assignment gives its moves distinct arms that reach them"
-            )
-        layout = self.layout
-        if layout is not None and all(mv.obj in layout.places for mv in step.moves):
-            index = {a: k for k, a in enumerate(arms)}
-            seats = {
-                t: [(index[a], mv.obj) for a, mv in zip(t, step.moves, strict=True)] for t in tuples
-            }
-            crossings = {t: layout.conflicts(seats[t]) for t in tuples}
-            tuples.sort(key=lambda t: (crossings[t], sum(cost[a, i] for i, a in enumerate(t)), t))
-        else:
-            tuples.sort(key=lambda t: (sum(cost[a, i] for i, a in enumerate(t)), t))
-        return tuples[: self.options.assignments]
+        """Arms for the step's moves, in order (:mod:`~solvers.sdar.assignment`)."""
+        return self.assigner.assignments(step, self.layout)
 
     def _ground(self, step: Step, arms: tuple[str, ...], mode: MotionMode) -> list[Grounding]:
         """Every grounding of ``step`` with ``arms`` not yet tried, cheapest estimate first:
@@ -198,6 +164,7 @@ class Grounder:
             stages.append((opt.pair_grasps, opt.pair_grasps))
         found: list[Grounding] = []
         misses: Counter[str] = Counter()  # why combinations of options failed
+        poses = self.cache.current_poses()
         for k, (limit, grasps) in enumerate(stages):
             allowed: Sequence[frozenset[str] | None] = [None] * len(step.moves)
             if grasps > opt.grasps:  # the pair search: only grasps of a pair that can work
@@ -206,6 +173,11 @@ class Grounder:
                     misses[_NO_FREE_PAIR] += 1
                     break
                 allowed = free or allowed
+            if self.k.pairwise(step):
+                remembered = self.k.pairs.meets(step, arms, (limit, grasps), poses)
+                if remembered is not None:  # found at an earlier assignment or decision
+                    misses[f"{remembered} (remembered)"] += 1
+                    continue
             per_move = [
                 self._move_options(a, m, lifted, limit, grasps, only, step.moves)
                 for a, m, only in zip(arms, step.moves, allowed, strict=True)
@@ -219,7 +191,7 @@ class Grounder:
                                       f"{show(m.obj)} and at {target}")  # fmt: skip
                     return []
             if all(per_move):
-                found = self._combinations(step, arms, per_move, mode, misses)
+                found = self._combinations(step, arms, per_move, mode, misses, (limit, grasps))
             exhausted = all(len(options) < limit for options in per_move)
             if found or (exhausted and not more_grasps):
                 break  # a later stage offers nothing new once every grasp was tried
@@ -337,16 +309,27 @@ class Grounder:
         per_move: Sequence[Sequence[Option]],
         mode: MotionMode,
         misses: Counter[str] | None = None,
+        stage: Hashable = None,
     ) -> list[Grounding]:
         """The groundings of every combination of the moves' options not yet tried whose
-        dual-arm configurations are collision-free; ``misses`` counts why the others fail."""
+        dual-arm configurations are collision-free; ``misses`` counts why the others fail
+        (``stage``: how many options of how many grasps, for :meth:`_pair_table`)."""
         idle = [a for a in self.home if a not in arms]
         current = self.cache.current_dualconf()
         found: list[Grounding] = []
         misses = Counter() if misses is None else misses
-        for combo in _product(per_move):
+        table = self.k.pair_table(step, arms, per_move, misses, stage)
+        if isinstance(table, str):
+            return found
+        for chosen in itertools.product(*(range(len(o)) for o in per_move)):
+            combo = tuple(o[k] for o, k in zip(per_move, chosen, strict=True))
             if self.tabu.blocked(self.key(step, arms, combo), mode):
                 misses[_TRIED] += 1
+                self._tabu_met = True
+                continue
+            why = table.why_not(chosen) if table is not None else None
+            if why is not None:
+                misses[why] += 1
                 continue
             if not self.options.one_arm_at_a_time and not self._grippers_clear(step, combo):
                 misses[_GRIPPERS] += 1
@@ -403,7 +386,7 @@ class Grounder:
         """The baseline motion planner's grounding: every gripper action happens with the
         acting arm at its configuration and the other arm at home (its retract pose)."""
         sequence: list[Event] = []
-        for index, pick in self._one_arm_order(step, [o.target for o in combo]):
+        for index, pick in one_arm_order(self.cache, step, [o.target for o in combo]):
             arm = arms[index]
             option = combo[index]
             confs = dict(self.home)
@@ -419,62 +402,6 @@ class Grounder:
         first, last = sequence[0].conf, sequence[-1].conf
         return Grounding(step, arms, combo, first, last, estimate, tuple(sequence))
 
-    def _one_arm_order(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
-        """``(move index, pick?)`` in execution order. A move whose target is clear of every
-        other resting object goes first, alone, then the other; otherwise (a swap) the first
-        arm picks and waits at home holding its object while the second arm works. More than
-        two moves: :meth:`_one_arm_order_k`."""
-        if len(step.moves) == 1:
-            return [(0, True), (0, False)]
-        if len(step.moves) > 2:
-            return self._one_arm_order_k(step, targets)
-        current = self.cache.current_poses()
-        for k, (obj, target) in enumerate(zip(step.objects, targets, strict=True)):
-            if all(
-                self.cache.test(self.cache.voc.cfree, (obj, target, other, pose))
-                for other, pose in current.items()
-                if other != obj
-            ):
-                return [(k, True), (k, False), (1 - k, True), (1 - k, False)]
-        return [(0, True), (1, True), (1, False), (0, False)]
-
-    def _one_arm_order_k(self, step: Step, targets: Sequence[str]) -> list[tuple[int, bool]]:
-        """One arm at a time for a step of more than two moves: a held object whose target is
-        clear of the resting objects is placed (the last picked first); else an object whose
-        target is clear is picked (to be placed next); else the first object left is picked
-        and held (its arm waits at home holding it); when nothing held can be placed and
-        nothing is left to pick, the last picked is placed anyway (the placement check of the
-        execution then refuses the grounding)."""
-        cache, cfree = self.cache, self.cache.voc.cfree
-        resting = dict(cache.current_poses())
-
-        def clear(k: int) -> bool:
-            obj = step.objects[k]
-            return all(
-                cache.test(cfree, (obj, targets[k], other, pose))
-                for other, pose in resting.items()
-                if other != obj
-            )
-
-        order: list[tuple[int, bool]] = []
-        todo = list(range(len(step.moves)))
-        held: list[int] = []
-        while todo or held:
-            place = next((k for k in reversed(held) if clear(k)), None)
-            if place is None and not todo:
-                place = held[-1]
-            if place is not None:
-                held.remove(place)
-                resting[step.objects[place]] = targets[place]
-                order.append((place, False))
-                continue
-            pick = next((k for k in todo if clear(k)), todo[0])
-            todo.remove(pick)
-            resting.pop(step.objects[pick])
-            held.append(pick)
-            order.append((pick, True))
-        return order
-
 
 #: The most combinations of options per stage grounded for a step of more than two moves (the
 #: two-arm expanded stage's 6 x 6).
@@ -486,8 +413,8 @@ _NO_FREE_PAIR = "no pair of grasps keeps the arms apart, whatever the other obje
 _TRIED = "tried before"
 _GRIPPERS = "a gripper meets the other object at its target"
 _ONE_ARM = "an arm collides with the other arm at home"
-_AT_PICK = "the arms collide at the objects"
-_AT_PLACE = "the arms collide at the targets"
+_AT_PICK = AT_PICK
+_AT_PLACE = AT_PLACE
 
 
 def _no_grounding(misses: Counter[str]) -> str:
@@ -496,10 +423,3 @@ def _no_grounding(misses: Counter[str]) -> str:
         return "no combination of grasp options to try"
     parts = ", ".join(f"{why} ({n})" for why, n in misses.most_common())
     return f"no combination of grasp options works: {parts}"
-
-
-def _product(options: Sequence[Sequence[Option]]) -> list[tuple[Option, ...]]:
-    combos: list[tuple[Option, ...]] = [()]
-    for choices in options:
-        combos = [(*c, o) for c in combos for o in choices]
-    return combos

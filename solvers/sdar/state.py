@@ -56,6 +56,8 @@ class LiftedState:
         self._of_type = objects_of_type
         self._cost = cost
         self._evaluator: Evaluator | None = None
+        self.version = 0
+        """Counts the actions applied: the fluents change only with it."""
 
     # -- facts (the Facts and Objects of language.state_index) ---------------------------------
     def __contains__(self, atom: object) -> bool:
@@ -120,4 +122,5 @@ class LiftedState:
         for atom in changes.adds:
             self._by_predicate[atom.predicate].add(atom.args)
         self._evaluator = None
+        self.version += 1
         return changes.cost
