@@ -61,7 +61,7 @@ class StreamSolver:
         self.policy = policy_for(self.context)
         self.log = RoundLog(options.verbose)
         # a real plan cost more than assumed once its deferred functions were evaluated: the
-        # search goes on at its level only for a cheaper one
+        # search goes on at its level only for a cheaper one on the real facts known
         self.confirming = False
 
     def solve(self) -> Solution:
@@ -166,6 +166,12 @@ class StreamSolver:
                 tried.clear()
                 continue
             actions, cost = found
+            if self.confirming and any(r.kind == "stream" for r in ordered.stream_plan):
+                # a cheaper plan would need new samples: the known one stands (binding and
+                # adaptive end at their first real plan too; searching on, one skeleton a
+                # round, cost focused half of its rounds on continuous_tamp)
+                self._end("a cheaper plan needs new samples: the best real plan stands")
+                return Status.SOLVED
             if context.builder.refine(ordered.stream_plan):
                 # it uses shared placeholders: plan again with the instances' own
                 self._end("plan on shared placeholders: refined")
