@@ -237,11 +237,14 @@ class StreamSolver:
         if context.stats.skeletons < context.options.max_skeletons:
             found = context.plan(world.facts, world.numeric, world)
             if found is None and world.more_calls and not context.unreachable:
-                # no plan with one new output per instance: offer later calls' outputs
-                world = context.builder.build(
+                # no plan with one new output per instance: offer later calls' outputs (when
+                # they all lie above the level, the same facts: the same search would fail)
+                further = context.builder.build(
                     level, self.policy.lazy, further=True, check_time=context.check_time
                 )
-                found = context.plan(world.facts, world.numeric, world)
+                if further.facts.keys() != world.facts.keys():
+                    found = context.plan(further.facts, further.numeric, further)
+                world = further
         return world, found
 
     def _new_plan(
