@@ -8,6 +8,7 @@ import time
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
+from solvers.classical.astar import deferred_astar
 from solvers.classical.bitset_task import CompiledTask
 from solvers.classical.errors import PlanValidationError
 from solvers.classical.ground import ground
@@ -166,6 +167,10 @@ def _search(
             len(landmarks.disjunctions),
             landmarks.reasonable,
         )
+    if search == "astar" and not lazy and landmarks is None and relaxed is not None:
+        # evaluated when taken out of the open list: the same optimal plans, without the
+        # heuristic on the successors that are never expanded (see astar.py)
+        return deferred_astar(compiled, relaxed, deadline, cost_bound)
     g_weight, h_weight = {
         "gbfs": (0.0, 1.0),
         "lazy-gbfs": (0.0, 1.0),

@@ -4,10 +4,12 @@ Each instance whose next result stays within the complexity limit contributes pl
 outputs (``#o<k>``). By default a placeholder belongs to its instance (``unique``); with
 ``StreamInfo(opt_gen_fn="shared")`` every instance of a stream shares one placeholder per output.
 A plan whose stream plan takes one shared placeholder from two instances (or feeds one back to
-the instance that made it) is ambiguous: :meth:`OptimisticBuilder.refine` then gives those
-instances placeholders of their own and the solver plans again before sampling, as PDDLStream
-refines its shared optimistic values; a shared placeholder one instance of the plan makes is
-bound to that instance's output directly.
+the instance that made it) is ambiguous: :meth:`OptimisticBuilder.refine` then gives every
+instance of that stream placeholders of its own for the rest of the solve and the solver plans
+again before sampling, as PDDLStream refines its shared optimistic values; a shared
+placeholder one instance of the plan makes is bound to that instance's output directly.
+(Refining only the plan's instances left the stream's other instances sharing: the next plan
+took two of those, and continuous_tamp spent half of its rounds refining, one pair a round.)
 
 With a callable ``StreamInfo(opt_gen_fn=gen_fn)`` (a stream with outputs; tests keep their
 default) an instance's optimistic outputs come from ``gen_fn`` called like the sampler on the
@@ -90,7 +92,7 @@ class OptimisticBuilder:
         # placeholder -> the value a callable opt_gen_fn gave it
         self.values: dict[str, object] = {}
         self._shared: set[str] = set()  # placeholders shared by the instances of a stream
-        self.refined: set[tuple[str, tuple[str, ...]]] = set()  # instances with their own
+        self.refined: set[str] = set()  # streams whose instances have placeholders of their own
         # (stream, inputs) -> the output tuples of its callable opt_gen_fn
         self._generated: dict[tuple[str, tuple[str, ...]], list[tuple[object, ...]]] = {}
         self._later: set[str] = set()  # placeholders of later calls (see _further)
@@ -216,7 +218,7 @@ class OptimisticBuilder:
             if callable(generator) and external.declaration.outputs:
                 batches = self._generated_outputs(external, inputs, generator)
             else:
-                shared = generator == "shared" and (name, inputs) not in self.refined
+                shared = generator == "shared" and name not in self.refined
                 outputs = tuple(
                     self.placeholder((name, i) if shared else (name, inputs, i))
                     for i in range(len(external.declaration.outputs))
@@ -255,9 +257,9 @@ class OptimisticBuilder:
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
 
     def refine(self, stream_plan: list[OptResult]) -> bool:
-        """Give the instances behind the ambiguous shared placeholders of ``stream_plan``
-        placeholders of their own in later builds; False when there is none (the plan binds
-        as it is).
+        """Give every instance of the streams behind the ambiguous shared placeholders of
+        ``stream_plan`` placeholders of its own in later builds; False when there is none (the
+        plan binds as it is).
 
         A shared placeholder is ambiguous when two results of the plan make it (the plan takes
         the outputs of two instances for one value) or when a result takes its own output as
@@ -273,7 +275,7 @@ class OptimisticBuilder:
                     producers.setdefault(name, set()).add((result.external, result.inputs))
         ambiguous = {n for n, made in producers.items() if len(made) > 1}
         ambiguous.update(n for r in results for n in r.outputs if n in r.inputs)
-        found = {(r.external, r.inputs) for r in results if any(n in ambiguous for n in r.outputs)}
+        found = {r.external for r in results if any(n in ambiguous for n in r.outputs)}
         new = found - self.refined
         self.refined.update(new)
         return bool(new)

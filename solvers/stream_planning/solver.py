@@ -61,7 +61,7 @@ class StreamSolver:
         self.policy = policy_for(self.context)
         self.log = RoundLog(options.verbose)
         # a real plan cost more than assumed once its deferred functions were evaluated: the
-        # search goes on at its level only for a cheaper one
+        # search goes on at its level only for a cheaper one on the real facts known
         self.confirming = False
 
     def solve(self) -> Solution:
@@ -166,6 +166,12 @@ class StreamSolver:
                 tried.clear()
                 continue
             actions, cost = found
+            if self.confirming and any(r.kind == "stream" for r in ordered.stream_plan):
+                # a cheaper plan would need new samples: the known one stands (binding and
+                # adaptive end at their first real plan too; searching on, one skeleton a
+                # round, cost focused half of its rounds on continuous_tamp)
+                self._end("a cheaper plan needs new samples: the best real plan stands")
+                return Status.SOLVED
             if context.builder.refine(ordered.stream_plan):
                 # it uses shared placeholders: plan again with the instances' own
                 self._end("plan on shared placeholders: refined")
@@ -231,11 +237,14 @@ class StreamSolver:
         if context.stats.skeletons < context.options.max_skeletons:
             found = context.plan(world.facts, world.numeric, world)
             if found is None and world.more_calls and not context.unreachable:
-                # no plan with one new output per instance: offer later calls' outputs
-                world = context.builder.build(
+                # no plan with one new output per instance: offer later calls' outputs (when
+                # they all lie above the level, the same facts: the same search would fail)
+                further = context.builder.build(
                     level, self.policy.lazy, further=True, check_time=context.check_time
                 )
-                found = context.plan(world.facts, world.numeric, world)
+                if further.facts.keys() != world.facts.keys():
+                    found = context.plan(further.facts, further.numeric, further)
+                world = further
         return world, found
 
     def _new_plan(

@@ -385,3 +385,48 @@ def test_a_sweep_budget_leaves_out_the_facts_of_deferred_predicates(
     assert all(made <= known for made, known, _ in sweeps)
     # the sweeps' true results joined the store; a budget counting them would have grown
     assert all(known < after for _, known, after in sweeps)
+
+
+SURVEY_DOMAIN = """
+(define (domain survey) (:requirements :strips :action-costs)
+  (:predicates (Spot ?p) (Known ?p) (Done))
+  (:functions (total-cost) (Dist ?p))
+  (:action survey :parameters (?p) :precondition (Spot ?p)
+    :effect (and (Known ?p) (increase (total-cost) 1)))
+  (:action go :parameters (?p) :precondition (Known ?p)
+    :effect (and (Done) (increase (total-cost) (Dist ?p)))))
+"""
+SURVEY_STREAMS = """
+(define (stream survey)
+  (:stream sample-spot :outputs (?p) :certified (Spot ?p))
+  (:function (Dist ?p) (Spot ?p)))
+"""
+
+
+def test_a_cheaper_plan_that_needs_new_samples_leaves_the_dearer_real_plan_standing(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The known spot's plan (assumed cost 1) costs 10 once its distance is evaluated; the
+    only cheaper candidate at the level surveys a spot not sampled yet (assumed 2): focused
+    returns the known plan without calling the sampler, as binding and adaptive end at a real
+    plan."""
+    sampled: list[str] = []
+
+    def spots():  # type: ignore[no-untyped-def]
+        for k in range(3):
+            sampled.append(f"s{k}")
+            yield (f"s{k}",)
+
+    problem = PDDLProblem(
+        SURVEY_DOMAIN,
+        {},
+        SURVEY_STREAMS,
+        {"sample-spot": lambda: spots(), "dist": lambda p: 10.0 if p == "home" else 0.5},
+        [("Spot", "home"), ("Known", "home")],
+        ("Done",),
+    )
+    solution = solve(problem, algorithm="focused", max_time=10, verbose=True, initial_complexity=1)
+    assert solution.solved and solution.plan is not None
+    assert [a.name for a in solution.plan] == ["go"] and solution.cost == 10.0
+    assert sampled == []
+    assert "a cheaper plan needs new samples: the best real plan stands" in capsys.readouterr().out

@@ -3,6 +3,7 @@ every algorithm (the plan re-checked here: both cups end inside the shelf, apart
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -67,3 +68,31 @@ def test_feasible_variants_are_solved(algorithm: str, sampler: str, negate: bool
     for x, y in poses.values():
         assert SHELF[0] + CUP / 2 - 1e-9 <= x <= SHELF[2] - CUP / 2 + 1e-9
         assert SHELF[1] + CUP / 2 - 1e-9 <= y <= SHELF[3] - CUP / 2 + 1e-9
+
+
+@pytest.mark.parametrize("algorithm", ["focused", "adaptive"])
+def test_a_round_never_searches_the_same_facts_twice(
+    algorithm: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When no plan is found and the world with later calls' outputs adds no fact (they all lie
+    above the level), that world is not searched again: the search would fail the same way."""
+    from solvers.stream_planning.context import SolveContext
+
+    searched: list[tuple[int, frozenset[object]]] = []
+    original = SolveContext.plan
+
+    def plan(self: SolveContext, facts, numeric, world=None):  # type: ignore[no-untyped-def]
+        searched.append((self.stats.iterations, frozenset(facts)))
+        return original(self, facts, numeric, world)
+
+    monkeypatch.setattr(SolveContext, "plan", plan)
+    solution = solve(
+        make_problem(1.0, "grid", 0),
+        algorithm=algorithm,
+        stream_info=stream_info(False),
+        max_time=60,
+        seed=0,
+        verbose=False,
+    )
+    assert solution.status is Status.SOLVED
+    assert all(a != b for a, b in itertools.pairwise(searched))

@@ -70,6 +70,38 @@ def test_a_plan_on_shared_placeholders_refines_its_instances() -> None:
     assert len(outputs) == 2  # each item's instance has its own
 
 
+def test_refining_gives_every_instance_of_the_stream_its_own_placeholder() -> None:
+    """A plan that takes the shared placeholder from two of three instances refines the
+    stream: the third instance, which the plan did not use, gets its own too (else the next
+    plan takes it and one other, and each round refines one more pair)."""
+    from solvers.stream_planning.engine import Engine
+    from solvers.stream_planning.optimistic import OptimisticBuilder
+
+    def slots(item: str):  # type: ignore[no-untyped-def]
+        yield (f"{item}-slot",)
+
+    problem = PDDLProblem(
+        DOMAIN,
+        {},
+        STREAMS,
+        {"sample-slot": from_gen_fn(slots)},
+        [("item", "a"), ("item", "b"), ("item", "c")],
+        ("and", ("placed", "a"), ("placed", "b")),
+    )
+    engine = Engine(problem, {"sample-slot": StreamInfo(opt_gen_fn="shared")})
+    engine.start()
+    builder = OptimisticBuilder(engine, frozenset())
+    world = builder.build(10)
+    results = [r for r in {id(r): r for r in world.provenance.values()}.values()]
+    assert len(results) == 3 and len({r.outputs for r in results}) == 1  # all share one
+    plan = results[:2]
+    assert builder.refine(plan) is True
+    assert builder.refined == {"sample-slot"}
+    refined = builder.build(10)
+    outputs = {r.inputs: r.outputs for r in refined.provenance.values()}
+    assert len(set(outputs.values())) == 3  # c's too
+
+
 def _one_item_problem() -> PDDLProblem:
     def slots(item: str):  # type: ignore[no-untyped-def]
         yield (f"{item}-slot",)
