@@ -12,12 +12,19 @@ cannot is itself boxed in, and the same search runs for it, down to ``max_depth`
 An evicted object does not come back to its goal before the object it made room for has left
 the pose where it was boxed in (and, when that pose is its goal, has come back to it):
 otherwise the eviction would be undone before it served (:class:`Deferral`).
+
+When neither a step toward the goals, nor an eviction, nor a buffer move can be grounded and
+executed with the first ``grasps`` grasps of each object, the solver tries the candidates once
+more with the first ``pair_grasps`` (:meth:`Recovery.wider`): an object whose few grasps all
+meet a neighbour, at its pose or at its goal, often has one among the moderate tilts that
+come after them (a 7-DoF arm's wrist, larger than the UR5e's, meets its neighbours sooner).
+Only at such a dead end, so a run that never meets one is unchanged.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from sdar_tamp.language.formula_model import Atom
@@ -89,6 +96,15 @@ class Recovery:
     def budget_left(self) -> bool:
         """Fewer evictions so far than twice the number of objects."""
         return self.evictions < 2 * len(self.goals)
+
+    def wider(self) -> SdarOptions | None:
+        """The options of the last attempt at a dead end: every move searched among the first
+        ``pair_grasps`` grasps of its object instead of the first ``grasps``; ``None`` when
+        that is no wider."""
+        opt = self.options
+        if opt.pair_grasps <= opt.grasps:
+            return None
+        return replace(opt, grasps=opt.pair_grasps)
 
     # -- candidates ---------------------------------------------------------------------------
     def candidates(self, view: TaskView) -> list[Step]:

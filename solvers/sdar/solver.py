@@ -284,7 +284,8 @@ class SdarSolver:
 
     def _decide(self, view: TaskView, candidates: Sequence[Step], decision: Decision) -> bool:
         """Execute one step: a candidate that brings an object to its goal if any works;
-        otherwise an eviction (dead-end recovery); otherwise a candidate that only buffers."""
+        otherwise an eviction (dead-end recovery); otherwise a candidate that only buffers;
+        otherwise the same with more grasps (:meth:`_wider`)."""
         productive = [s for s in candidates if s.progress > 0]
         if self._step(view, productive, decision) is not None:
             return True
@@ -294,7 +295,26 @@ class SdarSolver:
             if evicted is not None:
                 self.recovery.executed(evicted)
                 return True
-        return self._step(view, [s for s in candidates if s.progress == 0], decision) is not None
+        if self._step(view, [s for s in candidates if s.progress == 0], decision) is not None:
+            return True
+        return self._wider(view, candidates, decision)
+
+    def _wider(self, view: TaskView, candidates: Sequence[Step], decision: Decision) -> bool:
+        """A dead end: the candidates (toward the goals first) once more with more grasps per
+        object (:meth:`Recovery.wider`), for this decision only."""
+        wider = self.recovery.wider()
+        if wider is None or self.deadline.passed():
+            return False
+        narrow = self.grounder.options
+        self.grounder.options = wider
+        try:
+            productive = [s for s in candidates if s.progress > 0]
+            if self._step(view, productive, decision) is not None:
+                return True
+            buffering = [s for s in candidates if s.progress == 0]
+            return self._step(view, buffering, decision) is not None
+        finally:
+            self.grounder.options = narrow
 
     def _step(
         self, view: TaskView, candidates: Sequence[Step], decision: Decision, commit: bool = True
