@@ -36,8 +36,13 @@ T_BASE_DH[:3, :3] = rot_z(np.pi)
 #: Branches of the closed form (UR family) and distinct solutions kept by the numeric IK.
 CLOSED_FORM_BRANCHES = 8
 NUMERIC_BRANCHES = 4
-#: The numeric IK's effort in the planner (seeds per pose, rounds of fresh seeds).
-NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=4)
+#: The numeric IK's effort in the planner (seeds per pose, rounds of fresh seeds). Without the
+#: null-space pull, whose steps leave the pose by their second-order terms and so slow the
+#: descent: the redundancy is resolved by the seeds (the home first) and by keeping the
+#: solutions nearest the home. On the Panda cell's grasp poses (benchmarks/bench_numeric_ik.py
+#: --planner) this solves the same poses as 100 iterations, 4 rounds and the pull, in about a
+#: third of the iterations.
+NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=20, rounds=2, null_space_gain=0.0)
 #: Pose pairs an arm keeps solved by the numeric IK (grasp and pre-grasp; some 500 bytes each).
 PAIR_CACHE = 50_000
 
