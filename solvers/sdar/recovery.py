@@ -13,12 +13,13 @@ An evicted object does not come back to its goal before the object it made room 
 the pose where it was boxed in (and, when that pose is its goal, has come back to it):
 otherwise the eviction would be undone before it served (:class:`Deferral`).
 
-When neither a step toward the goals, nor an eviction, nor a buffer move can be grounded and
-executed with the first ``grasps`` grasps of each object, the solver tries the candidates once
-more with the first ``pair_grasps`` (:meth:`Recovery.wider`): an object whose few grasps all
-meet a neighbour, at its pose or at its goal, often has one among the moderate tilts that
-come after them (a 7-DoF arm's wrist, larger than the UR5e's, meets its neighbours sooner).
-Only at such a dead end, so a run that never meets one is unchanged.
+Before any eviction, the solver tries the candidate steps toward the goals once more with the
+first ``pair_grasps`` grasps of each object instead of the first ``grasps``
+(:meth:`Recovery.wider`): an object whose few grasps all meet a neighbour, at its pose or at
+its goal, often has one among the moderate tilts that come after them (a 7-DoF arm's wrist,
+larger than the UR5e's, meets its neighbours sooner), and a grasp costs no extra moves where an
+eviction costs two. Evicting first let two such objects evict each other in turn (each boxed
+in at its goal by the other) until the eviction budget ran out.
 """
 
 from __future__ import annotations
@@ -98,7 +99,7 @@ class Recovery:
         return self.evictions < 2 * len(self.goals)
 
     def wider(self) -> SdarOptions | None:
-        """The options of the last attempt at a dead end: every move searched among the first
+        """The options of the attempt before an eviction: every move searched among the first
         ``pair_grasps`` grasps of its object instead of the first ``grasps``; ``None`` when
         that is no wider."""
         opt = self.options
