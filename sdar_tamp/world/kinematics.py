@@ -43,6 +43,11 @@ NUMERIC_BRANCHES = 4
 #: --planner) this solves the same poses as 100 iterations, 4 rounds and the pull, in about a
 #: third of the iterations.
 NUMERIC_OPTIONS = NumericIKOptions(seeds=8, iterations=20, rounds=2, null_space_gain=0.0)
+#: Continuations (a pre-grasp from its grasp, the steps of a straight tool move from their
+#: start: :meth:`ArmKinematics.ik_tcp_from`) keep the pull toward the start, as before: it
+#: holds each solution on the start's self-motion, and a start near its target converges in
+#: a few iterations anyway.
+CONTINUATION_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=4)
 #: Pose pairs an arm keeps solved by the numeric IK (grasp and pre-grasp; some 500 bytes each).
 PAIR_CACHE = 50_000
 
@@ -238,7 +243,7 @@ class ArmKinematics:
         if self.params is None:
             T_root = inverse(self.T_world_base) @ T
             lo, hi = self.spec.lower_array, self.spec.upper_array
-            q_n, ok = numeric_ik_from(self.chain, T_root, lo, hi, q0, self.numeric)
+            q_n, ok = numeric_ik_from(self.chain, T_root, lo, hi, q0, CONTINUATION_OPTIONS)
             return IKSolutions(q_n, ok)
         sol = self.ik_tool0(T)
         d = np.abs(sol.q[:, None, :, :] - q0[:, :, None, :]).max(axis=-1)  # (n, b, 8)
