@@ -300,9 +300,10 @@ class SdarSolver:
         return self._step(view, [s for s in candidates if s.progress == 0], decision) is not None
 
     def _wider(self, view: TaskView, productive: Sequence[Step], decision: Decision) -> bool:
-        """No candidate toward the goals works with the first grasps: the same candidates
-        with more grasps per object (:meth:`Recovery.wider`), for this decision only."""
-        wider = self.recovery.wider()
+        """No candidate toward the goals works with the first grasps and some object is boxed
+        in: the same candidates with more grasps per object (:meth:`Recovery.wider`), for this
+        decision only."""
+        wider = self.recovery.wider(view)
         if wider is None or self.deadline.passed():
             return False
         narrow = self.grounder.options

@@ -154,7 +154,7 @@ def test_a_dead_end_is_tried_again_with_more_grasps(
 ) -> None:
     r = _few_grasps_problem(ctx, planner)
     solver = SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions(max_time=BUDGET))
-    wider = solver.recovery.wider()
+    wider = solver.recovery.wider(solver.view())  # a is boxed in with the first grasps
     assert wider is not None and wider.grasps == solver.options.pair_grasps
     solution = solver.solve()
     assert solution.status is Status.SOLVED, solution.diagnosis
@@ -164,3 +164,11 @@ def test_a_dead_end_is_tried_again_with_more_grasps(
     stuck = SdarSolver(_few_grasps_problem(ctx, planner).problem, SdarTaskPlanner(), narrow)
     assert stuck.recovery.wider() is None
     assert stuck.solve().status is Status.INFEASIBLE
+
+
+def test_more_grasps_only_for_a_boxed_in_object(ctx: WorldContext, planner: MotionPlanner) -> None:
+    inst = Instance("free", WORKSPACE, (ObjectSpec("a", SIZE, A_START, A_GOAL),))
+    solver = SdarSolver(rearrangement_problem(inst, ctx, planner=planner).problem,
+                        SdarTaskPlanner())  # fmt: skip
+    assert solver.recovery.wider() is not None  # without a view: the options alone
+    assert solver.recovery.wider(solver.view()) is None  # a has grasps: nothing boxed in
