@@ -34,6 +34,10 @@ class NumericIKOptions:
     max_step: float = 0.5  # [rad] or [m] per joint and iteration
     null_space_gain: float = 0.1
     rounds: int = 6  # fresh seeds for the targets not yet solved
+    #: Pose error norm below which the null-space pull fades out in proportion (0: never):
+    #: near the pose its steps leave the pose by their second-order terms and slow the last
+    #: iterations of the descent.
+    null_space_fade: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -233,13 +237,17 @@ def _descend(
             break
         qa, ea, da, fa, enda = q[rows], err[rows], damping[rows], frames[rows], end[rows]
         J = chain_jacobian(chain, fa, enda)
-        step = _step(J, ea, da, refs[rows] - qa, opts)
+        to_ref = refs[rows] - qa
+        if opts.null_space_fade > 0.0:
+            size = np.sqrt(np.einsum("ij,ij->i", ea, ea))
+            to_ref = to_ref * np.minimum(1.0, size / opts.null_space_fade)[:, None]
+        step = _step(J, ea, da, to_ref, opts)
         # a joint at a limit that the step pushes outward is frozen: solve without it
         blocked = ((qa <= lo) & (step < 0.0)) | ((qa >= hi) & (step > 0.0))
         some = np.flatnonzero(blocked.any(axis=1))
         if len(some):  # those rows again, without their frozen joints
             Jb = np.where(blocked[some, None, :], 0.0, J[some])
-            again = _step(Jb, ea[some], da[some], refs[rows[some]] - qa[some], opts)
+            again = _step(Jb, ea[some], da[some], to_ref[some], opts)
             step[some] = np.where(blocked[some], 0.0, again)
         trial = np.clip(qa + step, lo, hi)
         t_frames, t_end = chain_fk(chain, trial)
