@@ -34,6 +34,10 @@ class NumericIKOptions:
     max_step: float = 0.5  # [rad] or [m] per joint and iteration
     null_space_gain: float = 0.1
     rounds: int = 6  # fresh seeds for the targets not yet solved
+    #: Pose error norm below which the null-space pull fades out in proportion (0: never):
+    #: near the pose its steps leave the pose by their second-order terms and slow the last
+    #: iterations of the descent.
+    null_space_fade: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -68,6 +72,11 @@ def chain_fk(chain: Chain, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         axis = joint.axis / np.linalg.norm(joint.axis)
         if joint.kind == "prismatic":
             T[:, :3, 3] += (T[:, :3, :3] @ axis) * q[:, i, None]
+        elif axis[0] == 0.0 and axis[1] == 0.0 and axis[2] > 0.0:  # about z: turn x and y
+            c, s = np.cos(q[:, i])[:, None], np.sin(q[:, i])[:, None]
+            x, y = T[:, :3, 0].copy(), T[:, :3, 1].copy()
+            T[:, :3, 0] = c * x + s * y
+            T[:, :3, 1] = c * y - s * x
         else:
             T[:, :3, :3] = T[:, :3, :3] @ _rotations(axis, q[:, i])
         frames[:, i] = T
@@ -75,26 +84,16 @@ def chain_fk(chain: Chain, q: FloatArray) -> tuple[FloatArray, FloatArray]:
     return frames, end
 
 
-def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
-    """Row-wise cross products of ``(n, 3)`` arrays (``np.cross`` without its axis handling)."""
-    out = np.empty_like(a)
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
-
-
 def chain_jacobian(chain: Chain, frames: FloatArray, end: FloatArray) -> FloatArray:
     """Geometric Jacobians ``(n, 6, dof)`` (linear rows first) of the end frame, root frame."""
-    n = len(end)
-    J = np.zeros((n, 6, chain.dof))
-    for i, joint in enumerate(chain.joints):
-        z = frames[:, i, :3, :3] @ (joint.axis / np.linalg.norm(joint.axis))
-        if joint.kind == "prismatic":
-            J[:, :3, i] = z
-        else:
-            J[:, :3, i] = _cross(z, end[:, :3, 3] - frames[:, i, :3, 3])
-            J[:, 3:, i] = z
+    axes = np.stack([j.axis / np.linalg.norm(j.axis) for j in chain.joints])  # (dof, 3)
+    z = np.einsum("nijk,ik->nij", frames[:, :, :3, :3], axes)  # joint axes, root frame
+    prismatic = np.array([j.kind == "prismatic" for j in chain.joints])[None, :, None]
+    linear = np.where(prismatic, z, np.cross(z, end[:, None, :3, 3] - frames[:, :, :3, 3]))
+    J: FloatArray = np.concatenate(
+        [np.transpose(linear, (0, 2, 1)), np.transpose(np.where(prismatic, 0.0, z), (0, 2, 1))],
+        axis=1,
+    )
     return J
 
 
@@ -238,12 +237,18 @@ def _descend(
             break
         qa, ea, da, fa, enda = q[rows], err[rows], damping[rows], frames[rows], end[rows]
         J = chain_jacobian(chain, fa, enda)
-        step = _step(J, ea, da, refs[rows] - qa, opts)
+        to_ref = refs[rows] - qa
+        if opts.null_space_fade > 0.0:
+            size = np.sqrt(np.einsum("ij,ij->i", ea, ea))
+            to_ref = to_ref * np.minimum(1.0, size / opts.null_space_fade)[:, None]
+        step = _step(J, ea, da, to_ref, opts)
         # a joint at a limit that the step pushes outward is frozen: solve without it
         blocked = ((qa <= lo) & (step < 0.0)) | ((qa >= hi) & (step > 0.0))
-        if blocked.any():
-            J = np.where(blocked[:, None, :], 0.0, J)
-            step = np.where(blocked, 0.0, _step(J, ea, da, refs[rows] - qa, opts))
+        some = np.flatnonzero(blocked.any(axis=1))
+        if len(some):  # those rows again, without their frozen joints
+            Jb = np.where(blocked[some, None, :], 0.0, J[some])
+            again = _step(Jb, ea[some], da[some], to_ref[some], opts)
+            step[some] = np.where(blocked[some], 0.0, again)
         trial = np.clip(qa + step, lo, hi)
         t_frames, t_end = chain_fk(chain, trial)
         t_err = pose_error(targets[rows], t_end)

@@ -12,12 +12,20 @@ cannot is itself boxed in, and the same search runs for it, down to ``max_depth`
 An evicted object does not come back to its goal before the object it made room for has left
 the pose where it was boxed in (and, when that pose is its goal, has come back to it):
 otherwise the eviction would be undone before it served (:class:`Deferral`).
+
+Before any eviction, when some remaining object is boxed in, the solver tries the candidate
+steps toward the goals once more with the first ``pair_grasps`` grasps of each object instead
+of the first ``grasps`` (:meth:`Recovery.wider`): an object whose few grasps all meet a
+neighbour, at its pose or at its goal, often has one among the moderate tilts that come after
+them (a 7-DoF arm's wrist, larger than the UR5e's, meets its neighbours sooner), and a grasp
+costs no extra moves where an eviction costs two. Evicting first let two such objects evict
+each other in turn (each boxed in at its goal by the other) until the eviction budget ran out.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from sdar_tamp.language.formula_model import Atom
@@ -89,6 +97,20 @@ class Recovery:
     def budget_left(self) -> bool:
         """Fewer evictions so far than twice the number of objects."""
         return self.evictions < 2 * len(self.goals)
+
+    def wider(self, view: TaskView | None = None) -> SdarOptions | None:
+        """The options of the attempt before an eviction: every move searched among the first
+        ``pair_grasps`` grasps of its object instead of the first ``grasps``; ``None`` when
+        that is no wider or (given the ``view``) when no remaining object is boxed in
+        (:meth:`boxed`) with the first grasps: then more grasps are not what is missing."""
+        opt = self.options
+        if opt.pair_grasps <= opt.grasps:
+            return None
+        if view is not None:
+            current = self.cache.current_poses()
+            if all(self.boxed(o, view, current) is None for o in view.remaining):
+                return None
+        return replace(opt, grasps=opt.pair_grasps)
 
     # -- candidates ---------------------------------------------------------------------------
     def candidates(self, view: TaskView) -> list[Step]:

@@ -283,10 +283,13 @@ class SdarSolver:
         ]
 
     def _decide(self, view: TaskView, candidates: Sequence[Step], decision: Decision) -> bool:
-        """Execute one step: a candidate that brings an object to its goal if any works;
-        otherwise an eviction (dead-end recovery); otherwise a candidate that only buffers."""
+        """Execute one step: a candidate that brings an object to its goal if any works, with
+        the first grasps and then with more (:meth:`_wider`); otherwise an eviction (dead-end
+        recovery); otherwise a candidate that only buffers."""
         productive = [s for s in candidates if s.progress > 0]
         if self._step(view, productive, decision) is not None:
+            return True
+        if productive and self._wider(view, productive, decision):
             return True
         if self.recovery.budget_left:
             evictions = self.recovery.candidates(view)
@@ -295,6 +298,20 @@ class SdarSolver:
                 self.recovery.executed(evicted)
                 return True
         return self._step(view, [s for s in candidates if s.progress == 0], decision) is not None
+
+    def _wider(self, view: TaskView, productive: Sequence[Step], decision: Decision) -> bool:
+        """No candidate toward the goals works with the first grasps and some object is boxed
+        in: the same candidates with more grasps per object (:meth:`Recovery.wider`), for this
+        decision only."""
+        wider = self.recovery.wider(view)
+        if wider is None or self.deadline.passed():
+            return False
+        narrow = self.grounder.options
+        self.grounder.options = wider
+        try:
+            return self._step(view, productive, decision) is not None
+        finally:
+            self.grounder.options = narrow
 
     def _step(
         self, view: TaskView, candidates: Sequence[Step], decision: Decision, commit: bool = True

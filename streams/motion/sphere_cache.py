@@ -24,7 +24,7 @@ from streams.motion.codegen import cache_dir
 
 ENV_SWITCH = "SDAR_TAMP_SPHERE_CACHE"
 #: Changes whenever the fit would give other spheres for the same input.
-VERSION = "1"
+VERSION = "2"
 
 _log = get_logger(__name__)
 

@@ -78,19 +78,35 @@ def box_spheres(half: FloatArray, max_per_axis: int = 3) -> tuple[FloatArray, Fl
     return grid, np.full(len(grid), float(np.linalg.norm(step / 2.0)))
 
 
-def _gripper_box(prims: list[Primitive]) -> tuple[FloatArray, FloatArray]:
-    """Centre and half sides of the joint-frame bounding box of the gripper primitives (a
-    mesh's primitive is its bounding box, so meshes are bounded too)."""
-    pts = []
-    for p in prims:
-        h = np.array(p.half)
-        if p.kind == "cylinder":
-            h = np.array([p.half[0], p.half[0], p.half[2]])
-        grid = np.array(np.meshgrid(*[[-1.0, 1.0]] * 3)).reshape(3, -1).T * h
-        pts.append(grid @ p.T_joint_shape[:3, :3].T + p.T_joint_shape[:3, 3])
-    allp = np.concatenate(pts)
-    lo, hi = allp.min(axis=0), allp.max(axis=0)
-    return (lo + hi) / 2.0, (hi - lo) / 2.0
+def _corners(p: Primitive) -> FloatArray:
+    """The eight corners ``(8, 3)`` of a shape's bounding box in its joint frame (a mesh's
+    primitive is its bounding box, so meshes are bounded too)."""
+    h = np.array(p.half)
+    if p.kind == "cylinder":
+        h = np.array([p.half[0], p.half[0], p.half[2]])
+    grid = np.array(np.meshgrid(*[[-1.0, 1.0]] * 3)).reshape(3, -1).T * h
+    out: FloatArray = grid @ p.T_joint_shape[:3, :3].T + p.T_joint_shape[:3, 3]
+    return out
+
+
+def _gripper_box(prims: list[Primitive]) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Rotation ``(3, 3)`` (the box's axes in the joint frame), centre (joint frame) and half
+    sides of the smallest box holding the gripper primitives among those whose axes are the
+    joint frame's or one primitive's (a hand mounted turned about the flange, as the Panda's,
+    gets a box along the hand, not the much larger one along the flange's axes); the joint
+    frame's axes unless another is smaller by more than 1e-9 of its volume."""
+    corners = np.concatenate([_corners(p) for p in prims])
+    best: tuple[float, FloatArray, FloatArray, FloatArray] | None = None
+    for R in [np.eye(3), *(p.T_joint_shape[:3, :3] for p in prims)]:
+        local = corners @ R  # coordinates along the box's axes
+        lo, hi = local.min(axis=0), local.max(axis=0)
+        volume = float(np.prod(hi - lo))
+        if best is None or volume < best[0] * (1.0 - 1e-9):
+            best = (volume, R, (lo + hi) / 2.0, (hi - lo) / 2.0)
+    assert best is not None
+    _, R, mid, half = best
+    centre: FloatArray = R @ mid
+    return R, centre, half
 
 
 def gripper_shapes(prims: list[Primitive]) -> list[Primitive]:
@@ -200,10 +216,10 @@ def arm_spheres(
     (:mod:`streams.motion.sphere_fit`; ``options`` default to :class:`FitOptions`; at most
     ``options.max_spheres`` per link).
     ``coarse``: fewer, larger spheres (cylinders 2 radii apart, half the fitted spheres per
-    link, the whole gripper -- :func:`gripper_shapes` -- as one box), used for the arm-arm
-    pairs of the optimiser. Models are kept by :func:`model_digest` and the parameters, in
-    memory and (fitted ones) on disk (:mod:`streams.motion.sphere_cache`): the same
-    description is fitted once.
+    link, the whole gripper -- :func:`gripper_shapes` -- as one box along the hand), used for
+    the arm-arm pairs of the optimiser. Models are kept by :func:`model_digest` and the
+    parameters, in memory and (fitted ones) on disk (:mod:`streams.motion.sphere_cache`): the
+    same description is fitted once.
 
     Raises:
         ParameterError: ``fit`` is neither ``"meshes"`` nor ``"all"``.
@@ -252,8 +268,10 @@ def _build(
         prims = [p for p in prims if not any(p is g for g in grip)]
     joints, centres, radii = _covered_shapes(prims, coarse, fit, options)
     if grip:
-        centre, half = _gripper_box(grip)
+        R, centre, half = _gripper_box(grip)
         c, r = box_spheres(half)
+        if not np.array_equal(R, np.eye(3)):
+            c = c @ R.T
         joints.extend([min(g.joint for g in grip)] * len(r))  # the tool joint
         centres.append(c + centre)
         radii.append(r)

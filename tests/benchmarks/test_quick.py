@@ -107,6 +107,13 @@ def _numeric_ik(out: Summary) -> None:
     assert ur["poses"] == 100 and ur["within_limits"] is True and ur["success_rate"] >= 0.95
 
 
+def _numeric_ik_planner(out: Summary) -> None:
+    planner, default = out["planner"]["planner"], out["planner"]["default"]
+    assert out["poses"] == 10 and planner["grasps"] == default["grasps"] == 60
+    assert planner["grasps_solved"] >= default["grasps_solved"] > 0
+    assert planner["iterations_per_pose"] < default["iterations_per_pose"]
+
+
 def _parser(out: Summary) -> None:
     assert out["init_facts"] > 0 and out["problem_mb_per_s"] > 0
 
@@ -177,6 +184,7 @@ CHECKS: dict[tuple[str, tuple[str, ...]], Callable[[Summary], None]] = {
     ("bench_motion", ("--hard", "1")): _motion_hard,
     ("bench_motion_arms", ()): _motion_arms,
     ("bench_numeric_ik", ()): _numeric_ik,
+    ("bench_numeric_ik", ("--planner",)): _numeric_ik_planner,
     ("bench_parser", ()): _parser,
     ("bench_pddlstream_compat", ()): _pddlstream,
     ("bench_replan", ()): _replan,

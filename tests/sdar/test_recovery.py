@@ -11,6 +11,7 @@ import pytest
 from sdar_tamp.app import Rearrangement, rearrangement_problem, solve_rearrangement
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.scene import Workspace
+from solvers.sdar.options import SdarOptions
 from solvers.sdar.recovery import Boxed, Deferral, Recovery
 from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
@@ -128,3 +129,46 @@ def test_recovery_refuses_a_negative_depth(ctx: WorldContext, planner: MotionPla
     with pytest.raises(ValueError, match="max_depth must be >= 0, got -1"):
         Recovery(solver.cache, solver.options, solver.goals, tuple(solver.home),
                  solver.deadline, -1)  # fmt: skip
+
+
+def _few_grasps_problem(ctx: WorldContext, planner: MotionPlanner) -> Rearrangement:
+    """a's only grasps with IK are moderate tilts (the pair tilts, after the first
+    ``SdarOptions.grasps`` grasps of the grasp set): no step, eviction or buffer works with
+    the first grasps."""
+    inst = Instance("few", WORKSPACE, (ObjectSpec("a", SIZE, A_START, A_GOAL),))
+    real = make_stream_map(ctx, {o.name: o.size for o in inst.objects})["inverse-kinematics"]
+    first = SdarOptions().grasps
+
+    def tilted_only(arm: str, o: str, p: Pose2D, g: Any, fluents: Any = ()) -> Iterator[Any]:
+        if o == "a" and g.index < first:
+            return iter(())
+        return real(arm, o, p, g, fluents)
+
+    return rearrangement_problem(
+        inst, ctx, planner=planner, overrides={"inverse-kinematics": tilted_only}
+    )
+
+
+def test_a_dead_end_is_tried_again_with_more_grasps(
+    ctx: WorldContext, planner: MotionPlanner
+) -> None:
+    r = _few_grasps_problem(ctx, planner)
+    solver = SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions(max_time=BUDGET))
+    wider = solver.recovery.wider(solver.view())  # a is boxed in with the first grasps
+    assert wider is not None and wider.grasps == solver.options.pair_grasps
+    solution = solver.solve()
+    assert solution.status is Status.SOLVED, solution.diagnosis
+    assert solver.grounder.options is solver.options  # widened for that decision only
+    # without more grasps to search, the same instance is a dead end
+    narrow = SdarOptions(max_time=BUDGET, pair_grasps=SdarOptions().grasps)
+    stuck = SdarSolver(_few_grasps_problem(ctx, planner).problem, SdarTaskPlanner(), narrow)
+    assert stuck.recovery.wider() is None
+    assert stuck.solve().status is Status.INFEASIBLE
+
+
+def test_more_grasps_only_for_a_boxed_in_object(ctx: WorldContext, planner: MotionPlanner) -> None:
+    inst = Instance("free", WORKSPACE, (ObjectSpec("a", SIZE, A_START, A_GOAL),))
+    solver = SdarSolver(rearrangement_problem(inst, ctx, planner=planner).problem,
+                        SdarTaskPlanner())  # fmt: skip
+    assert solver.recovery.wider() is not None  # without a view: the options alone
+    assert solver.recovery.wider(solver.view()) is None  # a has grasps: nothing boxed in

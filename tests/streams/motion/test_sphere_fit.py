@@ -231,6 +231,30 @@ def test_coarse_model_groups_the_links_fixed_to_the_last_joint() -> None:
         assert covered(surface_points(tri, 4000, 6), coarse.centre[mine], coarse.radius[mine]).all()
 
 
+def test_a_turned_hand_gets_a_box_along_the_hand() -> None:
+    """The Panda's hand is mounted turned by -45 deg about the flange: its coarse box follows
+    the hand (points of every gripper shape covered) and is much smaller than the box along
+    the joint frame's axes; the UR5e's gripper, along the joint frame, keeps its box."""
+    urdf = Path("domains/dual_arm_rearrangement/robots/panda_hand.urdf")
+    prims = [p for p in arm_primitives(urdf) if p.joint != 0]
+    grip = gripper_shapes(prims)
+    R, _, half = spheres_module._gripper_box(grip)
+    assert not np.allclose(R, np.eye(3))
+    axis_box = np.concatenate([spheres_module._corners(p) for p in grip])
+    axis_volume = np.prod(axis_box.max(axis=0) - axis_box.min(axis=0))
+    assert np.prod(2 * half) < 0.5 * axis_volume
+    coarse = arm_spheres(urdf, coarse=True)
+    tool = coarse.joint == 7
+    rng = np.random.default_rng(3)
+    for p in grip:
+        local = rng.uniform(-1.0, 1.0, (500, 3)) * np.array(p.half)
+        points = local @ p.T_joint_shape[:3, :3].T + p.T_joint_shape[:3, 3]
+        assert covered(points, coarse.centre[tool], coarse.radius[tool]).all()
+    ur = [p for p in arm_primitives(Path("domains/dual_arm_rearrangement/robots/ur5e_2f85.urdf"))]
+    R_ur, _, _ = spheres_module._gripper_box(gripper_shapes([p for p in ur if p.joint != 0]))
+    assert np.array_equal(R_ur, np.eye(3))
+
+
 def test_a_bare_arm_has_no_gripper_box() -> None:
     prims = [p for p in arm_primitives(MESH_ARM, (MESHES,)) if p.link != "hand"]
     assert gripper_shapes(prims) == []
