@@ -64,8 +64,11 @@ def planner(ctx: WorldContext, optimisers: OptimiserCache) -> MotionPlanner:
 @pytest.fixture(scope="session")
 def benchmark_script() -> Callable[[str], ModuleType]:
     """Loads ``benchmarks/<name>.py`` as the module ``name`` (the benchmarks are scripts, not
-    a package), once per session."""
+    a package), once per session, with their folder importable as when a script runs (their
+    shared ``_*.py`` modules)."""
     folder = Path(__file__).resolve().parents[1] / "benchmarks"
+    if str(folder) not in sys.path:
+        sys.path.append(str(folder))
 
     def load(name: str) -> ModuleType:
         if name in sys.modules:
