@@ -37,7 +37,8 @@ from sdar_tamp.app.solving import solve_rearrangement
 from sdar_tamp.app.splicing import check_from, cut_at, splice, tail, walk_from
 from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
 from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile
-from sdar_tamp.plan_state import PlanState, prefix_plan
+from sdar_tamp.plan_rules import STILL_TOL, TIME_TOL
+from sdar_tamp.plan_state import Cut, PlanState, prefix_plan
 from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.kinematics import ArmKinematics
@@ -101,17 +102,17 @@ def repair(
     kins: Mapping[str, ArmKinematics],
     collision: CollisionWorld,
     sizes: Mapping[str, tuple[float, float, float]],
-) -> tuple[PlanFile, tuple[str, ...]] | None:
+) -> tuple[PlanFile, tuple[str, ...], bool] | None:
     """``plan`` (the prefix to ``state.t`` followed by the old plan's rest) repaired from
-    ``state`` (every arm empty and still) and the added objects it moves away, or None when
-    the repair fails."""
+    ``state`` (every arm empty and still), the added objects it moves away and whether it
+    changed (a task planned again or one more), or None when the repair fails."""
     scene = world.ctx.scene
     moved: tuple[str, ...] = ()
     deadline = time.perf_counter() + repair_budget(config.max_time)
-    for _ in range(MAX_TASKS + 1):
+    for tasks in range(MAX_TASKS + 1):
         plan, bad, why = check_from(instance, plan, scene, kins, collision, state)
         if bad is None:
-            return plan, moved
+            return plan, moved, tasks > 0
         left = deadline - time.perf_counter()
         if left <= 0.0:
             return None
@@ -179,7 +180,7 @@ def _replan_task(
         objects=tuple(ObjectSpec(n, sizes[n], Pose2D(*here[n]), g) for n, g in goals.items()),
     )
     mini, moved = continuation_instance(fake, here, sizes, config.seed, frozenset(culprits))
-    head = prefix_plan(plan, begin)
+    head = _head(plan, begin)
     q0 = head.q[-1]
     restart = PlanState(float(head.t[-1]), q0, {}, here)
     start = start_configuration(
@@ -242,6 +243,20 @@ def _append_task(
                            gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
     end = PlanState(float(plan.t[-1]), q0, {}, here)
     return splice(plan, more), moved, end
+
+
+def _head(plan: PlanFile, begin: Cut) -> PlanFile:
+    """``plan`` up to ``begin``, where a task planned again starts: cut there when the plan
+    already stands still over the sample spacing before it with every gripper dwell over (the
+    end of a hold or of a dwell: a new motion may start at once), else with a still hold after
+    it (:func:`~sdar_tamp.plan_state.prefix_plan`)."""
+    i = begin.index
+    events = plan.events[: begin.events]
+    dwells_over = all(e.t + GRIPPER_DWELL <= begin.t + TIME_TOL for e in events)
+    if i == 0 or not dwells_over or np.abs(plan.q[i] - plan.q[i - 1]).max() > STILL_TOL:
+        return prefix_plan(plan, begin)
+    head = prefix_plan(plan, begin)  # its events, steps and observations up to the cut
+    return dataclasses.replace(head, t=plan.t[: i + 1], q=plan.q[: i + 1])
 
 
 def _last_actors(items: list[MotionSegment | GripperEvent]) -> set[str]:

@@ -19,7 +19,13 @@ camera sees -> one new plan, the executed prefix spliced with a continuation.
    through them, that later cut is taken: the arms then stop clear of the objects rather than
    with open fingers around them.
 3. Repair: the rest of the old plan after the cut is kept as it is when it still validates
-   from the cut in the observed world (a change that touches none of its steps).
+   from the cut in the observed world (a change that touches none of its steps), or with the
+   tasks the change touches planned again (:mod:`sdar_tamp.app.repair`). A repair that changed
+   the plan is compared with a fresh continuation (step 4) solved within the time left of the
+   limit: the shorter execution of the two is kept (the repair unless the fresh one saves
+   more than :data:`SAVING` of its execution from the cut, or when the fresh solve gives no
+   plan in time or one that does not replay from the cut); both solves are
+   seeded, so the same inputs give the same choice whenever the fresh solve ends in time.
 4. Otherwise a fresh SDAR solve of the objects resting at the cut
    (:func:`~sdar_tamp.app.replan_world.continuation_instance`: a removed object's tasks are
    gone, an added object without a goal stays unless it blocks a goal, then it is moved
@@ -48,8 +54,9 @@ from sdar_tamp.app.problem import rearrangement_problem
 from sdar_tamp.app.repair import repair as repair_plan
 from sdar_tamp.app.replan_world import continuation_instance, start_configuration
 from sdar_tamp.app.solving import solve_rearrangement
-from sdar_tamp.app.splicing import cut_at, splice, tail, walk_from
+from sdar_tamp.app.splicing import check_from, cut_at, splice, tail, walk_from
 from sdar_tamp.plan_file import PlanFile, PlanObservation
+from sdar_tamp.plan_rules import TIME_TOL
 from sdar_tamp.plan_state import Cut, PlanState, cut_point, prefix_plan, state_at
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.replay_walk import ReplayWalk
@@ -67,6 +74,10 @@ from streams.stream_types import ArmConf, CellConf
 
 Pose3 = tuple[float, float, float]
 STATUSES = ("repaired", "replanned", "infeasible", "timeout")
+#: Share of a repaired plan's execution from the cut that a fresh continuation must save to
+#: replace it: the repair keeps the old plan's structure (its grasps, the order of its tasks),
+#: which a fresh plan a few samples shorter is not worth giving up.
+SAVING = 0.01
 
 
 @dataclass(frozen=True)
@@ -75,7 +86,9 @@ class ReplanOutcome:
     ``replanned``: a fresh continuation; ``infeasible``, ``timeout``), the spliced ``plan``
     (None without one), the ``cut`` time [s], the re-planning ``latency`` [s], the reasons
     and the objects ``blocking`` a plan; ``valid``/``violation``: the independent replay of
-    the whole new plan (when asked)."""
+    the whole new plan (when asked); ``alternative``: where a changed repair was compared with
+    a fresh continuation, the execution time [s] of the plan not kept (None: no comparison, or
+    the fresh solve gave no plan)."""
 
     status: str
     plan: PlanFile | None
@@ -86,6 +99,7 @@ class ReplanOutcome:
     moved_away: tuple[str, ...] = ()
     valid: bool | None = None
     violation: str = ""
+    alternative: float | None = None
 
     @property
     def success(self) -> bool:
@@ -104,6 +118,7 @@ def replan(
     validate: bool = True,
     repair: bool = True,
     retry: bool = True,
+    compare: bool = True,
 ) -> ReplanOutcome:
     """Re-plan ``plan`` of ``instance`` at time ``at`` [s] from the ``observed`` state (see
     the module docstring). ``config``: the planner configuration of a fresh continuation
@@ -111,7 +126,9 @@ def replan(
     instance's); ``cache``: keeps the world and motion planner between calls; ``validate``:
     replay the whole new plan independently; ``repair``: try keeping the old plan's rest
     first (False: always a fresh continuation); ``retry``: when a fresh continuation fails the
-    replay (``validate``), solve once more with the next seed and keep that one if valid.
+    replay (``validate``), solve once more with the next seed and keep that one if valid;
+    ``compare``: compare a repair that changed the plan with a fresh continuation and keep the
+    shorter execution (False: keep the repair).
 
     Raises:
         ObservedStateError: the observed state cannot be (located at its file entry).
@@ -180,24 +197,33 @@ def replan(
         empty = PlanState(t_hold, prefix.q[-1], {}, at_cut)
         fixed = repair_plan(world, config, instance, rest, empty, kins, collision, sizes)
         if fixed is not None:
-            return _finish("repaired", fixed[0], instance, scene, cut, started, validate, fixed[1])
-    cont_instance, moved = continuation_instance(instance, at_cut, sizes, config.seed)
+            kept, moved, changed = fixed
+            left = config.max_time - (time.perf_counter() - started)
+            if not (compare and changed and left > 0.0):
+                return _finish("repaired", kept, instance, scene, cut, started, validate, moved)
+            # the repair changed the plan: a fresh continuation within the time left, and
+            # the shorter execution of the two (the repair on a tie or a failed fresh one)
+            other = _fresh(world, config.replace(max_time=left), instance, prefix, at_cut,
+                           sizes, prove=False)  # fmt: skip
+            if other.plan is not None and _shorter(other.plan, kept, t_hold):
+                _, bad, _ = check_from(instance, other.plan, scene, kins, collision, empty)
+                if bad is None:
+                    return _finish("replanned", other.plan, instance, scene, cut, started,
+                                   validate, other.moved, kept.duration)  # fmt: skip
+            alternative = None if other.plan is None else other.plan.duration
+            return _finish("repaired", kept, instance, scene, cut, started, validate, moved,
+                           alternative)  # fmt: skip
     slices = {a: scene.layout.slice(a) for a in scene.arm_names}
     moving = prefix.q[prefix.t >= at - 1e-9]  # braked arms leave directly, not by a lift
     free = frozenset(a for a, sl in slices.items() if braked and np.ptp(moving[:, sl], 0).max() > 0)
-    start = start_configuration(_home(world), prefix.q[-1], slices, free)
-    r = rearrangement_problem(cont_instance, world.ctx, config=config, planner=world.planner,
-                              start=start)  # fmt: skip
-    solution = solve_rearrangement(r)
-    if solution.plan is None:
-        reasons = tuple(solution.diagnosis) or (f"no plan ({solution.status.value})",)
-        status = "timeout" if solution.status.value == "timeout" else "infeasible"
+    fresh = _fresh(world, config, instance, prefix, at_cut, sizes, free)
+    if fresh.plan is None:
+        reasons = fresh.reasons
+        status = "timeout" if fresh.status == "timeout" else "infeasible"
         blocking = _objects_in(" ".join(reasons), sizes)
         return ReplanOutcome(status, None, cut.t, time.perf_counter() - started, reasons,
-                             blocking, moved)  # fmt: skip
-    continuation = plan_file_from_solution(r, solution)
-    spliced = splice(prefix, continuation)
-    out = _finish("replanned", spliced, instance, scene, cut, started, validate, moved)
+                             blocking, fresh.moved)  # fmt: skip
+    out = _finish("replanned", fresh.plan, instance, scene, cut, started, validate, fresh.moved)
     if out.valid is False and retry:  # rare: one more solve with the next seed
         again = replan(instance, plan, at, observed, config=config.replace(seed=config.seed + 1),
                        scene_path=scene_path, cache=cache, validate=True, repair=False,
@@ -205,6 +231,45 @@ def replan(
         if again.valid:
             return dataclasses.replace(again, latency=time.perf_counter() - started)
     return out
+
+
+@dataclass(frozen=True)
+class _Fresh:
+    """A fresh continuation: the spliced ``plan`` (None without one), the added objects it
+    moves away, and the solve's ``status`` and ``reasons`` without a plan."""
+
+    plan: PlanFile | None
+    moved: tuple[str, ...]
+    status: str = ""
+    reasons: tuple[str, ...] = ()
+
+
+def _fresh(
+    world: PlanningWorld, config: PlannerConfig, instance: Instance, prefix: PlanFile,
+    at_cut: dict[str, Pose3], sizes: dict[str, tuple[float, float, float]],
+    free: frozenset[str] = frozenset(), *, prove: bool = True,
+) -> _Fresh:  # fmt: skip
+    """A fresh SDAR solve of the objects resting at the cut (``at_cut``), spliced after
+    ``prefix``: the arms start where ``prefix`` ends, idle arms at home; those in ``free``
+    (stopped in the middle of their motions) leave directly; ``prove``: the solve's
+    infeasibility proofs first (their diagnosis names the blocking objects)."""
+    scene = world.ctx.scene
+    cont_instance, moved = continuation_instance(instance, at_cut, sizes, config.seed)
+    slices = {a: scene.layout.slice(a) for a in scene.arm_names}
+    start = start_configuration(_home(world), prefix.q[-1], slices, free)
+    r = rearrangement_problem(cont_instance, world.ctx, config=config, planner=world.planner,
+                              start=start)  # fmt: skip
+    solution = solve_rearrangement(r, prove=prove)
+    if solution.plan is None:
+        reasons = tuple(solution.diagnosis) or (f"no plan ({solution.status.value})",)
+        return _Fresh(None, moved, solution.status.value, reasons)
+    return _Fresh(splice(prefix, plan_file_from_solution(r, solution)), moved)
+
+
+def _shorter(fresh: PlanFile, repaired: PlanFile, t_from: float) -> bool:
+    """Whether ``fresh`` ends more than :data:`SAVING` of ``repaired``'s execution after
+    ``t_from`` [s] before it."""
+    return fresh.duration - t_from < (1.0 - SAVING) * (repaired.duration - t_from) - TIME_TOL
 
 
 def _stop_short(
@@ -253,7 +318,7 @@ def _objects_in(text: str, sizes: dict[str, tuple[float, float, float]]) -> tupl
 
 def _finish(
     status: str, plan: PlanFile, instance: Instance, scene: Scene, cut: Cut, started: float,
-    validate: bool, moved: tuple[str, ...] = (),
+    validate: bool, moved: tuple[str, ...] = (), alternative: float | None = None,
 ) -> ReplanOutcome:  # fmt: skip
     latency = time.perf_counter() - started
     plan = dataclasses.replace(plan, metrics=plan.metrics.updated({"planning_time": latency}))
@@ -264,4 +329,4 @@ def _finish(
         if report.violation is not None:
             v = report.violation
             violation = f"t={v.t:.3f} s: {v.kind}: {v.message}"
-    return ReplanOutcome(status, plan, cut.t, latency, (), (), moved, valid, violation)
+    return ReplanOutcome(status, plan, cut.t, latency, (), (), moved, valid, violation, alternative)

@@ -101,6 +101,48 @@ def test_a_nudged_object_is_regrasped_at_its_new_pose(
     assert not report.ok and report.violation is not None and report.violation.t > AT
 
 
+def test_a_fresh_continuation_shorter_than_the_repair_is_kept(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """o4 nudged at 5.116 s (resting, its task still to come): the repair plans o4's task
+    again and rejoins the old plan, 13.70 s in all; a fresh continuation from the same cut
+    ends 0.5 s earlier. The re-plan compares the two and keeps the fresh one; without the
+    comparison it keeps the repair, and a fresh continuation alone is the same plan as the
+    one kept (same seed, same plan)."""
+    instance, plan = d5
+    at = 5.116
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    x, y, yaw = state_at(plan, starts, load_scene(), at).resting["o4"]
+    text = f"poses: [{{name: o4, pose: [{x + 0.0052}, {y + 0.0173}, {yaw - 0.1559}]}}]"
+    out = _replan(d5, cache, text, at=at)
+    kept = _replan(d5, cache, text, at=at, compare=False)
+    fresh = _replan(d5, cache, text, at=at, repair=False)
+    assert kept.status == "repaired" and kept.plan is not None and kept.valid is True
+    assert fresh.status == "replanned" and fresh.plan is not None and fresh.valid is True
+    assert out.status == "replanned" and out.plan is not None and out.valid is True
+    assert validate_plan(instance, out.plan, load_scene()).ok
+    assert out.cut == kept.cut == fresh.cut
+    assert out.alternative == pytest.approx(kept.plan.duration)  # the repair, not kept
+    assert out.plan.duration < 0.99 * kept.plan.duration
+    assert np.array_equal(out.plan.t, fresh.plan.t) and np.array_equal(out.plan.q, fresh.plan.q)
+    assert len(_grasp_poses(out.plan, "o4", out.cut)) == 1
+
+
+def test_a_repair_as_short_as_a_fresh_continuation_is_kept(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """At 12.3 s (every task done) o3 nudged off its goal: the repair's one more task and a
+    fresh continuation take as long; the repair is kept and the fresh one's duration is
+    reported."""
+    goal = _obj(d5[0], "o3").goal
+    new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
+    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]",
+                  at=12.3)  # fmt: skip
+    assert out.status == "repaired" and out.plan is not None and out.valid is True
+    assert out.alternative is not None
+    assert out.plan.duration - out.cut <= (out.alternative - out.cut) / 0.99
+
+
 @pytest.mark.parametrize("repair", [True, False])
 def test_a_nudged_object_at_its_goal_is_put_back(
     d5: tuple[Instance, PlanFile], cache: PlannerCache, repair: bool
@@ -132,14 +174,21 @@ def test_a_nudged_object_at_its_goal_gets_one_more_task_when_the_last_cannot_tak
     d5: tuple[Instance, PlanFile], cache: PlannerCache, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """When the last task cannot be planned again with o3 (made to fail here), the old plan's
-    rest is kept whole and one more task after it puts o3 back."""
+    rest is kept whole and one more task after it puts o3 back (without the comparison with a
+    fresh continuation, which is shorter here)."""
     from sdar_tamp.app import repair as repair_module
 
     monkeypatch.setattr(repair_module, "_replan_task", lambda *args: None)
     goal = _obj(d5[0], "o3").goal
     new = (goal.x + 0.012, goal.y + 0.006, goal.yaw - 0.2)
-    out = _replan(d5, cache, f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]")
-    assert out.status == "repaired"
+    text = f"poses: [{{name: o3, pose: [{new[0]}, {new[1]}, {new[2]}]}}]"
+    out = _replan(d5, cache, text, compare=False)
+    assert out.status == "repaired" and out.plan is not None
+    # compared, a fresh continuation (o3 put back within it) is shorter and kept
+    shorter = _replan(d5, cache, text)
+    assert shorter.status == "replanned" and shorter.plan is not None
+    assert shorter.alternative == pytest.approx(out.plan.duration)
+    assert shorter.plan.duration < 0.99 * out.plan.duration
     plan = _assert_valid_whole(d5, out)
     kept = [(e.type, e.object) for e in d5[1].events if e.t > AT]
     after = [(e.type, e.object) for e in plan.events if e.t > AT]
