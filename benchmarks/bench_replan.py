@@ -13,7 +13,8 @@ by the independent replay.
 Counted apart (not solvable by any re-plan from ``T``): ``cannot_stop``, where the running
 plan meets the observed world before its arms reach the next point at which they are at rest
 with empty grippers (the cut), and braking on their way does not stop them short of it
-either (an arm holds an object, a gripper acts first, or the change is too close).
+either (a gripper acts first, the change is too close, or what an arm holds cannot be put
+down).
 ``success_rate``: valid new plans over the other perturbed
 states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
 time of ``replan`` without the final validation (``cpu_median_s``: the process's CPU time

@@ -10,19 +10,36 @@ moves faster than in the plan, and an arm the plan keeps still (a gripper's dwel
 at least as long. Sample after sample, ``p`` advances the least that keeps every joint's
 second divided difference within its limit, until the arms can stand still (the last velocity
 within the rule of a plan's end, half the limit over one spacing: any still hold may follow).
-A path that turns too sharply to follow at the speed reached gives no braking.
+A path that turns too sharply to follow at the speed reached gives no braking. An object held
+moves with its tool along the braked path, as it would along the plan's.
+
+A continuation starts with empty grippers (SDAR's start state holds arm configurations only,
+every object resting), so an arm braked with an object in hand puts it down first
+(:func:`put_down`): one motion, planned among the objects resting where the arms stopped and
+carrying what they hold, to where the plan would have released it (or, failing that, back to
+where it was grasped), and the release there.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
+from collections.abc import Iterator, Mapping
 
 import numpy as np
 
-from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
+from sdar_tamp.plan_file import GRIPPER_DWELL, MAX_DT, PlanFile
 from sdar_tamp.plan_rules import LIMIT_RTOL, TIME_TOL
-from sdar_tamp.plan_state import Cut
-from sdar_tamp.world.transforms import FloatArray
+from sdar_tamp.plan_state import Cut, configuration_at
+from sdar_tamp.world.collision import ObjectBox
+from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
+from streams.motion.exact_check import HeldObject
+from streams.motion.ladder import plan_dual_motion
+from streams.motion.planner import MotionPlanner
+from streams.motion.records import MotionRequest
+
+Pose3 = tuple[float, float, float]
 
 #: Candidate advances of the plan time per sample, as shares of the spacing (the least that
 #: keeps the limits is taken).
@@ -45,12 +62,12 @@ class Braking:
 
 def brake(plan: PlanFile, at: float, v_max: FloatArray, a_max: FloatArray) -> Braking | None:
     """The arms of ``plan`` brought to rest along its path from time ``at`` [s] within
-    ``v_max`` [rad/s] and ``a_max`` [rad/s^2] ``(dof,)`` (see the module docstring); None when
-    an arm holds an object at ``at`` or a gripper acts before the arms are at rest (the
-    continuation starts with empty grippers), or when the path cannot be followed."""
+    ``v_max`` [rad/s] and ``a_max`` [rad/s^2] ``(dof,)`` (see the module docstring), what
+    they hold held on; None when a gripper acts before the arms are at rest, or when the path
+    cannot be followed."""
     t, q = plan.t, plan.q
     i0 = min(int(np.searchsorted(t, at - TIME_TOL)), len(t) - 1)
-    if i0 == 0 or _holding(plan, float(t[i0])):
+    if i0 == 0:
         return None
     h = float(t[i0] - t[i0 - 1])
     v = (q[i0] - q[i0 - 1]) / h
@@ -85,14 +102,85 @@ def brake(plan: PlanFile, at: float, v_max: FloatArray, a_max: FloatArray) -> Br
     return Braking(braked, Cut(len(braked.t) - 1, float(braked.t[-1]), events))
 
 
-def _holding(plan: PlanFile, t: float) -> bool:
-    """Whether an arm holds an object at ``t`` [s] (a grasp at ``t`` counts)."""
-    held: set[str] = set()
-    for e in plan.events:
-        if e.t > t + TIME_TOL:
-            break
-        if e.type == "grasp":
-            held.add(e.arm)
-        elif e.t < t - TIME_TOL:
-            held.discard(e.arm)
-    return bool(held)
+def still_until_dwells_end(plan: PlanFile, dwell: float = GRIPPER_DWELL) -> PlanFile:
+    """``plan`` (ending at rest) held still after its end until the dwell of every gripper
+    event is over (samples at most :data:`~sdar_tamp.plan_file.MAX_DT` apart), so that a
+    motion may follow at once."""
+    end = max((e.t + dwell for e in plan.events), default=0.0)
+    t_end = float(plan.t[-1])
+    if end <= t_end + TIME_TOL:
+        return plan
+    n = max(1, math.ceil((end - t_end) / MAX_DT - 1e-9))
+    hold = np.linspace(t_end, end, n + 1)[1:]
+    q = np.concatenate([plan.q, np.repeat(plan.q[-1][None], n, 0)])
+    return dataclasses.replace(plan, t=np.concatenate([plan.t, hold]), q=q)
+
+
+def put_down(
+    planner: MotionPlanner,
+    running: PlanFile,
+    at: float,
+    q_stop: FloatArray,
+    held: Mapping[str, str],
+    grips: Mapping[str, FloatArray],
+    resting: Mapping[str, Pose3],
+    sizes: Mapping[str, tuple[float, float, float]],
+    gripper_time: float = GRIPPER_DWELL,
+) -> Iterator[PlanFile]:
+    """The ways of putting down what the arms stopped at ``q_stop`` ``(dof,)`` [rad]
+    (``running`` braked from ``at`` [s]) hold: arm -> object ``held``, at ``grips`` (arm ->
+    ``T_tcp_object`` ``(4, 4)``), in order of preference: where ``running`` releases each
+    object next, then where each was grasped. Each is a plan piece from ``t = 0`` at
+    ``q_stop``: one motion among the objects ``resting`` (name -> ``(x, y, yaw)`` [m, m,
+    rad]) with the held ones carried (the arms without an object keep where they stopped),
+    every held object released at its end, and the dwell. Each motion is planned when the
+    next piece is asked for (none where no motion is found); the caller replays each piece
+    in the observed world."""
+    scene = planner.ctx.scene
+    q0 = np.asarray(q_stop)
+    ahead = {a: _event(running, a, "release", at, after=True) for a in held}
+    behind = {a: _event(running, a, "grasp", at, after=False) for a in held}
+    boxes = {n: _box(p, sizes[n]) for n, p in resting.items()}
+    carried = {
+        a: HeldObject(o, sizes[o], planner.ctx.kinematics[a].T_tool0_tcp @ grips[a])
+        for a, o in held.items()
+    }
+    starts = {**resting, **{o: (0.0, 0.0, 0.0) for o in held.values()}}  # placed at release
+    for targets in (ahead, behind):
+        q_goal = q0.copy()
+        for arm, when in targets.items():
+            if when is None:
+                break
+            sl = scene.layout.slice(arm)
+            q_goal[sl] = configuration_at(running, when)[sl]
+        else:
+            request = MotionRequest(
+                q0, q_goal, boxes, carried, tuple(False for _ in scene.arm_names),
+                tuple(a in held for a in scene.arm_names),
+            )  # fmt: skip
+            result = plan_dual_motion(planner, request)
+            if not result.success or result.trajectory is None:
+                continue
+            traj = result.trajectory
+            seg = MotionSegment(
+                traj.t, traj.q, result.level or "", tuple(held.values()), "put-down"
+            )
+            items: list[MotionSegment | GripperEvent] = [seg]
+            items += [GripperEvent(a, "release", o, grips[a]) for a, o in held.items()]
+            yield build_plan_file(
+                scene, running.instance, starts, {n: sizes[n] for n in starts}, items, {},
+                gripper_time=gripper_time, q_start=q0,
+            )  # fmt: skip
+
+
+def _event(plan: PlanFile, arm: str, kind: str, at: float, after: bool) -> float | None:
+    """The time [s] of ``arm``'s first ``kind`` event of ``plan`` after ``at`` (``after``), or
+    of its last one before."""
+    times = [e.t for e in plan.events if e.arm == arm and e.type == kind]
+    if after:
+        return next((t for t in times if t >= at - TIME_TOL), None)
+    return next((t for t in reversed(times) if t < at), None)
+
+
+def _box(p: Pose3, size: tuple[float, float, float]) -> ObjectBox:
+    return ObjectBox(pose_xyz_yaw(p[0], p[1], size[2] / 2.0, p[2]), size)

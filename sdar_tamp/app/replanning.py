@@ -12,9 +12,10 @@ camera sees -> one new plan, the executed prefix spliced with a continuation.
    cut_point`: every arm at rest with an empty gripper, the events of that instant left to
    the continuation); the stretch from ``at`` to the cut is replayed in the observed world
    (the validator's walk). Where it meets the change, the arms brake on their way instead
-   (:mod:`sdar_tamp.app.braking`: empty grippers, no gripper acting before they stand still)
-   and a fresh continuation starts there; when that stretch meets it too, or an arm holds an
-   object, the re-plan ends as ``infeasible``. When the
+   (:mod:`sdar_tamp.app.braking`: no gripper acting before they stand still; an object in
+   hand is then put down, where the plan would release it or else where it was grasped) and a
+   fresh continuation starts there; when that stretch meets it too, the re-plan ends as
+   ``infeasible``. When the
    cut falls on grasps about to happen and the plan's next cut is reached without violation
    through them, that later cut is taken: the arms then stop clear of the objects rather than
    with open fingers around them.
@@ -41,12 +42,13 @@ from __future__ import annotations
 import dataclasses
 import re
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from sdar_tamp.app.braking import brake
+from sdar_tamp.app.braking import brake, put_down, still_until_dwells_end
 from sdar_tamp.app.cache import PlannerCache, PlanningWorld
 from sdar_tamp.app.config import PlannerConfig
 from sdar_tamp.app.plan_export import plan_file_from_solution
@@ -70,6 +72,7 @@ from sdar_tamp.world.observed import (
     observed_arrangement,
 )
 from sdar_tamp.world.scene import Scene
+from sdar_tamp.world.transforms import FloatArray
 from streams.stream_types import ArmConf, CellConf
 
 Pose3 = tuple[float, float, float]
@@ -171,7 +174,8 @@ def replan(
     found = walk.walk(float(prefix.t[-1]), at)
     braked = False
     if found is not None:  # the arms meet the change on their way: stop them short of it
-        short = _stop_short(instance, old, at, scene, kins, collision, state)
+        short = _stop_short(world, config, instance, old, at, kins, collision, state, grips,
+                            sizes)  # fmt: skip
         if short is None:
             return ReplanOutcome(
                 "infeasible", None, cut.t, time.perf_counter() - started,
@@ -215,7 +219,10 @@ def replan(
                            alternative)  # fmt: skip
     slices = {a: scene.layout.slice(a) for a in scene.arm_names}
     moving = prefix.q[prefix.t >= at - 1e-9]  # braked arms leave directly, not by a lift
-    free = frozenset(a for a, sl in slices.items() if braked and np.ptp(moving[:, sl], 0).max() > 0)
+    free = frozenset(  # an arm that put an object down leaves by a lift
+        a for a, sl in slices.items()
+        if braked and a not in state.held and np.ptp(moving[:, sl], 0).max() > 0
+    )  # fmt: skip
     fresh = _fresh(world, config, instance, prefix, at_cut, sizes, free)
     if fresh.plan is None:
         reasons = fresh.reasons
@@ -273,21 +280,37 @@ def _shorter(fresh: PlanFile, repaired: PlanFile, t_from: float) -> bool:
 
 
 def _stop_short(
-    instance: Instance, plan: PlanFile, at: float, scene: Scene,
+    world: PlanningWorld, config: PlannerConfig, instance: Instance, plan: PlanFile, at: float,
     kins: dict[str, ArmKinematics], collision: CollisionWorld, state: PlanState,
+    grips: dict[str, FloatArray], sizes: dict[str, tuple[float, float, float]],
 ) -> tuple[Cut, PlanFile, ReplayWalk] | None:  # fmt: skip
-    """The arms braked on their way from ``at`` (:func:`~sdar_tamp.app.braking.brake`): the
-    cut where they stand still, the prefix with its hold and its walk from ``state``, when
-    the braked stretch meets nothing in the observed world; else None."""
+    """The arms braked on their way from ``at`` (:func:`~sdar_tamp.app.braking.brake`), and
+    what they hold (``state.held``, at ``grips``) put down
+    (:func:`~sdar_tamp.app.braking.put_down`): the cut where they stand still with empty
+    grippers, the prefix with its hold and its walk from ``state``, when that stretch meets
+    nothing in the observed world; else None."""
+    scene = world.ctx.scene
     v_max, a_max = scene.joint_array("velocity_limit"), scene.joint_array("acceleration_limit")
     stop = brake(plan, at, v_max, a_max)
     if stop is None:
         return None
-    prefix = prefix_plan(stop.plan, stop.cut)
-    walk = walk_from(instance, prefix, scene, kins, collision, state)
-    if walk.walk(float(prefix.t[-1]), at) is not None:
-        return None
-    return stop.cut, prefix, walk
+    if not state.held:
+        pieces: Iterator[PlanFile] = iter([stop.plan])
+    else:  # the braked stretch replayed first: where the objects rest when the arms stop
+        base = still_until_dwells_end(stop.plan)  # a grasp's dwell may not be over
+        walk = walk_from(instance, base, scene, kins, collision, state)
+        if walk.walk(float(base.t[-1]), at) is not None:
+            return None
+        downs = put_down(world.planner, plan, at, base.q[-1], state.held, grips,
+                         dict(walk.rest), sizes, config.gripper_time)  # fmt: skip
+        pieces = (splice(base, down) for down in downs)
+    for piece in pieces:
+        end = Cut(len(piece.t) - 1, float(piece.t[-1]), len(piece.events))
+        prefix = prefix_plan(piece, end)
+        walk = walk_from(instance, prefix, scene, kins, collision, state)
+        if walk.walk(float(prefix.t[-1]), at) is None:
+            return end, prefix, walk
+    return None
 
 
 def _resume(plan: PlanFile, cut: Cut, t_hold: float) -> Cut:

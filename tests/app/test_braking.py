@@ -1,5 +1,6 @@
 """Braking along the running motion (``sdar_tamp.app.braking``) on D5's stored plan: the arms
-come to rest on the plan's path within the validator's limits, or there is no braking."""
+come to rest on the plan's path within the validator's limits (what they hold held on), or
+there is no braking."""
 
 from __future__ import annotations
 
@@ -8,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sdar_tamp.app.braking import brake
-from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.app.braking import brake, still_until_dwells_end
+from sdar_tamp.plan_file import GRIPPER_DWELL, MAX_DT, PlanFile
 from sdar_tamp.plan_reading import load_plan
 from sdar_tamp.plan_rules import check_timeline
 from sdar_tamp.plan_state import prefix_plan
@@ -59,8 +60,26 @@ def test_arms_at_rest_stop_at_once(d5: PlanFile, scene: Scene) -> None:
     assert stop.cut.events == sum(e.t < 8.2 for e in d5.events)
 
 
-def test_no_braking_while_an_arm_holds_an_object(d5: PlanFile, scene: Scene) -> None:
-    assert brake(d5, 2.5, *_limits(scene)) is None  # the left arm carries o3
+@pytest.mark.parametrize("at", [2.5, 10.8])  # both arms carry (o3, o0); the left carries o2
+def test_braking_with_an_object_in_hand(d5: PlanFile, scene: Scene, at: float) -> None:
+    """The held objects stay held (no event on the braked stretch); the stop keeps the limits
+    once the dwells are over."""
+    stop = brake(d5, at, *_limits(scene))
+    assert stop is not None and stop.cut.t < at + 1.0
+    assert stop.plan.events == tuple(e for e in d5.events if e.t < at)
+    assert check_timeline(still_until_dwells_end(stop.plan), scene) is None
+
+
+def test_still_until_the_dwells_end(d5: PlanFile, scene: Scene) -> None:
+    """Braked at 1.5 s, in the dwell of the grasps of 1.386 s (the arms still): the plan is
+    held still to 1.886 s, samples at most MAX_DT apart; a plan past its dwells is kept."""
+    stop = brake(d5, 1.5, *_limits(scene))
+    assert stop is not None and stop.cut.t < 1.886
+    held = still_until_dwells_end(stop.plan)
+    assert held.t[-1] == pytest.approx(1.386 + GRIPPER_DWELL, abs=1e-3)
+    assert np.diff(held.t).max() <= MAX_DT + 1e-9
+    assert np.abs(held.q[len(stop.plan.t) - 1 :] - stop.plan.q[-1]).max() == 0.0
+    assert still_until_dwells_end(held) is held
 
 
 def test_no_braking_through_a_gripper_event(d5: PlanFile, scene: Scene) -> None:

@@ -294,6 +294,63 @@ def test_the_running_plan_meeting_the_change_is_infeasible_with_the_object(
     assert "nor braking on their way" in out.reasons[0]
 
 
+def _b1(x: float, y: float, height: float) -> str:
+    return f"added: [{{name: b1, size: [0.04, 0.04, {height}], pose: [{x}, {y}, 0]}}]"
+
+
+def _released_after(plan: PlanFile, t: float) -> list[tuple[str, str, str]]:
+    return [(e.arm, e.type, e.object) for e in plan.events if e.t > t]
+
+
+def test_an_arm_braked_with_an_object_in_hand_puts_it_down_where_the_plan_would(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """At 10.8 s the left arm carries o2 over the table (9 cm up) to its goal; b1, 10 cm
+    tall, stands on the way: the arm brakes with o2 in hand, carries it around b1 to its
+    goal and releases it there; nothing is left to do."""
+    out = _replan(d5, cache, _b1(0.07, -0.05, 0.1), at=10.8)
+    assert out.status == "replanned" and out.plan is not None and out.valid is True
+    assert validate_plan(d5[0], out.plan, load_scene()).ok
+    assert _released_after(out.plan, 10.8) == [("left", "release", "o2")]
+    goal = _obj(d5[0], "o2").goal
+    assert np.allclose(out.plan.final_poses["o2"][:2], (goal.x, goal.y), atol=1e-3)
+    assert out.plan.final_poses["b1"] == pytest.approx((0.07, -0.05, 0.0))
+    old = d5[1]
+    assert np.array_equal(out.plan.q[out.plan.t <= 10.8], old.q[old.t <= 10.8])
+
+
+def test_an_arm_braked_with_an_object_in_hand_puts_it_back_when_its_place_is_taken(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """b1 appears on o2's goal while the left arm carries o2 there: the way to the goal is
+    blocked, so the arm brakes, puts o2 back where it took it from, and the continuation
+    moves b1 away and o2 to its goal."""
+    goal = _obj(d5[0], "o2").goal
+    out = _replan(d5, cache, _b1(goal.x, goal.y, 0.05), at=10.8)
+    assert out.status == "replanned" and out.plan is not None and out.valid is True
+    assert validate_plan(d5[0], out.plan, load_scene()).ok
+    events = _released_after(out.plan, 10.8)
+    assert events[0] == ("left", "release", "o2")
+    assert out.moved_away == ("b1",) and ("right", "grasp", "b1") in events
+    start = _obj(d5[0], "o2").start
+    put_back = next(e for e in out.plan.events if e.t > 10.8 and e.type == "release")
+    state = state_at(out.plan, {o.name: o.start.as_tuple() for o in d5[0].objects}, load_scene(),
+                     put_back.t + 0.01)  # fmt: skip
+    assert np.allclose(state.resting["o2"][:2], (start.x, start.y), atol=1e-3)
+    assert np.allclose(out.plan.final_poses["o2"][:2], (goal.x, goal.y), atol=1e-3)
+
+
+def test_no_place_to_put_down_what_the_arms_hold_is_infeasible(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """At 2.4 s the arms swap o3 and o0 (each carries one to where the other was); b1 appears
+    where o3 comes down, next to where o0 was taken: neither the plan's placements nor the
+    grasps' are reachable with b1 there, so the running plan cannot stop short of it."""
+    out = _replan(d5, cache, _b1(-0.1929, -0.0573, 0.1), at=2.4)
+    assert out.status == "infeasible" and out.plan is None
+    assert "nor braking on their way" in out.reasons[0] and out.blocking == ("o3", "b1")
+
+
 @pytest.mark.parametrize(
     ("text", "message"),
     [
