@@ -19,7 +19,9 @@ down).
 states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
 time of ``replan`` without the final validation (``cpu_median_s``: the process's CPU time
 of the call, the validation included: on a loaded machine the wall time grows, the CPU time
-hardly). For every nudge re-planned, a fresh
+hardly). ``compared``: the re-plans whose repair changed the plan and was compared with a
+fresh continuation within the time left (``compared_fresh_kept``: those where the fresh one
+was shorter and kept). For every nudge re-planned, a fresh
 continuation from the same cut (``replan(..., repair=False)``) is planned too:
 ``nudge_execution_ratio`` is the new plan's execution from the cut over the fresh one's, and
 ``nudge_latency_median_s`` / ``nudge_fresh_latency_median_s`` the two latencies side by side.
@@ -167,6 +169,7 @@ def main() -> None:
                 "redrawn": p.redrawn, "status": out.status, "valid": out.valid,
                 "latency": out.latency, "cpu": cpu, "cut": out.cut,
                 "cannot_stop": any("before the arms can stop" in r for r in out.reasons),
+                "compared": out.alternative is not None,
                 "why": out.violation or "; ".join(out.reasons),
             }  # fmt: skip
             if kind == "nudge" and out.plan is not None:
@@ -226,6 +229,9 @@ def main() -> None:
         "nudge_latency_median_s": median(
             [float(r["latency"]) for r in rows if "fresh_latency" in r]  # type: ignore[arg-type]
         ),
+        "compared": sum(bool(r["compared"]) for r in rows),
+        "compared_fresh_kept": sum(bool(r["compared"]) and r["status"] == "replanned"
+                                   for r in rows),
         "by_kind": by_kind,
         "statuses": {s: sum(r["status"] == s for r in rows) for s in statuses},
         "seconds": round(time.perf_counter() - started, 1),

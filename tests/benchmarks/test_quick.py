@@ -126,6 +126,7 @@ def _replan(out: Summary) -> None:
     assert out["perturbations"] == 3 and out["instances"] == 1
     assert out["valid"] == out["solvable"] >= 1 and out["success_rate"] == 1.0
     assert out["latency_median_s"] > 0 and set(out["by_kind"]) == {"nudge", "remove", "add"}
+    assert 0 <= out["compared_fresh_kept"] <= out["compared"] <= out["perturbations"]
 
 
 def _sdar(out: Summary) -> None:
