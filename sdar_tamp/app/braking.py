@@ -17,12 +17,13 @@ A continuation starts with empty grippers (SDAR's start state holds arm configur
 every object resting), so an arm braked with an object in hand puts it down first
 (:func:`put_down`): one motion, planned among the objects resting where the arms stopped and
 carrying what they hold, to where the plan would have released it (or, failing that, back to
-where it was grasped), and the release there.
+where it was grasped, or straight down below where it is), and the release there.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 from collections.abc import Iterator, Mapping
 
@@ -33,7 +34,8 @@ from sdar_tamp.plan_file import GRIPPER_DWELL, MAX_DT, PlanFile
 from sdar_tamp.plan_rules import LIMIT_RTOL, TIME_TOL
 from sdar_tamp.plan_state import Cut, configuration_at
 from sdar_tamp.world.collision import ObjectBox
-from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw
 from streams.motion.exact_check import HeldObject
 from streams.motion.ladder import plan_dual_motion
 from streams.motion.planner import MotionPlanner
@@ -129,8 +131,10 @@ def put_down(
 ) -> Iterator[PlanFile]:
     """The ways of putting down what the arms stopped at ``q_stop`` ``(dof,)`` [rad]
     (``running`` braked from ``at`` [s]) hold: arm -> object ``held``, at ``grips`` (arm ->
-    ``T_tcp_object`` ``(4, 4)``), in order of preference: where ``running`` releases each
-    object next, then where each was grasped. Each is a plan piece from ``t = 0`` at
+    ``T_tcp_object`` ``(4, 4)``), in order of preference per arm: where ``running``
+    releases its object next, back where it was grasped, or straight down on the table below
+    where it is (:func:`_below`), the choices of the arms together ranked by the sum of their
+    ranks. Each is a plan piece from ``t = 0`` at
     ``q_stop``: one motion among the objects ``resting`` (name -> ``(x, y, yaw)`` [m, m,
     rad]) with the held ones carried (the arms without an object keep where they stopped),
     every held object released at its end, and the dwell. Each motion is planned when the
@@ -138,39 +142,58 @@ def put_down(
     in the observed world."""
     scene = planner.ctx.scene
     q0 = np.asarray(q_stop)
-    ahead = {a: _event(running, a, "release", at, after=True) for a in held}
-    behind = {a: _event(running, a, "grasp", at, after=False) for a in held}
+    layout = scene.layout
+    kins = planner.ctx.kinematics
+    options: dict[str, list[FloatArray]] = {}
+    for arm in held:
+        ahead = _event(running, arm, "release", at, after=True)
+        behind = _event(running, arm, "grasp", at, after=False)
+        here = layout.part(q0, arm)
+        below = _below(kins[arm], here, grips[arm], sizes[held[arm]])
+        times = [w for w in (ahead, behind) if w is not None]
+        options[arm] = [layout.part(configuration_at(running, w), arm) for w in times]
+        options[arm] += [below] if below is not None else []
     boxes = {n: _box(p, sizes[n]) for n, p in resting.items()}
-    carried = {
-        a: HeldObject(o, sizes[o], planner.ctx.kinematics[a].T_tool0_tcp @ grips[a])
-        for a, o in held.items()
-    }
+    carried = {a: HeldObject(o, sizes[o], kins[a].T_tool0_tcp @ grips[a]) for a, o in held.items()}
     starts = {**resting, **{o: (0.0, 0.0, 0.0) for o in held.values()}}  # placed at release
-    for targets in (ahead, behind):
+    arms = sorted(held, key=scene.arm_names.index)
+    ranks = sorted(itertools.product(*(range(len(options[a])) for a in arms)), key=sum)
+    for rank in ranks:
         q_goal = q0.copy()
-        for arm, when in targets.items():
-            if when is None:
-                break
-            sl = scene.layout.slice(arm)
-            q_goal[sl] = configuration_at(running, when)[sl]
-        else:
-            request = MotionRequest(
-                q0, q_goal, boxes, carried, tuple(False for _ in scene.arm_names),
-                tuple(a in held for a in scene.arm_names),
-            )  # fmt: skip
-            result = plan_dual_motion(planner, request)
-            if not result.success or result.trajectory is None:
-                continue
-            traj = result.trajectory
-            seg = MotionSegment(
-                traj.t, traj.q, result.level or "", tuple(held.values()), "put-down"
-            )
-            items: list[MotionSegment | GripperEvent] = [seg]
-            items += [GripperEvent(a, "release", o, grips[a]) for a, o in held.items()]
-            yield build_plan_file(
-                scene, running.instance, starts, {n: sizes[n] for n in starts}, items, {},
-                gripper_time=gripper_time, q_start=q0,
-            )  # fmt: skip
+        for arm, k in zip(arms, rank, strict=True):
+            q_goal[layout.slice(arm)] = options[arm][k]
+        request = MotionRequest(
+            q0, q_goal, boxes, carried, tuple(False for _ in scene.arm_names),
+            tuple(a in held for a in scene.arm_names),
+        )  # fmt: skip
+        result = plan_dual_motion(planner, request)
+        if not result.success or result.trajectory is None:
+            continue
+        traj = result.trajectory
+        seg = MotionSegment(traj.t, traj.q, result.level or "", tuple(held.values()), "put-down")
+        items: list[MotionSegment | GripperEvent] = [seg]
+        items += [GripperEvent(a, "release", o, grips[a]) for a, o in held.items()]
+        yield build_plan_file(
+            scene, running.instance, starts, {n: sizes[n] for n in starts}, items, {},
+            gripper_time=gripper_time, q_start=q0,
+        )  # fmt: skip
+
+
+def _below(
+    kin: ArmKinematics, q_arm: FloatArray, T_tcp_object: FloatArray,
+    size: tuple[float, float, float],
+) -> FloatArray | None:  # fmt: skip
+    """The arm's configuration ``(dof,)`` [rad] that sets the object it holds at
+    ``T_tcp_object`` down on the table straight below where it is at ``q_arm`` (its yaw
+    kept; the IK branch nearest ``q_arm``), or None out of reach."""
+    T = kin.fk_tcp(q_arm) @ T_tcp_object
+    yaw = math.atan2(T[1, 0], T[0, 0])
+    T_place = pose_xyz_yaw(float(T[0, 3]), float(T[1, 3]), size[2] / 2.0, yaw)
+    sol = kin.ik_tcp_from((T_place @ inverse(T_tcp_object))[None], q_arm[None, None])
+    if not bool(np.asarray(sol.valid).reshape(-1)[0]):
+        return None
+    q: FloatArray = np.asarray(sol.q, dtype=np.float64).reshape(-1, len(q_arm))[0]
+    return q
 
 
 def _event(plan: PlanFile, arm: str, kind: str, at: float, after: bool) -> float | None:

@@ -13,7 +13,7 @@ camera sees -> one new plan, the executed prefix spliced with a continuation.
    the continuation); the stretch from ``at`` to the cut is replayed in the observed world
    (the validator's walk). Where it meets the change, the arms brake on their way instead
    (:mod:`sdar_tamp.app.braking`: no gripper acting before they stand still; an object in
-   hand is then put down, where the plan would release it or else where it was grasped) and a
+   hand is then put down: where the plan would release it, where it was grasped, or below) and a
    fresh continuation starts there; when that stretch meets it too, the re-plan ends as
    ``infeasible``. When the
    cut falls on grasps about to happen and the plan's next cut is reached without violation

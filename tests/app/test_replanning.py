@@ -340,12 +340,43 @@ def test_an_arm_braked_with_an_object_in_hand_puts_it_back_when_its_place_is_tak
     assert np.allclose(out.plan.final_poses["o2"][:2], (goal.x, goal.y), atol=1e-3)
 
 
+def test_an_arm_braked_with_an_object_in_hand_sets_it_down_below_when_both_places_are_taken(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """At 11.1 s the left arm carries o2 to its goal; b1 stands on that goal and b2 where o2
+    was taken from: the arm brakes and sets o2 down straight below where it stopped (its yaw
+    kept); the continuation moves b1 away and o2 to its goal."""
+    goal, start = _obj(d5[0], "o2").goal, _obj(d5[0], "o2").start
+    box = "size: [0.04, 0.04, 0.05], pose"
+    text = (f"added: [{{name: b1, {box}: [{goal.x}, {goal.y}, 0]}}, "
+            f"{{name: b2, {box}: [{start.x}, {start.y}, 0]}}]")  # fmt: skip
+    out = _replan(d5, cache, text, at=11.1)
+    assert out.status == "replanned" and out.plan is not None and out.valid is True
+    assert validate_plan(d5[0], out.plan, load_scene()).ok
+    put = next(e for e in out.plan.events if e.t > 11.1)
+    assert (put.arm, put.type, put.object) == ("left", "release", "o2")
+    down = next(s for s in out.plan.steps if s.kind == "put-down")
+    assert down.t_start > 11.1 and down.t_end <= put.t  # from the stop to the release
+
+    def tcp(t: float) -> np.ndarray:
+        q = np.array([np.interp(t, out.plan.t, out.plan.q[:, j]) for j in range(12)])
+        return ArmKinematics.from_scene(scene, "left").fk_tcp(scene.layout.part(q, "left"))
+
+    scene = load_scene()
+    stop, placed = tcp(down.t_start), tcp(put.t)
+    assert np.allclose(placed[:2, 3], stop[:2, 3], atol=1e-6)  # straight below
+    assert stop[2, 3] > placed[2, 3] + 0.03
+    assert out.moved_away == ("b1",)
+    assert np.allclose(out.plan.final_poses["o2"][:2], (goal.x, goal.y), atol=1e-3)
+
+
 def test_no_place_to_put_down_what_the_arms_hold_is_infeasible(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
     """At 2.4 s the arms swap o3 and o0 (each carries one to where the other was); b1 appears
-    where o3 comes down, next to where o0 was taken: neither the plan's placements nor the
-    grasps' are reachable with b1 there, so the running plan cannot stop short of it."""
+    where o3 comes down, next to where o0 was taken: neither the plan's placements, nor the
+    grasps', nor straight below where the arms stop are reachable with b1 there, so the
+    running plan cannot stop short of it."""
     out = _replan(d5, cache, _b1(-0.1929, -0.0573, 0.1), at=2.4)
     assert out.status == "infeasible" and out.plan is None
     assert "nor braking on their way" in out.reasons[0] and out.blocking == ("o3", "b1")
