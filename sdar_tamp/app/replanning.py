@@ -209,12 +209,13 @@ def replan(
             # the shorter execution of the two (the repair on a tie or a failed fresh one)
             other = _fresh(world, config.replace(max_time=left), instance, prefix, at_cut,
                            sizes, prove=False)  # fmt: skip
+            alternative = None if other.plan is None else other.plan.duration
             if other.plan is not None and _shorter(other.plan, kept, t_hold):
                 _, bad, _ = check_from(instance, other.plan, scene, kins, collision, empty)
                 if bad is None:
                     return _finish("replanned", other.plan, instance, scene, cut, started,
                                    validate, other.moved, kept.duration)  # fmt: skip
-            alternative = None if other.plan is None else other.plan.duration
+                alternative = None  # the replay rejects it: no alternative
             return _finish("repaired", kept, instance, scene, cut, started, validate, moved,
                            alternative)  # fmt: skip
     slices = {a: scene.layout.slice(a) for a in scene.arm_names}

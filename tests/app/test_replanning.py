@@ -128,6 +128,29 @@ def test_a_fresh_continuation_shorter_than_the_repair_is_kept(
     assert len(_grasp_poses(out.plan, "o4", out.cut)) == 1
 
 
+@pytest.mark.parametrize("failure", ["no plan", "rejected"])
+def test_the_repair_is_kept_when_the_fresh_continuation_fails(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, monkeypatch: pytest.MonkeyPatch,
+    failure: str,
+) -> None:  # fmt: skip
+    """The case above, with the fresh continuation of the comparison giving no plan in the
+    time left, or one the replay from the cut rejects (both made so here): the repair is
+    kept, with no alternative."""
+    from sdar_tamp.app import replanning
+
+    if failure == "no plan":
+        monkeypatch.setattr(replanning, "_fresh",
+                            lambda *a, **k: replanning._Fresh(None, (), "timeout"))  # fmt: skip
+    else:
+        monkeypatch.setattr(replanning, "check_from", lambda *a: (a[1], 1.0, "made to fail"))
+    instance, plan = d5
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    x, y, yaw = state_at(plan, starts, load_scene(), 5.116).resting["o4"]
+    text = f"poses: [{{name: o4, pose: [{x + 0.0052}, {y + 0.0173}, {yaw - 0.1559}]}}]"
+    out = _replan(d5, cache, text, at=5.116)
+    assert out.status == "repaired" and out.valid is True and out.alternative is None
+
+
 def test_a_repair_as_short_as_a_fresh_continuation_is_kept(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
