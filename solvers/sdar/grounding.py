@@ -94,6 +94,8 @@ class Grounder:
         self.skip_family: FamilyCheck | None = None
         """Assignments it answers True for are not grounded (they count as tried before:
         :mod:`~solvers.sdar.spending`)."""
+        self.first_found = False
+        """Stop at the first assignment of arms that grounds (the anytime finish)."""
         self.layout: Layout | None = None
         """With more than two arms: the current view's layout; assignments whose arms cross
         (:meth:`~solvers.sdar.tasks.Layout.conflicts`) come after the others."""
@@ -137,6 +139,8 @@ class Grounder:
                     self._tabu_met = True
                     continue
                 found.extend(self._ground(step, arms, mode))
+                if self.first_found and len(found) > grounded:
+                    break
             if not (len(found) > grounded or self._tabu_met or self.deadline.passed()):
                 self.k.failed(step)
             if len(self.home) > 2:

@@ -52,11 +52,11 @@ class SdarOptions:
     fewer_moves_after: tuple[int, int] = (2, 6)  # with more than two arms: failed motions
     # in a decision after which it tries steps of at most two moves (of steps of three moves
     # or more), then of one move (in all); see solvers.sdar.spending
-    finish_reserve: float = 2.0  # [s] per remaining object: with a finite max_time, once less
+    finish_reserve: float = 2.5  # [s] per remaining object: with a finite max_time, once less
     # than this is left per remaining object the run finishes with steps of at most
     # finish_moves moves (0: never); the reserve is at most finish_share of max_time
     finish_moves: int = 1
-    finish_share: float = 0.8
+    finish_share: float = 0.9
     finish_min_time: float = 20.0  # [s] runs of a shorter max_time never finish early (a short
     # budget is a latency budget, e.g. a repair's: its caller falls back itself)
     home: object = None  # the cell configuration (a value of the problem) idle arms wait at;

@@ -228,9 +228,9 @@ class SdarSolver:
                 self.deadline.reserve(finish_reserve(self.options, len(view.remaining)))
                 if self.deadline.soft_passed():
                     self._finish()
+            self.grounder.layout = view.layout
             if self.finishing:
                 view = finishing_view(view, self.options.finish_moves)
-            self.grounder.layout = view.layout
             if self.deadline.expired():
                 status = Status.TIMEOUT
                 diagnosis.append(f"max_time reached with {len(view.remaining)} object(s) left")
@@ -284,6 +284,8 @@ class SdarSolver:
         self.finishing = True
         self.deadline.reserve(float("inf"))
         self.grounder.options = finishing_options(self.grounder.options)
+        self.grounder.first_found = True
+        self.grounder.assigner.by_plane = True
         LOG.info(
             "finishing with steps of at most %d move(s), %.1f s left",
             self.options.finish_moves,
