@@ -373,7 +373,7 @@ class SdarSolver:
                 if not groundings or groundings[0].step.rank != ladder.best_rank:
                     ladder.left = 0  # the best rank is used up: the full motion planner
                     continue
-            if not groundings:
+            if not groundings or self.deadline.passed():  # no motion started past the limit
                 return None
             g = groundings[0]
             key = self.grounder.key(g.step, g.arms, g.options)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
+from typing import cast
 
 import pytest
 
@@ -14,10 +15,14 @@ from sdar_tamp.app.problem import rearrangement_problem, table_plane
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
 from sdar_tamp.world.instance import load_instance
+from solvers.sdar.assignment import ArmAssigner
 from solvers.sdar.attempts import MotionMode
 from solvers.sdar.budget import Deadline
+from solvers.sdar.cache import StreamCache
 from solvers.sdar.k_steps import TaskScene, meets, rotations
+from solvers.sdar.move_option import Option
 from solvers.sdar.options import SdarOptions
+from solvers.sdar.report import Failures
 from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
 from solvers.sdar.spending import (
@@ -205,3 +210,22 @@ def test_a_rotation_whose_arms_cross_is_not_proposed_one_apart_is() -> None:
     }
     kept = rotations(TaskScene(_layout_view(ring, edges)), 4)
     assert [step.objects for _, step in kept] == [("a", "b", "c")]
+
+
+def test_the_finish_takes_a_one_move_steps_arms_by_plane_reach_without_ik() -> None:
+    asked: list[str] = []
+
+    def options(arm: str, *args: object) -> list[Option]:
+        asked.append(arm)
+        return []
+
+    home = {"east": "q", "north": "q", "south": "q", "west": "q"}
+    assigner = ArmAssigner(
+        cast(StreamCache, None), SdarOptions(), home, cast(Failures, None), options
+    )
+    bases = ((0.6, 0.0), (0.0, 0.5), (0.0, -0.5), (-0.6, 0.0))  # sorted arms: e, n, s, w
+    layout = Layout({"a": ((0.5, -0.1), (0.5, -0.2))}, bases)
+    assigner.by_plane = True
+    order = assigner.assignments(Step((Move("a"),), "single"), layout)
+    assert order == [("east",), ("south",), ("north",), ("west",)]
+    assert asked == []  # no IK asked to rank them
