@@ -6,7 +6,9 @@ reach its object and its target (the first grasp option of that arm, from the gr
 soonest; of their combinations with distinct arms the ``SdarOptions.assignments`` of least total
 estimate (with the view's :class:`~solvers.sdar.tasks.Layout`, fewest crossing pairs of arms
 first). So at most ``(moves + 1) ** moves`` combinations are ranked, never every ``k``-tuple of
-arms.
+arms. With :attr:`ArmAssigner.by_plane` (the anytime finish of :mod:`~solvers.sdar.spending`)
+and a layout, a one-move step's arms come in the order of their plane reach
+(:meth:`~solvers.sdar.tasks.Layout.reach`), without asking IK first.
 """
 
 from __future__ import annotations
@@ -46,6 +48,8 @@ class ArmAssigner:
         self.home = home
         self.failures = failures
         self.move_options = move_options
+        self.by_plane = False
+        """One-move steps: every arm, nearest by the layout's plane reach first, no IK asked."""
 
     def assignments(self, step: Step, layout: Layout | None = None) -> list[tuple[str, ...]]:
         """Arms for the step's moves, in order, best first; empty (and the reason recorded in
@@ -55,6 +59,10 @@ class ArmAssigner:
         m = len(step.moves)
         if len(arms) <= 2:
             return list(itertools.permutations(arms, m))
+        if self.by_plane and m == 1 and layout is not None and step.objects[0] in layout.places:
+            obj = step.objects[0]
+            order = sorted(range(len(arms)), key=lambda k: (layout.reach(k, obj), k))
+            return [(arms[k],) for k in order]
         cost = self.reach_costs(step)
         per_move = [
             [a for _, a in sorted((cost[a, i], a) for a in arms if (a, i) in cost)][: m + 1]

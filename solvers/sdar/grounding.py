@@ -40,6 +40,8 @@ if TYPE_CHECKING:
 
 
 BufferCheck = Callable[[tuple[Move, ...], str, str], bool]
+#: ``(step, arms, mode)`` -> the family (the step's moves with these arms) is not grounded now
+FamilyCheck = Callable[[Step, tuple[str, ...], MotionMode], bool]
 
 
 @dataclass(frozen=True)
@@ -89,6 +91,11 @@ class Grounder:
         self._free: dict[Hashable, tuple[frozenset[str], ...]] = {}
         self.buffer_check: BufferCheck | None = None
         """Keeps only the buffers it accepts for (the step's moves, object, buffer pose)."""
+        self.skip_family: FamilyCheck | None = None
+        """Assignments it answers True for are not grounded (they count as tried before:
+        :mod:`~solvers.sdar.spending`)."""
+        self.first_found = False
+        """Stop at the first assignment of arms that grounds (the anytime finish)."""
         self.layout: Layout | None = None
         """With more than two arms: the current view's layout; assignments whose arms cross
         (:meth:`~solvers.sdar.tasks.Layout.conflicts`) come after the others."""
@@ -128,7 +135,12 @@ class Grounder:
             self._tabu_met = False
             grounded = len(found)
             for arms in self._assignments(step):
+                if self.skip_family is not None and self.skip_family(step, arms, mode):
+                    self._tabu_met = True
+                    continue
                 found.extend(self._ground(step, arms, mode))
+                if self.first_found and len(found) > grounded:
+                    break
             if not (len(found) > grounded or self._tabu_met or self.deadline.passed()):
                 self.k.failed(step)
             if len(self.home) > 2:

@@ -7,6 +7,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
+from sdar_tamp.errors import ParameterError
 from solvers.sdar.vocabulary import SdarVocabulary
 
 
@@ -48,6 +49,31 @@ class SdarOptions:
     quick_attempts: int = 6  # best-ranked groundings tried with the quick motion stream first
     progress: Callable[[int, int], None] | None = None  # (objects at goal, objects) per step
     plane: Plane | None = None  # with more than two arms: where objects are (see Plane)
+    fewer_moves_after: tuple[int, int] = (2, 6)  # with more than two arms: failed motions
+    # in a decision after which it tries steps of at most two moves (of steps of three moves
+    # or more), then of one move (in all); see solvers.sdar.spending
+    finish_reserve: float = 2.5  # [s] per remaining object: with a finite max_time, once less
+    # than this is left per remaining object the run finishes with steps of at most
+    # finish_moves moves (0: never); the reserve is at most finish_share of max_time
+    finish_moves: int = 1
+    finish_share: float = 0.9
+    finish_min_time: float = 20.0  # [s] runs of a shorter max_time never finish early (a short
+    # budget is a latency budget, e.g. a repair's: its caller falls back itself)
     home: object = None  # the cell configuration (a value of the problem) idle arms wait at;
     # None: the initial one (a plan re-planned from arms away from home gives the home)
     vocabulary: SdarVocabulary = field(default_factory=SdarVocabulary)
+
+    def __post_init__(self) -> None:
+        few = self.fewer_moves_after
+        if len(few) != 2 or not 1 <= few[0] <= few[1]:
+            raise ParameterError(
+                f"fewer_moves_after must be two counts 1 <= a <= b, got {self.fewer_moves_after}"
+            )
+        if self.finish_moves < 1:
+            raise ParameterError(f"finish_moves must be >= 1, got {self.finish_moves}")
+        if not 0 <= self.finish_share <= 1:
+            raise ParameterError(f"finish_share must be in [0, 1], got {self.finish_share}")
+        if not self.finish_min_time >= 0:
+            raise ParameterError(f"finish_min_time must be >= 0 [s], got {self.finish_min_time}")
+        if not self.finish_reserve >= 0:
+            raise ParameterError(f"finish_reserve must be >= 0 [s], got {self.finish_reserve}")

@@ -38,6 +38,7 @@ from sdar_tamp.graph import DependencyGraph
 from sdar_tamp.language.formula_model import And, Atom
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
+from sdar_tamp.logs import get_logger
 from solvers.sdar.attempts import MotionMode, QuickLadder, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
@@ -53,8 +54,16 @@ from solvers.sdar.report import (
     build_solution,
     planned_step,
 )
+from solvers.sdar.spending import (
+    DecisionSpend,
+    finish_reserve,
+    finishing_options,
+    finishing_view,
+)
 from solvers.sdar.tasks import Layout, Step, TaskPlanner, TaskView
 from solvers.solution import Solution, Status
+
+LOG = get_logger(__name__)
 
 # SdarOptions and PlannedStep: their homes are options.py and report.py
 __all__ = ["Decision", "PlannedStep", "SdarOptions", "SdarSolver", "run_to_end"]
@@ -107,7 +116,11 @@ class SdarSolver:
         self.recovery = Recovery(self.cache, self.options, self.goals, tuple(self.home),
                                  self.deadline)  # fmt: skip
         self.grounder.buffer_check = self.recovery.buffer_clear
+        self.grounder.skip_family = self._family_spent
         self.records: list[TaskRecord] = []
+        self.spend: DecisionSpend = DecisionSpend(len(self.home), self.options.fewer_moves_after)
+        self.finishing = False
+        """The anytime finish: one-move steps until the goal (:mod:`~solvers.sdar.spending`)."""
         self.visited: set[frozenset[tuple[str, str]]] = set()  # arrangements met so far
 
     # -- set-up ------------------------------------------------------------------------------
@@ -211,8 +224,14 @@ class SdarSolver:
             view = self.view()
             if not view.remaining:
                 break
+            if not self.finishing:
+                self.deadline.reserve(finish_reserve(self.options, len(view.remaining)))
+                if self.deadline.soft_passed():
+                    self._finish()
             self.grounder.layout = view.layout
-            if time.perf_counter() - start > self.options.max_time:
+            if self.finishing:
+                view = finishing_view(view, self.options.finish_moves)
+            if self.deadline.expired():
                 status = Status.TIMEOUT
                 diagnosis.append(f"max_time reached with {len(view.remaining)} object(s) left")
                 break
@@ -223,10 +242,14 @@ class SdarSolver:
             self._check_sizes(proposed)
             candidates = self._new_arrangements(self.recovery.allowed(proposed))
             self.failures.clear()
+            self.spend = DecisionSpend(len(self.home), self.options.fewer_moves_after)
             planned = len(self.executor.plan)
             if self._decide(view, candidates, decision):
                 added = self.executor.plan[planned:]
                 yield planned_step(self.cache, len(self.records) - 1, self.records[-1], added)
+                continue
+            if not self.finishing and self.deadline.soft_passed() and not self.deadline.expired():
+                self._finish()  # the soft limit cut the decision short: finish from here
                 continue
             if self.deadline.passed():
                 status = Status.TIMEOUT
@@ -251,6 +274,23 @@ class SdarSolver:
             self.executor.cost,
         )
         return build_solution(self.cache, summary, self.records)
+
+    def _family_spent(self, step: Step, arms: tuple[str, ...], mode: MotionMode) -> bool:
+        return self.spend.blocked(step, arms, mode)
+
+    def _finish(self) -> None:
+        """Start the anytime finish (see :mod:`~solvers.sdar.spending`): no soft limit any
+        more, the first grounding found is taken."""
+        self.finishing = True
+        self.deadline.reserve(float("inf"))
+        self.grounder.options = finishing_options(self.grounder.options)
+        self.grounder.first_found = True
+        self.grounder.assigner.by_plane = True
+        LOG.info(
+            "finishing with steps of at most %d move(s), %.1f s left",
+            self.options.finish_moves,
+            self.deadline.left(),
+        )
 
     def _check_sizes(self, candidates: Sequence[Step]) -> None:
         """Every candidate holds at most one move per arm.
@@ -326,14 +366,14 @@ class SdarSolver:
         tried = 0
         while not self.deadline.passed():
             mode = ladder.mode
-            groundings = self.grounder.select(candidates, mode)
+            groundings = self.grounder.select(self.spend.allowed(candidates), mode)
             if mode is MotionMode.QUICK:
                 if ladder.best_rank is None and groundings:
                     ladder.best_rank = groundings[0].step.rank
                 if not groundings or groundings[0].step.rank != ladder.best_rank:
                     ladder.left = 0  # the best rank is used up: the full motion planner
                     continue
-            if not groundings:
+            if not groundings or self.deadline.passed():  # no motion started past the limit
                 return None
             g = groundings[0]
             key = self.grounder.key(g.step, g.arms, g.options)
@@ -356,6 +396,7 @@ class SdarSolver:
                     self.planner.commit(g.step, view)
                 return g.step
             self.tabu.add(key, mode)
+            self.spend.failed(g.step, g.arms, mode)
             if mode is MotionMode.QUICK:
                 ladder.left -= 1
         return None

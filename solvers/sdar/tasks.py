@@ -110,16 +110,35 @@ class Layout:
             for k in (0, 1)
         )
 
+    def sweep_gap(self, arm: int, obj: str, other_arm: int, other: str) -> float:
+        """The least distance [m] between the two arms' plane segments over their transfers:
+        each from its base to the point a fraction ``s`` of the way from its object's pose to
+        its goal, both at the same ``s`` (synchronous motions), for ``s`` in :data:`SWEEP`
+        (0 and 1 are :meth:`arm_gap`'s picks and places)."""
+        (a0, a1), (b0, b1) = self.places[obj], self.places[other]
+        return min(
+            _segment_gap(self.bases[arm], _lerp(a0, a1, s), self.bases[other_arm], _lerp(b0, b1, s))
+            for s in SWEEP
+        )
+
     def crosses(self, arm: int, obj: str, other_arm: int, other: str) -> bool:
         """Arm ``arm`` moving ``obj`` while ``other_arm`` moves ``other`` in the same step:
-        their :meth:`arm_gap` is under ``clearance``; two arms reaching so meet."""
-        return self.arm_gap(arm, obj, other_arm, other) < self.clearance
+        their :meth:`sweep_gap` is under ``clearance``; two arms reaching so meet."""
+        return self.sweep_gap(arm, obj, other_arm, other) < self.clearance
 
     def conflicts(self, assigned: Sequence[tuple[int, str]]) -> int:
         """Pairs of (arm, object) in ``assigned`` that :meth:`crosses`."""
         return sum(
             1 for (a, x), (b, y) in itertools.combinations(assigned, 2) if self.crosses(a, x, b, y)
         )
+
+
+#: Fractions of a transfer at which :meth:`Layout.sweep_gap` compares two arms.
+SWEEP = (0.0, 0.25, 0.5, 0.75, 1.0)
+
+
+def _lerp(p: tuple[float, float], q: tuple[float, float], s: float) -> tuple[float, float]:
+    return (p[0] + s * (q[0] - p[0]), p[1] + s * (q[1] - p[1]))
 
 
 def _segment_gap(
