@@ -84,21 +84,45 @@ class StreamMovePlanner:
         return None if not np.isfinite(best) else best
 
     def plan(
-        self, arm: int, stand: Stand, move: Move, resting: Mapping[str, Pose]
+        self,
+        arm: int,
+        stand: Stand,
+        move: Move,
+        resting: Mapping[str, Pose],
+        others: Sequence[FloatArray] | None = None,
     ) -> Iterator[PlannedMove]:
         name = self.names[arm]
+        home = {a: self.ctx.home(a) for a in self.names if a != name}
+        wheres = [home]
+        if others is not None:
+            standing = {a: np.asarray(q) for a, q in zip(self.names, others, strict=True)}
+            standing.pop(name)
+            if any(np.abs(standing[a] - home[a]).max() > 1e-9 for a in standing):
+                wheres.insert(0, standing)
+        for where in wheres:
+            yield from self._plan(name, stand, move, resting, where)
+
+    def _plan(
+        self,
+        name: str,
+        stand: Stand,
+        move: Move,
+        resting: Mapping[str, Pose],
+        where: Mapping[str, FloatArray],
+    ) -> Iterator[PlannedMove]:
+        """The planned moves with the other arms standing ``where`` (arm name -> joints)."""
         boxes = {o: self.streams.box(o, Pose2D(*p)) for o, p in resting.items()}
         after = dict(resting)
         after[move.obj] = move.end
         after_boxes = {o: self.streams.box(o, Pose2D(*p)) for o, p in after.items()}
-        current = {a: self.ctx.home(a) for a in self.names}
-        current[name] = stand.q
+        current = {**where, name: stand.q}
         picks = collision_free_candidates(
             self.ctx,
             self.scenes.world(frozenset(resting.items()), boxes),
             boxes,
             self.table(name, move.obj, move.start),
             current,
+            other_q=where,
         )
         places = collision_free_candidates(
             self.ctx,
@@ -106,6 +130,7 @@ class StreamMovePlanner:
             after_boxes,
             self.table(name, move.obj, move.end),
             current,
+            other_q=where,
         )
         pairs = [
             (
@@ -126,17 +151,18 @@ class StreamMovePlanner:
             grasp: Grasp = pick.grasp
             q_pick = ArmConf(name, tuple(map(float, pick.q)), tuple(map(float, pick.q_pre)))
             q_place = ArmConf(name, tuple(map(float, place.q)), tuple(map(float, place.q_pre)))
-            reach = self.motion(name, self.conf(name, stand), q_pick, fluents)
+            reach = self.motion(name, self.conf(name, stand), q_pick, fluents, where)
             if reach is None:
                 continue
-            carry = self.motion(name, q_pick, q_place, [*held, ("holding", name, move.obj, grasp)])
+            holding = [*held, ("holding", name, move.obj, grasp)]
+            carry = self.motion(name, q_pick, q_place, holding, where)
             if carry is None:
                 continue
             yield PlannedMove(
                 reach,
                 carry,
                 inverse(grasp.T_object_tcp),
-                Stand(np.array(place.q), np.array(place.q_pre)),
+                Stand(np.array(place.q), np.array(place.q_pre), approach_back(carry, place.q_pre)),
             )
 
     def buffer(self, move: Move, moves: Sequence[Move]) -> Pose | None:
@@ -189,3 +215,14 @@ class StreamMovePlanner:
                 else (np.array(traj.t), np.array(traj.q[:, self.ctx.layout.slice(name)]))
             )
         return self.motions[key]
+
+
+def approach_back(
+    motion: tuple[FloatArray, FloatArray], q_pre: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The end of ``motion`` (times ``(m,)``, configurations ``(m, k)``) from its last pass
+    by the pre-grasp ``q_pre`` on, played backwards: the way back out along the approach."""
+    t, q = motion
+    i = int(np.argmin(np.abs(q - np.asarray(q_pre)).max(axis=1)))
+    i = min(i, len(q) - 2)
+    return t[-1] - t[i:][::-1], q[i:][::-1].copy()
