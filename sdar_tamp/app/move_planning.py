@@ -217,12 +217,9 @@ class StreamMovePlanner:
         return self.motions[key]
 
 
-def approach_back(
-    motion: tuple[FloatArray, FloatArray], q_pre: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """The end of ``motion`` (times ``(m,)``, configurations ``(m, k)``) from its last pass
-    by the pre-grasp ``q_pre`` on, played backwards: the way back out along the approach."""
-    t, q = motion
+def approach_back(motion: tuple[FloatArray, FloatArray], q_pre: FloatArray) -> FloatArray:
+    """The path of ``motion`` (times ``(m,)``, configurations ``(m, k)``) from its pass by
+    the pre-grasp ``q_pre`` to its end, backwards: the way back out along the approach."""
+    q = motion[1]
     i = int(np.argmin(np.abs(q - np.asarray(q_pre)).max(axis=1)))
-    i = min(i, len(q) - 2)
-    return t[-1] - t[i:][::-1], q[i:][::-1].copy()
+    return q[min(i, len(q) - 2) :][::-1].copy()

@@ -18,13 +18,13 @@ from sdar_tamp.world.transforms import FloatArray
 class Stand:
     """Where an arm stands: ``q`` ``(k,)`` [rad] and, when it stands at a grasp or release
     configuration, ``pre`` ``(k,)`` (the pre-grasp it must retreat through), else None;
-    ``back``: the motion (times ``(m,)``, configurations ``(m, k)``) from ``q`` out to ``pre``
-    along the approach that brought the arm there, when known (else a straight joint-space
-    segment is taken)."""
+    ``back``: the path (configurations ``(m, k)``) from ``q`` out to ``pre`` along the
+    approach that brought the arm there, when known (else a straight joint-space segment is
+    taken)."""
 
     q: FloatArray
     pre: FloatArray | None = None
-    back: tuple[FloatArray, FloatArray] | None = None
+    back: FloatArray | None = None
 
 
 @dataclass(frozen=True)

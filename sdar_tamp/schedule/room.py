@@ -54,12 +54,8 @@ class Room(Placement):
         stand = self.stand[arm]
         if stand.pre is None:
             return False
-        if stand.back is not None:
-            t, q_path = stand.back
-        else:
-            q_path = np.linspace(stand.q, stand.pre, 9)
-            t = np.linspace(0.0, 1.0, 9)
-        q = self.retimers[arm].retime(t, q_path, True, False)
+        q_path = stand.back if stand.back is not None else np.linspace(stand.q, stand.pre, 9)
+        q = self.retimers[arm].retime(rest_to_rest(q_path), q_path, True, False)
         mark = self.mark()
         try:
             self.place([Entry(arm, block_of(arm, q), q, 0)])
@@ -115,6 +111,19 @@ class Room(Placement):
         self.waits += 1
 
 
+def rest_to_rest(q: FloatArray) -> FloatArray:
+    """Times ``(m,)`` [s] that play the path ``q`` ``(m, k)`` from rest to rest on a slow
+    cosine profile of its length (at least 1 s, 4 s per radian of the largest joint step):
+    the path's own timing (a stretch cut out of a motion) need not start or end at rest."""
+    steps = np.abs(np.diff(q, axis=0)).max(axis=1)
+    s = np.concatenate([[0.0], np.cumsum(steps)])
+    total = float(s[-1])
+    if total <= 0.0:
+        return np.linspace(0.0, 1.0, len(q))
+    duration = max(1.0, 4.0 * float(np.abs(q[-1] - q[0]).max()), 4.0 * total)
+    return duration * np.arccos(np.clip(1.0 - 2.0 * s / total, -1.0, 1.0)) / np.pi
+
+
 def block_of(arm: int, q: FloatArray, event: PlanEvent | None = None) -> Block:
     """A motion ``q`` of ``arm`` to place, ending in ``event`` when given."""
     return Block(arm, q, q, event, 0.0, 0.0, 0, None)
@@ -125,4 +134,4 @@ def no_block(arm: int) -> Block:
     return Block(arm, np.zeros((1, 1)), np.zeros((1, 1)), None, 0.0, 0.0, 0, None)
 
 
-__all__ = ["Room", "block_of", "no_block"]
+__all__ = ["Room", "block_of", "no_block", "rest_to_rest"]

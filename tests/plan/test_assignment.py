@@ -24,6 +24,7 @@ from sdar_tamp.app.move_planning import StreamMovePlanner
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_rules import check_timeline
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule.assignment import (
     FINGER_ROOM,
@@ -34,6 +35,7 @@ from sdar_tamp.schedule.assignment import (
     schedule_assigned,
 )
 from sdar_tamp.schedule.moves import CyclicMoves, Move, break_cycles, plan_moves, stuck_moves
+from sdar_tamp.schedule.room import rest_to_rest
 from sdar_tamp.schedule.scheduler import retimer
 from sdar_tamp.schedule.sweep import WorldSweep
 from sdar_tamp.world.collision import CollisionWorld
@@ -250,14 +252,16 @@ def test_an_arm_that_finished_retreats_along_its_approach(
     assert search.take(0, m)
     stand, released = search.stand[0], search.horizon(0)
     assert stand.pre is not None and stand.back is not None
-    assert np.allclose(stand.back[1][0], stand.q) and np.allclose(stand.back[1][-1], stand.pre)
+    assert np.allclose(stand.back[0], stand.q) and np.allclose(stand.back[-1], stand.pre)
     assert search.retreat(0)
     retreat = search.horizon(0) - released
     assert retreat > 0 and np.allclose(search.traj[0][-1], stand.pre, atol=1e-9)
     assert search.stand[0].pre is None and not search.parked[0]
     assert dict(search.figures())["retreats"] == 1.0
     assert not search.retreat(0)  # at no grasp or release: nothing to retreat from
-    report = validate_plan(instance, search.assemble(), ctx.scene)
+    result = search.assemble()
+    assert check_timeline(result, ctx.scene) is None  # from rest to rest, within the limits
+    report = validate_plan(instance, result, ctx.scene)
     assert report.violation is None or report.violation.kind == "goal", report.violation
     # the way home from the release configuration takes longer
     home = _search(ctx, instance, plan, planner)
@@ -337,3 +341,14 @@ def test_assignment_options_are_checked() -> None:
         with pytest.raises(ParameterError, match=next(iter(kwargs))):
             AssignmentOptions(**kwargs)
     assert AssignmentOptions(replans=0, slack=math.inf).replans == 0
+
+
+def test_a_retreat_cut_out_of_a_motion_still_starts_and_ends_at_rest() -> None:
+    """The retreat's path is the end of a carry, moving where it is cut: its times are made
+    anew, from rest to rest on a cosine profile of the path's length."""
+    q = np.linspace([0.0, 0.0], [0.3, -0.1], 13)
+    t = rest_to_rest(q)
+    assert t[0] == 0.0 and np.all(np.diff(t) > 0.0) and t[-1] >= 1.0
+    v = np.diff(q[:, 0]) / np.diff(t)
+    assert abs(v[0]) < abs(v[len(v) // 2]) and abs(v[-1]) < abs(v[len(v) // 2])
+    assert np.allclose(rest_to_rest(np.zeros((4, 2))), np.linspace(0.0, 1.0, 4))
