@@ -7,9 +7,12 @@ both the move's start and end poses (one grasp: the object lands as the synchron
 it). :meth:`StreamMovePlanner.estimate` ranks the pairs of inverse-kinematics branches of every
 grasp by the rest-to-rest times (each joint at its velocity and acceleration limits) from where
 the arm stands to the grasp and on to the release, collisions ignored; :meth:`~.plan` checks the
-best pairs against the resting objects and plans the two motions (retreat, transfer, approach)
-with the motion planner (its first rung, then its whole ladder), the other arms at home (on the
-way home, :meth:`~.park`, where they stand).
+best pairs against the resting objects and the other arms and plans the two motions (retreat,
+transfer, approach) with the motion planner (its first rung, then its whole ladder), first with
+the other arms standing where the caller says (where their committed timelines end, or where
+the scheduler's sweep met one), then with them at home (on the way home, :meth:`~.park`, where
+they stand). A planned move tells the way back out of its release (:func:`approach_back`: its
+approach backwards), which the scheduler's short retreat follows.
 :meth:`~.buffer` is the buffer stream's first pose clear of every pose the plan's moves use.
 """
 
