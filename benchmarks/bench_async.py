@@ -7,7 +7,8 @@ executed three ways side by side: synchronously, re-timed step by step
 arm (:func:`sdar_tamp.schedule.timelines.schedule_timelines`; ``best`` is what ``--execution
 timelines`` returns: the shorter of the two that the replay accepts) and with the moves assigned
 anew to whichever arm is free (:func:`sdar_tamp.schedule.assignment.schedule_assigned`;
-``assign`` is its own schedule, nan when none is found; the ratio after it is what
+``assign`` is its own schedule, nan when none is found, ``a/sync`` its ratio to the synchronous
+time; the ratio after it is what
 ``--execution assigned`` returns: the shortest of the three the replay accepts; ``--no-assigned``
 leaves it out). Every plan is checked by
 the independent replay. Execution time is the plan's duration; a scheduler that finds no
@@ -85,8 +86,8 @@ def main(argv: list[str] | None = None) -> None:
     solve_config = PlannerConfig(max_time=args.time_limit, execution="sync")
     rows = []
     print(f"{'instance':>8} {'sync [s]':>9} {'retime':>7} {'lines':>7} {'best':>7} {'ratio':>6} "
-          f"{'assign':>7} {'ratio':>6} {'valid':>5} {'bound':>6} {'dep':>5} {'arms':>5} "
-          f"{'tog':>3} {'cut':>5} {'time [s]':>8}  note")  # fmt: skip
+          f"{'assign':>7} {'a/sync':>6} {'ratio':>6} {'valid':>5} {'bound':>6} {'dep':>5} "
+          f"{'arms':>5} {'tog':>3} {'cut':>5} {'time [s]':>8}  note")  # fmt: skip
     for path in files:
         instance = load_instance(path)
         plan = stored_or_solved(
@@ -144,6 +145,9 @@ def main(argv: list[str] | None = None) -> None:
                 "order": today.order,
                 "assigned": None if assigned is None else round(assigned.plan.duration, 3),
                 "assigned_found": None if assigned is None else assigned.async_duration,
+                "ratio_assigned_own": None
+                if assigned is None or assigned.async_duration is None
+                else round(assigned.async_duration / plan.duration, 4),
                 "assigned_kept": assigned is not None and assigned.asynchronous,
                 "assigned_reason": "" if assigned is None else assigned.reason,
                 "best_assigned": round(best_assigned, 3),
@@ -169,7 +173,8 @@ def main(argv: list[str] | None = None) -> None:
         tog, cut = int(figures.get("together", 0)), figures.get("shortcut_saved", 0.0)
         print(f"{path.stem:>8} {plan.duration:9.2f} {today.plan.duration:7.2f} "
               f"{lines.plan.duration:7.2f} {best:7.2f} {best / plan.duration:6.3f} "
-              f"{found or float('nan'):7.2f} {best_assigned / plan.duration:6.3f} "
+              f"{found or float('nan'):7.2f} {(found or float('nan')) / plan.duration:6.3f} "
+              f"{best_assigned / plan.duration:6.3f} "
               f"{rows[-1]['valid']!s:>5} {bound:6.2f} {dep:5.1f} {arms:5.1f} {tog:3d} "
               f"{cut:5.2f} {sum(elapsed):8.1f}  {note}", flush=True)  # fmt: skip
 

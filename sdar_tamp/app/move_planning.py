@@ -7,9 +7,12 @@ both the move's start and end poses (one grasp: the object lands as the synchron
 it). :meth:`StreamMovePlanner.estimate` ranks the pairs of inverse-kinematics branches of every
 grasp by the rest-to-rest times (each joint at its velocity and acceleration limits) from where
 the arm stands to the grasp and on to the release, collisions ignored; :meth:`~.plan` checks the
-best pairs against the resting objects and plans the two motions (retreat, transfer, approach)
-with the motion planner (its first rung, then its whole ladder), the other arms at home (on the
-way home, :meth:`~.park`, where they stand).
+best pairs against the resting objects and the other arms and plans the two motions (retreat,
+transfer, approach) with the motion planner (its first rung, then its whole ladder), first with
+the other arms standing where the caller says (where their committed timelines end, or where
+the scheduler's sweep met one), then with them at home (on the way home, :meth:`~.park`, where
+they stand). A planned move tells the way back out of its release (:func:`approach_back`: its
+approach backwards), which the scheduler's short retreat follows.
 :meth:`~.buffer` is the buffer stream's first pose clear of every pose the plan's moves use.
 """
 
@@ -84,21 +87,45 @@ class StreamMovePlanner:
         return None if not np.isfinite(best) else best
 
     def plan(
-        self, arm: int, stand: Stand, move: Move, resting: Mapping[str, Pose]
+        self,
+        arm: int,
+        stand: Stand,
+        move: Move,
+        resting: Mapping[str, Pose],
+        others: Sequence[FloatArray] | None = None,
     ) -> Iterator[PlannedMove]:
         name = self.names[arm]
+        home = {a: self.ctx.home(a) for a in self.names if a != name}
+        wheres = [home]
+        if others is not None:
+            standing = {a: np.asarray(q) for a, q in zip(self.names, others, strict=True)}
+            standing.pop(name)
+            if any(np.abs(standing[a] - home[a]).max() > 1e-9 for a in standing):
+                wheres.insert(0, standing)
+        for where in wheres:
+            yield from self._plan(name, stand, move, resting, where)
+
+    def _plan(
+        self,
+        name: str,
+        stand: Stand,
+        move: Move,
+        resting: Mapping[str, Pose],
+        where: Mapping[str, FloatArray],
+    ) -> Iterator[PlannedMove]:
+        """The planned moves with the other arms standing ``where`` (arm name -> joints)."""
         boxes = {o: self.streams.box(o, Pose2D(*p)) for o, p in resting.items()}
         after = dict(resting)
         after[move.obj] = move.end
         after_boxes = {o: self.streams.box(o, Pose2D(*p)) for o, p in after.items()}
-        current = {a: self.ctx.home(a) for a in self.names}
-        current[name] = stand.q
+        current = {**where, name: stand.q}
         picks = collision_free_candidates(
             self.ctx,
             self.scenes.world(frozenset(resting.items()), boxes),
             boxes,
             self.table(name, move.obj, move.start),
             current,
+            other_q=where,
         )
         places = collision_free_candidates(
             self.ctx,
@@ -106,6 +133,7 @@ class StreamMovePlanner:
             after_boxes,
             self.table(name, move.obj, move.end),
             current,
+            other_q=where,
         )
         pairs = [
             (
@@ -126,17 +154,18 @@ class StreamMovePlanner:
             grasp: Grasp = pick.grasp
             q_pick = ArmConf(name, tuple(map(float, pick.q)), tuple(map(float, pick.q_pre)))
             q_place = ArmConf(name, tuple(map(float, place.q)), tuple(map(float, place.q_pre)))
-            reach = self.motion(name, self.conf(name, stand), q_pick, fluents)
+            reach = self.motion(name, self.conf(name, stand), q_pick, fluents, where)
             if reach is None:
                 continue
-            carry = self.motion(name, q_pick, q_place, [*held, ("holding", name, move.obj, grasp)])
+            holding = [*held, ("holding", name, move.obj, grasp)]
+            carry = self.motion(name, q_pick, q_place, holding, where)
             if carry is None:
                 continue
             yield PlannedMove(
                 reach,
                 carry,
                 inverse(grasp.T_object_tcp),
-                Stand(np.array(place.q), np.array(place.q_pre)),
+                Stand(np.array(place.q), np.array(place.q_pre), approach_back(carry, place.q_pre)),
             )
 
     def buffer(self, move: Move, moves: Sequence[Move]) -> Pose | None:
@@ -189,3 +218,11 @@ class StreamMovePlanner:
                 else (np.array(traj.t), np.array(traj.q[:, self.ctx.layout.slice(name)]))
             )
         return self.motions[key]
+
+
+def approach_back(motion: tuple[FloatArray, FloatArray], q_pre: FloatArray) -> FloatArray:
+    """The path of ``motion`` (times ``(m,)``, configurations ``(m, k)``) from its pass by
+    the pre-grasp ``q_pre`` to its end, backwards: the way back out along the approach."""
+    q = motion[1]
+    i = int(np.argmin(np.abs(q - np.asarray(q_pre)).max(axis=1)))
+    return q[min(i, len(q) - 2) :][::-1].copy()

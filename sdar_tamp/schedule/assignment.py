@@ -13,24 +13,34 @@ with the order those moves must keep) and decides, event by event, which arm car
    (:meth:`MovePlanner.estimate`: rest-to-rest times between the arm's configuration and the
    move's grasp and release configurations) from the end of its timeline and the dependencies'
    times; a move the synchronous plan gave this arm is preferred when two finish within
-   :data:`TIE` of each other. The ``candidates`` best are tried in turn.
+   :data:`TIE` of each other. The ``candidates`` best are tried in turn (with a finite
+   ``slack``, one that releases its object more than ``slack`` later than estimated is
+   compared with the next and the earliest release kept; by default the first that goes).
 3. The move's single-arm motions (free arm -> grasp, grasp -> release, each with the retreat
    and approach of a grasp) come from the planner (:meth:`MovePlanner.plan`: the motion
-   planner against the static world of resting objects, the other arms at home), re-timed for
-   the arm alone by the time-optimal path timing, and are committed at the earliest start
-   whose replay (:mod:`.sweep`) is clear of every arm's committed, time-parameterised
-   trajectory, the table and the objects where they rest then (an arm whose timeline has ended
-   stands where it ends), after the dependencies: the object's previous release and the
-   blockers' grasps, a dwell before; when the arm, holding the object, would stand in another
-   arm's way before the carry can start, the grasp is moved later. A planned path that never
-   clears within ``max_wait`` is dropped for the planner's next one, then for the next move.
-   When none of the ``candidates`` goes, the other arms standing in the workspace where their
-   timelines end go home and the best move is tried once more.
-4. An arm that finds no move to take goes to its home configuration (out of the workspace)
-   when it is not there, else waits until the next arm's timeline ends (the next event).
-   When every arm has come to one time, the arms still in the workspace go home; when every
-   arm is home and no move can be committed, there is no schedule
-   (:class:`~sdar_tamp.schedule.scheduler.NoPlacement`); the caller keeps another one.
+   planner against the static world of resting objects and the other arms standing where
+   their committed timelines end, then with the other arms at home), re-timed for the arm
+   alone by the time-optimal path timing, and are committed at the earliest start whose
+   replay (:mod:`.sweep`) is clear of every arm's committed, time-parameterised trajectory
+   (sampled at the same ticks: a motion may pass where another arm was, once it has left),
+   the table and the objects where they rest then (an arm whose timeline has ended stands
+   where it ends), after the dependencies: the object's previous release and the blockers'
+   grasps, a dwell before; when the arm, holding the object, would stand in another arm's
+   way before the carry can start, the grasp is moved later. When the earliest start meets
+   another arm and the motion waits :data:`DETOUR_AFTER` or more, the move is planned again
+   with that arm standing where the sweep met it (a conflict-based retry) and the path that
+   releases the object first is kept. A planned path that never clears within ``max_wait``
+   is dropped for the planner's next one, then for the next move. When none of the
+   ``candidates`` goes, the other arms that the attempts met (every other arm when they met
+   none) retreat from the grasp or release configuration where they stand to its pre-grasp
+   (back out along their approach, a few cm off the object) and the best move is tried once
+   more; then those arms go home and it is tried again.
+4. An arm that finds no move to take retreats to its pre-grasp when it stands at a grasp or
+   release configuration, else waits until the next arm's timeline ends (the next event); it
+   goes home only when another arm needs the room (step 3). When every arm has come to one
+   time, the arms still in the workspace go home; when every arm is home and no move can be
+   committed, there is no schedule (:class:`~sdar_tamp.schedule.scheduler.NoPlacement`); the
+   caller keeps another one.
 
 A move is committed whole (grasp and release together), so no arm ever holds an object while
 it waits for another arm: the only order is the moves' own, which the synchronous plan proves
@@ -41,27 +51,26 @@ one object sent through a buffer (:func:`~.moves.break_cycles`, :meth:`MovePlann
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
-from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
-from typing import Protocol
+from collections.abc import Iterator
 
 import numpy as np
 
 from sdar_tamp.plan_file import PlanEvent, PlanFile
 from sdar_tamp.plan_rules import check_timeline
+from sdar_tamp.schedule.move_records import AssignmentOptions, MovePlanner, PlannedMove, Stand
 from sdar_tamp.schedule.moves import CyclicMoves, Move, Pose, break_cycles, plan_moves
-from sdar_tamp.schedule.pieces import Block
 from sdar_tamp.schedule.retiming import ArmRetimer
+from sdar_tamp.schedule.room import Room, block_of, no_block
 from sdar_tamp.schedule.scheduler import (
     Entry,
     NoPlacement,
-    Placement,
     Schedule,
     ScheduleOptions,
     retimer,
 )
-from sdar_tamp.schedule.sweep import WorldSweep
+from sdar_tamp.schedule.sweep import Conflict, WorldSweep
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray
@@ -74,73 +83,14 @@ TIE = 0.05
 FINGER_ROOM = 0.03
 #: starts tried for a move's grasp when the carry after it finds none
 REGRASPS = 3
+#: [s] a move whose reach or carry waits this long for another arm is planned again with
+#: that arm where the wait met it (:meth:`Assignment.take`)
+DETOUR_AFTER = 0.2
+#: planned paths tried in such a retry
+PAIRS_TRIED = 2
 
 
-@dataclass(frozen=True)
-class Stand:
-    """Where an arm stands: ``q`` ``(k,)`` [rad] and, when it stands at a grasp or release
-    configuration, ``pre`` ``(k,)`` (the pre-grasp it must retreat through), else None."""
-
-    q: FloatArray
-    pre: FloatArray | None = None
-
-
-@dataclass(frozen=True)
-class PlannedMove:
-    """One arm's motions of a move: ``reach`` (from where it stands to the grasp) and
-    ``carry`` (grasp to release), each as times ``(m,)`` [s] and configurations ``(m, k)``
-    [rad]; ``T_tcp_object`` ``(4, 4)``: the grasp; ``end``: where the arm then stands."""
-
-    reach: tuple[FloatArray, FloatArray]
-    carry: tuple[FloatArray, FloatArray]
-    T_tcp_object: FloatArray
-    end: Stand
-
-
-class MovePlanner(Protocol):
-    """Grasps, inverse kinematics and single-arm motions of a cell (the streams)."""
-
-    def estimate(self, arm: int, stand: Stand, move: Move) -> float | None:
-        """Estimated duration [s] of ``move`` by arm ``arm`` (scene order) from ``stand``,
-        motions only; None when the arm cannot grasp the object at both poses."""
-        ...
-
-    def plan(
-        self, arm: int, stand: Stand, move: Move, resting: Mapping[str, Pose]
-    ) -> Iterator[PlannedMove]:
-        """The arm's motions for ``move``, best first, against the objects ``resting``
-        (name -> pose; the moved object at its start)."""
-        ...
-
-    def buffer(self, move: Move, moves: Sequence[Move]) -> Pose | None:
-        """A free pose for ``move``'s object, clear of every pose of ``moves``, or None."""
-        ...
-
-    def park(
-        self, arm: int, stand: Stand, resting: Mapping[str, Pose], others: Sequence[FloatArray]
-    ) -> tuple[FloatArray, FloatArray] | None:
-        """The arm's motion (times ``(m,)``, configurations ``(m, k)``) from ``stand`` to its
-        home configuration, the other arms standing at ``others`` (per arm, scene order; the
-        arm's own entry is ignored), or None."""
-        ...
-
-
-@dataclass(frozen=True)
-class AssignmentOptions:
-    """``candidates``: the ready moves tried per decision (best estimate first); ``stride``:
-    ticks between the starts tried for a motion (a wait is rounded up to it); ``max_wait``
-    [s]: the longest wait tried before a motion (past it the arm does something else);
-    ``max_checks``: the collision queries of the whole search (past them no schedule);
-    ``max_plans``: motion-planner calls of the whole search."""
-
-    candidates: int = 3
-    stride: int = 5
-    max_wait: float = 4.0
-    max_checks: int = 400_000
-    max_plans: int = 400
-
-
-class Assignment(Placement):
+class Assignment(Room):
     """The event-driven assignment of moves to arms (see the module docstring)."""
 
     def __init__(
@@ -167,6 +117,12 @@ class Assignment(Placement):
         self.planning_time = 0.0
         self.waits = 0
         self.parks = 0
+        self.retreats = 0
+        self.slack = assignment.slack
+        self.estimated: dict[int, int] = {}  # move -> its estimated release [ticks]
+        self.in_way: set[int] = set()  # arms met by the failed attempts of the decision
+        self.detours = 0
+        self.detours_kept = 0
         self.not_before = 0  # the least start of the reach being committed [ticks]
         self.stride = assignment.stride
         self.give_up_standing = True
@@ -202,20 +158,48 @@ class Assignment(Placement):
     def run(self) -> PlanFile:
         pending = list(self.moves)
         while pending:
-            if self.sweep.checks >= self.options.max_checks or self.plans >= self.options.max_plans:
-                raise NoPlacement(_no_block(0), None, "out of collision checks or motion plans")
+            if (
+                self.sweep.queries >= self.options.max_checks
+                or self.plans >= self.options.max_plans
+            ):
+                raise NoPlacement(no_block(0), None, "out of collision checks or motion plans")
             arm = min(self.arms, key=lambda a: (self.horizon(a), a))
             ranked = self.rank(arm, [m for m in pending if self.ready_move(m)])
-            done = next((m for m in ranked[: self.options.candidates] if self.take(arm, m)), None)
-            if done is None and ranked and self.clear_way(arm):
-                done = next((m for m in ranked[:1] if self.take(arm, m)), None)
+            self.in_way = set()
+            done = self.choose(arm, ranked[: self.options.candidates])
+            for clear in (self.back_off, self.clear_way):
+                if done is None and ranked and clear(arm):
+                    done = next((m for m in ranked[:1] if self.take(arm, m)), None)
             if done is not None:
                 pending.remove(done)
-            elif not self.parked[arm] and self.park(arm):
+            elif self.stand[arm].pre is not None and self.retreat(arm):
                 continue
             else:
                 self.wait(arm)
         return self.assemble()
+
+    def choose(self, arm: int, ranked: list[Move]) -> Move | None:
+        """Commit the first of ``ranked`` that releases its object within ``slack`` [s] of
+        the estimate; when each is later than that (it waits for other arms), the one that
+        releases first (None when none can be committed)."""
+        late: list[tuple[int, int, Move]] = []
+        for n, m in enumerate(ranked):
+            mark, before = self.mark(), (self.stand[arm], self.parked[arm], self.rest[m.obj])
+            if not self.take(arm, m):
+                continue
+            release = self.release_tick[m.index]
+            on_time = release * self.tick <= self.estimated[m.index] * self.tick + self.slack
+            if (on_time or n + 1 == len(ranked)) and (not late or release <= min(late)[0]):
+                return m
+            late.append((release, n, m))
+            self.undo(mark)
+            self.stand[arm], self.parked[arm], self.rest[m.obj] = before
+            for book in (self.carrier, self.grasp_tick, self.release_tick):
+                del book[m.index]
+        for _, _, m in sorted(late, key=lambda x: x[:2]):
+            if self.take(arm, m):
+                return m
+        return None
 
     def rank(self, arm: int, ready: list[Move]) -> list[Move]:
         """``ready`` moves the arm can do, by estimated finishing time (ties: the arm's own)."""
@@ -230,38 +214,84 @@ class Assignment(Placement):
                 max(max(h, grasp) + est + self.dwell * self.tick, release) + self.dwell * self.tick
             )
             scored.append((round(finish / TIE), m.arm != arm, m.index, m))
+            self.estimated[m.index] = math.ceil((finish - self.dwell * self.tick) / self.tick)
         scored.sort(key=lambda s: s[:3])
         return [s[3] for s in scored]
 
     def take(self, arm: int, m: Move) -> bool:
-        """Plan and commit ``m`` by ``arm``; False when no planned path can be committed."""
+        """Plan and commit ``m`` by ``arm``; False when no planned path can be committed.
+
+        The motions are planned against the other arms standing where their committed
+        timelines end. When the first path that commits has to wait for another arm (the
+        sweep meets that arm at the earliest start), the move is planned once more with
+        that arm standing where the sweep met it (a conflict-based retry, up to
+        ``replans`` times) and the path that releases the object first is kept."""
         resting = {o: p for o, p in self.rest.items() if o != m.obj}
         resting[m.obj] = m.start
-        name = self.plan.arm_names[arm]
-        timer = self.retimers[arm]
+        others = [np.array(self.traj[a][-1]) for a in self.arms]
         started = time.perf_counter()
-        options = self.planner.plan(arm, self.stand[arm], m, resting)
+        mark = self.mark()
         try:
-            for planned in options:
-                self.plans += 1
-                leaving = self.stand[arm].pre is not None
-                reach = timer.retime(*planned.reach, leaving, True)
-                carry = timer.retime(*planned.carry, True, True)
-                grasp = PlanEvent(0.0, name, "grasp", m.obj, planned.T_tcp_object)
-                release = PlanEvent(0.0, name, "release", m.obj, planned.T_tcp_object)
-                self.move_of[id(grasp)] = self.move_of[id(release)] = m
-                if not self.commit_move(arm, (reach, grasp), (carry, release)):
+            got = self.commit_first(
+                arm, m, self.planner.plan(arm, self.stand[arm], m, resting, others)
+            )
+            for _ in range(self.options.replans):
+                if got is None or got[1] is None:
+                    break
+                release, conflict = self.tick_of(got[0][2]), got[1]
+                dodge = list(others)
+                for a in self.arms:
+                    if a != arm and self.plan.arm_names[a] in conflict.arms:
+                        dodge[a] = np.array(self.rows(a, conflict.tick, conflict.tick)[0])
+                self.undo(mark)
+                self.detours += 1
+                plans = self.planner.plan(arm, self.stand[arm], m, resting, dodge)
+                alt = self.commit_first(arm, m, plans, limit=PAIRS_TRIED)
+                if alt is not None and self.tick_of(alt[0][2]) < release:
+                    got = alt
+                    self.detours_kept += 1
                     continue
-                self.grasp_tick[m.index] = self.tick_of(grasp)
-                self.release_tick[m.index] = self.tick_of(release)
-                self.carrier[m.index] = arm
-                self.rest[m.obj] = m.end
-                self.stand[arm] = planned.end
-                self.parked[arm] = False
-                return True
+                if alt is not None:
+                    self.undo(mark)
+                got = self.commit_first(arm, m, iter([got[0][0]]))
+                break
         finally:
             self.planning_time += time.perf_counter() - started
-        return False
+        if got is None:
+            return False
+        planned, grasp, release_event = got[0]
+        self.grasp_tick[m.index] = self.tick_of(grasp)
+        self.release_tick[m.index] = self.tick_of(release_event)
+        self.carrier[m.index] = arm
+        self.rest[m.obj] = m.end
+        self.stand[arm] = planned.end
+        self.parked[arm] = False
+        return True
+
+    def commit_first(
+        self, arm: int, m: Move, options: Iterator[PlannedMove], limit: int | None = None
+    ) -> tuple[tuple[PlannedMove, PlanEvent, PlanEvent], Conflict | None] | None:
+        """Commit the first of the planned ``options`` (at most ``limit`` tried) that the
+        sweep lets through: the planned move, its grasp and release events, and the conflict
+        with another arm that delayed it (None: not delayed by another arm, or less than
+        :data:`DETOUR_AFTER`); None when none goes."""
+        name = self.plan.arm_names[arm]
+        timer = self.retimers[arm]
+        for n, planned in enumerate(options):
+            if limit is not None and n >= limit:
+                break
+            self.plans += 1
+            leaving = self.stand[arm].pre is not None
+            reach = timer.retime(*planned.reach, leaving, True)
+            carry = timer.retime(*planned.carry, True, True)
+            grasp = PlanEvent(0.0, name, "grasp", m.obj, planned.T_tcp_object)
+            release = PlanEvent(0.0, name, "release", m.obj, planned.T_tcp_object)
+            self.move_of[id(grasp)] = self.move_of[id(release)] = m
+            delayed = self.commit_move(arm, (reach, grasp), (carry, release))
+            if delayed is False:
+                continue
+            return (planned, grasp, release), (None if delayed is True else delayed)
+        return None
 
     def tick_of(self, event: PlanEvent) -> int:
         """The tick of a committed event (by identity)."""
@@ -269,75 +299,48 @@ class Assignment(Placement):
 
     def commit_move(
         self, arm: int, reach: tuple[FloatArray, PlanEvent], carry: tuple[FloatArray, PlanEvent]
-    ) -> bool:
+    ) -> bool | Conflict:
         """Commit the reach (ending in the grasp), then the carry (ending in the release);
         when the carry finds no start because the arm, holding the object, stands in another
         arm's way, the grasp is tried later (up to :data:`REGRASPS` times). False: nothing
-        committed."""
+        committed; else the conflict with another arm that delayed the reach or the carry
+        by :data:`DETOUR_AFTER` or more (True: none)."""
         self.not_before = 0
+        least = math.ceil(DETOUR_AFTER / self.tick - 1e-9)
+        in_way: Conflict | None = None  # another arm in the carry's way at an earlier grasp
         try:
             for _ in range(REGRASPS):
                 mark = self.mark()
                 try:
-                    self.place([Entry(arm, _block(arm, reach[0], reach[1]), reach[0], 0)])
-                except NoPlacement:
+                    self.place([Entry(arm, block_of(arm, reach[0], reach[1]), reach[0], 0)])
+                except NoPlacement as exc:
                     self.undo(mark)
+                    self.note_in_way(arm, exc.conflict)
                     return False
+                delayed = self.arm_delay(least)
                 try:
-                    self.place([Entry(arm, _block(arm, carry[0], carry[1]), carry[0], 0)])
+                    self.place([Entry(arm, block_of(arm, carry[0], carry[1]), carry[0], 0)])
                 except NoPlacement as exc:
                     grasped = self.tick_of(reach[1])
                     self.undo(mark)
-                    if (
-                        exc.conflict is None
-                        or exc.conflict.tick < grasped
-                        or not exc.conflict.message.startswith("arms ")
-                    ):
+                    self.note_in_way(arm, exc.conflict)
+                    if exc.conflict is None or exc.conflict.tick < grasped or not exc.conflict.arms:
                         return False  # not another arm in the way: a later grasp is no better
+                    in_way = exc.conflict
                     start = grasped - (len(reach[0]) - 1)
                     self.not_before = max(start + 1, exc.conflict.tick - len(reach[0]) + 2)
                     continue
-                return True
+                found = delayed or self.arm_delay(least) or in_way
+                return True if found is None else found
             return False
         finally:
             self.not_before = 0
 
-    def clear_way(self, arm: int) -> bool:
-        """Send home the other arms that stand in the workspace where their timelines end
-        (they stand in the way of every motion after that); whether any went."""
-        return sum(self.park(a) for a in self.arms if a != arm and not self.parked[a]) > 0
-
-    def park(self, arm: int) -> bool:
-        """Send ``arm`` home from where it stands; False when that cannot be committed."""
-        ends = [np.array(self.traj[a][-1]) for a in self.arms]
-        motion = self.planner.park(arm, self.stand[arm], self.rest, ends)
-        self.plans += 1
-        if motion is None:
-            return False
-        q = self.retimers[arm].retime(*motion, self.stand[arm].pre is not None, False)
-        mark = self.mark()
-        try:
-            self.place([Entry(arm, _block(arm, q, None), q, 0)])
-        except NoPlacement:
-            self.undo(mark)
-            return False
-        self.stand[arm] = Stand(np.array(q[-1]))
-        self.parked[arm] = True
-        self.parks += 1
-        return True
-
-    def wait(self, arm: int) -> None:
-        """Let ``arm`` stand until the next arm's timeline ends; raises :class:`NoPlacement`
-        when no arm's ends later (every arm waits: no move can be committed)."""
-        h = self.horizon(arm)
-        later = [self.horizon(a) for a in self.arms if self.horizon(a) > h]
-        if not later:
-            # every arm is at the same time: one that stands in the workspace goes home
-            if any(self.park(a) for a in self.arms if not self.parked[a]):
-                return
-            raise NoPlacement(_no_block(arm), None, "every arm waits and no move can be committed")
-        self.traj[arm].extend([self.traj[arm][-1]] * (min(later) - h))
-        self.waits += 1
+    def arm_delay(self, least: int) -> Conflict | None:
+        """The conflict with another arm that delayed the last placement by ``least`` ticks
+        or more, else None."""
+        c = self.delayed_by
+        return c if self.delay >= least and c is not None and c.arms else None
 
     def figures(self) -> tuple[tuple[str, float], ...]:
         """Moves committed and how many went to another arm than in the synchronous plan,
@@ -350,15 +353,11 @@ class Assignment(Placement):
             ("planning_time", self.planning_time),
             ("waits", float(self.waits)),
             ("parks", float(self.parks)),
+            ("retreats", float(self.retreats)),
+            ("collision_queries", float(self.sweep.queries)),
+            ("detours", float(self.detours)),
+            ("detours_kept", float(self.detours_kept)),
         )
-
-
-def _block(arm: int, q: FloatArray, event: PlanEvent | None) -> Block:
-    return Block(arm, q, q, event, 0.0, 0.0, 0, None)
-
-
-def _no_block(arm: int) -> Block:
-    return Block(arm, np.zeros((1, 1)), np.zeros((1, 1)), None, 0.0, 0.0, 0, None)
 
 
 def schedule_assigned(

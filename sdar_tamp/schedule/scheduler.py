@@ -224,6 +224,10 @@ class Placement:
         #: :meth:`place` gives up at a conflict after every other arm's timeline has ended
         #: (those arms stand still from then on: a later start meets the same conflict)
         self.give_up_standing = False
+        #: the last successful :meth:`place`: its start's delay past the earliest [ticks] and
+        #: the conflict met at the earliest start (None: placed there)
+        self.delay = 0
+        self.delayed_by: Conflict | None = None
 
     def horizon(self, arm: int) -> int:
         return len(self.traj[arm]) - 1
@@ -289,7 +293,7 @@ class Placement:
         lengths, events, event_tick, steps = mark
         for traj, n in zip(self.traj, lengths, strict=True):
             del traj[n:]
-        self.events, self.event_tick = events, event_tick
+        self.events, self.event_tick = list(events), dict(event_tick)  # a mark serves again
         del self.steps[steps:]
 
     def ready(self, block: Block) -> bool:
@@ -357,7 +361,10 @@ class Placement:
             events = sorted([*later, *new], key=lambda e: e.tick)
             self.sweep.reset(before)
             conflict = self.sweep.run(k0, q, events)
+            if s == start:
+                self.delayed_by = conflict
             if conflict is None:
+                self.delay = s - start
                 placed = zip(entries, ends, _events_of(entries, new), strict=True)
                 for e, end, timed in sorted(placed, key=lambda x: (x[0].arm, x[0].offset)):
                     self.commit(e, s + e.offset, q[: end - k0 + 1, self.columns[e.arm]], k0, timed)

@@ -51,11 +51,13 @@ class TimedEvent:
 @dataclass(frozen=True)
 class Conflict:
     """The first broken rule of a stretch: at tick ``tick``, ``kind`` (collision, grasp,
-    release) and what."""
+    release) and what; ``arms``: the arms in contact with another arm (a collision between
+    arms or their held objects), in scene order, else empty."""
 
     tick: int
     kind: str
     message: str
+    arms: tuple[str, ...] = ()
 
 
 class WorldSweep:
@@ -73,6 +75,8 @@ class WorldSweep:
         self.held: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, T_tcp_object)
         self.exempt: dict[str, tuple[str, FloatArray]] = {}  # arm -> (object, q_arm)
         self.checks = 0
+        #: the checks the collision world answered (the others were remembered answers)
+        self.queries = 0
         self._columns = {a: scene.layout.slice(a) for a in self.names}
         self._intervals: dict[bytes, int] = {}
         self._memos: OrderedDict[Hashable, dict[bytes, bool]] = OrderedDict()
@@ -151,7 +155,11 @@ class WorldSweep:
         pairs = [p for p in self.world.report(q) if not self.allowed(p)]
         if not pairs:
             return None
-        return Conflict(tick, "collision", describe_contacts(pairs, self.world, len(pairs)))
+        owners = [(self.world.owner(p.first), self.world.owner(p.second)) for p in pairs]
+        between = {a for pair in owners if None not in pair and pair[0] != pair[1] for a in pair}
+        arms = tuple(a for a in self.names if a in between)
+        message = describe_contacts(pairs, self.world, len(pairs))
+        return Conflict(tick, "collision", message, arms)
 
     def _in_collision(self, q: FloatArray) -> bool:
         """``world.in_collision(q)``, remembered per arrangement and configuration."""
@@ -168,6 +176,7 @@ class WorldSweep:
         k = np.ascontiguousarray(q, dtype=np.float64).tobytes()
         hit = self._memo.get(k)
         if hit is None:
+            self.queries += 1
             hit = self._memo[k] = self.world.in_collision(q)
         return hit
 

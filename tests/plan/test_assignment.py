@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -20,8 +21,10 @@ import pytest
 
 from sdar_tamp.app.execution import SCHEDULERS, execution_options
 from sdar_tamp.app.move_planning import StreamMovePlanner
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_rules import check_timeline
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule.assignment import (
     FINGER_ROOM,
@@ -32,8 +35,10 @@ from sdar_tamp.schedule.assignment import (
     schedule_assigned,
 )
 from sdar_tamp.schedule.moves import CyclicMoves, Move, break_cycles, plan_moves, stuck_moves
+from sdar_tamp.schedule.room import rest_to_rest
 from sdar_tamp.schedule.scheduler import retimer
 from sdar_tamp.schedule.sweep import WorldSweep
+from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.instance import Instance, load_instance
 from sdar_tamp.world.suites import shipped_suite_dir
 from sdar_tamp.world.transforms import FloatArray
@@ -216,6 +221,7 @@ def test_a_planner_that_finds_no_motion_gives_no_schedule(
             stand: Stand,
             move: Move,
             resting: Mapping[str, tuple[float, float, float]],
+            others: Sequence[FloatArray] | None = None,
         ) -> Iterator[PlannedMove]:
             return iter(())
 
@@ -224,3 +230,125 @@ def test_a_planner_that_finds_no_motion_gives_no_schedule(
     )
     assert not s.asynchronous and s.plan is plan
     assert "no move can be committed" in s.reason
+
+
+def _first_move(search: Assignment, planner: StraightMoves, arm: int) -> Move:
+    stand = search.stand[arm]
+    return next(
+        m for m in search.moves if not m.blockers and m.previous is None
+        and planner.estimate(arm, stand, m) is not None
+    )  # fmt: skip
+
+
+def test_an_arm_that_finished_retreats_along_its_approach(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    """After a release the arm stands at the release configuration; a retreat takes it back
+    out along its approach to the pre-grasp (the carry's end played backwards), in less
+    time than the way home, and replays without contact."""
+    instance, plan, planner = r5
+    search = _search(ctx, instance, plan, planner)
+    m = _first_move(search, planner, 0)
+    assert search.take(0, m)
+    stand, released = search.stand[0], search.horizon(0)
+    assert stand.pre is not None and stand.back is not None
+    assert np.allclose(stand.back[0], stand.q) and np.allclose(stand.back[-1], stand.pre)
+    assert search.retreat(0)
+    retreat = search.horizon(0) - released
+    assert retreat > 0 and np.allclose(search.traj[0][-1], stand.pre, atol=1e-9)
+    assert search.stand[0].pre is None and not search.parked[0]
+    assert dict(search.figures())["retreats"] == 1.0
+    assert not search.retreat(0)  # at no grasp or release: nothing to retreat from
+    result = search.assemble()
+    assert check_timeline(result, ctx.scene) is None  # from rest to rest, within the limits
+    report = validate_plan(instance, result, ctx.scene)
+    assert report.violation is None or report.violation.kind == "goal", report.violation
+    # the way home from the release configuration takes longer
+    home = _search(ctx, instance, plan, planner)
+    assert home.take(0, m) and home.park(0)
+    assert home.horizon(0) - released > retreat
+
+
+def test_a_retreat_the_sweep_refuses_commits_nothing(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    """A retreat into the table is refused: False, the timeline as it was."""
+    instance, plan, planner = r5
+    search = _search(ctx, instance, plan, planner)
+    m = _first_move(search, planner, 0)
+    assert search.take(0, m)
+    stand, horizon = search.stand[0], search.horizon(0)
+    down = np.array(stand.q)
+    down[1] += 1.2  # the shoulder drives the arm down through the table
+    q = plan.q[0].copy()
+    q[search.columns[0]] = down
+    assert CollisionWorld(ctx.scene).in_collision(q)
+    search.stand[0] = dataclasses.replace(stand, pre=down, back=None)
+    assert not search.retreat(0)
+    assert search.horizon(0) == horizon and search.stand[0].pre is not None
+
+
+def test_motions_are_planned_against_the_other_arms_where_they_stand_then_at_home(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    instance, plan, _ = r5
+
+    class Recording(StraightMoves):
+        seen: list[dict[str, tuple[float, ...]]]
+
+        def motion(
+            self,
+            name: str,
+            q1: ArmConf,
+            q2: ArmConf,
+            fluents: Sequence[tuple[Any, ...]],
+            standing: Mapping[str, FloatArray] | None = None,
+        ) -> tuple[FloatArray, FloatArray] | None:
+            self.seen.append({a: tuple(map(float, q)) for a, q in (standing or {}).items()})
+            return super().motion(name, q1, q2, fluents, standing)
+
+    planner = Recording(instance, ctx.scene)
+    planner.seen = []
+    search = _search(ctx, instance, plan, planner)
+    m = _first_move(search, planner, 0)
+    raised = np.array(search.stand[1].q) + np.array([0.3, -0.2, 0.0, 0.0, 0.0, 0.0])
+    others = [np.array(search.stand[0].q), raised]
+    resting = {**search.rest, m.obj: m.start}
+    planned = list(planner.plan(0, search.stand[0], m, resting, others))
+    assert planned
+    right = ctx.arm_names[1]
+    where = [s[right] for s in planner.seen]
+    home = tuple(map(float, ctx.home(right)))
+    assert where[0] == tuple(map(float, raised)) and where[-1] == home
+    # the other arms at home already: one round only
+    planner.seen = []
+    list(planner.plan(0, search.stand[0], m, resting, [others[0], ctx.home(right)]))
+    assert {s[right] for s in planner.seen} == {home}
+
+
+def test_assignment_options_are_checked() -> None:
+    bad: list[dict[str, Any]] = [
+        {"candidates": 0},
+        {"stride": True},
+        {"max_checks": 1.5},
+        {"max_plans": -1},
+        {"replans": -1},
+        {"max_wait": -0.1},
+        {"slack": math.nan},
+        {"slack": "1"},
+    ]
+    for kwargs in bad:
+        with pytest.raises(ParameterError, match=next(iter(kwargs))):
+            AssignmentOptions(**kwargs)
+    assert AssignmentOptions(replans=0, slack=math.inf).replans == 0
+
+
+def test_a_retreat_cut_out_of_a_motion_still_starts_and_ends_at_rest() -> None:
+    """The retreat's path is the end of a carry, moving where it is cut: its times are made
+    anew, from rest to rest on a cosine profile of the path's length."""
+    q = np.linspace([0.0, 0.0], [0.3, -0.1], 13)
+    t = rest_to_rest(q)
+    assert t[0] == 0.0 and np.all(np.diff(t) > 0.0) and t[-1] >= 1.0
+    v = np.diff(q[:, 0]) / np.diff(t)
+    assert abs(v[0]) < abs(v[len(v) // 2]) and abs(v[-1]) < abs(v[len(v) // 2])
+    assert np.allclose(rest_to_rest(np.zeros((4, 2))), np.linspace(0.0, 1.0, 4))

@@ -1,0 +1,108 @@
+"""What the assignment of moves to arms (:mod:`.assignment`) works with: where an arm
+stands, a move's planned motions, the planner of a cell's single-arm motions (a protocol the
+application fills with its streams) and the search's options."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+from sdar_tamp.errors import ParameterError
+from sdar_tamp.schedule.moves import Move, Pose
+from sdar_tamp.world.transforms import FloatArray
+
+
+@dataclass(frozen=True)
+class Stand:
+    """Where an arm stands: ``q`` ``(k,)`` [rad] and, when it stands at a grasp or release
+    configuration, ``pre`` ``(k,)`` (the pre-grasp it must retreat through), else None;
+    ``back``: the path (configurations ``(m, k)``) from ``q`` out to ``pre`` along the
+    approach that brought the arm there, when known (else a straight joint-space segment is
+    taken)."""
+
+    q: FloatArray
+    pre: FloatArray | None = None
+    back: FloatArray | None = None
+
+
+@dataclass(frozen=True)
+class PlannedMove:
+    """One arm's motions of a move: ``reach`` (from where it stands to the grasp) and
+    ``carry`` (grasp to release), each as times ``(m,)`` [s] and configurations ``(m, k)``
+    [rad]; ``T_tcp_object`` ``(4, 4)``: the grasp; ``end``: where the arm then stands."""
+
+    reach: tuple[FloatArray, FloatArray]
+    carry: tuple[FloatArray, FloatArray]
+    T_tcp_object: FloatArray
+    end: Stand
+
+
+class MovePlanner(Protocol):
+    """Grasps, inverse kinematics and single-arm motions of a cell (the streams)."""
+
+    def estimate(self, arm: int, stand: Stand, move: Move) -> float | None:
+        """Estimated duration [s] of ``move`` by arm ``arm`` (scene order) from ``stand``,
+        motions only; None when the arm cannot grasp the object at both poses."""
+        ...
+
+    def plan(
+        self,
+        arm: int,
+        stand: Stand,
+        move: Move,
+        resting: Mapping[str, Pose],
+        others: Sequence[FloatArray] | None = None,
+    ) -> Iterator[PlannedMove]:
+        """The arm's motions for ``move``, best first, against the objects ``resting``
+        (name -> pose; the moved object at its start) and the other arms standing at
+        ``others`` (per arm, scene order; the arm's own entry is ignored), then at home."""
+        ...
+
+    def buffer(self, move: Move, moves: Sequence[Move]) -> Pose | None:
+        """A free pose for ``move``'s object, clear of every pose of ``moves``, or None."""
+        ...
+
+    def park(
+        self, arm: int, stand: Stand, resting: Mapping[str, Pose], others: Sequence[FloatArray]
+    ) -> tuple[FloatArray, FloatArray] | None:
+        """The arm's motion (times ``(m,)``, configurations ``(m, k)``) from ``stand`` to its
+        home configuration, the other arms standing at ``others`` (per arm, scene order; the
+        arm's own entry is ignored), or None."""
+        ...
+
+
+@dataclass(frozen=True)
+class AssignmentOptions:
+    """``candidates``: the ready moves tried per decision (best estimate first); ``stride``:
+    ticks between the starts tried for a motion (a wait is rounded up to it); ``max_wait``
+    [s]: the longest wait tried before a motion (past it the arm does something else);
+    ``max_checks``: the collision queries of the whole search that the collision world
+    answers (a remembered answer costs none; past them no schedule);
+    ``max_plans``: motion-planner calls of the whole search; ``replans``: conflict-based
+    retries per move (:meth:`Assignment.take`); ``slack`` [s]: a move committed this much
+    later than estimated is compared with the next candidates (:meth:`Assignment.choose`;
+    ``inf``: the first that goes is kept)."""
+
+    candidates: int = 3
+    stride: int = 5
+    max_wait: float = 4.0
+    max_checks: int = 400_000
+    max_plans: int = 400
+    replans: int = 1
+    slack: float = math.inf
+
+    def __post_init__(self) -> None:
+        for name in ("candidates", "stride", "max_checks", "max_plans", "replans"):
+            value = getattr(self, name)
+            least = 0 if name == "replans" else 1
+            if isinstance(value, bool) or not isinstance(value, int) or value < least:
+                raise ParameterError(f"{name}: expected an integer >= {least}, got {value!r}")
+        for name in ("max_wait", "slack"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and value >= 0.0) or math.isnan(value):
+                raise ParameterError(f"{name}: expected a number >= 0, got {value!r}")
+
+
+__all__ = ["AssignmentOptions", "MovePlanner", "PlannedMove", "Stand"]
