@@ -1,5 +1,6 @@
 """h_max of many states at once (solvers/classical/batch_hmax.py): exactly the queue's values,
-and A* with batched evaluation expands the same states and finds the same plan."""
+and A* with batched evaluation expands the same states and finds the same plan; the closures a
+task remembers are the ones it computes."""
 
 from __future__ import annotations
 
@@ -102,3 +103,20 @@ def test_random_relaxed_tasks(seed: int) -> None:
 def test_an_unreachable_goal_is_infinite() -> None:
     batch = BatchHMax(3, [[0]], [[1]], [2.5], [1, 2])
     assert batch.evaluate([0b001, 0b100, 0b101]) == [inf, inf, 2.5]
+
+
+@pytest.mark.parametrize(
+    ("domain", "problem"), [("briefcase", "office"), ("briefcase", "lights-out")]
+)
+def test_remembered_closures_are_the_computed_ones(
+    domain: str, problem: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    warm = CompiledTask(ground(load(domain, problem)))
+    assert warm.strata  # the domain has derived facts
+    states = _reachable(warm)  # closes every state reached, most of them more than once
+    assert len(warm._closed) > 1
+    monkeypatch.setattr("solvers.classical.bitset_task.CLOSED_MEMO", 0)
+    cold = CompiledTask(ground(load(domain, problem)))
+    assert _reachable(cold) == states and not cold._closed
+    for state in states:
+        assert warm.close(state) == cold.close(state) == state
