@@ -14,6 +14,7 @@ accepted when it is taken out: no entry left can lead to a cheaper plan.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from heapq import heappop, heappush
 from math import inf
 
@@ -29,9 +30,15 @@ def deferred_astar(
     heuristic: Heuristic,
     deadline: float | None,
     cost_bound: float = inf,
+    batch: Callable[[list[int]], list[float]] | None = None,
 ) -> SearchOutcome:
     """Optimal search from ``compiled.init`` with an admissible ``heuristic`` (ties: lower
-    ``h``, then the older entry). States whose cost so far reaches ``cost_bound`` are pruned."""
+    ``h``, then the older entry). States whose cost so far reaches ``cost_bound`` are pruned.
+
+    ``batch``, when given, computes ``heuristic``'s values of many states at once: the new
+    successors of an expansion are evaluated together right after it, and each value is used
+    when its state is taken out, as it would have been computed then (the same expansions and
+    plan; more states evaluated, each for less)."""
     costs = compiled.costs
     applicable, successor, is_goal = compiled.applicable, compiled.successor, compiled.is_goal
     init = compiled.init
@@ -45,6 +52,7 @@ def deferred_astar(
     closed: set[int] = set()
     heap: list[_Entry] = [(h_init, h_init, 0, init, 0.0, True)]
     counter = 1
+    ready: dict[int, float] = {}  # values computed by ``batch``, not yet taken out
     while heap:
         _, h, _, state, g, known = heappop(heap)
         if state in closed or g > best_g[state]:
@@ -54,9 +62,12 @@ def deferred_astar(
         if not known:
             value = h_of.get(state)
             if value is None:
-                value, _ = heuristic(state, False)
+                if state in ready:
+                    value = ready.pop(state)
+                else:
+                    value, _ = heuristic(state, False)
+                    evaluated += 1
                 h_of[state] = value
-                evaluated += 1
             if value == inf:
                 continue
             if value > h:
@@ -68,6 +79,7 @@ def deferred_astar(
             return SearchOutcome("timeout", (), expanded, generated, evaluated)
         closed.add(state)
         expanded += 1
+        fresh: list[int] = []
         for op in applicable(state):
             succ = successor(state, op)
             new_g = g + costs[op]
@@ -86,7 +98,14 @@ def deferred_astar(
             if succ_h is None:
                 bound = max(0.0, h - costs[op])
                 heappush(heap, (new_g + bound, bound, counter, succ, new_g, False))
+                if batch is not None and succ not in ready:
+                    ready[succ] = -1.0
+                    fresh.append(succ)
             else:
                 heappush(heap, (new_g + succ_h, succ_h, counter, succ, new_g, True))
             counter += 1
+        if fresh:
+            assert batch is not None
+            ready.update(zip(fresh, batch(fresh), strict=True))
+            evaluated += len(fresh)
     return SearchOutcome("unsolvable", (), expanded, generated, evaluated)

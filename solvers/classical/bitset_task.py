@@ -56,6 +56,8 @@ class _Node:
         self.children: dict[int, _Node] = {}
 
 
+#: At most this many closures are remembered per task (a large search's memory stays its own).
+CLOSED_MEMO = 200_000
 #: Strata with at least this many rules are closed by :class:`_CountedStratum`.
 COUNTED_STRATUM = 16
 
@@ -151,6 +153,8 @@ class CompiledTask:
             for s in sorted(grouped)
         ]
         self._root = self._build_trie()
+        # the closure of each basic state met (a search reaches many states more than once)
+        self._closed: dict[int, int] = {}
         self.init = self.close(mask(task.init))
         self._calls = 0
         self._jit: JitSuccessors | None = None
@@ -223,6 +227,10 @@ class CompiledTask:
         if not self.strata:
             return state
         state &= ~self.derived_mask
+        known = self._closed.get(state)
+        if known is not None:
+            return known
+        basic = state
         for layer, counted in zip(self.strata, self.counted, strict=True):
             if counted is not None:
                 state = counted.close(state)
@@ -238,6 +246,8 @@ class CompiledTask:
                 if len(waiting) == len(pending):
                     break
                 pending = waiting
+        if len(self._closed) < CLOSED_MEMO:
+            self._closed[basic] = state
         return state
 
     def is_goal(self, state: int) -> bool:

@@ -36,6 +36,7 @@ from math import inf
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
 from solvers.classical import jit, jit_relaxed
+from solvers.classical.batch_hmax import BatchHMax
 from solvers.classical.bitset_task import CompiledTask, bits, mask
 from solvers.classical.complements import complements, relaxed_operators
 from solvers.classical.jit_relaxed import JitRelaxed
@@ -131,6 +132,21 @@ class RelaxedHeuristic:
             if self.jit or self.jit_pending
             else ("python" if self.vector is None else "numpy")
         )
+        # h_max on a small task under "auto": the states of an expansion can be evaluated
+        # together (:meth:`values`; the same values as the queue)
+        self.batch = (
+            BatchHMax(count, upre, ueff, ucost, self.goal)
+            if name == "max" and engine == "auto" and self.engine == "python"
+            else None
+        )
+
+    def values(self, states: list[int]) -> list[float]:
+        """h of each of ``states`` (as ``self(state)[0]``), evaluated together when the
+        heuristic has a batch engine."""
+        if self.batch is None:
+            return [self(state)[0] for state in states]
+        extend = self.complements.extend
+        return self.batch.evaluate([extend(state) for state in states])
 
     def use_compiled(self) -> None:
         """Evaluate with the compiled engine from now on (numba must be installed). It settles

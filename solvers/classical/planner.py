@@ -170,7 +170,8 @@ def _search(
     if search == "astar" and not lazy and landmarks is None and relaxed is not None:
         # evaluated when taken out of the open list: the same optimal plans, without the
         # heuristic on the successors that are never expanded (see astar.py)
-        return deferred_astar(compiled, relaxed, deadline, cost_bound)
+        batch = relaxed.values if relaxed.batch is not None else None
+        return deferred_astar(compiled, relaxed, deadline, cost_bound, batch)
     g_weight, h_weight = {
         "gbfs": (0.0, 1.0),
         "lazy-gbfs": (0.0, 1.0),

@@ -35,7 +35,11 @@ def stream_plan_effort(
 class ActionEfforts:
     """The extra cost of an optimistic action (PDDLStream's stream efforts in the plan cost):
     ``weight`` times the effort (:func:`stream_plan_effort`) of the optimistic results behind
-    the positive preconditions of the action, each result counted once."""
+    the positive preconditions of the action, each result counted once.
+
+    One instance serves one grounding: the optimistic results behind each fact are found once
+    and shared by every action that needs the fact (in the order and with the sum
+    :func:`extract_stream_plan` gives)."""
 
     def __init__(
         self,
@@ -50,16 +54,59 @@ class ActionEfforts:
         self.info = info
         self.weight = weight
         self.unit_efforts = unit_efforts
+        # action name -> its positive preconditions, as (predicate, arguments)
+        self._atoms: dict[str, list[tuple[str, tuple[str, ...]]]] = {}
+        # facts keyed by (predicate, arguments): tuples hash in C, atoms in Python
+        self._provenance = {(a.predicate, a.args): r for a, r in world.provenance.items()}
+        self._behind: dict[_Key, tuple[OptResult, ...]] = {}  # fact -> results, deps first
 
     def __call__(self, name: str, args: tuple[str, ...]) -> float:
         action = self.domain.action(name)
         binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
-        provenance = self.world.provenance
-        facts = [a for a in positive_atoms(action.precondition, binding) if a in provenance]
+        templates = self._atoms.get(name)
+        if templates is None:
+            atoms = positive_atoms(action.precondition, {})
+            templates = self._atoms[name] = [(a.predicate, a.args) for a in atoms]
+        provenance = self._provenance
+        grounded = ((p, tuple([binding.get(a, a) for a in xs])) for p, xs in templates)
+        facts = [key for key in grounded if key in provenance]
         if not facts:
             return 0.0
-        results = extract_stream_plan(facts, self.world)
+        results: list[OptResult] = []
+        seen: set[int] = set()
+        for key in sorted(facts, key=_text):
+            for result in self._results_behind(key):
+                if id(result) not in seen:
+                    seen.add(id(result))
+                    results.append(result)
         return self.weight * stream_plan_effort(results, self.info, self.unit_efforts)
+
+    def _results_behind(self, key: _Key) -> tuple[OptResult, ...]:
+        """The optimistic results behind a fact, dependencies first (as
+        :func:`extract_stream_plan` orders them for that fact alone)."""
+        known = self._behind.get(key)
+        if known is not None:
+            return known
+        result = self._provenance.get(key)
+        order: list[OptResult] = []
+        if result is not None:
+            seen: set[int] = {id(result)}
+            for dependency in result.domain:
+                for earlier in self._results_behind((dependency.predicate, dependency.args)):
+                    if id(earlier) not in seen:
+                        seen.add(id(earlier))
+                        order.append(earlier)
+            order.append(result)
+        self._behind[key] = behind = tuple(order)
+        return behind
+
+
+_Key = tuple[str, tuple[str, ...]]
+
+
+def _text(key: _Key) -> str:
+    """``str`` of the atom ``key`` stands for (the order :func:`extract_stream_plan` takes)."""
+    return f"({' '.join((key[0], *key[1]))})"
 
 
 def positive_atoms(formula: Formula, binding: Mapping[str, str]) -> list[Atom]:

@@ -462,6 +462,43 @@ def test_action_efforts_count_each_result_once() -> None:
                                     extra_cost=lambda n, a: -1.0))  # fmt: skip
 
 
+def test_action_efforts_match_the_stream_plan_of_each_action() -> None:
+    from solvers.stream_planning.optimistic import OptimisticWorld, OptResult
+    from solvers.stream_planning.stream_plans import (
+        ActionEfforts,
+        extract_stream_plan,
+        positive_atoms,
+        stream_plan_effort,
+    )
+
+    # two poses from one sampler, a third from another whose input is the first pose: the
+    # results behind a fact are shared between facts and actions, found once per grounding
+    first = OptResult("sample-pose", ("a", "goal"), ("#o0",), (), (), 1, "stream")
+    pose_a = Atom("pose", ("a", "#o0"))
+    second = OptResult("sample-near", ("a", "#o0"), ("#o1",), (pose_a,), (), 2, "stream")
+    third = OptResult("sample-pose", ("a", "goal"), ("#o2",), (), (), 1, "stream")
+    provenance = {
+        pose_a: first,
+        Atom("contained", ("a", "#o0", "goal")): first,
+        Atom("pose", ("a", "#o1")): second,
+        Atom("pose", ("a", "#o2")): third,
+    }
+    world = OptimisticWorld(dict.fromkeys(provenance, 1), provenance, {})
+    info = {"sample-pose": StreamInfo(effort=0.7), "sample-near": StreamInfo(p_success=0.3)}
+    domain = parse_domain(LINE)
+    efforts = ActionEfforts(domain, world, info, 1.3, unit_efforts=False)
+    move = domain.action("move")
+    poses = ("0", "#o0", "#o1", "#o2")
+    for p1 in poses:
+        for p2 in poses:
+            binding = {"?b": "a", "?p1": p1, "?p2": p2}
+            needed = [a for a in positive_atoms(move.precondition, binding) if a in provenance]
+            expected = 1.3 * stream_plan_effort(extract_stream_plan(needed, world), info)
+            assert efforts("move", ("a", p1, p2)) == expected  # twice: from the shared table
+            assert efforts("move", ("a", p1, p2)) == expected
+    assert efforts("move", ("a", "0", "#o1")) == 1.3 * (0.7 + 1 / 0.3)
+
+
 def test_from_fn_stream_runs_once() -> None:
     calls: list[str] = []
 
