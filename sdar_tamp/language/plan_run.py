@@ -17,7 +17,14 @@ from sdar_tamp.errors import EvaluationError
 from sdar_tamp.language.domain_model import ActionSchema, Domain
 from sdar_tamp.language.durative import DurativeActionSchema
 from sdar_tamp.language.evaluator import Evaluator, Support
-from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Formula, FunctionTerm
+from sdar_tamp.language.formula_model import (
+    OBJECT_TYPE,
+    TOTAL_COST,
+    Atom,
+    Formula,
+    FunctionTerm,
+)
+from sdar_tamp.language.numeric import evaluate, rename_args
 from sdar_tamp.language.state_changes import Changes, CostOf, effect_changes
 from sdar_tamp.language.state_index import FactIndex, Facts, Objects
 from sdar_tamp.language.substitution import Binding, bind, ground_args
@@ -153,12 +160,12 @@ def _run_durative(
         return "at-end"
     end = effect_changes(later, action.end_effect, binding, cost_of)
     final = end.apply(middle)
-    duration = action.duration
-    if isinstance(duration, FunctionTerm):
-        term = FunctionTerm(duration.name, ground_args(duration.args, binding))
-        length = cost_of(term) if cost_of is not None else 0.0
-    else:
-        length = duration if cost_of is not None else 0.0
+    length = 0.0
+    if cost_of is not None:
+        value = evaluate(rename_args(action.duration, binding), cost_of)
+        if value is None:
+            raise EvaluationError(f"the duration of {action.name!r} is undefined")
+        length = value
     # facts the start effects made are the action's own, not something it relies on
     relied = found | start.support | ((over | end_found | end.support) - start.adds)
     changes = Changes(
@@ -171,26 +178,58 @@ def plan_timing(
     domain: Domain, plan: Sequence[tuple[str, Sequence[str]]], cost_of: CostOf
 ) -> tuple[tuple[float, float], ...]:
     """The ``(start, duration)`` of each step of ``plan`` run one after the other from time 0:
-    a durative action lasts its duration (``cost_of`` gives a function term's value), an
-    instantaneous action 0.
+    a durative action lasts its duration (an expression, evaluated when the step starts:
+    ``cost_of`` gives a function term's initial value, numeric effects of earlier steps change
+    it), an instantaneous action 0.
 
     Raises:
-        EvaluationError: a step names no action of ``domain`` or has the wrong arity.
+        EvaluationError: a step names no action of ``domain``, has the wrong arity or an
+            undefined duration.
     """
     timing: list[tuple[float, float]] = []
     now = 0.0
+    changed: dict[tuple[str, tuple[str, ...]], float] = {}
+
+    def lookup(term: FunctionTerm) -> float | None:
+        key = (term.name, term.args)
+        return changed[key] if key in changed else cost_of(term)
+
     for name, args in plan:
         action = domain.durative_action(name)
         length = 0.0
         if action is not None:
             if len(args) != len(action.parameters):
                 raise EvaluationError(f"({' '.join((name, *args))}) has the wrong arity")
-            duration = action.duration
-            if isinstance(duration, FunctionTerm):
-                binding = dict(zip((p.name for p in action.parameters), args, strict=True))
-                length = cost_of(FunctionTerm(duration.name, ground_args(duration.args, binding)))
-            else:
-                length = duration
+            binding = dict(zip((p.name for p in action.parameters), args, strict=True))
+            value = evaluate(rename_args(action.duration, binding), lookup)
+            if value is None:
+                raise EvaluationError(f"the duration of ({' '.join((name, *args))}) is undefined")
+            length = value
+        _apply_numeric(domain, name, args, lookup, changed)
         timing.append((now, length))
         now += length
     return tuple(timing)
+
+
+def _apply_numeric(
+    domain: Domain,
+    name: str,
+    args: Sequence[str],
+    lookup: Callable[[FunctionTerm], float | None],
+    changed: dict[tuple[str, tuple[str, ...]], float],
+) -> None:
+    """Record the numeric fluents that step ``(name args)`` changes."""
+    try:
+        schema = domain.action(name)
+    except KeyError:
+        return
+    binding = dict(zip((p.name for p in schema.parameters), args, strict=False))
+    updates = {}
+    for effect in schema.numeric_effects:
+        if effect.target.name == TOTAL_COST:
+            continue
+        value = evaluate(rename_args(effect.as_assignment(), binding), lookup)
+        if value is not None:
+            target = effect.target
+            updates[(target.name, ground_args(target.args, binding))] = value
+    changed.update(updates)
