@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TypeAlias
+from typing import Protocol, TypeAlias
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.errors import PddlSyntaxError, UnsupportedFeatureError
@@ -132,6 +132,25 @@ def function_terms(expression: Expression) -> list[FunctionTerm]:
     if isinstance(expression, Arithmetic):
         return [t for operand in expression.operands for t in function_terms(operand)]
     return []
+
+
+def numeric_terms(action: _HasNumericParts) -> list[FunctionTerm]:
+    """The function terms ``action``'s numeric conditions and effects read (targets and
+    ``?duration`` aside), in order, each once."""
+    exprs: list[Expression] = []
+    for condition in action.numeric_conditions:
+        exprs.extend((condition.left, condition.right))
+    exprs.extend(effect.value for effect in action.numeric_effects)
+    terms = (t for e in exprs for t in function_terms(e) if t != DURATION_TERM)
+    return list(dict.fromkeys(terms))
+
+
+class _HasNumericParts(Protocol):
+    @property
+    def numeric_conditions(self) -> tuple[Comparison, ...]: ...
+
+    @property
+    def numeric_effects(self) -> tuple[NumericEffect, ...]: ...
 
 
 def substitute_terms(

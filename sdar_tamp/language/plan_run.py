@@ -11,7 +11,7 @@ effects; its cost is its duration plus any ``total-cost`` increases."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from sdar_tamp.errors import EvaluationError
 from sdar_tamp.language.domain_model import ActionSchema, Domain
@@ -24,7 +24,7 @@ from sdar_tamp.language.formula_model import (
     Formula,
     FunctionTerm,
 )
-from sdar_tamp.language.numeric import evaluate, rename_args
+from sdar_tamp.language.numeric import Comparison, evaluate, holds, rename_args
 from sdar_tamp.language.state_changes import Changes, CostOf, effect_changes
 from sdar_tamp.language.state_index import FactIndex, Facts, Objects
 from sdar_tamp.language.substitution import Binding, bind, ground_args
@@ -88,6 +88,8 @@ def run_plan(
 
     ``view`` makes what conditions are evaluated on from a state (by default its facts as they
     are; a solver may let it answer for atoms it assumes, which then appear in the supports).
+    With ``cost_of`` (the initial values of function terms), numeric conditions are checked
+    and numeric effects change the values later steps read; without it they are not.
 
     Raises:
         EvaluationError: a formula has a variable that nothing binds.
@@ -102,6 +104,7 @@ def run_plan(
             state, tuple(states), tuple(supports), tuple(changes), None, step, reason
         )  # fmt: skip
 
+    numeric = _NumericState(cost_of)
     for step, (name, args) in enumerate(plan):
         shown = f"({' '.join((name, *args))})"
         try:
@@ -112,10 +115,14 @@ def run_plan(
         if problem is not None:
             return stop(step, problem)
         binding = bind(action, args)
+        failed = numeric.failed_condition(action, binding)
+        if failed is not None:
+            return stop(step, f"the numeric condition {failed} of {shown} does not hold")
+        step_cost_of = numeric.cost_of
         evaluator = Evaluator(domain, view(state), objects, explain=explain)
         durative = domain.durative_action(name)
         if durative is not None:
-            staged = _run_durative(durative, evaluator, binding, cost_of, view, state)
+            staged = _run_durative(durative, evaluator, binding, step_cost_of, view, state)
             if isinstance(staged, str):
                 return stop(step, f"the {staged} condition of {shown} does not hold")
             found, done = staged
@@ -124,7 +131,12 @@ def run_plan(
             if support is None:
                 return stop(step, f"the precondition of {shown} does not hold")
             found = support
-            done = effect_changes(evaluator, action.effect, binding, cost_of)
+            done = effect_changes(evaluator, action.effect, binding, step_cost_of)
+        extra = numeric.apply(action, binding, durative is not None)
+        if extra is None:
+            return stop(step, f"a numeric effect of {shown} is undefined")
+        if extra:
+            done = replace(done, cost=done.cost + extra)
         states.append(state)
         supports.append(found | done.support)
         changes.append(done)
@@ -134,6 +146,73 @@ def run_plan(
     if goal_support is None:
         return stop(-1, "the goal does not hold at the end of the plan")
     return PlanRun(state, tuple(states), tuple(supports), tuple(changes), goal_support)
+
+
+class _NumericState:
+    """The values of numeric fluents along a run: the initial ones from ``cost_of``, then as
+    the steps' numeric effects change them (nothing is checked without ``cost_of``)."""
+
+    def __init__(self, initial: CostOf | None) -> None:
+        self._initial = initial
+        self._changed: dict[tuple[str, tuple[str, ...]], float] = {}
+        self.cost_of: CostOf | None = None if initial is None else self._value
+
+    def _lookup(self, term: FunctionTerm) -> float | None:
+        key = (term.name, term.args)
+        if key in self._changed:
+            return self._changed[key]
+        if self._initial is None:
+            return None
+        try:
+            return self._initial(term)
+        except (KeyError, EvaluationError):
+            return None
+
+    def _value(self, term: FunctionTerm) -> float:
+        value = self._lookup(term)
+        if value is None:
+            raise EvaluationError(f"no value for ({' '.join((term.name, *term.args))})")
+        return value
+
+    def failed_condition(self, action: ActionSchema, binding: Binding) -> str | None:
+        """The first numeric condition of ``action`` that does not hold, shown; or None."""
+        if self._initial is None:
+            return None
+        for condition in action.numeric_conditions:
+            ground = Comparison(
+                condition.operator,
+                rename_args(condition.left, binding),
+                rename_args(condition.right, binding),
+            )
+            if not holds(ground, self._lookup):
+                return f"'{condition.operator}' at {condition.location}"
+        return None
+
+    def apply(self, action: ActionSchema, binding: Binding, durative: bool) -> float | None:
+        """Apply ``action``'s numeric effects; returns the cost they add (an expression
+        increasing ``total-cost``; a durative action's duration is counted apart), or None
+        when a new value is undefined."""
+        if self._initial is None:
+            return 0.0
+        cost = 0.0
+        updates: dict[tuple[str, tuple[str, ...]], float] = {}
+        for effect in action.numeric_effects:
+            value = evaluate(
+                rename_args(
+                    effect.as_assignment() if effect.target.name != TOTAL_COST else effect.value,
+                    binding,
+                ),
+                self._lookup,
+            )
+            if value is None:
+                return None
+            if effect.target.name == TOTAL_COST:
+                cost += 0.0 if durative else value
+            else:
+                target = effect.target
+                updates[(target.name, ground_args(target.args, binding))] = value
+        self._changed.update(updates)
+        return cost
 
 
 def _run_durative(

@@ -220,3 +220,35 @@ def test_numeric_goals_are_refused_located() -> None:
     problem = "(define (problem p) (:domain fuel) (:objects r - rover)\n(:goal (> (fuel r) 1)))"
     with pytest.raises(UnsupportedFeatureError, match=r"p.pddl:2:8: .*numeric condition"):
         parse_problem(problem, domain, "p.pddl")
+
+
+def test_a_plan_run_checks_numeric_conditions_and_follows_the_values() -> None:
+    from sdar_tamp.language.formula_model import Atom
+    from sdar_tamp.language.plan_run import run_plan
+    from sdar_tamp.language.state_index import TypedObjects
+
+    domain = parse_domain(FUEL, "d.pddl")
+    objects = TypedObjects(domain, {"a": "loc", "b": "loc", "c": "loc", "r": "rover"})
+    init = {Atom("at", ("r", "a")), Atom("depot", ("b",))}
+    init |= {Atom("road", pair) for pair in (("a", "b"), ("b", "c"))}
+    values = {
+        ("fuel", ("r",)): 3.0,
+        ("capacity", ("r",)): 4.0,
+        ("dist", ("a", "b")): 2.0,
+        ("dist", ("b", "c")): 3.0,
+    }
+
+    def value(term: FunctionTerm) -> float:
+        return values[(term.name, term.args)]
+
+    goal = Atom("at", ("r", "c"))
+    short = [("drive", ("r", "a", "b")), ("drive", ("r", "b", "c"))]
+    run = run_plan(domain, objects, init, short, goal, value)
+    assert run.failed_step == 1
+    assert "numeric condition '>=' at d.pddl:9" in run.reason
+    refuel = [short[0], ("refuel", ("r", "b")), short[1]]
+    run = run_plan(domain, objects, init, refuel, goal, value)
+    assert run.valid
+    assert run.cost == 2.0 + 1.0 + 3.0
+    # without the values, numeric conditions are not checked
+    assert run_plan(domain, objects, init, short, goal).valid
