@@ -65,3 +65,15 @@ def test_enough_fuel_drives_straight_through() -> None:
     solution = solve(_problem([], 6.0), algorithm="adaptive", max_time=60)
     assert solution.plan is not None
     assert [a.name for a in solution.plan] == ["drive", "drive", "drive"]
+
+
+def test_a_function_read_only_by_numeric_conditions_is_evaluated() -> None:
+    # the leg lengths no longer cost anything: only the fuel condition reads them
+    domain = DOMAIN.replace("(increase (total-cost) (Length ?a ?b))", "(increase (total-cost) 1)")
+    calls: list[tuple[Any, ...]] = []
+    problem = _problem(calls, 4.0)
+    problem = PDDLProblem(domain, {}, STREAMS, problem.stream_map, problem.init, problem.goal)
+    solution = solve(problem, algorithm="adaptive", max_time=60)
+    assert solution.plan is not None
+    assert [a.name for a in solution.plan] == ["drive", "refuel", "drive", "drive"]
+    assert calls
