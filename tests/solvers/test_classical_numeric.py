@@ -67,3 +67,45 @@ def test_a_tank_too_small_leaves_no_plan() -> None:
     result = plan(_task(2, 2), search="astar")  # b -> c needs 3
     assert result.status is PlanStatus.UNSOLVABLE
     assert result.plan is None
+
+
+DURATIVE = """
+(define (domain robot)
+  (:requirements :durative-actions :numeric-fluents)
+  (:predicates (at ?r ?q) (motion ?a ?t ?b) (dock ?q))
+  (:functions (energy ?r) (capacity ?r) (rate ?r) (length ?t))
+  (:durative-action recharge
+   :parameters (?r ?q)
+   :duration (= ?duration (/ (- (capacity ?r) (energy ?r)) (rate ?r)))
+   :condition (and (at start (at ?r ?q)) (at start (dock ?q))
+                   (at start (< (energy ?r) (capacity ?r))))
+   :effect (at end (increase (energy ?r) (* (rate ?r) ?duration))))
+  (:durative-action move
+   :parameters (?r ?a ?t ?b)
+   :duration (= ?duration (length ?t))
+   :condition (and (at start (at ?r ?a)) (at start (motion ?a ?t ?b))
+                   (at start (<= ?duration (energy ?r))))
+   :effect (and (at start (decrease (energy ?r) ?duration)) (at start (not (at ?r ?a)))
+                (at end (at ?r ?b)))))
+"""
+DURATIVE_PROBLEM = """
+(define (problem p) (:domain robot)
+  (:objects r a b c t1 t2)
+  (:init (at r a) (dock b) (motion a t1 b) (motion b t2 c)
+    (= (energy r) 5) (= (capacity r) 8) (= (rate r) 2) (= (length t1) 4) (= (length t2) 6))
+  (:goal (at r c))
+  (:metric minimize (total-time)))
+"""
+
+
+def test_durative_actions_with_numeric_fluents_recharge_on_the_way() -> None:
+    domain = parse_domain(DURATIVE, "d.pddl")
+    task = task_from_problem(domain, parse_problem(DURATIVE_PROBLEM, domain, "p.pddl"))
+    result = plan(task, search="astar")
+    assert result.plan == (
+        GroundAction("move", ("r", "a", "t1", "b")),
+        GroundAction("recharge", ("r", "b")),
+        GroundAction("move", ("r", "b", "t2", "c")),
+    )
+    # 4 s, then (8 - 1) / 2 = 3.5 s of recharge, then 6 s
+    assert result.cost == pytest.approx(4.0 + 3.5 + 6.0)
