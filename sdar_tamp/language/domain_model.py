@@ -12,8 +12,16 @@ from dataclasses import dataclass, field
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.durative import DurativeActionSchema
-from sdar_tamp.language.formula_model import OBJECT_TYPE, Atom, Effect, Formula, Parameter
+from sdar_tamp.language.formula_model import (
+    OBJECT_TYPE,
+    TOTAL_COST,
+    Atom,
+    Effect,
+    Formula,
+    Parameter,
+)
 from sdar_tamp.language.leniency import Leniency
+from sdar_tamp.language.numeric import Comparison, NumericEffect
 
 
 @dataclass(frozen=True)
@@ -42,6 +50,11 @@ class ActionSchema:
     precondition: Formula
     effect: Effect
     location: SourceLocation | None = field(default=None, compare=False)
+    numeric_conditions: tuple[Comparison, ...] = ()
+    """Numeric conditions, conjuncts of the precondition (:mod:`sdar_tamp.language.numeric`)."""
+    numeric_effects: tuple[NumericEffect, ...] = ()
+    """Numeric effects (and ``(increase (total-cost) ...)`` by an expression), conjuncts of
+    the effect."""
 
 
 @dataclass(frozen=True)
@@ -94,6 +107,22 @@ class Domain:
     @property
     def derived_predicates(self) -> frozenset[str]:
         return frozenset(axiom.predicate for axiom in self.axioms)
+
+    @property
+    def numeric_fluents(self) -> frozenset[str]:
+        """The functions that some action's numeric effect changes (``total-cost`` aside)."""
+        return frozenset(
+            effect.target.name
+            for action in self.actions
+            for effect in action.numeric_effects
+            if effect.target.name != TOTAL_COST
+        )
+
+    @property
+    def numeric(self) -> bool:
+        """True when an action has a numeric condition or effect (other than an action cost
+        given as a number or one function term)."""
+        return any(a.numeric_conditions or a.numeric_effects for a in self.actions)
 
     @property
     def temporal(self) -> bool:

@@ -46,6 +46,12 @@ from sdar_tamp.language.leniency import (
     LeniencyLog,
     note_glued_variables,
 )
+from sdar_tamp.language.numeric import (
+    NumericReader,
+    is_comparison,
+    is_numeric_effect,
+    split_conjuncts,
+)
 from sdar_tamp.language.pddl_sections import DOMAIN_SECTIONS, read_requirements, split_sections
 from sdar_tamp.language.sequential import compile_durative
 from sdar_tamp.language.sexpr import SExpr, SList, read_sexpr
@@ -194,15 +200,24 @@ def _action(section: SList, reader: FormulaReader, log: LeniencyLog) -> ActionSc
         else ()
     )
     scope = {p.name: p.type for p in params}
+    numeric = NumericReader(reader.term, reader.function_arity)
+    pre_node, comparisons = split_conjuncts(options.get(":precondition"), is_comparison)
     precondition = (
-        _existential_closure(
-            reader, options[":precondition"], scope, f"the precondition of {what}", log
-        )
-        if ":precondition" in options
+        _existential_closure(reader, pre_node, scope, f"the precondition of {what}", log)
+        if pre_node is not None
         else TRUE
     )
-    effect = reader.effect(options[":effect"], scope) if ":effect" in options else AndEffect(())
-    return ActionSchema(name, params, precondition, effect, section.location)
+    effect_node, changes = split_conjuncts(options.get(":effect"), is_numeric_effect)
+    effect = reader.effect(effect_node, scope) if effect_node is not None else AndEffect(())
+    return ActionSchema(
+        name,
+        params,
+        precondition,
+        effect,
+        section.location,
+        tuple(numeric.comparison(node, scope) for node in comparisons),
+        tuple(numeric.effect(node, scope) for node in changes),
+    )
 
 
 def _axiom(

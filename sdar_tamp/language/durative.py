@@ -2,15 +2,14 @@
 (:func:`read_durative_action`).
 
 A ``(:durative-action NAME :parameters (...) :duration (= ?duration D) :condition C :effect E)``
-has a fixed duration ``D`` (a non-negative number or one function term, e.g.
-``(TrajDistance ?t)``), conditions each tagged ``(at start ...)``, ``(over all ...)`` or
-``(at end ...)``, and effects each tagged ``(at start ...)`` or ``(at end ...)``. Plans run
-durative actions one after the other (:mod:`sdar_tamp.language.sequential` compiles each into
-one instantaneous action whose cost is its duration). Refused with a located
+has a fixed duration ``D`` (an expression: a number, function terms, ``+ - * /``, evaluated at
+its start), conditions each tagged ``(at start ...)``, ``(over all ...)`` or ``(at end ...)``
+and effects each tagged ``(at start ...)`` or ``(at end ...)``; both may be numeric
+(:mod:`sdar_tamp.language.numeric`) and use ``?duration``. Plans run durative actions one after
+the other (:mod:`sdar_tamp.language.sequential` compiles each into one instantaneous action
+whose cost is its duration). Refused with a located
 :class:`~sdar_tamp.language.errors.UnsupportedFeatureError`: duration inequalities
-(``(<= ?duration ...)``), arithmetic in durations, ``?duration`` in conditions or effects,
-numeric conditions (``(<= ...)``), continuous effects (``#t``) and numeric fluents other than
-``total-cost``.
+(``(<= ?duration ...)``) and continuous effects (``#t``).
 """
 
 from __future__ import annotations
@@ -27,17 +26,24 @@ from sdar_tamp.language.formula_model import (
     AndEffect,
     Effect,
     Formula,
-    NumericExpr,
     Parameter,
 )
 from sdar_tamp.language.formula_reader import FormulaReader
 from sdar_tamp.language.grammar import expect_list, expect_symbol, parse_options
+from sdar_tamp.language.numeric import (
+    DURATION,
+    Comparison,
+    Expression,
+    NumericEffect,
+    NumericReader,
+    is_comparison,
+    is_numeric_effect,
+    split_conjuncts,
+)
 from sdar_tamp.language.sexpr import SExpr, SList, Symbol
 
-DURATION = "?duration"
 START, OVER_ALL, END = "at start", "over all", "at end"
 _COMPARISONS = frozenset({"<", "<=", ">", ">="})
-_ARITHMETIC = frozenset({"+", "-", "*", "/"})
 
 NO_EFFECT: Effect = AndEffect(())
 
@@ -52,13 +58,17 @@ class DurativeActionSchema:
 
     name: str
     parameters: tuple[Parameter, ...]
-    duration: NumericExpr
+    duration: Expression
     at_start: Formula = TRUE
     over_all: Formula = TRUE
     at_end: Formula = TRUE
     start_effect: Effect = NO_EFFECT
     end_effect: Effect = NO_EFFECT
     location: SourceLocation | None = field(default=None, compare=False)
+    numeric_conditions: Mapping[str, tuple[Comparison, ...]] = field(default_factory=dict)
+    """The numeric conditions by tag (``"at start"``, ``"over all"``, ``"at end"``)."""
+    numeric_effects: Mapping[str, tuple[NumericEffect, ...]] = field(default_factory=dict)
+    """The numeric effects by tag (``"at start"``, ``"at end"``)."""
 
 
 def read_durative_action(
@@ -86,15 +96,26 @@ def read_durative_action(
     if ":duration" not in options:
         raise PddlSyntaxError(f"{what} has no ':duration'", section.location)
     scope = {p.name: p.type for p in params}
-    duration = _duration(options[":duration"], reader, scope, what)
+    numeric = NumericReader(reader.term, reader.function_arity, duration=True)
+    duration = _duration(options[":duration"], numeric, scope, what)
     conditions: dict[str, list[Formula]] = {START: [], OVER_ALL: [], END: []}
+    numeric_conditions: dict[str, list[Comparison]] = {START: [], OVER_ALL: [], END: []}
     for tag, node in _timed_parts(options.get(":condition"), (START, OVER_ALL, END), what):
-        _refuse_numeric(node, what)
-        conditions[tag].append(read_condition(reader, node, scope, f"a condition of {what}"))
+        _refuse_continuous(node)
+        rest, parts = split_conjuncts(node, is_comparison)
+        numeric_conditions[tag].extend(numeric.comparison(part, scope) for part in parts)
+        if rest is not None and not (isinstance(rest, SList) and not rest.items):
+            _refuse_duration_variable(rest, what)
+            conditions[tag].append(read_condition(reader, rest, scope, f"a condition of {what}"))
     effects: dict[str, list[Effect]] = {START: [], END: []}
+    numeric_effects: dict[str, list[NumericEffect]] = {START: [], END: []}
     for tag, node in _timed_parts(options.get(":effect"), (START, END), what):
-        effects[tag].append(reader.effect(node, scope))
-        _refuse_duration_variable(node, what)
+        _refuse_continuous(node)
+        rest, parts = split_conjuncts(node, is_numeric_effect)
+        numeric_effects[tag].extend(numeric.effect(part, scope) for part in parts)
+        if rest is not None:
+            _refuse_duration_variable(rest, what)
+            effects[tag].append(reader.effect(rest, scope))
     return DurativeActionSchema(
         name,
         params,
@@ -105,6 +126,8 @@ def read_durative_action(
         AndEffect(tuple(effects[START])),
         AndEffect(tuple(effects[END])),
         section.location,
+        {tag: tuple(parts) for tag, parts in numeric_conditions.items() if parts},
+        {tag: tuple(parts) for tag, parts in numeric_effects.items() if parts},
     )
 
 
@@ -113,8 +136,8 @@ def _conjunction(parts: list[Formula]) -> Formula:
 
 
 def _duration(
-    node: SExpr, reader: FormulaReader, scope: Mapping[str, str], what: str
-) -> NumericExpr:
+    node: SExpr, numeric: NumericReader, scope: Mapping[str, str], what: str
+) -> Expression:
     constraint = expect_list(node, f"the duration of {what}, '(= ?duration VALUE)'")
     items = constraint.items
     head = items[0] if items else constraint
@@ -137,16 +160,13 @@ def _duration(
     if not (isinstance(variable, Symbol) and variable.text == DURATION):
         raise PddlSyntaxError(f"{what}: expected '?duration' after '='", variable.location)
     value = items[2]
-    if isinstance(value, SList) and value.items:
-        operator = value.items[0]
-        if isinstance(operator, Symbol) and operator.text in _ARITHMETIC:
-            raise UnsupportedFeatureError(
-                f"{what}: arithmetic in a duration ('{operator.text}') is not supported; give "
-                "a number or one function term",
-                value.location,
-            )
     _refuse_duration_variable(value, what)
-    return reader.numeric(value, scope)
+    duration = numeric.expression(value, scope)
+    if isinstance(duration, float) and duration < 0:
+        raise PddlSyntaxError(
+            f"{what}: durations must be non-negative, got {duration:g}", value.location
+        )
+    return duration
 
 
 def _timed_parts(
@@ -182,15 +202,13 @@ def _timed_parts(
     raise PddlSyntaxError(f"{what}: expected a timed part, one of {shown}", lst.location)
 
 
-def _refuse_numeric(node: SExpr, what: str) -> None:
+def _refuse_continuous(node: SExpr) -> None:
     for lst in _lists(node):
-        head = lst.items[0] if lst.items else None
-        if isinstance(head, Symbol) and head.text in _COMPARISONS:
-            raise UnsupportedFeatureError(
-                f"{what}: numeric conditions ('{head.text}') are not supported (numeric fluents)",
-                lst.location,
-            )
-    _refuse_duration_variable(node, what)
+        for item in lst.items:
+            if isinstance(item, Symbol) and item.text == "#t":
+                raise UnsupportedFeatureError(
+                    "continuous effects ('#t') are not supported", item.location
+                )
 
 
 def _refuse_duration_variable(node: SExpr, what: str) -> None:
@@ -198,8 +216,8 @@ def _refuse_duration_variable(node: SExpr, what: str) -> None:
         for item in lst.items:
             if isinstance(item, Symbol) and item.text in (DURATION, "#t"):
                 raise UnsupportedFeatureError(
-                    f"{what}: '{item.text}' may only appear in ':duration' (continuous and "
-                    "duration-dependent conditions and effects are not supported)",
+                    f"{what}: '{item.text}' may only appear in ':duration', numeric conditions "
+                    "and numeric effects",
                     item.location,
                 )
 

@@ -44,6 +44,7 @@ from sdar_tamp.language.sexpr import SExpr, SList, Symbol
 _NOT_ATOMS = frozenset({EQUALITY, "and", "or", "not", "imply", "exists", "forall"})
 
 _TEXT = attrgetter("text")
+_NUMERIC_COMPARISONS = frozenset({"<", "<=", ">", ">="})
 
 MAX_FORMULA_DEPTH = 100
 """Formulas and effects nested deeper than this are rejected with a located error (they are
@@ -231,6 +232,15 @@ class FormulaReader:
             inner = {**scope, **{p.name: p.type for p in params}}
             body = self.formula(rest[1], inner)
             return Exists(params, body) if keyword == "exists" else ForAll(params, body)
+        if keyword in _NUMERIC_COMPARISONS or (
+            keyword == EQUALITY and any(isinstance(item, SList) for item in rest)
+        ):
+            raise UnsupportedFeatureError(
+                f"a numeric condition ('{keyword}') is supported only as a conjunct of an "
+                "action's precondition or of a durative action's timed condition (not in a "
+                "goal, a derived predicate, 'or', 'not', 'imply' or a quantifier)",
+                lst.location,
+            )
         return self.atom(lst, scope)
 
     def conjunction(self, node: SExpr, scope: Mapping[str, str], what: str) -> tuple[Atom, ...]:
@@ -277,7 +287,8 @@ class FormulaReader:
             return self._increase(lst, scope)
         if keyword in ("decrease", "assign", "scale-up", "scale-down"):
             raise UnsupportedFeatureError(
-                f"numeric effect '{keyword}' is not supported; only '(increase (total-cost) N)' is",
+                f"a numeric effect ('{keyword}') is supported only as a conjunct of an action's "
+                "effect (not inside 'when' or 'forall')",
                 lst.location,
             )
         return Literal(self._effect_atom(lst, scope))
@@ -300,7 +311,9 @@ class FormulaReader:
             or expect_symbol(target.items[0], "total-cost").text != TOTAL_COST
         ):
             raise UnsupportedFeatureError(
-                "only '(increase (total-cost) ...)' is supported", target.location
+                "a numeric effect ('increase') on a fluent other than 'total-cost' is supported "
+                "only as a conjunct of an action's effect (not inside 'when' or 'forall')",
+                target.location,
             )
         return IncreaseCost(self.numeric(node.items[2], scope))
 

@@ -31,6 +31,7 @@ REQUIREMENTS = frozenset(
         ":action-costs",
         ":adl",
         ":durative-actions",
+        ":numeric-fluents",
     }
 )
 DOMAIN_SECTIONS = (

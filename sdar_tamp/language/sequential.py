@@ -27,6 +27,7 @@ from sdar_tamp.language.formula_model import (
     EQUALITY,
     FALSE,
     OBJECT_TYPE,
+    TOTAL_COST,
     TRUE,
     And,
     AndEffect,
@@ -36,6 +37,7 @@ from sdar_tamp.language.formula_model import (
     ForAll,
     ForAllEffect,
     Formula,
+    FunctionTerm,
     Imply,
     IncreaseCost,
     Literal,
@@ -44,6 +46,8 @@ from sdar_tamp.language.formula_model import (
     Parameter,
     When,
 )
+from sdar_tamp.language.numeric import DURATION_TERM, NumericEffect
+from sdar_tamp.language.sequential_numeric import numeric_parts
 from sdar_tamp.language.traversal import iter_atoms, substitute
 
 
@@ -72,8 +76,25 @@ def compile_durative(action: DurativeActionSchema, axioms: tuple[Axiom, ...]) ->
     end_effect = _map_effect_conditions(action.end_effect, regress)
     end = list(_touches(end_effect, TRUE, (), fresh))
     kept_start = _drop_overridden(action.start_effect, end)
-    effect = AndEffect((kept_start, end_effect, IncreaseCost(action.duration)))
-    return ActionSchema(action.name, action.parameters, precondition, effect, action.location)
+    conditions, numeric_effects = numeric_parts(action)
+    duration = action.duration
+    parts: tuple[Effect, ...] = (kept_start, end_effect)
+    if isinstance(duration, float | int) or (
+        isinstance(duration, FunctionTerm) and duration != DURATION_TERM
+    ):
+        parts += (IncreaseCost(duration),)
+    else:  # an expression: a numeric cost (sdar_tamp.language.numeric_compile)
+        total = NumericEffect("increase", FunctionTerm(TOTAL_COST), duration, action.location)
+        numeric_effects += (total,)
+    return ActionSchema(
+        action.name,
+        action.parameters,
+        precondition,
+        AndEffect(parts),
+        action.location,
+        conditions,
+        numeric_effects,
+    )
 
 
 class _Fresh:

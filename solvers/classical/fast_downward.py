@@ -20,6 +20,7 @@ from pathlib import Path
 
 from sdar_tamp.errors import ParameterError
 from solvers.classical.errors import BackendUnavailableError, PlanValidationError
+from solvers.classical.numeric_task import plan_numeric
 from solvers.classical.plan_check import validated_plan_cost
 from solvers.classical.planner import ground_or_timeout
 from solvers.classical.problem import (
@@ -212,6 +213,18 @@ def plan_task_with_fast_downward(
     search_engine(search, heuristic, weight)  # an unknown pair fails before grounding
     if time_limit is not None and math.isinf(time_limit):
         time_limit = None
+    if task.domain.numeric:  # numeric fluents: compiled away for their reachable values
+        return plan_numeric(
+            task,
+            lambda t: plan_task_with_fast_downward(
+                t,
+                search=search,
+                heuristic=heuristic,
+                weight=weight,
+                time_limit=time_limit,
+                cost_bound=cost_bound,
+            ),
+        )
     start = time.perf_counter()
     deadline = None if time_limit is None else start + time_limit
     ground_task = ground_or_timeout(task, start, deadline)

@@ -14,6 +14,7 @@ from solvers.classical.errors import PlanValidationError
 from solvers.classical.ground import ground
 from solvers.classical.heuristics import HEURISTICS, RelaxedHeuristic
 from solvers.classical.landmarks import LandmarkCount
+from solvers.classical.numeric_task import plan_numeric
 from solvers.classical.plan_check import validated_plan_cost
 from solvers.classical.postprocess import eliminate_redundant_actions
 from solvers.classical.problem import (
@@ -87,6 +88,13 @@ def plan(
     """
     _check("search", search, SEARCHES)
     _check("heuristic", heuristic, HEURISTICS)
+    if task.domain.numeric:  # numeric fluents: compiled away for their reachable values
+        options = dict(search=search, heuristic=heuristic, weight=weight, lazy=lazy)
+        options.update(preferred_operators=preferred_operators, exploration=exploration)
+        return plan_numeric(
+            task,
+            lambda t: plan(t, time_limit=time_limit, cost_bound=cost_bound, **options),  # type: ignore[arg-type]
+        )
     if not weight >= 1.0:
         raise ParameterError(f"weight must be >= 1; got {weight!r}")
     greedy_lazy = search == "lazy-gbfs" or (search == "gbfs" and lazy)

@@ -24,6 +24,7 @@ from collections.abc import Callable, Collection, Iterable, Mapping
 
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import Atom, Formula, FunctionTerm, IncreaseCost
+from sdar_tamp.language.numeric import numeric_terms
 from sdar_tamp.language.traversal import iter_effects
 from solvers.stream_planning.assumed import Assumed
 from solvers.stream_planning.engine import Engine
@@ -34,15 +35,21 @@ PlanSteps = list[tuple[str, tuple[str, ...]]]
 
 def cost_terms(domain: Domain, actions: Iterable[tuple[str, tuple[str, ...]]]) -> list[Atom]:
     """The ground cost terms ``(f args)`` of a plan's steps, as atoms, in plan order (terms
-    under conditional effects included: the check decides whether they apply)."""
+    under conditional effects included: the check decides whether they apply), and the terms
+    of functions its numeric conditions and effects read (numeric fluents aside)."""
     terms: list[Atom] = []
+    fluents = domain.numeric_fluents
     for name, args in actions:
         action = domain.action(name)
         binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
-        for effect in iter_effects(action.effect):
-            if isinstance(effect, IncreaseCost) and isinstance(effect.amount, FunctionTerm):
-                term = effect.amount
-                terms.append(Atom(term.name, tuple(binding.get(a, a) for a in term.args)))
+        used = [
+            effect.amount
+            for effect in iter_effects(action.effect)
+            if isinstance(effect, IncreaseCost) and isinstance(effect.amount, FunctionTerm)
+        ]
+        used.extend(t for t in numeric_terms(action) if t.name not in fluents)
+        for term in used:
+            terms.append(Atom(term.name, tuple(binding.get(a, a) for a in term.args)))
     return terms
 
 

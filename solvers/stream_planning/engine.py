@@ -32,6 +32,7 @@ from typing import Any
 
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import Atom, FunctionTerm, IncreaseCost
+from sdar_tamp.language.numeric import numeric_terms
 from sdar_tamp.language.objects import ObjectTable
 from sdar_tamp.language.options import FunctionInfo, StreamInfo, unsupported_options
 from sdar_tamp.language.problem import PDDLProblem
@@ -325,13 +326,14 @@ class Engine:
 
 
 def cost_functions(domain: Domain) -> frozenset[str]:
-    """Names of the functions that appear in some action's cost increase."""
+    """Names of the functions that appear in some action's cost increase, numeric conditions
+    or numeric effects."""
     return frozenset(
         e.amount.name
         for action in domain.actions
         for e in iter_effects(action.effect)
         if isinstance(e, IncreaseCost) and isinstance(e.amount, FunctionTerm)
-    )
+    ) | frozenset(t.name for action in domain.actions for t in numeric_terms(action))
 
 
 def bind_externals(
