@@ -19,9 +19,9 @@ tries the candidate steps toward the goals once more with the first ``pair_grasp
 each object instead of the first ``grasps`` (:meth:`Recovery.wider`): an object whose few
 grasps all meet a neighbour, at its pose or at its goal, often has one among the moderate tilts
 that come after them (a 7-DoF arm's wrist, larger than the UR5e's, meets its neighbours
-sooner), and a grasp
-costs no extra moves where an eviction costs two. Evicting first let two such objects evict
-each other in turn (each boxed in at its goal by the other) until the eviction budget ran out.
+sooner), and a grasp costs no extra moves where an eviction costs two. Evicting first let two
+such objects evict each other in turn (each boxed in at its goal by the other) until the
+eviction budget ran out.
 """
 
 from __future__ import annotations
