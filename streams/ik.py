@@ -252,6 +252,10 @@ class SceneCache:
         self.builds = 0
         self.hits = 0
 
+    def holds(self, key: Hashable, world: CollisionWorld) -> bool:
+        """Whether ``world`` is still the one kept for the arrangement ``key``."""
+        return self._worlds.get(key) is world
+
     def world(self, key: Hashable, objects: Mapping[str, ObjectBox]) -> CollisionWorld:
         """The world holding exactly ``objects`` (the arrangement ``key``)."""
         world = self._worlds.get(key)

@@ -193,9 +193,12 @@ class RearrangementStreams:
             index = 0
         home = {a: self.ctx.home(a) for a in self.ctx.arm_names}
         key = frozenset(placed.items())
+        held = [self.scenes.world(key, objects)]
 
-        def world() -> CollisionWorld:  # the arrangement's (the cache may reuse a world)
-            return self.scenes.world(key, objects)
+        def world() -> CollisionWorld:  # the arrangement's (the cache may have reused it)
+            if not self.scenes.holds(key, held[0]):
+                held[0] = self.scenes.world(key, objects)
+            return held[0]
 
         wanted = [index]
         twin = self._twins(obj)[index] if table.grasps is self.grasps(obj) else None

@@ -95,6 +95,8 @@ def test_scene_cache_keeps_one_world_per_arrangement(
     c = cache.world("one", {names[0]: objects[names[0]]})
     assert c is a and set(c.objects) == {names[0]} and cache.builds == 3
     assert cache.world("fewer", fewer) is b and cache.hits == 2
+    # the world of "all" now serves "one": a holder of it must ask again
+    assert cache.holds("one", a) and not cache.holds("all", a) and cache.holds("fewer", b)
 
 
 def test_scene_cache_refuses_no_capacity(ctx: WorldContext) -> None:
