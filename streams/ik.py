@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import heapq
 from collections import OrderedDict
-from collections.abc import Hashable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -124,32 +124,49 @@ def collision_free_candidates(
 ) -> list[IKCandidate]:
     """The branches of ``table`` (grasps ``indices``, default all) whose grasp, pre-grasp and
     approach are collision-free among ``objects`` (see the module docstring), cheapest first."""
+    return list(
+        iter_collision_free_candidates(
+            ctx, lambda: world, objects, table, q_current, indices, other_q
+        )
+    )
+
+
+def iter_collision_free_candidates(
+    ctx: WorldContext,
+    world_of: Callable[[], CollisionWorld],
+    objects: Mapping[str, ObjectBox],
+    table: GraspIK,
+    q_current: Mapping[str, FloatArray],
+    indices: Sequence[int] | None = None,
+    other_q: Mapping[str, FloatArray] | None = None,
+) -> Iterator[IKCandidate]:
+    """:func:`collision_free_candidates` one at a time, cheapest first: the branches are
+    ordered by cost (which needs no collision check) and checked in that order, so a caller
+    that takes the first candidates checks only as many branches as it needs. ``world_of``
+    gives the world to check in at each branch (a caller's scratch world may serve other
+    arrangements between two candidates); it is given exactly ``objects`` first."""
     park = {a: ctx.home(a) for a in ctx.arm_names}
     if other_q is not None:
         park.update({a: np.asarray(q, dtype=np.float64) for a, q in other_q.items()})
-    ensure_objects(world, objects)
     arm, obj = table.arm, table.obj
     ref = np.asarray(q_current[arm], dtype=np.float64)
     wanted = range(len(table.grasps)) if indices is None else indices
-    out: list[IKCandidate] = []
-    for gi in wanted:
-        for b in np.flatnonzero(table.ok[gi]):
-            q, q_pre = table.q[gi, b], table.q_pre[gi, b]
-            if _collides(ctx, world, park, arm, obj, q) or _collides(
-                ctx, world, park, arm, obj, q_pre
-            ):
-                continue
-            sweep = table.sweep(gi, int(b))
-            if sweep is None or any(
-                _collides(ctx, world, park, arm, obj, qs) for qs in sweep[1:-1]
-            ):
-                continue  # the straight approach between them is blocked or unreachable
-            cost = float(np.linalg.norm(q_pre - ref))
-            out.append(
-                IKCandidate(arm, obj, table.grasps[gi], int(b), q.copy(), q_pre.copy(), cost)
-            )
-    out.sort(key=lambda c: c.cost)
-    return out
+    ranked = [
+        (float(np.linalg.norm(table.q_pre[gi, b] - ref)), gi, int(b))
+        for gi in wanted
+        for b in np.flatnonzero(table.ok[gi])
+    ]
+    ranked.sort(key=lambda item: item[0])  # stable: equal costs keep grasp, branch order
+    for cost, gi, b in ranked:
+        world = world_of()
+        ensure_objects(world, objects)
+        q, q_pre = table.q[gi, b], table.q_pre[gi, b]
+        if _collides(ctx, world, park, arm, obj, q) or _collides(ctx, world, park, arm, obj, q_pre):
+            continue
+        sweep = table.sweep(gi, b)
+        if sweep is None or any(_collides(ctx, world, park, arm, obj, qs) for qs in sweep[1:-1]):
+            continue  # the straight approach between them is blocked or unreachable
+        yield IKCandidate(arm, obj, table.grasps[gi], b, q.copy(), q_pre.copy(), cost)
 
 
 def solve_ik_candidates(
@@ -234,6 +251,10 @@ class SceneCache:
         self._worlds: OrderedDict[Hashable, CollisionWorld] = OrderedDict()
         self.builds = 0
         self.hits = 0
+
+    def holds(self, key: Hashable, world: CollisionWorld) -> bool:
+        """Whether ``world`` is still the one kept for the arrangement ``key``."""
+        return self._worlds.get(key) is world
 
     def world(self, key: Hashable, objects: Mapping[str, ObjectBox]) -> CollisionWorld:
         """The world holding exactly ``objects`` (the arrangement ``key``)."""

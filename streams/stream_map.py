@@ -26,7 +26,7 @@ import numpy as np
 
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.logs import get_logger
-from sdar_tamp.world.collision import ObjectBox
+from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.footprint import corners, overlap_matrix
 from sdar_tamp.world.instance import Pose2D
 from sdar_tamp.world.transforms import FloatArray, pose_xyz_yaw
@@ -34,7 +34,11 @@ from streams.buffers import GRASP_CORRIDOR, BufferPool
 from streams.context import WorldContext
 from streams.finger_blocking import GraspBlocking, cell_gripper_boxes
 from streams.grasps import DEFAULT_GRASPS, Grasp, GraspOptions, half_turn_twins, sample_grasps
-from streams.ik import GraspIK, SceneCache, collision_free_candidates
+from streams.ik import (
+    GraspIK,
+    SceneCache,
+    iter_collision_free_candidates,
+)
 from streams.motion.planner import MotionPlanner
 from streams.motion_streams import MotionStreams
 from streams.stream_types import ArmConf, CellConf
@@ -188,13 +192,20 @@ class RearrangementStreams:
             table = GraspIK(self.ctx, arm, obj, objects[obj], (g,))  # a grasp from elsewhere
             index = 0
         home = {a: self.ctx.home(a) for a in self.ctx.arm_names}
-        world = self.scenes.world(frozenset(placed.items()), objects)
+        key = frozenset(placed.items())
+        held = [self.scenes.world(key, objects)]
+
+        def world() -> CollisionWorld:  # the arrangement's (the cache may have reused it)
+            if not self.scenes.holds(key, held[0]):
+                held[0] = self.scenes.world(key, objects)
+            return held[0]
+
         wanted = [index]
         twin = self._twins(obj)[index] if table.grasps is self.grasps(obj) else None
         if twin is not None and self.half_turns and g.is_top_down:
             wanted.append(twin)  # the same hold with wrist 3 turned by pi: after g's own
-        for k in wanted:
-            for c in collision_free_candidates(self.ctx, world, objects, table, home, (k,)):
+        for k in wanted:  # checked as they are asked for, cheapest first
+            for c in iter_collision_free_candidates(self.ctx, world, objects, table, home, (k,)):
                 yield (ArmConf(arm, tuple(map(float, c.q)), tuple(map(float, c.q_pre))),)
 
     def _twins(self, obj: str) -> tuple[int | None, ...]:

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sdar_tamp.world import ik_kernel
 from sdar_tamp.world._pin import Chain, PinRobot, chain_to
 from sdar_tamp.world.dls_ik import DlsOptions, DlsResult, dls_ik
 from sdar_tamp.world.errors import KinematicsError
@@ -132,6 +133,8 @@ class ArmKinematics:
         T_root_base = _root_to_base(robot, spec.base_frame)
         found = ur_parameters(robot, tool_frame)
         if found is None:
+            if numeric.compiled:
+                ik_kernel.kernel()  # loaded (or compiled) with the arm, not in its first IK
             return ArmKinematics(
                 spec, robot, tcp_offset, chain, None, np.eye(4), numeric, T_root_base
             )

@@ -8,6 +8,8 @@ reference configuration (the home, or the centre of the limits). Joints are clam
 limits after every step. Every target is tried from several seeds (the reference first, then
 uniform draws inside the limits), and the targets no seed solved get fresh seeds in up to
 ``rounds`` rounds; of the seeds that converge, the one closest to the reference is kept.
+The descent runs compiled (:mod:`.ik_kernel`, one start after the other) where numba runs, else
+(or with ``NumericIKOptions(compiled=False)``) with numpy, the starts side by side.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sdar_tamp.world import ik_kernel
 from sdar_tamp.world._pin import Chain
 from sdar_tamp.world.errors import KinematicsError
 from sdar_tamp.world.transforms import BoolArray, FloatArray
@@ -38,6 +41,9 @@ class NumericIKOptions:
     #: near the pose its steps leave the pose by their second-order terms and slow the last
     #: iterations of the descent.
     null_space_fade: float = 0.0
+    #: Descend with the compiled kernel (:mod:`.ik_kernel`, one start after the other) where
+    #: numba runs, else (or when False) with numpy, the starts side by side.
+    compiled: bool = True
 
 
 @dataclass(frozen=True)
@@ -215,6 +221,29 @@ def _descend(
     squared error has not fallen by :data:`_PROGRESS_RATIO` in :data:`_PROGRESS_WINDOW`
     iterations, or (``enough``) when ``enough`` starts of its target have converged."""
     n, s, dof = starts.shape
+    compiled = ik_kernel.kernel() if opts.compiled else None
+    if compiled is not None:
+        settings = (
+            opts.position_tolerance,
+            opts.rotation_tolerance,
+            opts.damping,
+            opts.max_step,
+            opts.null_space_gain,
+            opts.null_space_fade,
+        )
+        refs_all = np.empty(starts.shape)  # writable: the kernel's one signature
+        refs_all[...] = ref
+        return compiled(
+            ik_kernel.pack(chain),
+            np.array(T_t, dtype=np.float64, order="C"),
+            np.array(starts, dtype=np.float64, order="C"),
+            refs_all,
+            np.array(lo, dtype=np.float64, order="C"),
+            np.array(hi, dtype=np.float64, order="C"),
+            settings,
+            int(opts.iterations),
+            0 if enough is None else int(enough),
+        )
     q = starts.reshape(n * s, dof).copy()
     targets = np.repeat(T_t, s, axis=0)
     refs = np.broadcast_to(ref, starts.shape).reshape(n * s, dof)

@@ -13,13 +13,15 @@ An evicted object does not come back to its goal before the object it made room 
 the pose where it was boxed in (and, when that pose is its goal, has come back to it):
 otherwise the eviction would be undone before it served (:class:`Deferral`).
 
-Before any eviction, when some remaining object is boxed in, the solver tries the candidate
-steps toward the goals once more with the first ``pair_grasps`` grasps of each object instead
-of the first ``grasps`` (:meth:`Recovery.wider`): an object whose few grasps all meet a
-neighbour, at its pose or at its goal, often has one among the moderate tilts that come after
-them (a 7-DoF arm's wrist, larger than the UR5e's, meets its neighbours sooner), and a grasp
-costs no extra moves where an eviction costs two. Evicting first let two such objects evict
-each other in turn (each boxed in at its goal by the other) until the eviction budget ran out.
+Before any eviction, when some remaining object is boxed in (or no arm holds it with one of
+the first grasps both where it rests and at its goal, :meth:`Recovery.carried`), the solver
+tries the candidate steps toward the goals once more with the first ``pair_grasps`` grasps of
+each object instead of the first ``grasps`` (:meth:`Recovery.wider`): an object whose few
+grasps all meet a neighbour, at its pose or at its goal, often has one among the moderate tilts
+that come after them (a 7-DoF arm's wrist, larger than the UR5e's, meets its neighbours
+sooner), and a grasp costs no extra moves where an eviction costs two. Evicting first let two
+such objects evict each other in turn (each boxed in at its goal by the other) until the
+eviction budget ran out.
 """
 
 from __future__ import annotations
@@ -108,9 +110,32 @@ class Recovery:
             return None
         if view is not None:
             current = self.cache.current_poses()
-            if all(self.boxed(o, view, current) is None for o in view.remaining):
+            if all(
+                self.boxed(o, view, current) is None and self.carried(o, view, current)
+                for o in view.remaining
+            ):
                 return None
         return replace(opt, grasps=opt.pair_grasps)
+
+    def carried(self, obj: str, view: TaskView, current: Mapping[str, str]) -> bool:
+        """Some arm holds ``obj`` with one of the first grasps both where it rests and at its
+        goal (the other objects resting as they do); also ``True`` when something's footprint
+        is at its goal (then the goal is not what is in question). A move carries its object
+        with one grasp, so an object graspable where it rests with some grasps and at its goal
+        with others (neither :meth:`boxed`) cannot be moved to its goal either."""
+        if view.blockers(obj):
+            return True
+        cache, voc = self.cache, self.cache.voc
+        here, goal = current[obj], self.goals[obj]
+        resting = cache.fluents(voc.atpose)
+        after = cache.fluents(voc.atpose, without=frozenset((obj,)))
+        grasps = cache.outputs(voc.grasp, (obj,), self.options.grasps)
+        return any(
+            cache.outputs(voc.ik, (arm, obj, here, g), 1, resting)
+            and cache.outputs(voc.ik, (arm, obj, goal, g), 1, after)
+            for arm in self.arms
+            for (g,) in grasps
+        )
 
     # -- candidates ---------------------------------------------------------------------------
     def candidates(self, view: TaskView) -> list[Step]:

@@ -112,6 +112,9 @@ def _numeric_ik_planner(out: Summary) -> None:
     assert out["poses"] == 10 and planner["grasps"] == default["grasps"] == 60
     assert planner["grasps_solved"] >= default["grasps_solved"] > 0
     assert planner["iterations_per_pose"] < default["iterations_per_pose"]
+    compiled = out["planner"]["compiled"]  # the same options, descending compiled
+    assert compiled["grasps"] == 60 and compiled["grasps_solved"] >= planner["grasps_solved"] - 1
+    assert compiled["iterations_per_pose"] is None
 
 
 def _parser(out: Summary) -> None:

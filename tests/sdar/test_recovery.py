@@ -172,3 +172,40 @@ def test_more_grasps_only_for_a_boxed_in_object(ctx: WorldContext, planner: Moti
                         SdarTaskPlanner())  # fmt: skip
     assert solver.recovery.wider() is not None  # without a view: the options alone
     assert solver.recovery.wider(solver.view()) is None  # a has grasps: nothing boxed in
+
+
+def _split_grasps_problem(ctx: WorldContext, planner: MotionPlanner) -> Rearrangement:
+    """a has IK where it rests with the even ones of its first grasps and at its goal with the
+    odd ones: reachable at both (not boxed in), but no first grasp carries it from one to the
+    other; the grasps after the first have IK everywhere."""
+    inst = Instance("split", WORKSPACE, (ObjectSpec("a", SIZE, A_START, A_GOAL),))
+    real = make_stream_map(ctx, {o.name: o.size for o in inst.objects})["inverse-kinematics"]
+    first = SdarOptions().grasps
+
+    def split(arm: str, o: str, p: Pose2D, g: Any, fluents: Any = ()) -> Iterator[Any]:
+        if o == "a" and g.index < first:
+            here = p == A_START and g.index % 2 == 0
+            there = p == A_GOAL and g.index % 2 == 1
+            if not (here or there):
+                return iter(())
+        return real(arm, o, p, g, fluents)
+
+    return rearrangement_problem(
+        inst, ctx, planner=planner, overrides={"inverse-kinematics": split}
+    )
+
+
+def test_more_grasps_when_no_first_grasp_serves_both_ends(
+    ctx: WorldContext, planner: MotionPlanner
+) -> None:
+    r = _split_grasps_problem(ctx, planner)
+    solver = SdarSolver(r.problem, SdarTaskPlanner(), SdarOptions(max_time=BUDGET))
+    view = solver.view()
+    current = solver.cache.current_poses()
+    (a,) = view.remaining
+    assert solver.recovery.boxed(a, view, current) is None  # graspable at both ends
+    assert not solver.recovery.carried(a, view, current)  # but not with one grasp
+    wider = solver.recovery.wider(view)
+    assert wider is not None and wider.grasps == solver.options.pair_grasps
+    solution = solver.solve()
+    assert solution.status is Status.SOLVED, solution.diagnosis

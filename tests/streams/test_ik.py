@@ -11,6 +11,7 @@ from streams.ik import (
     SceneCache,
     collision_free_candidates,
     compatible_pairs,
+    iter_collision_free_candidates,
     solve_ik_candidates,
 )
 
@@ -94,6 +95,8 @@ def test_scene_cache_keeps_one_world_per_arrangement(
     c = cache.world("one", {names[0]: objects[names[0]]})
     assert c is a and set(c.objects) == {names[0]} and cache.builds == 3
     assert cache.world("fewer", fewer) is b and cache.hits == 2
+    # the world of "all" now serves "one": a holder of it must ask again
+    assert cache.holds("one", a) and not cache.holds("all", a) and cache.holds("fewer", b)
 
 
 def test_scene_cache_refuses_no_capacity(ctx: WorldContext) -> None:
@@ -126,3 +129,40 @@ def test_one_grasp_ik_table_serves_every_arrangement(
     blocked = collision_free_candidates(ctx, world, crowded, table, home)
     assert len(blocked) < len(kept)
     assert not any(c.grasp.is_top_down for c in blocked)
+
+
+def test_candidates_one_at_a_time_check_only_what_is_asked_for(
+    ctx: WorldContext, objects: dict[str, ObjectBox]
+) -> None:
+    """The lazy candidates are the list's, in its order; taking the first one checks fewer
+    configurations than the list; a world used for another arrangement in between is given
+    the candidates' objects back before the next check."""
+    name = next(iter(objects))
+    arm = ctx.arm_names[0]
+    grasps = sample_grasps(objects[name].size, ctx.scene.grasp_limits)
+    table = GraspIK(ctx, arm, name, objects[name], grasps)
+    home = {a: ctx.home(a) for a in ctx.arm_names}
+    world = ctx.new_world()
+    calls = [0]
+    check = world.in_collision
+
+    def counted(q: np.ndarray | None = None) -> bool:
+        calls[0] += 1
+        return check(q)
+
+    world.in_collision = counted  # type: ignore[method-assign]
+    every = collision_free_candidates(ctx, world, objects, table, home)
+    assert len(every) >= 2
+    all_checks, calls[0] = calls[0], 0
+    lazy = iter_collision_free_candidates(ctx, lambda: world, objects, table, home)
+    first = next(lazy)
+    assert calls[0] < all_checks
+    assert (first.grasp, first.branch, first.cost) == (
+        every[0].grasp,
+        every[0].branch,
+        every[0].cost,
+    )
+    world.set_objects({})  # the scratch world serves another arrangement meanwhile
+    rest = list(lazy)
+    assert world.objects.keys() == objects.keys()
+    assert [(c.grasp, c.branch) for c in rest] == [(c.grasp, c.branch) for c in every[1:]]
