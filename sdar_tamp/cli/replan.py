@@ -38,7 +38,7 @@ def cmd_replan(args: argparse.Namespace) -> int:
     config = PlannerConfig(max_time=args.time_limit, seed=args.seed)
     outcome = replan(
         instance, plan, args.at, observed, config=config, scene_path=scene_path,
-        repair=not args.fresh,
+        repair=not args.fresh, compare=not args.no_compare,
     )  # fmt: skip
     written = None
     if outcome.plan is not None and args.output is not None:
@@ -54,6 +54,7 @@ def cmd_replan(args: argparse.Namespace) -> int:
             "reasons": list(outcome.reasons),
             "blocking": list(outcome.blocking),
             "moved_away": list(outcome.moved_away),
+            "alternative": outcome.alternative,
             "plan_file": None if written is None else str(written),
         }
         print(json.dumps(record, sort_keys=True))
@@ -67,6 +68,8 @@ def _summary(outcome: Any, written: Path | None) -> str:
     if outcome.plan is not None:
         verdict = "valid" if outcome.valid else f"INVALID ({outcome.violation})"
         lines.append(f"new plan: {outcome.plan.duration:.2f} s of execution, {verdict}")
+    if outcome.alternative is not None:
+        lines.append(f"compared with: {outcome.alternative:.2f} s of execution (not kept)")
     if outcome.moved_away:
         lines.append(f"moved away: {', '.join(outcome.moved_away)}")
     if outcome.blocking:
@@ -99,5 +102,10 @@ def add_replan_parser(sub: argparse._SubParsersAction[Any]) -> None:
     p.add_argument(
         "--fresh", action="store_true", help="no repair: always a fresh continuation from the cut"
     )
+    p.add_argument(
+        "--no-compare", action="store_true",
+        help="keep a valid repair without solving a fresh continuation to compare it with "
+        "(lower latency; the execution may be longer)",
+    )  # fmt: skip
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(func=cmd_replan)

@@ -87,3 +87,32 @@ def test_replan_missing_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     ):
         code, _, err = _run(["replan", *argv], capsys)
         assert code == 2 and "none." in err
+
+
+def test_replan_no_compare_keeps_the_repair(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """o4 nudged at 5.116 s: by default the repair is compared with a fresh continuation,
+    which is shorter and kept (the repair's duration reported as the alternative); with
+    --no-compare the repair is kept and nothing is compared."""
+    from sdar_tamp.plan_state import state_at
+    from sdar_tamp.world.instance import load_instance
+    from sdar_tamp.world.scene import load_scene
+
+    instance = load_instance(Path(D5))
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    x, y, yaw = state_at(load_plan(PLAN), starts, load_scene(), 5.116).resting["o4"]
+    obs = _observed(tmp_path, f"poses: [{{name: o4, pose: [{x + 0.0052}, {y + 0.0173}, "
+                              f"{yaw - 0.1559}]}}]\n")  # fmt: skip
+    argv = ["replan", D5, PLAN, "--at", "5.116", "--observed", obs, "--json"]
+    code, out, _ = _run(argv, capsys)
+    compared = json.loads(out)
+    code_no, out_no, _ = _run([*argv, "--no-compare"], capsys)
+    kept = json.loads(out_no)
+    assert code == 0 and compared["status"] == "replanned" and compared["valid"] is True
+    assert code_no == 0 and kept["status"] == "repaired" and kept["valid"] is True
+    assert kept["alternative"] is None
+    assert compared["alternative"] == pytest.approx(kept["execution_time"])
+    assert compared["execution_time"] < kept["execution_time"]
+    code, out, _ = _run(argv[:-1], capsys)
+    assert code == 0 and "compared with: " in out and "(not kept)" in out
