@@ -48,6 +48,7 @@ from sdar_tamp.app.move_planning import StreamMovePlanner
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.schedule import ScheduleOptions, schedule_async
 from sdar_tamp.schedule.assignment import schedule_assigned
+from sdar_tamp.schedule.move_records import POLICIES, AssignmentOptions
 from sdar_tamp.schedule.pieces import arm_blocks
 from sdar_tamp.schedule.scheduler import retimer
 from sdar_tamp.schedule.timelines import schedule_timelines
@@ -75,12 +76,29 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument(
         "--no-assigned", action="store_true", help="leave out the moves assigned anew (slow)"
     )
+    ap.add_argument(
+        "--assign-seconds",
+        type=float,
+        default=AssignmentOptions.max_seconds,
+        help="wall-clock cap [s] of the assignment search per instance",
+    )
+    ap.add_argument(
+        "--policies",
+        default=",".join(POLICIES),
+        help=f"the assignment's policies, tried in turn (some of {','.join(POLICIES)})",
+    )
+    ap.add_argument("--no-pauses", action="store_true", help="motions do not pause on the way")
     ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
     args = ap.parse_args(argv)
     if args.quick:  # explicit options still win
         ap.set_defaults(**QUICK)
         args = ap.parse_args(argv)
     only = {s for s in args.only.split(",") if s}
+    assignment_options = AssignmentOptions(
+        max_seconds=args.assign_seconds,
+        policies=tuple(p for p in args.policies.split(",") if p),
+        pauses=not args.no_pauses,
+    )
     files = [p for p in shipped_suite_files(args.suite) if not only or p.stem in only]
     cache = PlannerCache()
     solve_config = PlannerConfig(max_time=args.time_limit, execution="sync")
@@ -109,7 +127,12 @@ def main(argv: list[str] | None = None) -> None:
         assigned = None
         if not args.no_assigned:
             assigned = schedule_assigned(
-                plan, instance, scene, options, StreamMovePlanner(instance, scene)
+                plan,
+                instance,
+                scene,
+                options,
+                StreamMovePlanner(instance, scene),
+                assignment_options,
             )
         elapsed = (middle - start, after - middle, time.perf_counter() - after)
         valid_today = validate_plan(instance, today.plan, scene).ok
@@ -168,6 +191,10 @@ def main(argv: list[str] | None = None) -> None:
             }
         )
         note = lines.reason[:40] + (" | " + assigned.reason[:40] if assigned is not None else "")
+        if assigned is not None:  # each policy's schedule [s]
+            note += " | " + " ".join(
+                f"{k[9:]}={v:.2f}" for k, v in assigned.figures if k.startswith("duration_")
+            )
         found = assigned.async_duration if assigned is not None else None
         dep, arms = figures.get("wait_dependencies", 0.0), figures.get("wait_other_arms", 0.0)
         tog, cut = int(figures.get("together", 0)), figures.get("shortcut_saved", 0.0)

@@ -27,10 +27,10 @@ with the order those moves must keep) and decides, event by event, which arm car
    where it ends), after the dependencies: the object's previous release and the blockers'
    grasps, a dwell before; when the arm, holding the object, would stand in another arm's
    way before the carry can start, the grasp is moved later. When the earliest start meets
-   another arm and the motion waits :data:`DETOUR_AFTER` or more, the move is planned again
-   with that arm standing where the sweep met it (a conflict-based retry) and the path that
-   releases the object first is kept. A planned path that never clears within ``max_wait``
-   is dropped for the planner's next one, then for the next move. When none of the
+   another arm and the motion waits :data:`~.move_commit.DETOUR_AFTER` or more, the move is
+   planned again with that arm standing where the sweep met it (a conflict-based retry) and
+   the path that releases the object first is kept. A planned path that never clears within
+   ``max_wait`` is dropped for the planner's next one, then for the next move. When none of the
    ``candidates`` goes, the other arms that the attempts met (every other arm when they met
    none) retreat from the grasp or release configuration where they stand to its pre-grasp
    (back out along their approach, a few cm off the object) and the best move is tried once
@@ -41,6 +41,13 @@ with the order those moves must keep) and decides, event by event, which arm car
    time, the arms still in the workspace go home; when every arm is home and no move can be
    committed, there is no schedule (:class:`~sdar_tamp.schedule.scheduler.NoPlacement`); the
    caller keeps another one.
+
+How the free arm chooses (step 2) is the search's *policy* (:data:`POLICIES`); the search is
+run once per policy of :attr:`AssignmentOptions.policies` and the shortest schedule kept,
+within :attr:`AssignmentOptions.max_seconds` of wall-clock time for all of them (a search
+past it stops at its next decision; the best schedule found so far is returned). How a
+motion is committed in time, pausing on the way when another arm delays it, is
+:mod:`.move_commit`'s.
 
 A move is committed whole (grasp and release together), so no arm ever holds an object while
 it waits for another arm: the only order is the moves' own, which the synchronous plan proves
@@ -53,16 +60,22 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Iterator
 
 import numpy as np
 
-from sdar_tamp.plan_file import PlanEvent, PlanFile
+from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_rules import check_timeline
-from sdar_tamp.schedule.move_records import AssignmentOptions, MovePlanner, PlannedMove, Stand
+from sdar_tamp.schedule.move_commit import MoveCommit
+from sdar_tamp.schedule.move_records import (
+    POLICIES,
+    AssignmentOptions,
+    MovePlanner,
+    PlannedMove,
+    Stand,
+)
 from sdar_tamp.schedule.moves import CyclicMoves, Move, Pose, break_cycles, plan_moves
 from sdar_tamp.schedule.retiming import ArmRetimer
-from sdar_tamp.schedule.room import Room, block_of, no_block
+from sdar_tamp.schedule.room import no_block
 from sdar_tamp.schedule.scheduler import (
     Entry,
     NoPlacement,
@@ -70,10 +83,9 @@ from sdar_tamp.schedule.scheduler import (
     ScheduleOptions,
     retimer,
 )
-from sdar_tamp.schedule.sweep import Conflict, WorldSweep
+from sdar_tamp.schedule.sweep import WorldSweep
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
-from sdar_tamp.world.transforms import FloatArray
 
 #: [s] two moves whose estimated finishing times are this close count as equal (the
 #: synchronous plan's arm is preferred then)
@@ -81,16 +93,11 @@ TIE = 0.05
 #: [m] the room beside an object that fingers need to grasp or release it: moves whose poses
 #: come this close keep their synchronous order (:func:`~sdar_tamp.schedule.moves.plan_moves`)
 FINGER_ROOM = 0.03
-#: starts tried for a move's grasp when the carry after it finds none
-REGRASPS = 3
-#: [s] a move whose reach or carry waits this long for another arm is planned again with
-#: that arm where the wait met it (:meth:`Assignment.take`)
-DETOUR_AFTER = 0.2
 #: planned paths tried in such a retry
 PAIRS_TRIED = 2
 
 
-class Assignment(Room):
+class Assignment(MoveCommit):
     """The event-driven assignment of moves to arms (see the module docstring)."""
 
     def __init__(
@@ -102,8 +109,13 @@ class Assignment(Room):
         planner: MovePlanner,
         retimers: list[ArmRetimer],
         assignment: AssignmentOptions,
+        policy: str = "earliest",
+        deadline: float = math.inf,
     ) -> None:
         super().__init__(plan, [[] for _ in plan.arms], sweep, options, "objects")
+        self.policy, self.deadline = policy, deadline
+        self.pauses, self.paused = assignment.pauses, 0
+        self.queries_before = sweep.queries  # the sweep is shared by the policies' searches
         self.moves, self.planner, self.retimers = moves, planner, retimers
         self.options = assignment
         self.stand = [Stand(np.array(plan.q[0, self.columns[a]])) for a in self.arms]
@@ -159,10 +171,12 @@ class Assignment(Room):
         pending = list(self.moves)
         while pending:
             if (
-                self.sweep.queries >= self.options.max_checks
+                self.sweep.queries - self.queries_before >= self.options.max_checks
                 or self.plans >= self.options.max_plans
             ):
                 raise NoPlacement(no_block(0), None, "out of collision checks or motion plans")
+            if time.perf_counter() > self.deadline:
+                raise NoPlacement(no_block(0), None, "out of time")
             arm = min(self.arms, key=lambda a: (self.horizon(a), a))
             ranked = self.rank(arm, [m for m in pending if self.ready_move(m)])
             self.in_way = set()
@@ -172,11 +186,19 @@ class Assignment(Room):
                     done = next((m for m in ranked[:1] if self.take(arm, m)), None)
             if done is not None:
                 pending.remove(done)
-            elif self.stand[arm].pre is not None and self.retreat(arm):
-                continue
-            else:
+                if self.policy == "clear":  # leave the spot at once
+                    self.retreat(arm)
+            elif not self.make_room(arm):
                 self.wait(arm)
         return self.assemble()
+
+    def make_room(self, arm: int) -> bool:
+        """``arm`` found no move: it retreats when it stands at a grasp or release
+        configuration, and (policy ``clear``) goes home when it stands elsewhere in the
+        workspace; whether it moved."""
+        if self.stand[arm].pre is not None and self.retreat(arm):
+            return True
+        return self.policy == "clear" and not self.parked[arm] and self.park(arm)
 
     def choose(self, arm: int, ranked: list[Move]) -> Move | None:
         """Commit the first of ``ranked`` that releases its object within ``slack`` [s] of
@@ -202,7 +224,8 @@ class Assignment(Room):
         return None
 
     def rank(self, arm: int, ready: list[Move]) -> list[Move]:
-        """``ready`` moves the arm can do, by estimated finishing time (ties: the arm's own)."""
+        """``ready`` moves the arm can do, by estimated finishing time (ties: the arm's own;
+        policy ``plan-order``: by their order in the synchronous plan)."""
         h = self.horizon(arm) * self.tick
         scored: list[tuple[float, int, int, Move]] = []
         for m in ready:
@@ -213,7 +236,8 @@ class Assignment(Room):
             finish = (
                 max(max(h, grasp) + est + self.dwell * self.tick, release) + self.dwell * self.tick
             )
-            scored.append((round(finish / TIE), m.arm != arm, m.index, m))
+            first = m.index if self.policy == "plan-order" else round(finish / TIE)
+            scored.append((first, m.arm != arm, m.index, m))
             self.estimated[m.index] = math.ceil((finish - self.dwell * self.tick) / self.tick)
         scored.sort(key=lambda s: s[:3])
         return [s[3] for s in scored]
@@ -268,80 +292,6 @@ class Assignment(Room):
         self.parked[arm] = False
         return True
 
-    def commit_first(
-        self, arm: int, m: Move, options: Iterator[PlannedMove], limit: int | None = None
-    ) -> tuple[tuple[PlannedMove, PlanEvent, PlanEvent], Conflict | None] | None:
-        """Commit the first of the planned ``options`` (at most ``limit`` tried) that the
-        sweep lets through: the planned move, its grasp and release events, and the conflict
-        with another arm that delayed it (None: not delayed by another arm, or less than
-        :data:`DETOUR_AFTER`); None when none goes."""
-        name = self.plan.arm_names[arm]
-        timer = self.retimers[arm]
-        for n, planned in enumerate(options):
-            if limit is not None and n >= limit:
-                break
-            self.plans += 1
-            leaving = self.stand[arm].pre is not None
-            reach = timer.retime(*planned.reach, leaving, True)
-            carry = timer.retime(*planned.carry, True, True)
-            grasp = PlanEvent(0.0, name, "grasp", m.obj, planned.T_tcp_object)
-            release = PlanEvent(0.0, name, "release", m.obj, planned.T_tcp_object)
-            self.move_of[id(grasp)] = self.move_of[id(release)] = m
-            delayed = self.commit_move(arm, (reach, grasp), (carry, release))
-            if delayed is False:
-                continue
-            return (planned, grasp, release), (None if delayed is True else delayed)
-        return None
-
-    def tick_of(self, event: PlanEvent) -> int:
-        """The tick of a committed event (by identity)."""
-        return next(e.tick for e in self.events if e.event is event)
-
-    def commit_move(
-        self, arm: int, reach: tuple[FloatArray, PlanEvent], carry: tuple[FloatArray, PlanEvent]
-    ) -> bool | Conflict:
-        """Commit the reach (ending in the grasp), then the carry (ending in the release);
-        when the carry finds no start because the arm, holding the object, stands in another
-        arm's way, the grasp is tried later (up to :data:`REGRASPS` times). False: nothing
-        committed; else the conflict with another arm that delayed the reach or the carry
-        by :data:`DETOUR_AFTER` or more (True: none)."""
-        self.not_before = 0
-        least = math.ceil(DETOUR_AFTER / self.tick - 1e-9)
-        in_way: Conflict | None = None  # another arm in the carry's way at an earlier grasp
-        try:
-            for _ in range(REGRASPS):
-                mark = self.mark()
-                try:
-                    self.place([Entry(arm, block_of(arm, reach[0], reach[1]), reach[0], 0)])
-                except NoPlacement as exc:
-                    self.undo(mark)
-                    self.note_in_way(arm, exc.conflict)
-                    return False
-                delayed = self.arm_delay(least)
-                try:
-                    self.place([Entry(arm, block_of(arm, carry[0], carry[1]), carry[0], 0)])
-                except NoPlacement as exc:
-                    grasped = self.tick_of(reach[1])
-                    self.undo(mark)
-                    self.note_in_way(arm, exc.conflict)
-                    if exc.conflict is None or exc.conflict.tick < grasped or not exc.conflict.arms:
-                        return False  # not another arm in the way: a later grasp is no better
-                    in_way = exc.conflict
-                    start = grasped - (len(reach[0]) - 1)
-                    self.not_before = max(start + 1, exc.conflict.tick - len(reach[0]) + 2)
-                    continue
-                found = delayed or self.arm_delay(least) or in_way
-                return True if found is None else found
-            return False
-        finally:
-            self.not_before = 0
-
-    def arm_delay(self, least: int) -> Conflict | None:
-        """The conflict with another arm that delayed the last placement by ``least`` ticks
-        or more, else None."""
-        c = self.delayed_by
-        return c if self.delay >= least and c is not None and c.arms else None
-
     def figures(self) -> tuple[tuple[str, float], ...]:
         """Moves committed and how many went to another arm than in the synchronous plan,
         motion plans made and their time [s], waits for the next event, trips home."""
@@ -357,6 +307,7 @@ class Assignment(Room):
             ("collision_queries", float(self.sweep.queries)),
             ("detours", float(self.detours)),
             ("detours_kept", float(self.detours_kept)),
+            ("paused", float(self.paused)),
         )
 
 
@@ -391,16 +342,38 @@ def schedule_assigned(
     limited = dataclasses.replace(
         options, max_checks=assignment.max_checks, max_wait=assignment.max_wait
     )
-    search = Assignment(plan, sweep, limited, moves, planner, retimers, assignment)
-    try:
-        result = search.run()
-    except NoPlacement as exc:
-        return kept(str(exc), None, search.figures())
-    figures = search.figures()
-    result = dataclasses.replace(result, metrics=result.metrics.updated({"execution": "assigned"}))
-    limit = check_timeline(result, scene, options.dwell)
-    if limit is not None:  # by construction this does not happen
-        return kept(f"{limit.kind} at t={limit.t:.3f} s: {limit.message}", None, figures)
+    deadline = time.perf_counter() + assignment.max_seconds
+    best: tuple[PlanFile, str, tuple[tuple[str, float], ...]] | None = None
+    reasons: list[str] = []
+    found: list[tuple[str, float]] = []
+    figures: tuple[tuple[str, float], ...] = ()
+    for policy in assignment.policies:
+        if time.perf_counter() > deadline:
+            reasons.append(f"{policy}: not tried (out of time)")
+            continue
+        search = Assignment(
+            plan, sweep, limited, moves, planner, retimers, assignment, policy, deadline
+        )
+        try:
+            result = search.run()
+        except NoPlacement as exc:
+            reasons.append(f"{policy}: {exc}")
+            figures = figures or search.figures()
+            continue
+        result = dataclasses.replace(
+            result, metrics=result.metrics.updated({"execution": "assigned"})
+        )
+        limit = check_timeline(result, scene, options.dwell)
+        if limit is not None:  # by construction this does not happen
+            reasons.append(f"{policy}: {limit.kind} at t={limit.t:.3f} s: {limit.message}")
+            continue
+        found.append((f"duration_{policy}", result.duration))
+        if best is None or result.duration < best[0].duration:
+            best = (result, policy, search.figures())
+    if best is None:
+        return kept("; ".join(reasons), None, figures)
+    result, policy, figures = best
+    figures = (*figures, ("policy", float(POLICIES.index(policy))), *found)
     if result.duration >= plan.duration - 1e-9:
         why = f"not shorter ({result.duration:.2f} s >= {plan.duration:.2f} s)"
         return kept(why, result.duration, figures)
@@ -410,6 +383,7 @@ def schedule_assigned(
 
 
 __all__ = [
+    "POLICIES",
     "TIE",
     "Assignment",
     "AssignmentOptions",

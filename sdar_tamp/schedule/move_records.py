@@ -73,17 +73,29 @@ class MovePlanner(Protocol):
         ...
 
 
+#: How the free arm chooses its next move: ``earliest``: the ready move it would finish first
+#: (by the planner's estimate); ``clear``: the same, and an arm leaves every grasp or release
+#: spot as soon as it has let go (its short retreat), and goes home when it finds no move, so
+#: it does not stand where another arm's move must go; ``plan-order``: the ready move that
+#: comes first in the synchronous plan (another order of the same moves).
+POLICIES = ("earliest", "clear", "plan-order")
+
+
 @dataclass(frozen=True)
 class AssignmentOptions:
     """``candidates``: the ready moves tried per decision (best estimate first); ``stride``:
     ticks between the starts tried for a motion (a wait is rounded up to it); ``max_wait``
     [s]: the longest wait tried before a motion (past it the arm does something else);
-    ``max_checks``: the collision queries of the whole search that the collision world
+    ``max_checks``: the collision queries of one policy's search that the collision world
     answers (a remembered answer costs none; past them no schedule);
-    ``max_plans``: motion-planner calls of the whole search; ``replans``: conflict-based
+    ``max_plans``: motion-planner calls of one policy's search; ``replans``: conflict-based
     retries per move (:meth:`Assignment.take`); ``slack`` [s]: a move committed this much
     later than estimated is compared with the next candidates (:meth:`Assignment.choose`;
-    ``inf``: the first that goes is kept)."""
+    ``inf``: the first that goes is kept); ``pauses``: a motion that another arm delays may
+    stop on the way and wait there (:mod:`.move_commit`); ``policies``: the ways of choosing
+    the next move (:data:`POLICIES`), each searched in turn, the shortest schedule kept;
+    ``max_seconds`` [s]: the wall-clock time of the whole search, every policy together
+    (past it the best schedule found so far is returned)."""
 
     candidates: int = 3
     stride: int = 5
@@ -92,8 +104,19 @@ class AssignmentOptions:
     max_plans: int = 400
     replans: int = 1
     slack: float = math.inf
+    pauses: bool = True
+    policies: tuple[str, ...] = POLICIES
+    max_seconds: float = 300.0
 
     def __post_init__(self) -> None:
+        bad = [p for p in self.policies if p not in POLICIES]
+        if bad or not self.policies or isinstance(self.policies, str):
+            raise ParameterError(
+                f"policies: expected some of {list(POLICIES)}, got {self.policies!r}"
+            )
+        seconds = self.max_seconds
+        if isinstance(seconds, bool) or not (isinstance(seconds, (int, float)) and seconds > 0):
+            raise ParameterError(f"max_seconds: expected a time > 0, got {self.max_seconds!r}")
         for name in ("candidates", "stride", "max_checks", "max_plans", "replans"):
             value = getattr(self, name)
             least = 0 if name == "replans" else 1
@@ -105,4 +128,4 @@ class AssignmentOptions:
                 raise ParameterError(f"{name}: expected a number >= 0, got {value!r}")
 
 
-__all__ = ["AssignmentOptions", "MovePlanner", "PlannedMove", "Stand"]
+__all__ = ["POLICIES", "AssignmentOptions", "MovePlanner", "PlannedMove", "Stand"]
