@@ -18,7 +18,12 @@ order's dependencies and for the other arms' motions, ``tog`` the groups that ha
 together at their synchronous pace (swap halves), ``cut`` the time [s] shortened paths saved.
 
     python benchmarks/bench_async.py [--suite paper] [--only R4,R6,D5] [--plans DIR] [--save]
-                                     [--time-limit 60] [--sync-pace]
+                                     [--time-limit 60] [--sync-pace] [--assign-seconds 300]
+                                     [--policies earliest,clear,plan-order] [--no-pauses]
+
+``--assign-seconds`` caps the assignment's wall-clock time per instance (the result then
+depends on the machine's load), ``--policies`` chooses its policies, ``--no-pauses`` keeps
+motions from pausing on the way; the note gives each policy's schedule [s].
 
 ``--suite`` may be a suite of the shared table's cells (``table_1arm`` ... ``table_4arm``: each
 instance names its cell).
