@@ -14,11 +14,12 @@ comparison runs while they execute it:
    plan is (``first``: the wall time it was yielded).
 2. The fresh continuation (:func:`~sdar_tamp.app.replanning.fresh_continuation`, without
    infeasibility proofs) starts at a cut point of the repaired plan (every arm still with an
-   empty gripper): the first, from ``resume`` on, that the arms reach at least
-   :data:`MIN_BUDGET` after now, from the objects where the repaired plan leaves them there;
-   its solve's wall-time limit is the time until the arms reach it, less :data:`RESERVE` for
-   the checks. A solve that runs out of that time is tried again from the next cut point (at
-   most :data:`TRIES` solves, none past the re-plan's time limit).
+   empty gripper): the first, from ``resume`` on, that leaves the solve at least the repair's
+   own latency (a fresh solve plans every task left, the repair one or a few) and
+   :data:`MIN_BUDGET`, from the objects where the repaired plan leaves them there; its solve's
+   wall-time limit is the time until the arms reach it, less :data:`RESERVE` for the checks.
+   A solve that runs out of that time is tried again from the first cut point that leaves
+   twice that time (at most :data:`TRIES` solves, none past the re-plan's time limit).
 3. It replaces the repair, yielded as a second outcome (``replanned``, its ``alternative``
    the repair's execution), when it ends more than :data:`~sdar_tamp.app.replanning.SAVING`
    of the repair's execution from ``resume`` earlier, replays without violation from its cut,
@@ -132,8 +133,9 @@ def improve(
     starts = {o.name: o.start.as_tuple() for o in instance.objects}
     deadline = observed_at + config.max_time
     t = repaired.resume
+    need = max(MIN_BUDGET, repaired.latency)
     for _ in range(TRIES):
-        cut = _next_cut(plan, t, arrival)
+        cut = _next_cut(plan, t, arrival, need)
         if cut is None:
             return None
         by = min(arrival.at(cut.t), deadline)
@@ -147,7 +149,7 @@ def improve(
         if fresh.plan is None:
             if fresh.status != "timeout":
                 return None
-            t = cut.t + 1e-6  # out of time before the arms got there: the next cut point
+            t, need = cut.t + 1e-6, 2.0 * budget  # out of time: a later cut, twice the time
             continue
         if not shorter(fresh.plan, plan, repaired.resume):
             return None
@@ -159,16 +161,15 @@ def improve(
     return None
 
 
-def _next_cut(plan: PlanFile, t: float, arrival: Arrival) -> Cut | None:
+def _next_cut(plan: PlanFile, t: float, arrival: Arrival, need: float) -> Cut | None:
     """The first cut point of ``plan`` at or after ``t`` [s] that the arms reach at least
-    :data:`MIN_BUDGET` plus :data:`RESERVE` after now, before the plan's end (None if
-    none)."""
+    ``need`` [s] plus :data:`RESERVE` after now, before the plan's end (None if none)."""
     end = float(plan.t[-1])
     while t < end:
         cut = cut_point(plan, t)
         if cut.t >= end - 1e-9:
             return None
-        if arrival.at(cut.t) - time.perf_counter() >= MIN_BUDGET + RESERVE:
+        if arrival.at(cut.t) - time.perf_counter() >= need + RESERVE:
             return cut
         t = cut.t + 1e-6
     return None

@@ -4,6 +4,8 @@ when it is found before the arms reach the cut point it starts from."""
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import time
 from pathlib import Path
 
@@ -83,25 +85,51 @@ def test_no_time_left_keeps_the_repair(
     assert improve(d5[0], repaired, gone, config=CONFIG, cache=cache) is None
 
 
-def test_a_solve_out_of_time_is_tried_again_from_the_next_cut_point(
-    d5: tuple[Instance, PlanFile], cache: PlannerCache, repaired: ReplanOutcome,
-    monkeypatch: pytest.MonkeyPatch,
+def _out_of_time(
+    monkeypatch: pytest.MonkeyPatch, calls: list[tuple[float, float]]
 ) -> None:  # fmt: skip
-    """Each fresh solve made to run out of its time: the next starts from a later cut point
-    with a budget up to the arms' arrival there, at most ``TRIES`` solves in all."""
-    calls: list[tuple[float, float]] = []
+    """Every fresh solve made to run out of its time; ``calls``: (start, budget) of each."""
 
     def out_of_time(world, config, instance, prefix, *a, **k):  # type: ignore[no-untyped-def]
         calls.append((float(prefix.t[-1]), config.max_time))
         return Fresh(None, (), "timeout")
 
     monkeypatch.setattr(replan_moving, "fresh_continuation", out_of_time)
+
+
+def test_a_solve_out_of_time_is_tried_again_from_a_later_cut_point(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, repaired: ReplanOutcome,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:  # fmt: skip
+    """The arms far away, each solve limited by the re-plan's time limit: the next starts from
+    a later cut point, at most ``TRIES`` solves in all."""
+    calls: list[tuple[float, float]] = []
+    _out_of_time(monkeypatch, calls)
     later = Arrival(time.perf_counter() + 1000.0, repaired.resume)
     assert improve(d5[0], repaired, later, config=CONFIG, cache=cache) is None
     assert len(calls) == replan_moving.TRIES
     starts = [c[0] for c in calls]
     assert starts == sorted(starts) and len(set(starts)) == len(starts)
     assert all(0.0 < budget <= CONFIG.max_time for _, budget in calls)
+
+
+def test_a_later_try_leaves_twice_the_time(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache, repaired: ReplanOutcome,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:  # fmt: skip
+    """The arms on their way now (the repair given at once): the first solve starts at the
+    first cut point they reach at least ``MIN_BUDGET`` + ``RESERVE`` from now, each next one
+    where they leave it twice the time the last had."""
+    calls: list[tuple[float, float]] = []
+    _out_of_time(monkeypatch, calls)
+    now = dataclasses.replace(repaired, latency=0.0)
+    moving = Arrival(time.perf_counter(), repaired.resume)
+    assert improve(d5[0], now, moving, config=CONFIG, cache=cache) is None
+    assert 2 <= len(calls) <= replan_moving.TRIES
+    budgets = [c[1] for c in calls]
+    assert budgets[0] >= replan_moving.MIN_BUDGET
+    assert all(b >= 2.0 * a for a, b in itertools.pairwise(budgets))
+    assert [c[0] for c in calls] == sorted(c[0] for c in calls)
 
 
 @pytest.mark.parametrize("failure", ["infeasible", "longer"])
