@@ -15,13 +15,27 @@ plan meets the observed world before its arms reach the next point at which they
 with empty grippers (the cut), and braking on their way does not stop them short of it
 either (a gripper acts first, the change is too close, or what an arm holds cannot be put
 down).
-``success_rate``: valid new plans over the other perturbed
-states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
-time of ``replan`` without the final validation (``cpu_median_s``: the process's CPU time
-of the call, the validation included: on a loaded machine the wall time grows, the CPU time
-hardly). ``compared``: the re-plans whose repair changed the plan and was compared with a
-fresh continuation within the time left (``compared_fresh_kept``: those where the fresh one
-was shorter and kept). For every nudge re-planned, a fresh
+``success_rate``: valid new plans (the plan finally kept) over the other perturbed
+states (every ``infeasible`` or ``timeout`` there counts as a failure).
+
+``--compare`` says when a repair that changed the plan is compared with a fresh continuation:
+``moving`` (default) while the arms execute the repair
+(:func:`sdar_tamp.app.replan_moving.replan_while_moving`: the repair is given first, a
+shorter fresh continuation from a later cut point replaces it only when found before the
+arms get there), ``sync`` before ``replan`` returns (``replan(..., compare=True)``, the
+measure of the releases before this option), ``none`` never. Latencies, wall time from the
+call (the observation) on, the final validation of each plan excluded:
+``latency_median_s`` until the first plan, when the arms can move on (with ``sync`` or
+``none`` the only plan, as before); ``latency_final_median_s`` until the plan finally kept
+(with ``moving``: the fresh continuation's when it replaced the repair);
+``latency_done_median_s`` (and ``latency_done_p90_s``) until the re-plan is over, the
+comparison and the validations included (with ``sync``: ``latency``, the old definition, plus
+the final validation). ``improved``: re-plans where a fresh continuation found while moving replaced
+the repair. ``cpu_median_s``: the process's CPU time of the whole re-plan, the comparison
+and validations included (on a loaded machine the wall time grows, the CPU time hardly).
+``compared``: the re-plans whose plan kept was compared with another (``alternative``, the
+other's execution, known; ``compared_fresh_kept``: those where the fresh one was shorter and
+kept). For every nudge re-planned, a fresh
 continuation from the same cut (``replan(..., repair=False)``) is planned too:
 ``nudge_execution_ratio`` is the new plan's execution from the cut over the fresh one's, and
 ``nudge_latency_median_s`` / ``nudge_fresh_latency_median_s`` the two latencies side by side.
@@ -29,6 +43,7 @@ continuation from the same cut (``replan(..., repair=False)``) is planned too:
     python benchmarks/bench_replan.py [--suite paper] [--only R4,D5] [--per-instance 6]
                                       [--seed 0] [--plans DIR] [--save] [--time-limit 60]
                                       [--solve-time-limit 60]
+                                      [--compare moving|sync|none]
     python benchmarks/bench_replan.py --quick    # R4, one perturbation of each kind
 
 Prints one row per perturbation, then one JSON object on the last line (``success_rate``,

@@ -157,7 +157,8 @@ def improve(
         _, bad, _ = check_from(instance, fresh.plan, scene, kins, collision, start)
         if bad is not None or time.perf_counter() > by:
             return None
-        return _outcome(instance, scene, repaired, fresh.plan, observed_at, validate)
+        out = _outcome(instance, scene, repaired, fresh.plan, observed_at, validate)
+        return None if out.valid is False else out  # never a plan the replay rejects
     return None
 
 
