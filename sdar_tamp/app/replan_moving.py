@@ -14,12 +14,14 @@ comparison runs while they execute it:
    plan is (``first``: the wall time it was yielded).
 2. The fresh continuation (:func:`~sdar_tamp.app.replanning.fresh_continuation`, without
    infeasibility proofs) starts at a cut point of the repaired plan (every arm still with an
-   empty gripper): the first, from ``resume`` on, that leaves the solve at least the repair's
-   own latency (a fresh solve plans every task left, the repair one or a few) and
-   :data:`MIN_BUDGET`, from the objects where the repaired plan leaves them there; its solve's
-   wall-time limit is the time until the arms reach it, less :data:`RESERVE` for the checks.
-   A solve that runs out of that time is tried again from the first cut point that leaves
-   twice that time (at most :data:`TRIES` solves, none past the re-plan's time limit).
+   empty gripper): the first, from ``resume`` on, that leaves the solve at least
+   :data:`MIN_BUDGET` before the arms get there, from the objects where the repaired plan
+   leaves them there; its solve's wall-time limit is the time until the arms reach it, less
+   :data:`RESERVE` for the checks. A solve that runs out of that time is tried again from the
+   first cut point that leaves twice that time (at most :data:`TRIES` solves, none past the
+   re-plan's time limit): the earlier the cut point, the more a fresh plan may save, and the
+   time a solve needs is not known before it ends (a fraction of a second to tens of seconds
+   on the paper suite, depending on the objects left and the machine's load).
 3. It replaces the repair, yielded as a second outcome (``replanned``, its ``alternative``
    the repair's execution), when it ends more than :data:`~sdar_tamp.app.replanning.SAVING`
    of the repair's execution from ``resume`` earlier, replays without violation from its cut,
@@ -48,13 +50,12 @@ from sdar_tamp.plan_state import Cut, PlanState, cut_point, state_at
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.instance import Instance
-from sdar_tamp.world.kinematics import ArmKinematics
 from sdar_tamp.world.observed import ObservedState
 from sdar_tamp.world.scene import Scene
 
 MIN_BUDGET = 0.3  #: [s] of wall time a fresh solve gets at least (else a later cut point)
 RESERVE = 0.2  #: [s] of wall time kept for the checks after a fresh solve, before the cut
-TRIES = 3  #: fresh solves at most (a timed-out one is tried again from the next cut point)
+TRIES = 4  #: fresh solves at most (a timed-out one is tried again from a later cut point)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -125,7 +126,7 @@ def improve(
     cache = cache or PlannerCache()
     world = cache.world(scene_path or instance.scene_path(), config.trajopt)
     scene = world.ctx.scene
-    kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+    kins = dict(world.ctx.kinematics)  # the world's, built once with it
     collision = CollisionWorld(scene)
     sizes = {o.name: o.size for o in instance.objects}
     for seen in plan.observations:
@@ -133,7 +134,7 @@ def improve(
     starts = {o.name: o.start.as_tuple() for o in instance.objects}
     deadline = observed_at + config.max_time
     t = repaired.resume
-    need = max(MIN_BUDGET, repaired.latency)
+    need = MIN_BUDGET
     for _ in range(TRIES):
         cut = _next_cut(plan, t, arrival, need)
         if cut is None:

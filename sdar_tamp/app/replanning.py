@@ -147,7 +147,7 @@ def replan(
     world = cache.world(scene_path or instance.scene_path(), config.trajopt)
     started = time.perf_counter()
     scene = world.ctx.scene
-    kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+    kins = dict(world.ctx.kinematics)  # the world's, built once with it
     sizes = {o.name: o.size for o in instance.objects}
     for seen in plan.observations:
         sizes.update(seen.added)
