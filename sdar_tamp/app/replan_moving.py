@@ -150,7 +150,9 @@ def improve(
         if fresh.plan is None:
             if fresh.status != "timeout":
                 return None
-            t, need = cut.t + 1e-6, 2.0 * budget  # out of time: a later cut, twice the time
+            # out of time: a cut point after this one's hold (those within a gripper's dwell
+            # start where it ends), with twice the time
+            t, need = float(prefix.t[-1]) + 1e-6, 2.0 * budget
             continue
         if not shorter(fresh.plan, plan, repaired.resume):
             return None
