@@ -15,13 +15,27 @@ plan meets the observed world before its arms reach the next point at which they
 with empty grippers (the cut), and braking on their way does not stop them short of it
 either (a gripper acts first, the change is too close, or what an arm holds cannot be put
 down).
-``success_rate``: valid new plans over the other perturbed
-states (every ``infeasible`` or ``timeout`` there counts as a failure). ``latency``: the wall
-time of ``replan`` without the final validation (``cpu_median_s``: the process's CPU time
-of the call, the validation included: on a loaded machine the wall time grows, the CPU time
-hardly). ``compared``: the re-plans whose repair changed the plan and was compared with a
-fresh continuation within the time left (``compared_fresh_kept``: those where the fresh one
-was shorter and kept). For every nudge re-planned, a fresh
+``success_rate``: valid new plans (the plan finally kept) over the other perturbed
+states (every ``infeasible`` or ``timeout`` there counts as a failure).
+
+``--compare`` says when a repair that changed the plan is compared with a fresh continuation:
+``moving`` (default) while the arms execute the repair
+(:func:`sdar_tamp.app.replan_moving.replan_while_moving`: the repair is given first, a
+shorter fresh continuation from a later cut point replaces it only when found before the
+arms get there), ``sync`` before ``replan`` returns (``replan(..., compare=True)``, the
+measure of the releases before this option), ``none`` never. Latencies, wall time from the
+call (the observation) on, the final validation of each plan excluded:
+``latency_median_s`` until the first plan, when the arms can move on (with ``sync`` or
+``none`` the only plan, as before); ``latency_final_median_s`` until the plan finally kept
+(with ``moving``: the fresh continuation's when it replaced the repair);
+``latency_done_median_s`` (and ``latency_done_p90_s``) until the re-plan is over, the
+comparison and the validations included (with ``sync``: ``latency``, the old definition, plus
+the final validation). ``improved``: re-plans where a fresh continuation found while moving replaced
+the repair. ``cpu_median_s``: the process's CPU time of the whole re-plan, the comparison
+and validations included (on a loaded machine the wall time grows, the CPU time hardly).
+``compared``: the re-plans whose plan kept was compared with another (``alternative``, the
+other's execution, known; ``compared_fresh_kept``: those where the fresh one was shorter and
+kept). For every nudge re-planned, a fresh
 continuation from the same cut (``replan(..., repair=False)``) is planned too:
 ``nudge_execution_ratio`` is the new plan's execution from the cut over the fresh one's, and
 ``nudge_latency_median_s`` / ``nudge_fresh_latency_median_s`` the two latencies side by side.
@@ -29,6 +43,7 @@ continuation from the same cut (``replan(..., repair=False)``) is planned too:
     python benchmarks/bench_replan.py [--suite paper] [--only R4,D5] [--per-instance 6]
                                       [--seed 0] [--plans DIR] [--save] [--time-limit 60]
                                       [--solve-time-limit 60]
+                                      [--compare moving|sync|none]
     python benchmarks/bench_replan.py --quick    # R4, one perturbation of each kind
 
 Prints one row per perturbation, then one JSON object on the last line (``success_rate``,
@@ -52,7 +67,8 @@ import numpy as np
 from _suites import shipped_suite_files, stored_or_solved
 
 from sdar_tamp.app import PlannerCache, PlannerConfig
-from sdar_tamp.app.replanning import replan
+from sdar_tamp.app.replan_moving import replan_while_moving
+from sdar_tamp.app.replanning import ReplanOutcome, replan
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_state import state_at
 from sdar_tamp.world.collision import CollisionWorld
@@ -121,6 +137,22 @@ def _draw(
     return None
 
 
+def _replan(
+    compare: str, instance: Instance, plan: PlanFile, p: Perturbation, config: PlannerConfig,
+    cache: PlannerCache,
+) -> tuple[ReplanOutcome, ReplanOutcome, float]:  # fmt: skip
+    """The re-plan's outcome kept, its first one (the arms move again then) and the wall
+    time [s] until it is done (the comparison over)."""
+    started = time.perf_counter()
+    if compare != "moving":
+        out = replan(instance, plan, p.at, p.observed, config=config, cache=cache,
+                     compare=compare == "sync")  # fmt: skip
+        return out, out, time.perf_counter() - started
+    outcomes = list(replan_while_moving(instance, plan, p.at, p.observed, config=config,
+                                        cache=cache, observed_at=started))  # fmt: skip
+    return outcomes[-1], outcomes[0], time.perf_counter() - started
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--suite", default="paper")
@@ -131,6 +163,13 @@ def main() -> None:
     ap.add_argument("--save", action="store_true")
     ap.add_argument("--time-limit", type=float, default=None, help="[s] of a re-plan (60)")
     ap.add_argument("--solve-time-limit", type=float, default=60.0, help="[s] of a first solve")
+    ap.add_argument(
+        "--compare",
+        choices=("moving", "sync", "none"),
+        default="moving",
+        help="a changed repair compared with a fresh continuation while the arms "
+        "execute it (moving), before the re-plan returns (sync), or not",
+    )
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args()
     only = args.only or ("R4" if args.quick else None)
@@ -162,12 +201,13 @@ def main() -> None:
             if p is None:
                 continue
             cpu = time.process_time()
-            out = replan(instance, plan, p.at, p.observed, config=config, cache=cache)
+            out, first, done = _replan(args.compare, instance, plan, p, config, cache)
             cpu = time.process_time() - cpu  # the final validation included
             row: dict[str, object] = {
                 "instance": path.stem, "kind": kind, "at": round(p.at, 3), "what": p.what,
                 "redrawn": p.redrawn, "status": out.status, "valid": out.valid,
-                "latency": out.latency, "cpu": cpu, "cut": out.cut,
+                "latency": first.latency, "latency_final": out.latency, "latency_done": done,
+                "improved": out is not first, "cpu": cpu, "cut": out.cut,
                 "cannot_stop": any("before the arms can stop" in r for r in out.reasons),
                 "compared": out.alternative is not None,
                 "why": out.violation or "; ".join(out.reasons),
@@ -183,7 +223,8 @@ def main() -> None:
             ratio = (f" ratio {row['ratio']:.3f} (fresh {row['fresh_latency']:.3f} s)"
                      if "ratio" in row else "")  # fmt: skip
             print(f"{path.stem:4s} {kind:6s} t={p.at:6.2f} {p.what:28s} {out.status:10s} "
-                  f"valid={out.valid} {out.latency:6.3f} s (cpu {cpu:.3f} s){ratio}",
+                  f"valid={out.valid} {first.latency:6.3f} s (final {out.latency:.3f} s, "
+                  f"done {done:.3f} s, cpu {cpu:.3f} s){ratio}",
                   flush=True)  # fmt: skip
             if out.valid is not True:
                 print(f"     why: {row['why']}", flush=True)
@@ -218,6 +259,12 @@ def main() -> None:
         "valid": len(ok),
         "success_rate": round(len(ok) / len(solvable), 4) if solvable else None,
         "latency_median_s": median(latencies),
+        "latency_final_median_s": median([float(r["latency_final"]) for r in solvable]),  # type: ignore[arg-type]
+        "latency_done_median_s": median([float(r["latency_done"]) for r in solvable]),  # type: ignore[arg-type]
+        "latency_done_p90_s": round(float(np.percentile(
+            [float(r["latency_done"]) for r in solvable], 90)), 4) if solvable else None,  # type: ignore[arg-type]
+        "improved": sum(bool(r["improved"]) for r in rows),
+        "compare": args.compare,
         "cpu_median_s": median([float(r["cpu"]) for r in solvable]),  # type: ignore[arg-type]
         "latency_p90_s": round(float(np.percentile(latencies, 90)), 4) if latencies else None,
         "nudge_execution_ratio_median": median(ratios),

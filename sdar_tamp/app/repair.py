@@ -34,11 +34,10 @@ from sdar_tamp.app.problem import rearrangement_problem
 from sdar_tamp.app.records import task_records
 from sdar_tamp.app.replan_world import continuation_instance, start_configuration
 from sdar_tamp.app.solving import solve_rearrangement
-from sdar_tamp.app.splicing import check_from, cut_at, splice, tail, walk_from
+from sdar_tamp.app.splicing import check_from, cut_at, head_at, splice, tail, walk_from
 from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
 from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile
-from sdar_tamp.plan_rules import STILL_TOL, TIME_TOL
-from sdar_tamp.plan_state import Cut, PlanState, prefix_plan
+from sdar_tamp.plan_state import PlanState
 from sdar_tamp.world.collision import CollisionWorld, ObjectBox
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.kinematics import ArmKinematics
@@ -109,10 +108,11 @@ def repair(
     scene = world.ctx.scene
     moved: tuple[str, ...] = ()
     deadline = time.perf_counter() + repair_budget(config.max_time)
+    plan, emptied = without_gone(plan, state)
     for tasks in range(MAX_TASKS + 1):
         plan, bad, why = check_from(instance, plan, scene, kins, collision, state)
         if bad is None:
-            return plan, moved, tasks > 0
+            return plan, moved, emptied or tasks > 0
         left = deadline - time.perf_counter()
         if left <= 0.0:
             return None
@@ -124,6 +124,36 @@ def repair(
         plan, more, state = fixed  # the next replay begins where the repaired task does
         moved = tuple(dict.fromkeys((*moved, *more)))
     return None
+
+
+def without_gone(plan: PlanFile, state: PlanState) -> tuple[PlanFile, bool]:
+    """``plan`` without the grasps and releases after ``state.t`` of the objects gone from
+    the table (grasped later, not resting in ``state``: removed) in the tasks that move other
+    objects too, and whether any was dropped. The arm that was to carry a gone object makes
+    the same motions with an empty gripper, beside the task's other arms, so no motion is
+    planned again (an empty gripper where an object was carries less: the plan's motions
+    stay clear). A task of gone objects only is left as it is: the repair replaces it by one
+    motion to the next task (:func:`_replan_task`)."""
+    after = [e for e in plan.events if e.t >= state.t - 1e-9]
+    gone = {e.object for e in after} - set(state.resting) - set(state.held.values())
+    spans = [
+        (k.start, k.end) for k in tasks_of(plan, state.t)
+        if set(k.objects) & gone and set(k.objects) - gone
+    ]  # fmt: skip
+    if not spans:
+        return plan, False
+
+    def emptied(t: float) -> bool:
+        return any(start <= t < end for start, end in spans)
+
+    events = tuple(e for e in plan.events if not (e.object in gone and emptied(e.t)))
+    steps = tuple(
+        dataclasses.replace(s, objects=tuple(n for n in s.objects if n not in gone))
+        if emptied(s.t_start) else s
+        for s in plan.steps
+    )  # fmt: skip
+    metrics = plan.metrics.updated({"actions": sum(e.type == "release" for e in events)})
+    return dataclasses.replace(plan, events=events, steps=steps, metrics=metrics), True
 
 
 def _repair_task(
@@ -180,7 +210,7 @@ def _replan_task(
         objects=tuple(ObjectSpec(n, sizes[n], Pose2D(*here[n]), g) for n, g in goals.items()),
     )
     mini, moved = continuation_instance(fake, here, sizes, config.seed, frozenset(culprits))
-    head = _head(plan, begin)
+    head = head_at(plan, begin)
     q0 = head.q[-1]
     restart = PlanState(float(head.t[-1]), q0, {}, here)
     start = start_configuration(
@@ -243,20 +273,6 @@ def _append_task(
                            gripper_time=config.gripper_time, q_start=q0)  # fmt: skip
     end = PlanState(float(plan.t[-1]), q0, {}, here)
     return splice(plan, more), moved, end
-
-
-def _head(plan: PlanFile, begin: Cut) -> PlanFile:
-    """``plan`` up to ``begin``, where a task planned again starts: cut there when the plan
-    already stands still over the sample spacing before it with every gripper dwell over (the
-    end of a hold or of a dwell: a new motion may start at once), else with a still hold after
-    it (:func:`~sdar_tamp.plan_state.prefix_plan`)."""
-    i = begin.index
-    events = plan.events[: begin.events]
-    dwells_over = all(e.t + GRIPPER_DWELL <= begin.t + TIME_TOL for e in events)
-    if i == 0 or not dwells_over or np.abs(plan.q[i] - plan.q[i - 1]).max() > STILL_TOL:
-        return prefix_plan(plan, begin)
-    head = prefix_plan(plan, begin)  # its events, steps and observations up to the cut
-    return dataclasses.replace(head, t=plan.t[: i + 1], q=plan.q[: i + 1])
 
 
 def _last_actors(items: list[MotionSegment | GripperEvent]) -> set[str]:

@@ -91,7 +91,10 @@ class ReplanOutcome:
     and the objects ``blocking`` a plan; ``valid``/``violation``: the independent replay of
     the whole new plan (when asked); ``alternative``: where a changed repair was compared with
     a fresh continuation, the execution time [s] of the plan not kept (None: no comparison, or
-    the fresh solve gave no plan)."""
+    the fresh solve gave no plan); ``changed``: the outcome is a repair that changed the old
+    plan's rest (a fresh continuation might be shorter: :mod:`sdar_tamp.app.replan_moving`
+    compares them while the arms move); ``resume``: the plan time [s] where the continuation
+    begins (the end of the prefix's hold)."""
 
     status: str
     plan: PlanFile | None
@@ -103,6 +106,8 @@ class ReplanOutcome:
     valid: bool | None = None
     violation: str = ""
     alternative: float | None = None
+    changed: bool = False
+    resume: float = 0.0
 
     @property
     def success(self) -> bool:
@@ -142,7 +147,7 @@ def replan(
     world = cache.world(scene_path or instance.scene_path(), config.trajopt)
     started = time.perf_counter()
     scene = world.ctx.scene
-    kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+    kins = dict(world.ctx.kinematics)  # the world's, built once with it
     sizes = {o.name: o.size for o in instance.objects}
     for seen in plan.observations:
         sizes.update(seen.added)
@@ -204,34 +209,36 @@ def replan(
             kept, moved, changed = fixed
             left = config.max_time - (time.perf_counter() - started)
             if not (compare and changed and left > 0.0):
-                return _finish("repaired", kept, instance, scene, cut, started, validate, moved)
+                return _finish("repaired", kept, instance, scene, cut, started, validate, moved,
+                               changed=changed, resume=t_hold)  # fmt: skip
             # the repair changed the plan: a fresh continuation within the time left, and
             # the shorter execution of the two (the repair on a tie or a failed fresh one)
-            other = _fresh(world, config.replace(max_time=left), instance, prefix, at_cut,
-                           sizes, prove=False)  # fmt: skip
+            other = fresh_continuation(world, config.replace(max_time=left), instance, prefix,
+                                       at_cut, sizes, prove=False)  # fmt: skip
             alternative = None if other.plan is None else other.plan.duration
-            if other.plan is not None and _shorter(other.plan, kept, t_hold):
+            if other.plan is not None and shorter(other.plan, kept, t_hold):
                 _, bad, _ = check_from(instance, other.plan, scene, kins, collision, empty)
                 if bad is None:
                     return _finish("replanned", other.plan, instance, scene, cut, started,
-                                   validate, other.moved, kept.duration)  # fmt: skip
+                                   validate, other.moved, kept.duration, resume=t_hold)  # fmt: skip
                 alternative = None  # the replay rejects it: no alternative
             return _finish("repaired", kept, instance, scene, cut, started, validate, moved,
-                           alternative)  # fmt: skip
+                           alternative, resume=t_hold)  # fmt: skip
     slices = {a: scene.layout.slice(a) for a in scene.arm_names}
     moving = prefix.q[prefix.t >= at - 1e-9]  # braked arms leave directly, not by a lift
     free = frozenset(  # an arm that put an object down leaves by a lift
         a for a, sl in slices.items()
         if braked and a not in state.held and np.ptp(moving[:, sl], 0).max() > 0
     )  # fmt: skip
-    fresh = _fresh(world, config, instance, prefix, at_cut, sizes, free)
+    fresh = fresh_continuation(world, config, instance, prefix, at_cut, sizes, free)
     if fresh.plan is None:
         reasons = fresh.reasons
         status = "timeout" if fresh.status == "timeout" else "infeasible"
         blocking = _objects_in(" ".join(reasons), sizes)
         return ReplanOutcome(status, None, cut.t, time.perf_counter() - started, reasons,
                              blocking, fresh.moved)  # fmt: skip
-    out = _finish("replanned", fresh.plan, instance, scene, cut, started, validate, fresh.moved)
+    out = _finish("replanned", fresh.plan, instance, scene, cut, started, validate, fresh.moved,
+                  resume=t_hold)  # fmt: skip
     if out.valid is False and retry:  # rare: one more solve with the next seed
         again = replan(instance, plan, at, observed, config=config.replace(seed=config.seed + 1),
                        scene_path=scene_path, cache=cache, validate=True, repair=False,
@@ -242,7 +249,7 @@ def replan(
 
 
 @dataclass(frozen=True)
-class _Fresh:
+class Fresh:
     """A fresh continuation: the spliced ``plan`` (None without one), the added objects it
     moves away, and the solve's ``status`` and ``reasons`` without a plan."""
 
@@ -252,11 +259,11 @@ class _Fresh:
     reasons: tuple[str, ...] = ()
 
 
-def _fresh(
+def fresh_continuation(
     world: PlanningWorld, config: PlannerConfig, instance: Instance, prefix: PlanFile,
     at_cut: dict[str, Pose3], sizes: dict[str, tuple[float, float, float]],
     free: frozenset[str] = frozenset(), *, prove: bool = True,
-) -> _Fresh:  # fmt: skip
+) -> Fresh:  # fmt: skip
     """A fresh SDAR solve of the objects resting at the cut (``at_cut``), spliced after
     ``prefix``: the arms start where ``prefix`` ends, idle arms at home; those in ``free``
     (stopped in the middle of their motions) leave directly; ``prove``: the solve's
@@ -270,11 +277,11 @@ def _fresh(
     solution = solve_rearrangement(r, prove=prove)
     if solution.plan is None:
         reasons = tuple(solution.diagnosis) or (f"no plan ({solution.status.value})",)
-        return _Fresh(None, moved, solution.status.value, reasons)
-    return _Fresh(splice(prefix, plan_file_from_solution(r, solution)), moved)
+        return Fresh(None, moved, solution.status.value, reasons)
+    return Fresh(splice(prefix, plan_file_from_solution(r, solution)), moved)
 
 
-def _shorter(fresh: PlanFile, repaired: PlanFile, t_from: float) -> bool:
+def shorter(fresh: PlanFile, repaired: PlanFile, t_from: float) -> bool:
     """Whether ``fresh`` ends more than :data:`SAVING` of ``repaired``'s execution after
     ``t_from`` [s] before it."""
     return fresh.duration - t_from < (1.0 - SAVING) * (repaired.duration - t_from) - TIME_TOL
@@ -342,7 +349,8 @@ def _objects_in(text: str, sizes: dict[str, tuple[float, float, float]]) -> tupl
 
 def _finish(
     status: str, plan: PlanFile, instance: Instance, scene: Scene, cut: Cut, started: float,
-    validate: bool, moved: tuple[str, ...] = (), alternative: float | None = None,
+    validate: bool, moved: tuple[str, ...] = (), alternative: float | None = None, *,
+    changed: bool = False, resume: float = 0.0,
 ) -> ReplanOutcome:  # fmt: skip
     latency = time.perf_counter() - started
     plan = dataclasses.replace(plan, metrics=plan.metrics.updated({"planning_time": latency}))
@@ -353,4 +361,5 @@ def _finish(
         if report.violation is not None:
             v = report.violation
             violation = f"t={v.t:.3f} s: {v.kind}: {v.message}"
-    return ReplanOutcome(status, plan, cut.t, latency, (), (), moved, valid, violation, alternative)
+    return ReplanOutcome(status, plan, cut.t, latency, (), (), moved, valid, violation, alternative,
+                         changed, resume)  # fmt: skip

@@ -14,9 +14,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.plan_rules import check_timeline
-from sdar_tamp.plan_state import Cut, PlanState, shift_steps
+from sdar_tamp.plan_file import GRIPPER_DWELL, PlanFile
+from sdar_tamp.plan_rules import STILL_TOL, TIME_TOL, check_timeline
+from sdar_tamp.plan_state import Cut, PlanState, prefix_plan, shift_steps
 from sdar_tamp.replay_walk import ReplayWalk
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.instance import Instance
@@ -64,6 +64,20 @@ def cut_at(plan: PlanFile, t: float) -> Cut:
     index = min(int(np.searchsorted(plan.t, t - 1e-9)), len(plan.t) - 1)
     at = float(plan.t[index])
     return Cut(index, at, sum(e.t < at - 1e-9 for e in plan.events))
+
+
+def head_at(plan: PlanFile, begin: Cut) -> PlanFile:
+    """``plan`` up to ``begin``, where a continuation starts: cut there when the plan
+    already stands still over the sample spacing before it with every gripper dwell over (the
+    end of a hold or of a dwell: a new motion may start at once), else with a still hold after
+    it (:func:`~sdar_tamp.plan_state.prefix_plan`)."""
+    i = begin.index
+    events = plan.events[: begin.events]
+    dwells_over = all(e.t + GRIPPER_DWELL <= begin.t + TIME_TOL for e in events)
+    if i == 0 or not dwells_over or np.abs(plan.q[i] - plan.q[i - 1]).max() > STILL_TOL:
+        return prefix_plan(plan, begin)
+    head = prefix_plan(plan, begin)  # its events, steps and observations up to the cut
+    return dataclasses.replace(head, t=plan.t[: i + 1], q=plan.q[: i + 1])
 
 
 def walk_from(

@@ -18,8 +18,11 @@ def cmd_replan(args: argparse.Namespace) -> int:
     continuation, with the observation recorded) is validated by independent replay and
     written with -o. Exit status 0 when re-planned and valid, 1 when no plan (infeasible, with
     the blocking objects) or invalid, 2 for a bad file (an impossible observed state is
-    located in its file)."""
+    located in its file). With --while-moving the repair is written (and reported) as soon as
+    it is valid, and a shorter fresh continuation found before the arms reach its start is
+    written over it afterwards (a second record)."""
     from sdar_tamp.app.config import PlannerConfig
+    from sdar_tamp.app.replan_moving import replan_while_moving
     from sdar_tamp.app.replanning import replan
     from sdar_tamp.plan_reading import load_plan
     from sdar_tamp.plan_writing import save_plan
@@ -36,14 +39,27 @@ def cmd_replan(args: argparse.Namespace) -> int:
     plan = load_plan(args.plan, scene.layout)
     observed = load_observed(args.observed)
     config = PlannerConfig(max_time=args.time_limit, seed=args.seed)
-    outcome = replan(
-        instance, plan, args.at, observed, config=config, scene_path=scene_path,
-        repair=not args.fresh, compare=not args.no_compare,
-    )  # fmt: skip
-    written = None
-    if outcome.plan is not None and args.output is not None:
-        written = save_plan(outcome.plan, args.output)
-    if args.json:
+    if args.while_moving:
+        outcomes = replan_while_moving(
+            instance, plan, args.at, observed, config=config, scene_path=scene_path
+        )
+    else:
+        outcomes = iter([replan(
+            instance, plan, args.at, observed, config=config, scene_path=scene_path,
+            repair=not args.fresh, compare=not args.no_compare,
+        )])  # fmt: skip
+    code = 1
+    for outcome in outcomes:
+        written = None
+        if outcome.plan is not None and args.output is not None:
+            written = save_plan(outcome.plan, args.output)
+        _report(outcome, written, args.json)
+        code = 0 if outcome.plan is not None and outcome.valid else 1
+    return code
+
+
+def _report(outcome: Any, written: Path | None, as_json: bool) -> None:
+    if as_json:
         record = {
             "status": outcome.status,
             "valid": outcome.valid,
@@ -57,10 +73,9 @@ def cmd_replan(args: argparse.Namespace) -> int:
             "alternative": outcome.alternative,
             "plan_file": None if written is None else str(written),
         }
-        print(json.dumps(record, sort_keys=True))
+        print(json.dumps(record, sort_keys=True), flush=True)
     else:
-        print(_summary(outcome, written))
-    return 0 if outcome.plan is not None and outcome.valid else 1
+        print(_summary(outcome, written), flush=True)
 
 
 def _summary(outcome: Any, written: Path | None) -> str:
@@ -99,13 +114,19 @@ def add_replan_parser(sub: argparse._SubParsersAction[Any]) -> None:
         "--time-limit", type=TIME_LIMIT.parse, default=60.0, help="seconds (default: 60)"
     )
     p.add_argument("--seed", type=SEED.parse, default=0, help="random seed (default: 0)")
-    p.add_argument(
+    how = p.add_mutually_exclusive_group()
+    how.add_argument(
         "--fresh", action="store_true", help="no repair: always a fresh continuation from the cut"
     )
-    p.add_argument(
+    how.add_argument(
         "--no-compare", action="store_true",
         help="keep a valid repair without solving a fresh continuation to compare it with "
         "(lower latency; the execution may be longer)",
+    )  # fmt: skip
+    how.add_argument(
+        "--while-moving", action="store_true",
+        help="write the repair at once, then a shorter fresh continuation over it when one is "
+        "found before the arms reach its start (docs/replanning.md)",
     )  # fmt: skip
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(func=cmd_replan)

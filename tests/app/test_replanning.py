@@ -139,8 +139,8 @@ def test_the_repair_is_kept_when_the_fresh_continuation_fails(
     from sdar_tamp.app import replanning
 
     if failure == "no plan":
-        monkeypatch.setattr(replanning, "_fresh",
-                            lambda *a, **k: replanning._Fresh(None, (), "timeout"))  # fmt: skip
+        monkeypatch.setattr(replanning, "fresh_continuation",
+                            lambda *a, **k: replanning.Fresh(None, (), "timeout"))  # fmt: skip
     else:
         monkeypatch.setattr(replanning, "check_from", lambda *a: (a[1], 1.0, "made to fail"))
     instance, plan = d5

@@ -130,6 +130,8 @@ def _replan(out: Summary) -> None:
     assert out["valid"] == out["solvable"] >= 1 and out["success_rate"] == 1.0
     assert out["latency_median_s"] > 0 and set(out["by_kind"]) == {"nudge", "remove", "add"}
     assert 0 <= out["compared_fresh_kept"] <= out["compared"] <= out["perturbations"]
+    assert out["compare"] == "moving" and 0 <= out["improved"] <= out["perturbations"]
+    assert out["latency_median_s"] <= out["latency_final_median_s"] <= out["latency_done_median_s"]
 
 
 def _sdar(out: Summary) -> None:

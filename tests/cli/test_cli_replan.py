@@ -116,3 +116,34 @@ def test_replan_no_compare_keeps_the_repair(
     assert compared["execution_time"] < kept["execution_time"]
     code, out, _ = _run(argv[:-1], capsys)
     assert code == 0 and "compared with: " in out and "(not kept)" in out
+
+
+def test_replan_while_moving_writes_the_repair_first(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """o4 nudged at 5.116 s with --while-moving: the first record is the repair, valid and
+    written; a second one, when the fresh continuation is found in time, is shorter and
+    written over it. --while-moving with --fresh or --no-compare is refused."""
+    from sdar_tamp.plan_state import state_at
+    from sdar_tamp.world.instance import load_instance
+    from sdar_tamp.world.scene import load_scene
+
+    instance = load_instance(Path(D5))
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    x, y, yaw = state_at(load_plan(PLAN), starts, load_scene(), 5.116).resting["o4"]
+    obs = _observed(tmp_path, f"poses: [{{name: o4, pose: [{x + 0.0052}, {y + 0.0173}, "
+                              f"{yaw - 0.1559}]}}]\n")  # fmt: skip
+    new = tmp_path / "new.json"
+    argv = ["replan", D5, PLAN, "--at", "5.116", "--observed", obs, "--while-moving"]
+    code, out, _ = _run([*argv, "--json", "-o", str(new)], capsys)
+    records = [json.loads(line) for line in out.splitlines()]
+    assert code == 0 and 1 <= len(records) <= 2
+    assert records[0]["status"] == "repaired" and records[0]["valid"] is True
+    for later in records[1:]:
+        assert later["status"] == "replanned" and later["valid"] is True
+        assert later["execution_time"] < records[0]["execution_time"]
+        assert later["alternative"] == pytest.approx(records[0]["execution_time"])
+    assert load_plan(new).duration == pytest.approx(records[-1]["execution_time"])
+    for other in ("--fresh", "--no-compare"):
+        code, _, err = _run([*argv, other], capsys)
+        assert code == 2 and "not allowed with" in err
