@@ -51,6 +51,13 @@ NUMERIC_OPTIONS = NumericIKOptions(
 #: holds each solution on the start's self-motion, and a start near its target converges in
 #: a few iterations anyway.
 CONTINUATION_OPTIONS = NumericIKOptions(seeds=8, iterations=100, rounds=4)
+#: Largest joint difference [rad] under which two numeric IK solutions of one pose count as one
+#: branch. Starts that converge from different seeds land at slightly different points of the
+#: same self-motion (a 7-DoF arm's: on the Panda cell's grasps often 0.01 to 0.05 rad apart,
+#: since the null-space pull fades out near the pose); kept as separate branches they were
+#: checked for collisions one after the other, nearly always with the same outcome, and
+#: compared as placements that differ by nothing.
+NUMERIC_DISTINCT = 0.2
 #: Pose pairs an arm keeps solved by the numeric IK (grasp and pre-grasp; some 500 bytes each).
 PAIR_CACHE = 50_000
 
@@ -221,8 +228,9 @@ class ArmKinematics:
             lo, hi = self.spec.lower_array, self.spec.upper_array
             home = np.asarray(self.spec.home, dtype=np.float64)
             q_n, ok = numeric_ik_branches(
-                self.chain, T_root, lo, hi, home, NUMERIC_BRANCHES, self.numeric
-            )
+                self.chain, T_root, lo, hi, home, NUMERIC_BRANCHES, self.numeric,
+                distinct=NUMERIC_DISTINCT,
+            )  # fmt: skip
             return IKSolutions(q_n, ok)
         T_dh = inverse(self.T_world_base @ self.T_base_dh) @ T
         q, real = ur_ik(self.params, T_dh)

@@ -22,6 +22,13 @@ that come after them (a 7-DoF arm's wrist, larger than the UR5e's, meets its nei
 sooner), and a grasp costs no extra moves where an eviction costs two. Evicting first let two
 such objects evict each other in turn (each boxed in at its goal by the other) until the
 eviction budget ran out.
+
+An object that is graspable where it rests and at its goal, but with no grasp in common (not
+:meth:`Recovery.carried`), is not boxed in, so no eviction helps it; if more grasps do not
+either, it is regrasped through a buffer (a ``regrasp`` step, one extra move): it goes to a
+buffer from which some arm carries it to its goal with one of the first grasps
+(:meth:`Recovery.buffer_clear` keeps only such buffers), picked there with another grasp than
+the one that put it down.
 """
 
 from __future__ import annotations
@@ -40,6 +47,9 @@ if TYPE_CHECKING:
     from solvers.sdar.options import SdarOptions
 
 LOG = get_logger(__name__)
+#: Rank of a regrasp among the recovery's candidates: after the evictions that free a boxed-in
+#: remaining object directly (ranks 0 to 2), level with the first of those one level deeper.
+REGRASP_RANK = 3
 
 
 @dataclass(frozen=True)
@@ -93,6 +103,7 @@ class Recovery:
         self.evictions = 0
         self.deferred: dict[str, list[Deferral]] = {}  # evicted object -> what it waits for
         self._reasons: dict[tuple[Move, ...], tuple[tuple[str, Boxed], ...]] = {}
+        self._regrasps: dict[tuple[Move, ...], str] = {}  # regrasp step -> its object
         self._boxed_in: dict[str, str] = {}  # boxed object -> where it rested then
 
     @property
@@ -142,6 +153,7 @@ class Recovery:
         """Evictions that give a boxed-in remaining object a grasp, or (deeper) give a grasp to
         a boxed-in object in the way of one; best first (see the module docstring)."""
         self._reasons = {}
+        self._regrasps = {}
         self._boxed_in = {}
         ranked: list[tuple[int, int, Step]] = []
         current = self.cache.current_poses()
@@ -153,6 +165,10 @@ class Recovery:
             boxed = self.boxed(obj, view, current)
             if boxed is not None:
                 self._unblock(boxed, current, done, 0, (obj,), ranked)
+            elif not self.carried(obj, view, current):
+                step = Step((Move(obj, True),), "regrasp", REGRASP_RANK)
+                self._regrasps[step.moves] = obj
+                ranked.append((REGRASP_RANK, len(ranked), step))
         ranked.sort(key=lambda item: item[:2])
         seen: set[tuple[Move, ...]] = set()
         out: list[Step] = []
@@ -268,6 +284,8 @@ class Recovery:
         """``obj``, evicted by the step of ``moves`` (one of the last :meth:`candidates`) to
         ``pose``, does not box in again the object it makes room for (``True`` for the
         buffers of other steps)."""
+        if self._regrasps.get(moves) == obj:
+            return self.carries_from(obj, pose)
         lifted = {m.obj for m in moves}
         voc = self.cache.voc
         for evicted, boxed in self._reasons.get(moves, ()):
@@ -281,6 +299,21 @@ class Recovery:
             if not self.reachable(boxed, fluents):
                 return False
         return True
+
+    def carries_from(self, obj: str, pose: str) -> bool:
+        """Some arm holds ``obj``, put down at ``pose`` (the other objects resting as they do
+        now), with one of the first grasps both there and at its goal."""
+        cache, voc = self.cache, self.cache.voc
+        goal = self.goals[obj]
+        others = cache.fluents(voc.atpose, without=frozenset((obj,)))
+        there = tuple(sorted((*others, Atom(voc.atpose, (obj, pose))), key=str))
+        grasps = cache.outputs(voc.grasp, (obj,), self.options.grasps)
+        return any(
+            cache.outputs(voc.ik, (arm, obj, pose, g), 1, there)
+            and cache.outputs(voc.ik, (arm, obj, goal, g), 1, others)
+            for arm in self.arms
+            for (g,) in grasps
+        )
 
     # -- execution ------------------------------------------------------------------------------
     def executed(self, step: Step) -> None:

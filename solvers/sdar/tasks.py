@@ -33,8 +33,8 @@ class Step:
     cell, see :func:`step_is_valid`), arms not yet assigned.
 
     ``kind`` names the rule that proposed it (``pair``, ``chain``, ``swap``, ``rotate``,
-    ``cycle``, ``single``, ``buffer``, ``last``, ``plan``, ``evict``); ``rank`` orders candidates
-    (lower is better).
+    ``cycle``, ``single``, ``buffer``, ``last``, ``plan``, ``evict``, ``regrasp``); ``rank``
+    orders candidates (lower is better).
     ``tie``: candidates of one rank with equal ties are alike to the task planner (their order
     is only by object name), so the motion planner may take whichever it expects to execute
     soonest; None: the task planner's order stands.

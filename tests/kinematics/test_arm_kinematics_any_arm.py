@@ -10,7 +10,12 @@ import numpy as np
 import pytest
 
 from sdar_tamp.world.errors import KinematicsError
-from sdar_tamp.world.kinematics import NUMERIC_BRANCHES, ArmKinematics, IKSolutions
+from sdar_tamp.world.kinematics import (
+    NUMERIC_BRANCHES,
+    NUMERIC_DISTINCT,
+    ArmKinematics,
+    IKSolutions,
+)
 from sdar_tamp.world.numeric_ik import numeric_ik_branches, pose_error
 from sdar_tamp.world.scene import Scene, load_scene
 from tests.kinematics.conftest import ARM7_URDF
@@ -59,7 +64,7 @@ def test_numeric_ik_round_trips_on_reachable_poses(kin7: ArmKinematics) -> None:
         assert np.all(np.diff(d) >= 0.0)
         for a in range(len(qs)):
             for b in range(a):
-                assert np.abs(qs[a] - qs[b]).max() >= 1e-3
+                assert np.abs(qs[a] - qs[b]).max() >= NUMERIC_DISTINCT
     best, ok = sol.closest(q_true[0])
     assert best.shape == (300, 7) and ok.mean() > 0.99
 

@@ -209,3 +209,56 @@ def test_more_grasps_when_no_first_grasp_serves_both_ends(
     assert wider is not None and wider.grasps == solver.options.pair_grasps
     solution = solver.solve()
     assert solution.status is Status.SOLVED, solution.diagnosis
+
+
+def _regrasp_problem(ctx: WorldContext, planner: MotionPlanner) -> Rearrangement:
+    """a has IK where it rests only with the even ones of its first grasps and at its goal only
+    with the odd ones, and no other grasp has IK at either: no grasp carries it, more grasps do
+    not help, nothing boxes it in; elsewhere (a buffer) every grasp has IK."""
+    inst = Instance("regrasp", WORKSPACE, (ObjectSpec("a", SIZE, A_START, A_GOAL),))
+    real = make_stream_map(ctx, {o.name: o.size for o in inst.objects})["inverse-kinematics"]
+    first = SdarOptions().grasps
+
+    def split(arm: str, o: str, p: Pose2D, g: Any, fluents: Any = ()) -> Iterator[Any]:
+        if o == "a" and p in (A_START, A_GOAL):
+            here = p == A_START and g.index < first and g.index % 2 == 0
+            there = p == A_GOAL and g.index < first and g.index % 2 == 1
+            if not (here or there):
+                return iter(())
+        return real(arm, o, p, g, fluents)
+
+    return rearrangement_problem(
+        inst, ctx, planner=planner, overrides={"inverse-kinematics": split}
+    )
+
+
+def test_an_object_no_grasp_carries_is_regrasped_through_a_buffer(
+    ctx: WorldContext, planner: MotionPlanner
+) -> None:
+    solver = SdarSolver(_regrasp_problem(ctx, planner).problem, SdarTaskPlanner(),
+                        SdarOptions(max_time=BUDGET))  # fmt: skip
+    view = solver.view()
+    current = solver.cache.current_poses()
+    (a,) = view.remaining
+    assert solver.recovery.boxed(a, view, current) is None
+    assert not solver.recovery.carried(a, view, current)
+    (step,) = solver.recovery.candidates(view)
+    assert step.kind == "regrasp" and step.moves[0].obj == a and step.moves[0].to_buffer
+    # a buffer is kept only when some first grasp carries a from it to its goal
+    assert solver.recovery.buffer_clear(step.moves, a, current[a]) is False  # where it rests
+    solution = solver.solve()
+    assert solution.status is Status.SOLVED, solution.diagnosis
+    moves = [(o, b) for t in solution.trace for o, b in zip(t.objects, t.to_buffer, strict=True)]
+    assert moves == [("a", True), ("a", False)]
+    assert [t.kind for t in solution.trace] == ["regrasp", "last"]
+
+
+def test_without_regrasps_the_same_object_is_a_dead_end(
+    ctx: WorldContext, planner: MotionPlanner
+) -> None:
+    """The recovery's budget spent, nothing regrasps a: the instance above is a dead end."""
+    solver = SdarSolver(_regrasp_problem(ctx, planner).problem, SdarTaskPlanner(),
+                        SdarOptions(max_time=BUDGET))  # fmt: skip
+    solver.recovery.evictions = 2 * len(solver.goals)
+    assert not solver.recovery.budget_left
+    assert solver.solve().status is Status.INFEASIBLE
