@@ -38,6 +38,7 @@ from typing import Any
 
 from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import SINGLE_CALL
+from sdar_tamp.language.options import never_assumed
 from solvers.stream_planning.assumed import Assumed, OptimisticCosts, refuted_fact
 from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
@@ -200,6 +201,8 @@ class OptimisticBuilder:
             external = engine.streams[name]
             if lazy and real and not external.declaration.fluents:
                 return []
+            if never_assumed(external.info):
+                return []  # p_success=0: only its real (eager) results count
             state = engine.instance(name, inputs) if real else None
             next_level = level + first_call_level(external)
             if state is not None:

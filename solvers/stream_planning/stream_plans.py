@@ -3,6 +3,7 @@ is expected to cost (PDDLStream's stream efforts, optionally added to the plan c
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping, Sequence
 
 from sdar_tamp.language.domain_model import Domain
@@ -28,7 +29,8 @@ def stream_plan_effort(
             total += 1.0
         else:
             overhead = 1.0 if options.overhead is None else options.overhead
-            total += overhead / (1.0 if options.p_success is None else options.p_success)
+            p_success = 1.0 if options.p_success is None else options.p_success
+            total += overhead / p_success if p_success > 0 else math.inf
     return total
 
 
