@@ -29,9 +29,11 @@ class StreamInfo:
         eager: call each new instance once as soon as its inputs exist (before planning), as
             an incremental stream would; at most 10,000 eager calls per solve.
         p_success: prior probability that one call succeeds, in [0, 1]. 0 (with no
-            ``effort``): the stream's effort is infinite, so the optimistic algorithms never
-            assume its outputs; only its real results count (``eager`` calls it on real
-            inputs), as PDDLStream prunes such streams from its optimistic instantiation.
+            ``effort``): the stream's effort is infinite. Without ``effort_weight`` the
+            optimistic algorithms never assume its outputs, only its real results count
+            (``eager`` calls it on real inputs), as PDDLStream prunes such streams; with
+            ``effort_weight`` it is assumed, each optimistic result costing ``overhead`` / 1e-9
+            efforts (1 with ``unit_efforts``).
         overhead: expected cost of one call [s], >= 0.
         effort: fixed effort used in place of the one derived from p_success and overhead.
         opt_gen_fn: placeholder outputs: ``"unique"`` (default, one per instance) or
@@ -107,6 +109,6 @@ def unsupported_options(info: StreamInfo | FunctionInfo, supported: set[str]) ->
 
 
 def never_assumed(info: StreamInfo) -> bool:
-    """A stream the optimistic algorithms never assume (``p_success=0`` and no ``effort``):
-    its effort would be infinite."""
+    """A stream whose effort is infinite (``p_success=0`` and no ``effort``): never assumed
+    optimistically when efforts do not weigh on plans (see ``StreamInfo.p_success``)."""
     return info.p_success == 0 and info.effort is None

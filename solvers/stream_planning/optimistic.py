@@ -38,7 +38,6 @@ from typing import Any
 
 from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import SINGLE_CALL
-from sdar_tamp.language.options import never_assumed
 from solvers.stream_planning.assumed import Assumed, OptimisticCosts, refuted_fact
 from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
@@ -83,10 +82,15 @@ class OptimisticBuilder:
     """Builds optimistic worlds for one engine (placeholders keep their names across builds)."""
 
     def __init__(
-        self, engine: Engine, negated: frozenset[str], assumed: Assumed | None = None
+        self,
+        engine: Engine,
+        negated: frozenset[str],
+        assumed: Assumed | None = None,
+        pruned: frozenset[str] = frozenset(),
     ) -> None:
         self.engine = engine
         self.negated = negated
+        self.pruned = pruned  # streams never assumed: only their real results count
         self.assumed = assumed if assumed is not None else Assumed({}, {})
         self._placeholders: dict[tuple[object, ...], str] = {}
         self.producers: dict[str, str] = {}  # placeholder -> the stream that makes it
@@ -201,7 +205,7 @@ class OptimisticBuilder:
             external = engine.streams[name]
             if lazy and real and not external.declaration.fluents:
                 return []
-            if never_assumed(external.info):
+            if name in self.pruned:
                 return []  # p_success=0: only its real (eager) results count
             state = engine.instance(name, inputs) if real else None
             next_level = level + first_call_level(external)

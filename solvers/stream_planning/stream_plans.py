@@ -3,7 +3,6 @@ is expected to cost (PDDLStream's stream efforts, optionally added to the plan c
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping, Sequence
 
 from sdar_tamp.language.domain_model import Domain
@@ -11,6 +10,10 @@ from sdar_tamp.language.formula_model import And, Atom, Formula
 from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.substitution import ground_atom
 from solvers.stream_planning.optimistic import OptimisticWorld, OptResult
+
+#: the p_success a ``p_success=0`` stream is costed with where it is assumed at all (with an
+#: ``effort_weight``; else it is pruned, see ``context.py``): overhead / 1e-9 efforts
+LAST_RESORT_P_SUCCESS = 1e-9
 
 
 def stream_plan_effort(
@@ -30,7 +33,7 @@ def stream_plan_effort(
         else:
             overhead = 1.0 if options.overhead is None else options.overhead
             p_success = 1.0 if options.p_success is None else options.p_success
-            total += overhead / p_success if p_success > 0 else math.inf
+            total += overhead / max(p_success, LAST_RESORT_P_SUCCESS)
     return total
 
 

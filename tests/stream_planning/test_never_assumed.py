@@ -1,6 +1,7 @@
 """``StreamInfo(p_success=0)``: a stream whose effort is infinite is never assumed by the
-optimistic algorithms (as PDDLStream prunes it from its optimistic instantiation): only its
-real results count, those of eager calls on real inputs."""
+optimistic algorithms without ``effort_weight`` (as PDDLStream prunes it from its optimistic
+instantiation): only its real results count, those of eager calls on real inputs. With
+``effort_weight`` it is assumed at a very high effort."""
 
 from __future__ import annotations
 
@@ -88,3 +89,14 @@ def test_an_effort_overrides_p_success_zero() -> None:
 def test_p_success_must_lie_in_zero_one() -> None:
     with pytest.raises(ValueError, match=r"p_success must be in \[0, 1\]"):
         StreamInfo(p_success=-0.1)
+
+
+def test_with_effort_weight_p_success_zero_is_a_last_resort() -> None:
+    # efforts weigh on plans: the test is assumed (at 1e9 efforts a result), so a plan may
+    # rest on a sampled conf
+    calls = dict.fromkeys(("sample-conf", "test-safe"), 0)
+    info = {"test-safe": StreamInfo(eager=True, p_success=0)}
+    problem = _problem(calls, INIT)
+    solution = solve(problem, algorithm="adaptive", stream_info=info, effort_weight=1, max_time=30)
+    assert solution.plan is not None
+    assert calls["sample-conf"] >= 1

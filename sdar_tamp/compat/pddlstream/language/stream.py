@@ -63,7 +63,8 @@ class StreamInfo(_CoreStreamInfo):
     effort=None, estimate=False)``.
 
     ``p_success=0`` with no ``effort`` makes the stream's effort infinite: as in PDDLStream
-    it is never assumed optimistically, only its real (eager) results count.
+    it is never assumed optimistically, only its real (eager) results count, unless
+    ``solve(effort_weight=...)`` is given (then its results cost ``overhead`` / 1e-9 efforts).
     ``estimate=True`` clears ``p_success``, ``overhead`` and ``effort``; the default defer
     function is stored as None. ``eager_skeleton`` is accepted and has no effect.
     """
