@@ -28,7 +28,12 @@ class StreamInfo:
     Attributes:
         eager: call each new instance once as soon as its inputs exist (before planning), as
             an incremental stream would; at most 10,000 eager calls per solve.
-        p_success: prior probability that one call succeeds, in (0, 1].
+        p_success: prior probability that one call succeeds, in [0, 1]. 0 (with no
+            ``effort``): the stream's effort is infinite. Without ``effort_weight`` the
+            optimistic algorithms never assume its outputs, only its real results count
+            (``eager`` calls it on real inputs), as PDDLStream prunes such streams; with
+            ``effort_weight`` it is assumed, each optimistic result costing ``overhead`` / 1e-9
+            efforts (1 with ``unit_efforts``).
         overhead: expected cost of one call [s], >= 0.
         effort: fixed effort used in place of the one derived from p_success and overhead.
         opt_gen_fn: placeholder outputs: ``"unique"`` (default, one per instance) or
@@ -54,8 +59,8 @@ class StreamInfo:
     defer_fn: Callable[..., Any] | None = None
 
     def __post_init__(self) -> None:
-        if self.p_success is not None and not 0.0 < self.p_success <= 1.0:
-            raise ValueError(f"StreamInfo.p_success must be in (0, 1], got {self.p_success}")
+        if self.p_success is not None and not 0.0 <= self.p_success <= 1.0:
+            raise ValueError(f"StreamInfo.p_success must be in [0, 1], got {self.p_success}")
         if isinstance(self.opt_gen_fn, str) and self.opt_gen_fn not in ("shared", "unique"):
             raise ValueError(
                 f"StreamInfo.opt_gen_fn must be 'shared', 'unique' or a callable, "
@@ -101,3 +106,9 @@ def unsupported_options(info: StreamInfo | FunctionInfo, supported: set[str]) ->
         for f in fields(info)
         if f.name not in supported and getattr(info, f.name) != getattr(defaults, f.name)
     ]
+
+
+def never_assumed(info: StreamInfo) -> bool:
+    """A stream whose effort is infinite (``p_success=0`` and no ``effort``): never assumed
+    optimistically when efforts do not weigh on plans (see ``StreamInfo.p_success``)."""
+    return info.p_success == 0 and info.effort is None

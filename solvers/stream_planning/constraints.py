@@ -73,13 +73,14 @@ def compile_constraints(problem: PDDLProblem, constraints: PlanConstraints) -> P
                 predicates[fact] = Predicate(fact, (Parameter("?v"),))
                 pre.append(Atom(fact, (parameter.name,)))
                 init.add(Atom(fact, (problem.objects.name(value),)))
+            # replace() keeps the schema's numeric conditions and effects (fuel, costs by
+            # expression): a copy is the same action plus the stage bookkeeping
             actions.append(
-                ActionSchema(
-                    f"{schema.name}{MARK}{i}.{k}",
-                    schema.parameters,
-                    And(tuple(pre)),
-                    AndEffect(tuple(eff)),
-                    schema.location,
+                dataclasses.replace(
+                    schema,
+                    name=f"{schema.name}{MARK}{i}.{k}",
+                    precondition=And(tuple(pre)),
+                    effect=AndEffect(tuple(eff)),
                 )
             )
         finals.append(stage[-1])

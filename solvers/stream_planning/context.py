@@ -14,6 +14,7 @@ from typing import Any
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import Atom, FunctionTerm
 from sdar_tamp.language.generators import SINGLE_CALL
+from sdar_tamp.language.options import never_assumed
 from sdar_tamp.language.problem import PDDLProblem, infer_object_types
 from sdar_tamp.logs import get_logger
 from solvers.classical import PlanningTask, PlanStatus
@@ -75,7 +76,14 @@ class SolveContext:
         # the search's domain and goal: deferred instances assumed (see assumed.py)
         self.domain: Domain = self.assumed.rewrite(guard_costs(problem.domain))
         self.search_goal = self.assumed.formula(self.goal)
-        self.builder = OptimisticBuilder(self.engine, negated, self.assumed)
+        # p_success=0 streams (no effort) are never assumed, as in PDDLStream, unless efforts
+        # weigh on plans: then their results cost overhead / 1e-9 efforts (stream_plans.py)
+        pruned = frozenset(
+            name
+            for name, stream in self.engine.streams.items()
+            if options.effort_weight is None and never_assumed(stream.info)
+        )
+        self.builder = OptimisticBuilder(self.engine, negated, self.assumed, pruned)
         self.fluent_streams = {n: e.declaration.fluents for n, e in self.engine.streams.items()}
         self.blocks = Blocks(guard_fluent_uses(self.domain, problem.streams.streams))
         self.stats = SearchStatistics()

@@ -82,10 +82,15 @@ class OptimisticBuilder:
     """Builds optimistic worlds for one engine (placeholders keep their names across builds)."""
 
     def __init__(
-        self, engine: Engine, negated: frozenset[str], assumed: Assumed | None = None
+        self,
+        engine: Engine,
+        negated: frozenset[str],
+        assumed: Assumed | None = None,
+        pruned: frozenset[str] = frozenset(),
     ) -> None:
         self.engine = engine
         self.negated = negated
+        self.pruned = pruned  # streams never assumed: only their real results count
         self.assumed = assumed if assumed is not None else Assumed({}, {})
         self._placeholders: dict[tuple[object, ...], str] = {}
         self.producers: dict[str, str] = {}  # placeholder -> the stream that makes it
@@ -200,6 +205,8 @@ class OptimisticBuilder:
             external = engine.streams[name]
             if lazy and real and not external.declaration.fluents:
                 return []
+            if name in self.pruned:
+                return []  # p_success=0: only its real (eager) results count
             state = engine.instance(name, inputs) if real else None
             next_level = level + first_call_level(external)
             if state is not None:

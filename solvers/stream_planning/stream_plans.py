@@ -11,6 +11,10 @@ from sdar_tamp.language.options import StreamInfo
 from sdar_tamp.language.substitution import ground_atom
 from solvers.stream_planning.optimistic import OptimisticWorld, OptResult
 
+#: the p_success a ``p_success=0`` stream is costed with where it is assumed at all (with an
+#: ``effort_weight``; else it is pruned, see ``context.py``): overhead / 1e-9 efforts
+LAST_RESORT_P_SUCCESS = 1e-9
+
 
 def stream_plan_effort(
     stream_plan: Sequence[OptResult], info: Mapping[str, StreamInfo], unit_efforts: bool = False
@@ -28,7 +32,8 @@ def stream_plan_effort(
             total += 1.0
         else:
             overhead = 1.0 if options.overhead is None else options.overhead
-            total += overhead / (1.0 if options.p_success is None else options.p_success)
+            p_success = 1.0 if options.p_success is None else options.p_success
+            total += overhead / max(p_success, LAST_RESORT_P_SUCCESS)
     return total
 
 

@@ -22,7 +22,6 @@ from sdar_tamp.compat.pddlstream import (
     solve,
 )
 from sdar_tamp.compat.pddlstream.check import check_solution
-from sdar_tamp.compat.pddlstream.language.stream import MIN_P_SUCCESS
 from sdar_tamp.language.errors import StreamMapError
 from solvers.solution import Action, Solution
 
@@ -75,7 +74,7 @@ def test_debug_stream_maps_plan_with_stand_in_values(mode: str) -> None:
 
 def test_stream_info_accepts_pddlstream_keywords() -> None:
     info = StreamInfo(p_success=0, eager=True, defer_fn=never_defer, eager_skeleton=True)
-    assert info.p_success == MIN_P_SUCCESS and info.defer_fn is None and info.eager
+    assert info.p_success == 0 and info.defer_fn is None and info.eager
     assert StreamInfo(opt_gen_fn=PartialInputs(unique=False)).opt_gen_fn == "shared"
     assert StreamInfo(opt_gen_fn=PartialInputs(unique=True)).opt_gen_fn == "unique"
     assert StreamInfo(p_success=0.5, overhead=2, estimate=True).p_success is None

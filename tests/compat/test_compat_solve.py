@@ -212,3 +212,48 @@ def test_streams_without_stream_info_get_pddlstream_shared_default(
     assert seen[first] is unique  # given: kept
     assert all(seen[name].opt_gen_fn == "shared" for name in others)  # type: ignore[attr-defined]
     assert StreamInfo().opt_gen_fn == "shared"
+
+
+def _captured_info(monkeypatch: pytest.MonkeyPatch, **keywords: object) -> dict[str, object]:
+    from sdar_tamp.compat.pddlstream.algorithms import meta
+
+    seen: dict[str, object] = {}
+
+    def capture(problem: object, **options: object) -> object:
+        seen.update(options["stream_info"])  # type: ignore[call-overload]
+        return "captured"
+
+    monkeypatch.setattr(meta, "core_solve", capture)
+    assert meta.solve(_problem(), **keywords) == "captured"  # type: ignore[arg-type,comparison-overlap]
+    return seen
+
+
+def test_defer_fn_without_replan_actions_changes_nothing_as_in_pddlstream(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    from sdar_tamp.compat.pddlstream.language.external import defer_shared
+    from sdar_tamp.compat.pddlstream.language.stream import PartialInputs, StreamInfo
+
+    given = StreamInfo(opt_gen_fn=PartialInputs(unique=True), defer_fn=defer_shared)
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.compat"):
+        seen = _captured_info(monkeypatch, stream_info={"sample-pose": given})
+    passed = seen["sample-pose"]
+    assert passed.defer_fn is None  # type: ignore[attr-defined]
+    assert passed.opt_gen_fn == "unique"  # type: ignore[attr-defined]  # the rest kept
+    assert given.defer_fn is defer_shared  # the program's own object is not changed
+    assert "defer_fn" not in caplog.text
+
+
+def test_defer_fn_with_replan_actions_is_noted(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    from sdar_tamp.compat.pddlstream.language.external import defer_unique
+    from sdar_tamp.compat.pddlstream.language.function import FunctionInfo
+    from sdar_tamp.compat.pddlstream.language.stream import StreamInfo
+
+    info = {"sample-pose": StreamInfo(defer_fn=defer_unique), "lift": FunctionInfo()}
+    with caplog.at_level(logging.INFO, logger="sdar_tamp.compat"):
+        seen = _captured_info(monkeypatch, stream_info=info, replan_actions={"pick"})
+    assert all(item.defer_fn is None for item in seen.values())  # type: ignore[attr-defined]
+    assert seen["lift"] is info["lift"]
+    assert "defer_fn of sample-pose with replan_actions=['pick']" in caplog.text

@@ -9,7 +9,9 @@ from typing import Any
 
 import pytest
 
+from sdar_tamp.language.options import PlanConstraints
 from sdar_tamp.language.problem import PDDLProblem
+from solvers.solution import Status
 from solvers.solve import solve
 
 DOMAIN = """
@@ -77,3 +79,28 @@ def test_a_function_read_only_by_numeric_conditions_is_evaluated() -> None:
     assert solution.plan is not None
     assert [a.name for a in solution.plan] == ["drive", "refuel", "drive", "drive"]
     assert calls
+
+
+def test_a_skeleton_keeps_the_fuel_condition() -> None:
+    # without its numeric condition the skeleton's copy of drive would run dry between b and c
+    straight = PlanConstraints(skeletons=[[("drive", ("a", "b")), ("drive", ("b", "c"))]])
+    problem = _problem([], 4.0)
+    problem = PDDLProblem(DOMAIN, {}, STREAMS, problem.stream_map, problem.init, ("At", "c"))
+    solution = solve(problem, algorithm="adaptive", max_time=20, constraints=straight)
+    assert solution.plan is None
+    assert solution.status is not Status.SOLVED
+
+
+def test_a_skeleton_keeps_the_numeric_effects() -> None:
+    skeleton = [("drive", ("a", "b")), ("refuel", ("b",)), ("drive", ("b", "c"))]
+    skeleton.append(("drive", ("c", "d")))
+    solution = solve(
+        _problem([], 4.0),
+        algorithm="adaptive",
+        max_time=60,
+        constraints=PlanConstraints(skeletons=[skeleton]),
+    )
+    assert solution.plan is not None
+    assert [a.name for a in solution.plan] == ["drive", "refuel", "drive", "drive"]
+    # the legs' lengths (2 + 3 + 1) and the refuel (1), costed by expression
+    assert solution.cost == pytest.approx(7.0)

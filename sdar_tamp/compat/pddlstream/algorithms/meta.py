@@ -10,6 +10,7 @@ result (a returned plan is always fully evaluated and checked).
 from __future__ import annotations
 
 import argparse
+import copy
 import dataclasses
 import logging
 import math
@@ -159,7 +160,9 @@ def solve(
     solution = core_solve(
         problem,
         algorithm=algorithm,
-        stream_info=_with_default_info(problem, stream_info),
+        stream_info=_without_defer_fns(
+            _with_default_info(problem, stream_info), keywords.get("replan_actions")
+        ),
         constraints=_constraints(constraints, max_cost),
         unit_costs=unit_costs,
         success_cost=success_cost,
@@ -224,3 +227,42 @@ def _with_default_info(
         if stream.name.lower() not in given:
             info[stream.name] = PddlstreamStreamInfo()
     return info
+
+
+def _without_defer_fns(
+    info: dict[str, StreamInfo | FunctionInfo], replan_actions: Any
+) -> dict[str, StreamInfo | FunctionInfo]:
+    """``info`` with every ``defer_fn`` removed, after saying what that changes.
+
+    PDDLStream consults a defer function only for the stream results a plan needs at or after
+    the step following its first action named in ``replan_actions`` (they are returned as
+    stream actions, unevaluated, for the program to re-plan at that action). Without such
+    actions no result is deferred there either, so the functions are dropped silently. With
+    them, the plan returned here is evaluated in full instead (noted in the log).
+    """
+    deferring = sorted(name for name, item in info.items() if _defer_fn(item) is not None)
+    if not deferring:
+        return info
+    if replan_actions:
+        LOG.info(
+            "defer_fn of %s with replan_actions=%r: deferral is not built here; the plan "
+            "returned is evaluated in full (no stream actions are left in it)",
+            ", ".join(deferring),
+            sorted(replan_actions),
+        )
+    return {name: _no_defer_fn(item) for name, item in info.items()}
+
+
+def _no_defer_fn(item: StreamInfo | FunctionInfo) -> StreamInfo | FunctionInfo:
+    """A copy of ``item`` without its defer function (copied, not rebuilt: the compat
+    classes' constructors take PDDLStream's arguments, not the stored values)."""
+    if _defer_fn(item) is None:
+        return item
+    bare = copy.copy(item)
+    object.__setattr__(bare, "defer_fn", None)
+    return bare
+
+
+def _defer_fn(item: StreamInfo | FunctionInfo) -> Any:
+    """The defer function of ``item`` (the core ``FunctionInfo`` has none)."""
+    return getattr(item, "defer_fn", None)

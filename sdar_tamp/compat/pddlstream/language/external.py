@@ -1,10 +1,12 @@
 """``pddlstream.language.external``: the debug stream-map modes and the defer functions.
 
-A defer function tells PDDLStream to postpone a stream until a plan is executed up to its
-use. The solvers here evaluate every stream a plan needs before returning it (a stronger
-guarantee), so these functions are accepted in ``StreamInfo(defer_fn=...)`` and noted in the
-log; the predicates still answer as documented when a program calls them itself.
-"""
+In PDDLStream a defer function is consulted only for the stream results a plan needs at or
+after the step that follows its first action named in ``solve(replan_actions=...)``; those are
+left unevaluated in the returned plan, for the program to re-plan at that action. Without
+replan actions nothing is deferred there. ``solve`` here drops the functions in that case (the
+same result) and notes in the log that it evaluates the whole plan when replan actions are
+given (:func:`sdar_tamp.compat.pddlstream.algorithms.meta.solve`); the predicates still answer
+as documented when a program calls them itself."""
 
 from __future__ import annotations
 

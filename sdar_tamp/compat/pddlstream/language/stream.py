@@ -25,9 +25,6 @@ __all__ = [
 ]
 
 LOG = logging.getLogger(__name__)
-#: What ``p_success=0`` becomes: the stream is (almost) never worth assuming optimistically;
-#: its instances still run (eagerly, or when a plan needs them).
-MIN_P_SUCCESS = 1e-9
 
 
 class PartialInputs:
@@ -65,7 +62,9 @@ class StreamInfo(_CoreStreamInfo):
     eager=False, eager_skeleton=False, defer_fn=never_defer, p_success=None, overhead=None,
     effort=None, estimate=False)``.
 
-    ``p_success=0`` (allowed, as in PDDLStream) is stored as :data:`MIN_P_SUCCESS`;
+    ``p_success=0`` with no ``effort`` makes the stream's effort infinite: as in PDDLStream
+    it is never assumed optimistically, only its real (eager) results count, unless
+    ``solve(effort_weight=...)`` is given (then its results cost ``overhead`` / 1e-9 efforts).
     ``estimate=True`` clears ``p_success``, ``overhead`` and ``effort``; the default defer
     function is stored as None. ``eager_skeleton`` is accepted and has no effect.
     """
@@ -88,8 +87,6 @@ class StreamInfo(_CoreStreamInfo):
     ) -> None:
         if estimate:
             p_success = overhead = effort = None
-        if p_success is not None and p_success == 0:
-            p_success = MIN_P_SUCCESS
         values = {
             "eager": bool(eager),
             "p_success": p_success,
