@@ -181,6 +181,9 @@ def kitchen_rows(algorithms: list[str], seeds: int, max_time: float) -> list[dic
                     "max_cpu": cpus[-1],
                     "rounds_per_s": round(sum(rates) / len(rates), 1) if rates else None,
                     "stream_calls": [r["stream_calls"] for r in runs],
+                    # per seed, in seed order: wall and CPU time [s]
+                    "times": [r["time"] for r in runs],
+                    "cpus": [r["cpu"] for r in runs],
                 }
             )
     return rows
@@ -240,6 +243,7 @@ def tamp_rows(checkout: Path, algorithms: list[str], seeds: int) -> list[dict[st
                 "max_cpu": cpus[-1],
                 "rounds_per_s": None,
                 "solve_seconds": [r["solve_seconds"] for r in runs],
+                "cpus": [r["cpu"] for r in runs],  # per seed, the example's process
             }
         )
     return rows

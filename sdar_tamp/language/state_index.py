@@ -41,15 +41,19 @@ class FactIndex:
 
     def __init__(self, atoms: Iterable[Atom]) -> None:
         self.atoms = frozenset(atoms)
+        # filled per predicate when first asked for (a plan's states are many and large, and
+        # most are asked about few predicates, or none)
         self._by_predicate: dict[str, list[tuple[str, ...]]] = {}
-        for atom in self.atoms:
-            self._by_predicate.setdefault(atom.predicate, []).append(atom.args)
 
     def __contains__(self, atom: object) -> bool:
         return atom in self.atoms
 
     def args_of(self, predicate: str) -> Collection[tuple[str, ...]]:
-        return self._by_predicate.get(predicate, ())
+        found = self._by_predicate.get(predicate)
+        if found is None:
+            found = [atom.args for atom in self.atoms if atom.predicate == predicate]
+            self._by_predicate[predicate] = found
+        return found
 
 
 class TypedObjects:

@@ -162,6 +162,7 @@ class SolveContext:
         )
         self.last_search_seconds = time.perf_counter() - start
         self.stats.search_time += self.last_search_seconds
+        self.stats.grounding_time += result.statistics.grounding_time
         self.search_seconds += self.last_search_seconds
         statistics = result.statistics
         LOG.debug(

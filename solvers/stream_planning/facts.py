@@ -28,6 +28,14 @@ class FactStore:
             self._by_argument.setdefault((atom.predicate, position, value), {})[atom.args] = level
         return old is None
 
+    def copy(self) -> FactStore:
+        """A store with the same atoms and levels (and the same iteration orders)."""
+        store = FactStore()
+        store.levels = dict(self.levels)
+        store._by_predicate = {p: dict(found) for p, found in self._by_predicate.items()}
+        store._by_argument = {k: dict(found) for k, found in self._by_argument.items()}
+        return store
+
     def _candidates(self, atom: Atom, binding: dict[str, str]) -> dict[tuple[str, ...], int]:
         """The known argument tuples of ``atom``'s predicate that may match it: those with the
         value of its most selective bound argument, or all of them."""

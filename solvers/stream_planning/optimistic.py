@@ -38,6 +38,7 @@ from typing import Any
 
 from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import SINGLE_CALL
+from sdar_tamp.language.substitution import ground_atom
 from solvers.stream_planning.assumed import Assumed, OptimisticCosts, refuted_fact
 from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
@@ -103,6 +104,11 @@ class OptimisticBuilder:
         self._later: set[str] = set()  # placeholders of later calls (see _further)
         # the optimistic values of deferred function terms (asked for by the search)
         self._optimistic: dict[tuple[str, tuple[str, ...]], float] = {}
+        # (external, inputs, outputs) -> its (domain, certified) facts: every build meets the
+        # same instances and placeholders again (their names persist across builds)
+        self._atoms: dict[
+            tuple[str, tuple[str, ...], tuple[str, ...]], tuple[tuple[Atom, ...], tuple[Atom, ...]]
+        ] = {}
 
     def placeholder(self, key: tuple[object, ...]) -> str:
         name = self._placeholders.get(key)
@@ -126,10 +132,13 @@ class OptimisticBuilder:
         without, ``more_calls`` only says whether some instance could. ``check_time`` is
         called every so often (it raises when the solve's time is up: a world can grow large)."""
         engine = self.engine
-        store = FactStore()
         facts = engine.planning_facts()
-        for atom, level in facts.items():
-            store.add(atom, level)
+        if engine.hidden:
+            store = FactStore()
+            for atom, level in facts.items():
+                store.add(atom, level)
+        else:  # every real fact: a copy of the engine's store (the same orders)
+            store = engine.store.copy()
         numeric = OptimisticCosts(engine.numeric, frozenset(self.assumed.functions), self.value)
         world = OptimisticWorld(dict(facts), {}, numeric)
         for atom in engine.refuted:
@@ -233,14 +242,12 @@ class OptimisticBuilder:
                 if shared:
                     self._shared.update(outputs)
                 batches = [outputs]
-            domain = external.domain(inputs)
             return [
                 OptResult(
                     name,
                     inputs,
                     outputs,
-                    domain,
-                    external.certified(inputs, outputs),
+                    *self._stream_atoms(external, inputs, outputs),
                     next_level,
                     "stream",
                 )
@@ -251,17 +258,32 @@ class OptimisticBuilder:
             if not real:
                 return self._function(function, inputs, level, world)
             return []  # evaluated for real by the engine
-        rule = engine.rules[name]
-        mapping = dict(zip(rule.parameters, inputs, strict=True))
-        domain = tuple(
-            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.domain
-        )
+        key = (name, inputs, ())
+        atoms = self._atoms.get(key)
+        if atoms is None:
+            rule = engine.rules[name]
+            mapping = dict(zip(rule.parameters, inputs, strict=True))
+            atoms = self._atoms[key] = (
+                tuple(ground_atom(a, mapping) for a in rule.domain),
+                tuple(ground_atom(a, mapping) for a in rule.certified),
+            )
+        domain, certified = atoms
         if real and all(a in engine.store for a in domain):
             return []  # rules on real facts were applied by the engine
-        certified = tuple(
-            Atom(a.predicate, tuple(mapping.get(t, t) for t in a.args)) for a in rule.certified
-        )
         return [OptResult(name, inputs, (), domain, certified, level, "rule")]
+
+    def _stream_atoms(
+        self, external: StreamExternal, inputs: tuple[str, ...], outputs: tuple[str, ...]
+    ) -> tuple[tuple[Atom, ...], tuple[Atom, ...]]:
+        """The domain and certified facts of a stream on ``inputs`` giving ``outputs``."""
+        key = (external.name, inputs, outputs)
+        atoms = self._atoms.get(key)
+        if atoms is None:
+            atoms = self._atoms[key] = (
+                external.domain(inputs),
+                external.certified(inputs, outputs),
+            )
+        return atoms
 
     def refine(self, stream_plan: list[OptResult]) -> bool:
         """Give every instance of the streams behind the ambiguous shared placeholders of
@@ -335,13 +357,14 @@ class OptimisticBuilder:
                 )
                 outputs = tuple(self.placeholder((*base, i, k)) for i in range(len(result.outputs)))
                 self._later.update(outputs)
+                _, certified = self._stream_atoms(external, result.inputs, outputs)
                 further.append(
                     OptResult(
                         result.external,
                         result.inputs,
                         outputs,
                         result.domain,
-                        external.certified(result.inputs, outputs),
+                        certified,
                         level,
                         "stream",
                     )
@@ -390,7 +413,11 @@ class OptimisticBuilder:
     ) -> list[OptResult]:
         if function.is_predicate and function.name in self.negated:
             return []  # optimistically false: a negated use must not be blocked by a guess
-        domain = function.domain(inputs)
+        key = (function.name, inputs, ())
+        atoms = self._atoms.get(key)
+        if atoms is None:
+            atoms = self._atoms[key] = (function.domain(inputs), ())
+        domain = atoms[0]
         if function.is_predicate:
             return [
                 OptResult(

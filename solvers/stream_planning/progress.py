@@ -76,7 +76,9 @@ class RoundLog:
             f"{algorithm}: {status} after {int(statistics.get('iterations', 0))} round(s), "
             f"{int(statistics.get('skeletons', 0))} skeleton(s), "
             f"complexity {int(statistics.get('complexity', 0))}, "
-            f"search {statistics.get('search_time', 0.0):.3f} s, "
+            f"search {statistics.get('search_time', 0.0):.3f} s "
+            f"(grounding {statistics.get('grounding_time', 0.0):.3f} s), "
+            f"worlds {statistics.get('world_time', 0.0):.3f} s, "
             f"sampling {statistics.get('sample_time', 0.0):.3f} s, "
             f"total {statistics.get('time', 0.0):.3f} s"
         )

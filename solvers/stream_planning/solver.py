@@ -98,7 +98,18 @@ class StreamSolver:
         lazy = self.policy.lazy
         if lazy and not any(context.fluent_streams.values()):
             return OptimisticWorld(dict(engine.planning_facts()), {}, dict(engine.numeric))
-        return context.builder.build(level, lazy, check_time=context.check_time)
+        return self._build(level, further=False)
+
+    def _build(self, level: int, further: bool) -> OptimisticWorld:
+        """The optimistic world at ``level`` (its time counted in ``world_time``)."""
+        context = self.context
+        start = time.perf_counter()
+        try:
+            return context.builder.build(
+                level, self.policy.lazy, further=further, check_time=context.check_time
+            )
+        finally:
+            context.stats.world_time += time.perf_counter() - start
 
     def _complete(self, world: OptimisticWorld) -> bool:
         """Nothing left out at this level: no plan now means no plan at all."""
@@ -239,9 +250,7 @@ class StreamSolver:
             if found is None and world.more_calls and not context.unreachable:
                 # no plan with one new output per instance: offer later calls' outputs (when
                 # they all lie above the level, the same facts: the same search would fail)
-                further = context.builder.build(
-                    level, self.policy.lazy, further=True, check_time=context.check_time
-                )
+                further = self._build(level, further=True)
                 if further.facts.keys() != world.facts.keys():
                     found = context.plan(further.facts, further.numeric, further)
                 world = further

@@ -59,32 +59,49 @@ class ActionEfforts:
         self.info = info
         self.weight = weight
         self.unit_efforts = unit_efforts
-        # action name -> its positive preconditions, as (predicate, arguments)
-        self._atoms: dict[str, list[tuple[str, tuple[str, ...]]]] = {}
+        # action name -> its positive preconditions, as (predicate, arguments: the index of
+        # an action parameter, or a constant)
+        self._atoms: dict[str, list[tuple[str, tuple[int | str, ...]]]] = {}
+        self._texts: dict[_Key, str] = {}
         # facts keyed by (predicate, arguments): tuples hash in C, atoms in Python
         self._provenance = {(a.predicate, a.args): r for a, r in world.provenance.items()}
         self._behind: dict[_Key, tuple[OptResult, ...]] = {}  # fact -> results, deps first
 
     def __call__(self, name: str, args: tuple[str, ...]) -> float:
-        action = self.domain.action(name)
-        binding = {p.name: a for p, a in zip(action.parameters, args, strict=True)}
         templates = self._atoms.get(name)
         if templates is None:
+            action = self.domain.action(name)
+            position = {p.name: i for i, p in enumerate(action.parameters)}
             atoms = positive_atoms(action.precondition, {})
-            templates = self._atoms[name] = [(a.predicate, a.args) for a in atoms]
+            templates = self._atoms[name] = [
+                (a.predicate, tuple(position.get(t, t) for t in a.args)) for a in atoms
+            ]
         provenance = self._provenance
-        grounded = ((p, tuple([binding.get(a, a) for a in xs])) for p, xs in templates)
-        facts = [key for key in grounded if key in provenance]
+        facts = []
+        for predicate, spec in templates:
+            key = (predicate, tuple([args[t] if type(t) is int else t for t in spec]))
+            if key in provenance:
+                facts.append(key)
         if not facts:
             return 0.0
+        if len(facts) > 1:
+            facts.sort(key=self._text)
         results: list[OptResult] = []
         seen: set[int] = set()
-        for key in sorted(facts, key=_text):
+        for key in facts:
             for result in self._results_behind(key):
                 if id(result) not in seen:
                     seen.add(id(result))
                     results.append(result)
         return self.weight * stream_plan_effort(results, self.info, self.unit_efforts)
+
+    def _text(self, key: _Key) -> str:
+        """``str`` of the atom ``key`` stands for (the order :func:`extract_stream_plan` takes),
+        kept: many actions share a fact."""
+        text = self._texts.get(key)
+        if text is None:
+            text = self._texts[key] = _text(key)
+        return text
 
     def _results_behind(self, key: _Key) -> tuple[OptResult, ...]:
         """The optimistic results behind a fact, dependencies first (as

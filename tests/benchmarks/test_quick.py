@@ -170,6 +170,8 @@ def _spheres(out: Summary) -> None:
 
 def _streams(out: Summary) -> None:
     assert out["runs"] and out["all_expected"] is True and out["max_time_probes"]
+    assert out["kitchen_2d"]  # per seed: wall and CPU time
+    assert all(len(r["times"]) == len(r["cpus"]) == r["seeds"] for r in out["kitchen_2d"])
 
 
 def _world(out: Summary) -> None:

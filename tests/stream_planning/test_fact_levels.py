@@ -55,3 +55,23 @@ def test_a_shared_placeholder_keeps_its_lowest_level() -> None:
     assert solution.plan[1].args[:2] == ("a", "pa")
     assert solution.streams["sample"].calls <= 12
     assert solution.statistics["complexity"] <= 3
+
+
+def test_a_copied_fact_store_joins_as_the_original_and_stays_apart() -> None:
+    """The optimistic world starts from a copy of the real facts: the same levels, the same
+    join results in the same order, and what the copy learns stays out of the original."""
+    from sdar_tamp.language.formula_model import Atom
+    from solvers.stream_planning.facts import FactStore
+
+    store = FactStore()
+    store.add(Atom("pos", ("a", "p1")), 2)
+    store.add(Atom("pos", ("b", "p2")), 0)
+    store.add(Atom("pos", ("a", "p1")), 1)  # a lower level for a known atom
+    copy = store.copy()
+    query = (Atom("pos", ("?o", "?p")),)
+    assert list(copy.join(query, {})) == list(store.join(query, {}))
+    assert copy.levels == {Atom("pos", ("a", "p1")): 1, Atom("pos", ("b", "p2")): 0}
+    assert copy.add(Atom("pos", ("c", "p3")), 3)
+    assert Atom("pos", ("c", "p3")) not in store
+    assert [b["?o"] for b, _ in store.join((Atom("pos", ("?o", "p3")),), {})] == []
+    assert [b["?o"] for b, _ in copy.join((Atom("pos", ("?o", "p3")),), {})] == ["c"]

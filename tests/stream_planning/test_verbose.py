@@ -94,3 +94,23 @@ def test_a_terminal_also_sees_what_the_search_is_doing(monkeypatch: pytest.Monke
     visible = re.sub(r"\r\x1b\[K[^\n\r]*(?=\r\x1b\[K)", "", text).replace("\r\x1b[K", "")
     assert "searching..." not in visible
     assert ROUND.match(visible.splitlines()[0])
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
+def test_the_round_costs_are_split_into_worlds_grounding_and_search(
+    algorithm: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``world_time`` (building optimistic worlds) and ``grounding_time`` (the planner's
+    grounding, part of ``search_time``) are counted, and the summary line gives them."""
+    solution = solve(_problem(cfree=True), algorithm=algorithm, max_time=60, verbose=True)
+    statistics = solution.statistics
+    assert 0.0 < statistics["grounding_time"] <= statistics["search_time"]
+    if algorithm == "incremental":  # plans on the real facts: no optimistic world is built
+        assert statistics["world_time"] == 0.0
+    else:
+        assert statistics["world_time"] > 0.0
+    assert statistics["world_time"] + statistics["search_time"] <= statistics["time"]
+    summary = next(line for line in capsys.readouterr().out.splitlines() if " after " in line)
+    assert re.search(
+        r"search \d+\.\d{3} s \(grounding \d+\.\d{3} s\), worlds \d+\.\d{3} s", summary
+    )
