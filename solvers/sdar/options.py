@@ -57,7 +57,7 @@ class SdarOptions:
     # with a finite max_time, once the time left is what the remaining objects need at the
     # run's measured pace (solvers.sdar.budget.Pace) the run finishes with steps of at most
     # finish_moves moves (0: never); the reserve is at most finish_share of max_time
-    finish_safety: float = 1.3  # the measured seconds per object are multiplied by this
+    finish_safety: float = 1.5  # the measured seconds per object are multiplied by this
     finish_moves: int = 1
     finish_gap: float = 0.2  # [m] with more than two arms: the finish also proposes a step of
     # one-object moves with arms whose plane segments stay this far apart (0: never); see

@@ -233,7 +233,7 @@ def test_cheap_motions_never_finish_early() -> None:
 
 def test_dear_motions_finish_once_the_pace_measured_needs_the_time_left() -> None:
     """Motions of 8 s: the first two-object step takes 16 s; at that pace the two objects left
-    need more than the 44 s left (1.3 x 16 s each, plus the longest attempt), so the run
+    need more than the 44 s left (1.5 x 16 s each, plus the longest attempt), so the run
     finishes with one-move steps from there and ends before max_time."""
     solver, solution, switches, clock = _solve_on_fake_clock(PAPER / "R4.yaml", 8.0, max_time=60.0)
     assert solution.status.value == "solved"
@@ -290,7 +290,7 @@ def test_a_finish_moves_four_objects_apart_in_one_step_and_the_replay_accepts_it
 
 def test_a_finish_whose_own_pace_leaves_room_goes_back_to_the_normal_search() -> None:
     """The same prior, motions of 20 s: after two finishing steps (a buffer, then one object
-    in 80 s) the three objects left need 3 x 1.3 x 80 s = 312 s of the 520 s left, so the run
+    in 80 s) the three objects left need 3 x 1.5 x 80 s = 360 s of the 520 s left, so the run
     goes back to the normal search, which rotates the 3-cycle left in one step."""
     solver, solution, switches, _ = _solve_on_fake_clock(
         DATA / "four_arm_cycle.yaml", 20.0, max_time=600.0, finish_reserve=1000.0,
