@@ -14,9 +14,13 @@ normal decisions, and at least the mean time of one executed attempt of theirs (
 step of one move plans about the motions a normal step plans for several); before any decision
 ``SdarOptions.finish_reserve``. Measured rates are multiplied by a safety factor; added is the
 longest single attempt of the normal search (a decision stops at the soft limit only between
-attempts, so one attempt may run past it). So the finish starts when the objects left need the
-time left at the pace measured, not after a fixed time per object; and once its own pace shows
-room for a normal decision again, the run goes back to the normal search
+attempts, so one attempt may run past it). The reserve never exceeds ``finish_reserve`` per
+object (nor ``finish_share`` of ``max_time``): on a loaded machine the measured pace would start
+the finish earlier than that, and a finish's steps are not much quicker per object than a
+two-arm cell's normal ones, so the paper suite would lose plans it still completes in time
+(measured: docs/benchmarks.md). So the finish starts when the objects left need the time left
+at the pace measured, up to that ceiling, not always at the ceiling; and once its own pace
+shows room for a normal decision again, the run goes back to the normal search
 (:meth:`Pace.room_for_normal`).
 """
 
@@ -90,8 +94,8 @@ class _Tally:
 class Pace:
     """The measured pace of a run and the reserve the anytime finish needs from it (see the
     module docstring). ``prior`` [s] per object before any decision brought an object to its
-    goal; ``safety`` multiplies the measured seconds per object; ``share`` caps the reserve at
-    that share of ``max_time``."""
+    goal, and the most per object ever kept; ``safety`` multiplies the measured seconds per
+    object; ``share`` caps the reserve at that share of ``max_time``."""
 
     def __init__(self, max_time: float, prior: float, safety: float, share: float) -> None:
         self.max_time = max_time
@@ -132,10 +136,10 @@ class Pace:
         return self.prior
 
     def reserve(self, remaining: int) -> float:
-        """The seconds [s] to keep for ``remaining`` objects (at most ``share`` of
-        ``max_time``)."""
+        """The seconds [s] to keep for ``remaining`` objects: the measured need, at most
+        ``prior`` per object and ``share`` of ``max_time``."""
         need = self.per_object() * remaining + self.normal.longest_attempt
-        return min(need, self.share * self.max_time)
+        return min(need, self.prior * remaining, self.share * self.max_time)
 
     def room_for_normal(self, left: float, remaining: int) -> bool:
         """With ``left`` [s] to go, a normal decision of the average measured time fits before

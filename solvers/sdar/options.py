@@ -53,10 +53,10 @@ class SdarOptions:
     fewer_moves_after: tuple[int, int] = (2, 6)  # with more than two arms: failed motions
     # in a decision after which it tries steps of at most two moves (of steps of three moves
     # or more), then of one move (in all); see solvers.sdar.spending
-    finish_reserve: float = 1.5  # [s] per remaining object before any decision is measured:
-    # with a finite max_time, once the time left is what the remaining objects need at the
-    # run's measured pace (solvers.sdar.budget.Pace) the run finishes with steps of at most
-    # finish_moves moves (0: never); the reserve is at most finish_share of max_time
+    finish_reserve: float = 2.5  # [s] per remaining object before any decision is measured,
+    # and at most: with a finite max_time, once the time left is what the remaining objects
+    # need at the run's measured pace (solvers.sdar.budget.Pace) the run finishes with steps of
+    # at most finish_moves moves (0: never); the reserve is at most finish_share of max_time
     finish_safety: float = 1.5  # the measured seconds per object are multiplied by this
     finish_moves: int = 1
     finish_gap: float = 0.2  # [m] with more than two arms: the finish also proposes a step of

@@ -125,16 +125,21 @@ def test_the_soft_limit_comes_before_max_time_and_can_be_lifted() -> None:
 
 
 def test_the_reserve_follows_the_pace_measured_in_the_run() -> None:
-    pace = Pace(max_time=60.0, prior=1.5, safety=1.3, share=0.9)
-    assert pace.reserve(10) == pytest.approx(15.0)  # nothing measured: the prior per object
+    pace = Pace(max_time=60.0, prior=4.0, safety=1.3, share=0.9)
+    assert pace.reserve(10) == pytest.approx(40.0)  # nothing measured: the prior per object
     pace.decided(6.0, 0, finishing=False)  # a decision that only buffered: still the prior
-    assert pace.reserve(10) == pytest.approx(15.0)
+    assert pace.reserve(10) == pytest.approx(40.0)
     pace.attempted(5.0, True, finishing=False)
     pace.attempted(9.0, False, finishing=False)  # the longest attempt: kept on top
     pace.decided(8.0, 4, finishing=False)  # 14 s for 4 objects, the executed attempt 5 s
     assert pace.per_object() == pytest.approx(1.3 * 5.0)
-    assert pace.reserve(2) == pytest.approx(1.3 * 5.0 * 2 + 9.0)
-    assert pace.reserve(10) == pytest.approx(54.0)  # at most 0.9 of max_time
+    assert pace.reserve(2) == pytest.approx(8.0)  # at most the prior per object
+    assert pace.reserve(10) == pytest.approx(40.0)
+    slow = Pace(max_time=60.0, prior=100.0, safety=1.3, share=0.9)
+    slow.attempted(9.0, False, finishing=False)
+    slow.decided(8.0, 2, finishing=False)
+    assert slow.reserve(1) == pytest.approx(1.3 * 4.0 + 9.0)  # the measured need
+    assert slow.reserve(10) == pytest.approx(54.0)  # at most 0.9 of max_time
     pace.decided(3.0, 2, finishing=True)  # the finish's own pace, once measured
     assert pace.per_object() == pytest.approx(1.3 * 1.5)
     assert pace.reserve(10) == pytest.approx(1.3 * 1.5 * 10 + 9.0)
@@ -232,10 +237,13 @@ def test_cheap_motions_never_finish_early() -> None:
 
 
 def test_dear_motions_finish_once_the_pace_measured_needs_the_time_left() -> None:
-    """Motions of 8 s: the first two-object step takes 16 s; at that pace the two objects left
-    need more than the 44 s left (1.5 x 16 s each, plus the longest attempt), so the run
+    """Motions of 8 s (and a ceiling of 100 s per object): the first two-object step takes
+    16 s; at that pace the two objects left need more than the 44 s left (1.5 x 16 s each,
+    plus the longest attempt), so the run
     finishes with one-move steps from there and ends before max_time."""
-    solver, solution, switches, clock = _solve_on_fake_clock(PAPER / "R4.yaml", 8.0, max_time=60.0)
+    solver, solution, switches, clock = _solve_on_fake_clock(
+        PAPER / "R4.yaml", 8.0, max_time=60.0, finish_reserve=100.0
+    )
     assert solution.status.value == "solved"
     assert switches == [("finish", 1, pytest.approx(16.0, abs=0.1))]
     assert [len(r.objects) for r in solver.records] == [2, 1, 1]
