@@ -124,6 +124,7 @@ def main(argv: list[str] | None = None) -> None:
             "motion_time": f.motion_time,
             "bound": None if outcome.bound is None else outcome.bound.seconds,
             "execution_over_bound": outcome.execution_over_bound,
+            "reason": None if outcome.success else failure_reason(outcome),
         }
         if outcome.plan is not None:
             m = outcome.plan.metrics
@@ -143,7 +144,7 @@ def main(argv: list[str] | None = None) -> None:
             f"{float(row.get('execution_time', 0.0)):>7.1f} {_num(row['bound'], 7, 1)} "
             f"{_num(row['execution_over_bound'], 5, 2)} {row['planning_time']:>7.2f} "
             f"{float(row.get('step_time_median', 0.0)):>8.3f} {row.get('levels', '')}"
-            + ("" if row["success"] else f"  {outcome.violation or outcome.diagnosis}"),
+            + ("" if row["success"] else f"  {row['reason']}"),
             flush=True,
         )
         for record in _steps(outcome):
@@ -187,6 +188,7 @@ def main(argv: list[str] | None = None) -> None:
         "planning_time_total": sum(r["planning_time"] for r in rows),
         "wall_time": time.perf_counter() - start,
         "failures": [r["instance"] for r in rows if not r["success"]],
+        "failure_reasons": {r["instance"]: r["reason"] for r in rows if not r["success"]},
         "quick": args.quick,
     }
     print(
@@ -199,6 +201,16 @@ def main(argv: list[str] | None = None) -> None:
         f"{_fmt(summary['execution_over_bound_median'])}"
     )
     print(json.dumps(summary))
+
+
+def failure_reason(outcome: SolveOutcome) -> str:
+    """Why an instance counts as a failure: the solver's status and diagnosis when it returned
+    no plan (e.g. ``timeout: max_time reached with 3 object(s) left``), else the replay's
+    violation."""
+    if outcome.plan is None:
+        why = "; ".join(outcome.diagnosis) or outcome.violation
+        return f"{outcome.status}: {why}"
+    return f"invalid: {outcome.violation}"
 
 
 def _wanted(path: Path, args: argparse.Namespace) -> bool:

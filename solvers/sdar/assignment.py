@@ -8,7 +8,9 @@ estimate (with the view's :class:`~solvers.sdar.tasks.Layout`, fewest crossing p
 first). So at most ``(moves + 1) ** moves`` combinations are ranked, never every ``k``-tuple of
 arms. With :attr:`ArmAssigner.by_plane` (the anytime finish of :mod:`~solvers.sdar.spending`)
 and a layout, a one-move step's arms come in the order of their plane reach
-(:meth:`~solvers.sdar.tasks.Layout.reach`), without asking IK first.
+(:meth:`~solvers.sdar.tasks.Layout.reach`), without asking IK first; a step of several moves
+gets one assignment, each move the nearest arm not taken by an earlier move
+(:func:`~solvers.sdar.spending.plane_seating`).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from typing import TYPE_CHECKING
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.move_option import Option
 from solvers.sdar.report import Failures
+from solvers.sdar.spending import plane_seating
 from solvers.sdar.tasks import Layout, Move, Step
 
 if TYPE_CHECKING:
@@ -59,10 +62,14 @@ class ArmAssigner:
         m = len(step.moves)
         if len(arms) <= 2:
             return list(itertools.permutations(arms, m))
-        if self.by_plane and m == 1 and layout is not None and step.objects[0] in layout.places:
-            obj = step.objects[0]
-            order = sorted(range(len(arms)), key=lambda k: (layout.reach(k, obj), k))
-            return [(arms[k],) for k in order]
+        if self.by_plane and layout is not None and all(o in layout.places for o in step.objects):
+            if m == 1:
+                obj = step.objects[0]
+                order = sorted(range(len(arms)), key=lambda k: (layout.reach(k, obj), k))
+                return [(arms[k],) for k in order]
+            nearest = plane_seating(layout, step.moves)
+            if len(nearest) == m:
+                return [tuple(arms[k] for k in nearest)]
         cost = self.reach_costs(step)
         per_move = [
             [a for _, a in sorted((cost[a, i], a) for a in arms if (a, i) in cost)][: m + 1]

@@ -4,6 +4,7 @@ can read them without importing the decision loop."""
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -52,13 +53,19 @@ class SdarOptions:
     fewer_moves_after: tuple[int, int] = (2, 6)  # with more than two arms: failed motions
     # in a decision after which it tries steps of at most two moves (of steps of three moves
     # or more), then of one move (in all); see solvers.sdar.spending
-    finish_reserve: float = 2.5  # [s] per remaining object: with a finite max_time, once less
-    # than this is left per remaining object the run finishes with steps of at most
-    # finish_moves moves (0: never); the reserve is at most finish_share of max_time
+    finish_reserve: float = 2.5  # [s] per remaining object before any decision is measured,
+    # and at most: with a finite max_time, once the time left is what the remaining objects
+    # need at the run's measured pace (solvers.sdar.budget.Pace) the run finishes with steps of
+    # at most finish_moves moves (0: never); the reserve is at most finish_share of max_time
+    finish_safety: float = 1.5  # the measured seconds per object are multiplied by this
     finish_moves: int = 1
+    finish_gap: float = 0.2  # [m] with more than two arms: the finish also proposes a step of
+    # one-object moves with arms whose plane segments stay this far apart (0: never); see
+    # solvers.sdar.spending.spread_steps
     finish_share: float = 0.9
     finish_min_time: float = 20.0  # [s] runs of a shorter max_time never finish early (a short
     # budget is a latency budget, e.g. a repair's: its caller falls back itself)
+    clock: Callable[[], float] = time.perf_counter  # [s] the budget's clock (tests: a fake one)
     home: object = None  # the cell configuration (a value of the problem) idle arms wait at;
     # None: the initial one (a plan re-planned from arms away from home gives the home)
     vocabulary: SdarVocabulary = field(default_factory=SdarVocabulary)
@@ -75,5 +82,9 @@ class SdarOptions:
             raise ParameterError(f"finish_share must be in [0, 1], got {self.finish_share}")
         if not self.finish_min_time >= 0:
             raise ParameterError(f"finish_min_time must be >= 0 [s], got {self.finish_min_time}")
+        if not self.finish_gap >= 0:
+            raise ParameterError(f"finish_gap must be >= 0 [m], got {self.finish_gap}")
+        if not self.finish_safety >= 1:
+            raise ParameterError(f"finish_safety must be >= 1, got {self.finish_safety}")
         if not self.finish_reserve >= 0:
             raise ParameterError(f"finish_reserve must be >= 0 [s], got {self.finish_reserve}")

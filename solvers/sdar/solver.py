@@ -56,9 +56,10 @@ from solvers.sdar.report import (
 )
 from solvers.sdar.spending import (
     DecisionSpend,
-    finish_reserve,
+    finish_pace,
     finishing_options,
     finishing_view,
+    spread_steps,
 )
 from solvers.sdar.tasks import Layout, Step, TaskPlanner, TaskView
 from solvers.solution import Solution, Status
@@ -105,7 +106,9 @@ class SdarSolver:
         self.goals = self._goal_poses(problem)
         arms = sorted(self.cache.of_type(self.voc.arm_type))
         self.home = {arm: self._home_conf(arm) for arm in arms}
-        self.deadline = Deadline(self.options.max_time)
+        self.deadline = Deadline(self.options.max_time, self.options.clock)
+        self.pace = finish_pace(self.options)
+        """The run's measured pace, which sets the finish's reserve (None: no finish)."""
         self.failures = Failures(self.cache.show)
         self.tabu = TabuLists()
         self.grounder = Grounder(
@@ -120,7 +123,9 @@ class SdarSolver:
         self.records: list[TaskRecord] = []
         self.spend: DecisionSpend = DecisionSpend(len(self.home), self.options.fewer_moves_after)
         self.finishing = False
-        """The anytime finish: one-move steps until the goal (:mod:`~solvers.sdar.spending`)."""
+        """The anytime finish: small steps, the first grounding found
+        (:mod:`~solvers.sdar.spending`)."""
+        self._normal_grounding = (self.grounder.options, self.grounder.first_found)
         self.visited: set[frozenset[tuple[str, str]]] = set()  # arrangements met so far
 
     # -- set-up ------------------------------------------------------------------------------
@@ -224,11 +229,10 @@ class SdarSolver:
             view = self.view()
             if not view.remaining:
                 break
-            if not self.finishing:
-                self.deadline.reserve(finish_reserve(self.options, len(view.remaining)))
-                if self.deadline.soft_passed():
-                    self._finish()
+            self._pace(len(view.remaining))
+            clock = self.options.clock()
             self.grounder.layout = view.layout
+            whole = view
             if self.finishing:
                 view = finishing_view(view, self.options.finish_moves)
             if self.deadline.expired():
@@ -239,12 +243,18 @@ class SdarSolver:
                 self.options.progress(len(view.done), len(self.goals))
             self.visited.add(self._arrangement())
             proposed = self.planner.candidates(view)
+            if self.finishing:
+                proposed = spread_steps(whole, proposed, self.options.finish_gap)
             self._check_sizes(proposed)
             candidates = self._new_arrangements(self.recovery.allowed(proposed))
             self.failures.clear()
             self.spend = DecisionSpend(len(self.home), self.options.fewer_moves_after)
             planned = len(self.executor.plan)
-            if self._decide(view, candidates, decision):
+            decided = self._decide(view, candidates, decision)
+            if self.pace is not None:
+                placed = sum(not b for b in self.records[-1].to_buffer) if decided else 0
+                self.pace.decided(self.options.clock() - clock, placed, self.finishing)
+            if decided:
                 added = self.executor.plan[planned:]
                 yield planned_step(self.cache, len(self.records) - 1, self.records[-1], added)
                 continue
@@ -278,12 +288,25 @@ class SdarSolver:
     def _family_spent(self, step: Step, arms: tuple[str, ...], mode: MotionMode) -> bool:
         return self.spend.blocked(step, arms, mode)
 
+    def _pace(self, remaining: int) -> None:
+        """Before a decision of ``remaining`` objects: go back to the normal search when the
+        finish's pace leaves room for a normal decision; else set the soft limit at the
+        reserve the objects need, and finish when it has passed."""
+        if self.pace is None:
+            return
+        if self.finishing and self.pace.room_for_normal(self.deadline.left(), remaining):
+            self._resume()
+        if not self.finishing:
+            self.deadline.reserve(self.pace.reserve(remaining))
+            if self.deadline.soft_passed():
+                self._finish()
+
     def _finish(self) -> None:
         """Start the anytime finish (see :mod:`~solvers.sdar.spending`): no soft limit any
         more, the first grounding found is taken."""
         self.finishing = True
         self.deadline.reserve(float("inf"))
-        self.grounder.options = finishing_options(self.grounder.options)
+        self.grounder.options = finishing_options(self._normal_grounding[0])
         self.grounder.first_found = True
         self.grounder.assigner.by_plane = True
         LOG.info(
@@ -291,6 +314,13 @@ class SdarSolver:
             self.options.finish_moves,
             self.deadline.left(),
         )
+
+    def _resume(self) -> None:
+        """Leave the finish: the normal search again (its soft limit is set by the caller)."""
+        self.finishing = False
+        self.grounder.options, self.grounder.first_found = self._normal_grounding
+        self.grounder.assigner.by_plane = False
+        LOG.info("back to the normal search, %.1f s left", self.deadline.left())
 
     def _check_sizes(self, candidates: Sequence[Step]) -> None:
         """Every candidate holds at most one move per arm.
@@ -386,7 +416,10 @@ class SdarSolver:
             record = TaskRecord(
                 g.step.kind, g.step.objects, g.arms, tuple(m.to_buffer for m in g.step.moves)
             )
+            attempt = self.options.clock()
             ok = self.executor.execute(g, record, mode)
+            if self.pace is not None:
+                self.pace.attempted(self.options.clock() - attempt, ok, self.finishing)
             record.tried = tried
             record.motion_time = self.executor.motion_time - decision.motion_time
             record.selection_time = time.perf_counter() - decision.start - record.motion_time

@@ -14,32 +14,37 @@ lists of :mod:`~solvers.sdar.attempts` (which never retry one grounding):
   all, steps of one move. So a decision tries at most ``fewer_moves_after[1]`` groundings of
   several moves before it falls back to one arm at a time, instead of the 15 to 41 it could
   try before. With one or two arms neither rule applies (their plans are unchanged).
-* **Near the end of the budget, in every cell** (:func:`finish_reserve`): a run whose
+* **Near the end of the budget, in every cell** (:func:`finish_pace`): a run whose
   ``max_time`` is finite and at least ``finish_min_time`` sets the soft limit of its
-  :class:`~solvers.sdar.budget.Deadline` to ``finish_reserve`` [s] per remaining object before
-  ``max_time`` (at most ``finish_share`` of ``max_time``). Once it passes, the run *finishes*:
+  :class:`~solvers.sdar.budget.Deadline` before ``max_time`` by the reserve its remaining
+  objects need at the pace measured in the run (:class:`~solvers.sdar.budget.Pace`: seconds
+  per object times ``finish_safety``, ``finish_reserve`` per object before anything is
+  measured; at most ``finish_share`` of ``max_time``). Once it passes, the run *finishes*:
   the task planner sees a view of at most ``finish_moves`` arms (one by default: SDAR-T's
   one-arm rules, ``n + |minimum FVS|`` moves for what is left; two: its two-arm rules, measured
   slower to finish with four arms), the first grounding found is executed and no decision
   compares groundings. One-move steps ground and plan quickly (one arm moving, the others
   going to or waiting at home; with three arms or more the optimiser sees only the moving
   arms), so the run returns a valid, perhaps longer, plan where it would have run out of time;
-  it still ends at ``max_time`` if that is not enough.
+  it still ends at ``max_time`` if that is not enough. When the finish's own pace leaves
+  room for a normal decision before the reserve again, the run goes back to the normal search
+  (so a pessimistic first estimate costs a few finishing steps, not the plan's rest).
 
 Candidates are so bounded: per decision, at most ``fewer_moves_after[1]`` groundings of steps of
 several moves fail their motions (each family once) before the decision tries one-move steps
-alone; per run, everything after the soft limit is steps of at most ``finish_moves`` moves.
+alone; per run, every step taken while finishing holds at most ``finish_moves`` moves.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections import Counter
-from collections.abc import Hashable, Sequence
+from collections.abc import Hashable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
 from solvers.sdar.attempts import MotionMode
-from solvers.sdar.tasks import Step, TaskView
+from solvers.sdar.budget import Pace
+from solvers.sdar.tasks import Layout, Move, Step, TaskView
 
 if TYPE_CHECKING:
     from solvers.sdar.options import SdarOptions
@@ -92,23 +97,117 @@ class DecisionSpend:
         self.failed_by_size[len(step.moves)] += 1
 
 
-def finish_reserve(options: SdarOptions, remaining: int) -> float:
-    """The reserve [s] the anytime finish keeps for ``remaining`` objects (``inf``: no
-    finish, when ``max_time`` is infinite or under ``finish_min_time``, or the reserve per
-    object is 0)."""
+def finish_pace(options: SdarOptions) -> Pace | None:
+    """The pace that sets the anytime finish's reserve (:class:`~solvers.sdar.budget.Pace`);
+    None: no finish, when ``max_time`` is infinite or under ``finish_min_time``, or
+    ``finish_reserve`` is 0."""
     if (
         options.finish_reserve <= 0
         or options.max_time == float("inf")
         or options.max_time < options.finish_min_time
     ):
-        return float("inf")
-    return min(options.finish_reserve * remaining, options.finish_share * options.max_time)
+        return None
+    return Pace(
+        options.max_time, options.finish_reserve, options.finish_safety, options.finish_share
+    )
 
 
 def finishing_view(view: TaskView, moves: int) -> TaskView:
     """The view the task planner sees while the run finishes: at most ``moves`` arms (a
     step of at most ``moves`` moves), no layout."""
     return dataclasses.replace(view, arms=min(view.arms, moves), layout=None)
+
+
+def plane_seating(layout: Layout, moves: Sequence[Move]) -> tuple[int, ...]:
+    """Arms (indices into ``layout.bases``) for ``moves`` in order: each the arm of least plane
+    reach (:meth:`~solvers.sdar.tasks.Layout.reach`, a buffer move's at its object's pose
+    alone: :func:`moves_layout`) not taken by an earlier one (the first of equals); shorter
+    than ``moves`` when the arms run out."""
+    plane = moves_layout(layout, moves)
+    free = list(range(len(layout.bases)))
+    seats: list[int] = []
+    for move in moves:
+        if not free:
+            break
+        arm = min(free, key=lambda k: (plane.reach(k, move.obj), k))
+        seats.append(arm)
+        free.remove(arm)
+    return tuple(seats)
+
+
+def moves_layout(layout: Layout, moves: Sequence[Move]) -> Layout:
+    """``layout`` with each object moved to a buffer in ``moves`` at its pose at both ends (its
+    buffer is not chosen yet; the arm reaches for the object first)."""
+    buffered = {m.obj for m in moves if m.to_buffer}
+    if not buffered:
+        return layout
+    places = {
+        o: (here, here) if o in buffered else (here, goal)
+        for o, (here, goal) in layout.places.items()
+    }
+    return dataclasses.replace(layout, places=places)
+
+
+def spread_steps(view: TaskView, singles: Sequence[Step], gap: float) -> list[Step]:
+    """The finish's candidates with more than two arms: ``singles`` (the one-arm candidates,
+    in their order) preceded by one step that makes several of their moves at once, each
+    with the nearest arm still free (:func:`plane_seating`), when there is such a step.
+
+    Greedily from the first single's move, then the other singles' moves, then the goal
+    moves of the other objects left: a move joins while the step holds fewer moves than
+    ``view.arms`` and its arm's plane segments stay ``gap`` [m] from every other arm of the
+    step over the whole transfer (:meth:`~solvers.sdar.tasks.Layout.sweep_gap`: at the picks,
+    the places and between; a buffer move at its object's pose); a goal move when its goal is
+    free once the step's objects are lifted, it does not have to wait for an object still to
+    be placed (:meth:`~solvers.sdar.tasks.TaskView.must_wait`) and no object of the step waits
+    for it or it for one; a buffer move when its object lies on a dependency cycle that no
+    other buffer move of the step breaks (one buffer per cycle, as the one-arm rules spend).
+    Arms so far apart rarely meet, so the step's motion is found about as quickly as one
+    arm's, and up to ``view.arms`` one-move steps execute in the time of one. Without a
+    layout, with two arms or fewer, with ``gap`` 0 or with nothing to join: ``singles``
+    alone."""
+    layout = view.layout
+    if layout is None or view.arms <= 2 or gap <= 0 or not singles:
+        return list(singles)
+    if len(singles[0].moves) != 1:
+        return list(singles)
+    names = view.graph.names
+    cycle = {
+        names[i]: k for k, part in enumerate(view.graph.components()) if len(part) > 1 for i in part
+    }
+    pool = [s.moves[0] for s in singles if len(s.moves) == 1]
+    pool += [Move(o) for o in names if all(m.obj != o for m in pool)]
+    group: list[Move] = []
+    for move in pool:
+        obj = move.obj
+        if len(group) == view.arms:
+            break
+        if obj not in layout.places or any(m.obj == obj for m in group):
+            continue
+        if group and not _joins(view, group, move, cycle):
+            continue
+        trial = [*group, move]
+        seats = plane_seating(layout, trial)
+        plane = moves_layout(layout, trial)
+        if len(seats) == len(trial) and all(
+            plane.sweep_gap(seats[-1], obj, arm, m.obj) >= gap
+            for arm, m in zip(seats, group, strict=False)
+        ):
+            group.append(move)
+    if len(group) < 2:
+        return list(singles)
+    return [Step(tuple(group), "spread", singles[0].rank), *singles]
+
+
+def _joins(view: TaskView, group: Sequence[Move], move: Move, cycle: Mapping[str, int]) -> bool:
+    """``move`` may join the moves of ``group`` (see :func:`spread_steps`), arms apart."""
+    obj = move.obj
+    if any((obj, m.obj) in view.waits or (m.obj, obj) in view.waits for m in group):
+        return False
+    if move.to_buffer:
+        return obj in cycle and all(cycle.get(m.obj) != cycle[obj] for m in group if m.to_buffer)
+    lifted = frozenset([obj, *(m.obj for m in group)])
+    return view.goal_free_after(obj, lifted) and not view.must_wait(obj)
 
 
 def finishing_options(options: SdarOptions) -> SdarOptions:

@@ -7,17 +7,20 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import cast
+from typing import Any, cast
 
 import pytest
 
+from sdar_tamp.app.plan_export import plan_file_from_solution
 from sdar_tamp.app.problem import rearrangement_problem, table_plane
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
+from sdar_tamp.replay import validate_plan
+from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import load_instance
 from solvers.sdar.assignment import ArmAssigner
 from solvers.sdar.attempts import MotionMode
-from solvers.sdar.budget import Deadline
+from solvers.sdar.budget import Deadline, Pace
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.k_steps import TaskScene, meets, rotations
 from solvers.sdar.move_option import Option
@@ -27,14 +30,18 @@ from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
 from solvers.sdar.spending import (
     DecisionSpend,
-    finish_reserve,
+    finish_pace,
     finishing_options,
     finishing_view,
+    plane_seating,
+    spread_steps,
 )
 from solvers.sdar.tasks import Layout, Move, Step, TaskView
+from solvers.solution import Solution
 from streams.context import WorldContext
 
 DATA = Path(__file__).parent / "data"
+PAPER = domain_file("dual_arm_rearrangement", "domain.pddl").parent / "suites" / "paper"
 #: The bases of the four-arm test table (south, north, west, east).
 BASES = ((0.0, -0.5), (0.0, 0.5), (-0.6, 0.0), (0.6, 0.0))
 
@@ -85,32 +92,67 @@ def test_with_two_arms_nothing_is_blocked_or_cut() -> None:
 # -- the budget and the finish -------------------------------------------------------------------
 
 
+class FakeClock:
+    """A clock [s] that moves only when told (and by 1 ms per reading, so that time passes
+    between two readings)."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        self.now += 1e-3
+        return self.now
+
+
 def test_the_soft_limit_comes_before_max_time_and_can_be_lifted() -> None:
-    deadline = Deadline(1000.0)
+    clock = FakeClock()
+    deadline = Deadline(1000.0, clock)
     assert not deadline.passed() and deadline.left() == math.inf  # not started
     deadline.start()
-    assert 990.0 < deadline.left() <= 1000.0
-    deadline.reserve(999.9999)  # the soft limit 0.1 ms after the start
-    time.sleep(0.01)
+    assert deadline.left() == pytest.approx(1000.0, abs=0.01)
+    deadline.reserve(400.0)  # the soft limit at 600 s
+    clock.now += 599.0
+    assert not deadline.passed()
+    clock.now += 1.0
     assert deadline.soft_passed() and deadline.passed() and not deadline.expired()
     deadline.reserve(math.inf)  # lifted: only max_time counts
     assert not deadline.soft_passed() and not deadline.passed()
     deadline.reserve(-1.0)  # a negative reserve is none
     assert not deadline.passed()
-    over = Deadline(0.0)
-    over.start()
-    time.sleep(0.001)
-    assert over.expired() and over.passed() and not over.soft_passed()
+    clock.now += 400.0
+    assert deadline.expired() and deadline.passed() and not deadline.soft_passed()
+    assert Deadline(1.0).clock is time.perf_counter  # the real clock by default
 
 
-def test_the_reserve_grows_with_the_objects_left_up_to_a_share_of_the_budget() -> None:
-    options = SdarOptions(max_time=60.0, finish_reserve=2.0, finish_share=0.5)
-    assert finish_reserve(options, 3) == pytest.approx(6.0)
-    assert finish_reserve(options, 24) == pytest.approx(30.0)  # capped at half of 60 s
-    assert finish_reserve(SdarOptions(max_time=60.0, finish_reserve=0.0), 3) == math.inf
-    assert finish_reserve(SdarOptions(finish_reserve=2.0), 3) == math.inf  # no max_time
-    short = SdarOptions(max_time=10.0, finish_min_time=20.0)  # a latency budget
-    assert finish_reserve(short, 3) == math.inf
+def test_the_reserve_follows_the_pace_measured_in_the_run() -> None:
+    pace = Pace(max_time=60.0, prior=4.0, safety=1.3, share=0.9)
+    assert pace.reserve(10) == pytest.approx(40.0)  # nothing measured: the prior per object
+    pace.decided(6.0, 0, finishing=False)  # a decision that only buffered: still the prior
+    assert pace.reserve(10) == pytest.approx(40.0)
+    pace.attempted(5.0, True, finishing=False)
+    pace.attempted(9.0, False, finishing=False)  # the longest attempt: kept on top
+    pace.decided(8.0, 4, finishing=False)  # 14 s for 4 objects, the executed attempt 5 s
+    assert pace.per_object() == pytest.approx(1.3 * 5.0)
+    assert pace.reserve(2) == pytest.approx(8.0)  # at most the prior per object
+    assert pace.reserve(10) == pytest.approx(40.0)
+    slow = Pace(max_time=60.0, prior=100.0, safety=1.3, share=0.9)
+    slow.attempted(9.0, False, finishing=False)
+    slow.decided(8.0, 2, finishing=False)
+    assert slow.reserve(1) == pytest.approx(1.3 * 4.0 + 9.0)  # the measured need
+    assert slow.reserve(10) == pytest.approx(54.0)  # at most 0.9 of max_time
+    pace.decided(3.0, 2, finishing=True)  # the finish's own pace, once measured
+    assert pace.per_object() == pytest.approx(1.3 * 1.5)
+    assert pace.reserve(10) == pytest.approx(1.3 * 1.5 * 10 + 9.0)
+    # a normal decision took 7 s on average: it fits only with 7 s to spare above the reserve
+    assert pace.room_for_normal(50.0, 10) and not pace.room_for_normal(25.0, 10)
+
+
+def test_the_pace_exists_for_finite_budgets_long_enough() -> None:
+    pace = finish_pace(SdarOptions(max_time=60.0, finish_reserve=2.0, finish_share=0.5))
+    assert pace is not None and pace.reserve(24) == pytest.approx(30.0)  # capped at 30 s
+    assert finish_pace(SdarOptions(max_time=60.0, finish_reserve=0.0)) is None
+    assert finish_pace(SdarOptions(finish_reserve=2.0)) is None  # no max_time
+    assert finish_pace(SdarOptions(max_time=10.0, finish_min_time=20.0)) is None  # latency
 
 
 def test_the_finishing_view_and_options() -> None:
@@ -132,6 +174,8 @@ def test_the_finishing_view_and_options() -> None:
         ("fewer_moves_after", (1,), "fewer_moves_after"),
         ("finish_reserve", -1.0, "finish_reserve"),
         ("finish_reserve", math.nan, "finish_reserve"),
+        ("finish_safety", 0.5, "finish_safety"),
+        ("finish_gap", -0.1, "finish_gap"),
         ("finish_moves", 0, "finish_moves"),
         ("finish_share", 1.5, "finish_share"),
         ("finish_min_time", -1.0, "finish_min_time"),
@@ -142,24 +186,212 @@ def test_bad_spending_options_are_refused(field: str, value: object, message: st
         SdarOptions(**{field: value})  # type: ignore[arg-type]
 
 
-def test_a_run_past_its_soft_limit_finishes_with_one_move_steps() -> None:
-    """A reserve larger than the budget: the run finishes from its first decision; every step
-    holds one move, and the goal is reached (the anytime finish, not a timeout)."""
-    path = DATA / "four_arm_cycle.yaml"
+def _solve_on_fake_clock(
+    path: Path, motion_cost: float, **options: object
+) -> tuple[SdarSolver, Solution, list[tuple[str, int, float]], FakeClock]:
+    """Solve ``path`` on a fake clock on which every motion planned costs ``motion_cost``
+    [s]; also the switches into and out of the finish: (which, tasks executed before, time)."""
     instance = load_instance(path)
     ctx = WorldContext.load(instance.scene_path(path))
     r = rearrangement_problem(instance, ctx)
-    options = SdarOptions(
-        max_time=600.0, finish_reserve=1000.0, finish_share=1.0, finish_moves=1,
-        plane=table_plane(ctx),
+    clock = FakeClock()
+    solver = SdarSolver(
+        r.problem,
+        SdarTaskPlanner(),
+        SdarOptions(clock=clock, plane=table_plane(ctx), **options),  # type: ignore[arg-type]
+    )
+    motion = solver.executor._motion
+    switches: list[tuple[str, int, float]] = []
+    finish, resume = solver._finish, solver._resume
+
+    def dear(*args: Any) -> str | None:
+        clock.now += motion_cost
+        return motion(*args)
+
+    def on_finish() -> None:
+        switches.append(("finish", len(solver.records), clock.now))
+        finish()
+
+    def on_resume() -> None:
+        switches.append(("resume", len(solver.records), clock.now))
+        resume()
+
+    solver.executor._motion = dear  # type: ignore[method-assign]
+    solver._finish = on_finish  # type: ignore[method-assign]
+    solver._resume = on_resume  # type: ignore[method-assign]
+    return solver, solver.solve(), switches, clock
+
+
+def test_cheap_motions_never_finish_early() -> None:
+    """Motions of 0.5 s: four objects take a few seconds of a 20 s budget, so the run never
+    finishes early and plans as a run without the finish (a fixed 2.5 s per object would have
+    reserved half the budget)."""
+    path = PAPER / "R4.yaml"
+    solver, solution, switches, _ = _solve_on_fake_clock(path, 0.5, max_time=20.0)
+    assert solution.status.value == "solved" and switches == []
+    plain, _, _, _ = _solve_on_fake_clock(path, 0.5, max_time=20.0, finish_reserve=0.0)
+    assert [(r.objects, r.arms) for r in solver.records] == [
+        (r.objects, r.arms) for r in plain.records
+    ]
+    assert [len(r.objects) for r in solver.records] == [2, 2]
+
+
+def test_dear_motions_finish_once_the_pace_measured_needs_the_time_left() -> None:
+    """Motions of 8 s (and a ceiling of 100 s per object): the first two-object step takes
+    16 s; at that pace the two objects left need more than the 44 s left (1.5 x 16 s each,
+    plus the longest attempt), so the run
+    finishes with one-move steps from there and ends before max_time."""
+    solver, solution, switches, clock = _solve_on_fake_clock(
+        PAPER / "R4.yaml", 8.0, max_time=60.0, finish_reserve=100.0
+    )
+    assert solution.status.value == "solved"
+    assert switches == [("finish", 1, pytest.approx(16.0, abs=0.1))]
+    assert [len(r.objects) for r in solver.records] == [2, 1, 1]
+    assert clock.now < 60.0
+
+
+def test_a_run_past_its_soft_limit_finishes_with_one_move_steps() -> None:
+    """Without spread steps (``finish_gap=0``), a prior reserve larger than the budget: the
+    run finishes from its first decision; at 50 s a motion its own pace keeps it finishing
+    until the last object, and the goal is reached (the anytime finish, not a timeout)."""
+    solver, solution, switches, _ = _solve_on_fake_clock(
+        DATA / "four_arm_cycle.yaml", 50.0, max_time=600.0, finish_reserve=1000.0,
+        finish_share=1.0, finish_moves=1, finish_gap=0.0,
     )  # fmt: skip
-    solver = SdarSolver(r.problem, SdarTaskPlanner(), options)
-    solution = solver.solve()
     assert solution.status.value == "solved", solution.diagnosis
-    assert solver.finishing
+    assert switches[0] == ("finish", 0, pytest.approx(0.0, abs=0.1))
     assert all(len(record.objects) == 1 for record in solver.records)
     # the 4-cycle without a rotation: one object through a buffer
     assert sum(sum(record.to_buffer) for record in solver.records) == 1
+
+
+def test_a_finish_moves_four_objects_apart_in_one_step_and_the_replay_accepts_it() -> None:
+    """Finishing from the first decision, four objects each in front of its own arm go in one
+    spread step (two motions) instead of four one-move steps (eight)."""
+    path = DATA / "four_arm_apart.yaml"
+    options = {"max_time": 600.0, "finish_reserve": 1000.0, "finish_share": 1.0}
+    solver, solution, switches, clock = _solve_on_fake_clock(path, 50.0, **options)
+    assert solution.status.value == "solved", solution.diagnosis
+    assert switches == [("finish", 0, pytest.approx(0.0, abs=0.1))]
+    (record,) = solver.records
+    value = solver.cache.table.value
+    assert record.kind == "spread" and sorted(map(value, record.objects)) == [
+        "o0",
+        "o1",
+        "o2",
+        "o3",
+    ]
+    assert sorted(map(value, record.arms)) == ["east", "north", "south", "west"]
+    assert clock.now == pytest.approx(100.0, abs=0.5)  # two motions
+    instance = load_instance(path)
+    r = rearrangement_problem(instance, WorldContext.load(instance.scene_path(path)))
+    replayed = SdarSolver(
+        r.problem, SdarTaskPlanner(), SdarOptions(plane=table_plane(r.ctx), **options)
+    )  # the real clock: the same plan
+    plan = plan_file_from_solution(r, replayed.solve())
+    assert [t.kind for t in replayed.records] == ["spread"]
+    report = validate_plan(instance, plan, r.ctx.scene)
+    assert report.ok, report.violation
+    _, one_by_one, _, slow = _solve_on_fake_clock(path, 50.0, finish_gap=0.0, **options)
+    assert one_by_one.status.value == "solved" and slow.now > clock.now
+
+
+def test_a_finish_whose_own_pace_leaves_room_goes_back_to_the_normal_search() -> None:
+    """The same prior, motions of 20 s: after two finishing steps (a buffer, then one object
+    in 80 s) the three objects left need 3 x 1.5 x 80 s = 360 s of the 520 s left, so the run
+    goes back to the normal search, which rotates the 3-cycle left in one step."""
+    solver, solution, switches, _ = _solve_on_fake_clock(
+        DATA / "four_arm_cycle.yaml", 20.0, max_time=600.0, finish_reserve=1000.0,
+        finish_share=1.0, finish_moves=1, finish_gap=0.0,
+    )  # fmt: skip
+    assert solution.status.value == "solved", solution.diagnosis
+    assert [s[:2] for s in switches] == [("finish", 0), ("resume", 2)]
+    assert [len(r.objects) for r in solver.records] == [1, 1, 3]
+
+
+# -- the finish's spread steps -------------------------------------------------------------------
+
+#: Four objects each in front of its own arm of the four-arm table (south, north, west, east).
+APART = {
+    "a": ((0.0, -0.3), (0.1, -0.3)),
+    "b": ((0.0, 0.3), (0.1, 0.3)),
+    "c": ((-0.4, 0.0), (-0.4, 0.1)),
+    "d": ((0.4, 0.0), (0.4, 0.1)),
+}
+
+
+def _singles(*objs: str) -> list[Step]:
+    return [Step((Move(o),), "single", 1) for o in objs]
+
+
+def test_plane_seating_gives_each_object_the_nearest_free_arm() -> None:
+    layout = Layout(APART, BASES)
+    assert plane_seating(layout, [Move(o) for o in "abcd"]) == (0, 1, 2, 3)
+    near_a = dict(APART, e=((0.05, -0.25), (0.1, -0.2)))
+    # e's nearest arm (south) is a's: the next nearest free one
+    assert plane_seating(Layout(near_a, BASES), [Move("a"), Move("e")])[1] != 0
+    assert plane_seating(Layout(APART, BASES[:2]), [Move(o) for o in "abc"]) == (0, 1)
+    # a buffer move is seated by its object's pose alone: f's goal is at the north arm
+    far_goal = dict(APART, f=((0.0, -0.3), (0.0, 0.45)))
+    assert plane_seating(Layout(far_goal, BASES), [Move("f")]) == (1,)
+    assert plane_seating(Layout(far_goal, BASES), [Move("f", True)]) == (0,)
+
+
+def test_the_finish_moves_objects_far_apart_with_their_nearest_arms_at_once() -> None:
+    view = _layout_view(APART)
+    singles = _singles("a", "b", "c", "d")
+    steps = spread_steps(view, singles, 0.2)
+    assert steps[0].objects == ("a", "b", "c", "d") and steps[0].kind == "spread"
+    assert steps[0].rank == 1 and steps[1:] == singles
+    assigner = ArmAssigner(
+        cast(StreamCache, None), SdarOptions(), dict.fromkeys("snwe", "q"), cast(Failures, None),
+        lambda *args: [],
+    )  # fmt: skip
+    assigner.by_plane = True  # arms sorted e, n, s, w: bases in that order
+    sorted_bases = (BASES[3], BASES[1], BASES[0], BASES[2])
+    layout = Layout(APART, sorted_bases)
+    assert assigner.assignments(steps[0], layout) == [("s", "n", "w", "e")]
+
+
+def test_the_finish_joins_no_object_near_another_arm_blocked_or_waiting() -> None:
+    near_a = dict(APART, e=((0.05, -0.25), (0.1, -0.2)))
+    assert spread_steps(_layout_view(near_a), _singles("a", "e", "b"), 0.2)[0].objects == (
+        "a", "b", "c", "d",
+    )  # fmt: skip
+    names = tuple(sorted(APART))  # a's goal overlaps d's pose: a waits for d to leave
+    blocked = _layout_view(APART, ((names.index("a"), names.index("d")),))
+    # a is skipped; d joins after it (the other objects left come after the singles)
+    assert spread_steps(blocked, _singles("b", "a", "c"), 0.2)[0].objects == ("b", "c", "d")
+    graph = DependencyGraph(names, ())
+    waiting = TaskView(graph, frozenset(), frozenset(), frozenset({("c", "a")}), 4,
+                       Layout(APART, BASES))  # fmt: skip
+    assert spread_steps(waiting, _singles("a", "c", "d"), 0.2)[0].objects == ("a", "d", "b")
+    buffered = [Step((Move("a", True),), "buffer", 1), *_singles("b")]
+    spread = spread_steps(_layout_view(APART), buffered, 0.2)[0]
+    assert spread.moves == (Move("a", True), Move("b"), Move("c"), Move("d"))
+
+
+def test_the_finish_breaks_two_cycles_at_once_never_one_twice() -> None:
+    names = tuple(sorted(APART))  # cycles a <-> b and c <-> d
+    i = names.index
+    edges = ((i("a"), i("b")), (i("b"), i("a")), (i("c"), i("d")), (i("d"), i("c")))
+    view = _layout_view(APART, edges)
+    breaks = [Step((Move(o, True),), "cycle", 2) for o in "abcd"]
+    spread = spread_steps(view, breaks, 0.2)[0]
+    assert spread.moves == (Move("a", True), Move("c", True))
+    # with a lifted, b's goal is free: b joins a's buffer move if their arms stay apart
+    chain = spread_steps(view, [breaks[0]], 0.2)[0]
+    assert chain.moves[0] == Move("a", True) and Move("b", True) not in chain.moves
+
+
+def test_without_layout_two_arms_or_gap_the_finish_keeps_its_single_steps() -> None:
+    singles = _singles("a", "b")
+    assert spread_steps(_layout_view(APART), singles, 0.0) == singles
+    graph = DependencyGraph(tuple(sorted(APART)), ())
+    two = TaskView(graph, frozenset(), frozenset(), arms=2, layout=Layout(APART, BASES[:2]))
+    assert spread_steps(two, singles, 0.2) == singles
+    bare = TaskView(graph, frozenset(), frozenset(), arms=4)
+    assert spread_steps(bare, singles, 0.2) == singles
 
 
 # -- SDAR-T: steps whose arms obviously meet -----------------------------------------------------
