@@ -43,11 +43,16 @@ from pathlib import Path
 
 from sdar_tamp.app.cache import PlannerCache
 from sdar_tamp.app.config import PlannerConfig
-from sdar_tamp.app.replanning import ReplanOutcome, fresh_continuation, replan, shorter
+from sdar_tamp.app.replanning import (
+    ReplanOutcome,
+    fresh_continuation,
+    replan,
+    shorter,
+    timed_and_checked,
+)
 from sdar_tamp.app.splicing import check_from, head_at
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_state import Cut, PlanState, cut_point, state_at
-from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.observed import ObservedState
@@ -184,14 +189,7 @@ def _outcome(
     observed_at: float, validate: bool,
 ) -> ReplanOutcome:  # fmt: skip
     latency = time.perf_counter() - observed_at
-    plan = dataclasses.replace(plan, metrics=plan.metrics.updated({"planning_time": latency}))
-    valid, violation = None, ""
-    if validate:
-        report = validate_plan(instance, plan, scene)
-        valid = report.ok
-        if report.violation is not None:
-            v = report.violation
-            violation = f"t={v.t:.3f} s: {v.kind}: {v.message}"
+    plan, valid, violation = timed_and_checked(plan, latency, instance, scene, validate)
     assert repaired.plan is not None
     known = {o.name for o in instance.objects}
     moved = tuple(dict.fromkeys(

@@ -353,13 +353,19 @@ def _finish(
     changed: bool = False, resume: float = 0.0,
 ) -> ReplanOutcome:  # fmt: skip
     latency = time.perf_counter() - started
-    plan = dataclasses.replace(plan, metrics=plan.metrics.updated({"planning_time": latency}))
-    valid, violation = None, ""
-    if validate:
-        report = validate_plan(instance, plan, scene)
-        valid = report.ok
-        if report.violation is not None:
-            v = report.violation
-            violation = f"t={v.t:.3f} s: {v.kind}: {v.message}"
+    plan, valid, violation = timed_and_checked(plan, latency, instance, scene, validate)
     return ReplanOutcome(status, plan, cut.t, latency, (), (), moved, valid, violation, alternative,
                          changed, resume)  # fmt: skip
+
+
+def timed_and_checked(
+    plan: PlanFile, latency: float, instance: Instance, scene: Scene, validate: bool
+) -> tuple[PlanFile, bool | None, str]:
+    """``plan`` with ``latency`` [s] as its planning time, whether the independent replay
+    accepts it (``None`` without ``validate``) and its first violation as text ("" if none)."""
+    plan = dataclasses.replace(plan, metrics=plan.metrics.updated({"planning_time": latency}))
+    if not validate:
+        return plan, None, ""
+    report = validate_plan(instance, plan, scene)
+    v = report.violation
+    return plan, report.ok, "" if v is None else f"t={v.t:.3f} s: {v.kind}: {v.message}"
