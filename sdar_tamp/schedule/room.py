@@ -56,13 +56,8 @@ class Room(Placement):
             return False
         q_path = stand.back if stand.back is not None else np.linspace(stand.q, stand.pre, 9)
         q = self.retimers[arm].retime(rest_to_rest(q_path), q_path, True, False)
-        mark = self.mark()
-        try:
-            self.place([Entry(arm, block_of(arm, q), q, 0)])
-        except NoPlacement:
-            self.undo(mark)
+        if not self._commit(arm, q):
             return False
-        self.stand[arm] = Stand(np.array(q[-1]))
         self.retreats += 1
         return True
 
@@ -86,6 +81,15 @@ class Room(Placement):
         if motion is None:
             return False
         q = self.retimers[arm].retime(*motion, self.stand[arm].pre is not None, False)
+        if not self._commit(arm, q):
+            return False
+        self.parked[arm] = True
+        self.parks += 1
+        return True
+
+    def _commit(self, arm: int, q: FloatArray) -> bool:
+        """Commit ``arm``'s timed motion ``q`` where its timeline ends, the arm then standing at
+        its last configuration; False (nothing committed) when it cannot be placed."""
         mark = self.mark()
         try:
             self.place([Entry(arm, block_of(arm, q), q, 0)])
@@ -93,8 +97,6 @@ class Room(Placement):
             self.undo(mark)
             return False
         self.stand[arm] = Stand(np.array(q[-1]))
-        self.parked[arm] = True
-        self.parks += 1
         return True
 
     def wait(self, arm: int) -> None:
