@@ -10,6 +10,12 @@ and what the domain reads that nothing can make true.
     defines, no stream, rule or external predicate certifies and no initial fact holds: every
     use of it is false (often a typo in the domain or the stream file). Located at the first
     action or derived predicate that reads it.
+``untyped-output``
+    an action parameter of a declared type (``?p - room``) sits, in a precondition atom, where
+    a stream certifies one of its outputs. A stream's outputs are new objects of type
+    ``object`` unless the stream also certifies a type fact for them (``(room ?p)``), so the
+    action can never use them there: often PDDL's typed-list rule bit (``?p ?r - room`` gives
+    both variables the type ``room``). Located at the action.
 
 Both are :class:`~sdar_tamp.language.leniency.Leniency` items: ``PDDLProblem.leniencies``
 records them for a problem with streams (logged: ``unachievable-predicate`` as a warning,
@@ -23,8 +29,21 @@ from collections.abc import Iterable, Iterator
 
 from sdar_tamp.errors import SourceLocation
 from sdar_tamp.language.domain_model import Domain
-from sdar_tamp.language.formula_model import AndEffect, Atom, Effect, ForAllEffect, Formula, When
-from sdar_tamp.language.leniency import UNACHIEVABLE_PREDICATE, UNUSED_CERTIFIED, Leniency
+from sdar_tamp.language.formula_model import (
+    OBJECT_TYPE,
+    AndEffect,
+    Atom,
+    Effect,
+    ForAllEffect,
+    Formula,
+    When,
+)
+from sdar_tamp.language.leniency import (
+    UNACHIEVABLE_PREDICATE,
+    UNTYPED_OUTPUT,
+    UNUSED_CERTIFIED,
+    Leniency,
+)
 from sdar_tamp.language.stream_model import (
     Rule,
     Stream,
@@ -62,6 +81,46 @@ def _reads(domain: Domain) -> Iterator[tuple[str, SourceLocation | None]]:
             yield atom.predicate, axiom.location
 
 
+def _output_slots(domain: Domain, streams: StreamFile) -> dict[tuple[str, int], tuple[str, str]]:
+    """(predicate, argument position) -> (stream, output) for every certified atom position
+    filled by an output the stream gives no type (no certified unary type fact)."""
+    types = domain.types
+    slots = dict[tuple[str, int], tuple[str, str]]()
+    for stream in streams.streams:
+        typed = {
+            a.args[0] for a in stream.certified if len(a.args) == 1 and a.predicate in types.parents
+        }
+        for atom in stream.certified:
+            for position, arg in enumerate(atom.args):
+                if arg in stream.outputs and arg not in typed:
+                    slots.setdefault((atom.predicate, position), (stream.name, arg))
+    return slots
+
+
+def _untyped_outputs(domain: Domain, streams: StreamFile) -> Iterator[Leniency]:
+    """The ``untyped-output`` warnings (see the module's docstring)."""
+    slots = _output_slots(domain, streams)
+    for action in domain.actions:
+        typed = {p.name: p.type for p in action.parameters if p.type != OBJECT_TYPE}
+        seen = set[str]()
+        for atom in iter_atoms(action.precondition):
+            for position, arg in enumerate(atom.args):
+                slot = slots.get((atom.predicate, position))
+                if arg not in typed or arg in seen or slot is None:
+                    continue
+                seen.add(arg)
+                stream, output = slot
+                yield Leniency(
+                    UNTYPED_OUTPUT,
+                    f"action {action.name!r}: parameter {arg} has type {typed[arg]!r}, but "
+                    f"argument {position + 1} of {atom.predicate!r} is stream {stream!r}'s "
+                    f"output {output}, an object of type 'object'; in a typed list "
+                    f"'?a ?b - {typed[arg]}' both variables get the type (write '?a - object "
+                    f"?b - {typed[arg]}'), or certify ({typed[arg]} {output}) in the stream",
+                    action.location,
+                )
+
+
 def has_streams(streams: StreamFile) -> bool:
     return bool(streams.streams or streams.functions or streams.predicates or streams.rules)
 
@@ -92,7 +151,7 @@ def cross_check(
         read.update(a.predicate for a in declaration.domain)
     if goal is not None:
         read.update(a.predicate for a in iter_atoms(goal))
-    found: list[Leniency] = []
+    found: list[Leniency] = list(_untyped_outputs(domain, streams))
     for producer in producers:
         label = "a rule" if isinstance(producer, Rule) else f"stream {producer.name!r}"
         for predicate in dict.fromkeys(a.predicate for a in producer.certified):

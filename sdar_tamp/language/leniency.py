@@ -30,14 +30,16 @@ logged), and reject it only with ``strict=True`` (:class:`StrictModeError`). The
     (``(Cost ?a ?b)``), as PDDLStream programs do: the first use gives its arity, which a
     stream file's ``(:function (Cost ?a ?b) ...)`` must then match.
 
-``unused-certified``, ``unachievable-predicate``
+``unused-certified``, ``unachievable-predicate``, ``untyped-output``
     a stream file checked against its domain (:mod:`sdar_tamp.language.cross_check`): a
-    certified predicate nothing reads, a predicate the domain reads that nothing makes true.
+    certified predicate nothing reads, a predicate the domain reads that nothing makes true,
+    an action parameter of a declared type read where only a stream's (untyped) output can be.
 
-``undeclared-parent-type``, ``init-type``, ``function-arity`` and ``unachievable-predicate``
-are more likely mistakes than dialect, so they are logged as warnings; the others at info
-level (``unused-certified`` too: PDDLStream programs often certify type-like facts such as
-``(Grasp ?o ?g)`` that nothing reads; ``sdar check`` still prints it as a warning).
+``undeclared-parent-type``, ``init-type``, ``function-arity``, ``unachievable-predicate`` and
+``untyped-output`` are more likely mistakes than dialect, so they are logged as warnings; the
+others at info level (``unused-certified`` too: PDDLStream programs often certify type-like
+facts such as ``(Grasp ?o ?g)`` that nothing reads; ``sdar check`` still prints it as a
+warning).
 """
 
 from __future__ import annotations
@@ -63,6 +65,7 @@ FREE_VARIABLE = "free-variable"
 FUNCTION_ARITY = "function-arity"
 UNUSED_CERTIFIED = "unused-certified"
 UNACHIEVABLE_PREDICATE = "unachievable-predicate"
+UNTYPED_OUTPUT = "untyped-output"
 
 KINDS = (
     GLUED_VARIABLE,
@@ -76,9 +79,10 @@ KINDS = (
     FUNCTION_ARITY,
     UNUSED_CERTIFIED,
     UNACHIEVABLE_PREDICATE,
+    UNTYPED_OUTPUT,
 )
 _WARNING_KINDS = frozenset(
-    {UNDECLARED_PARENT_TYPE, INIT_TYPE, FUNCTION_ARITY, UNACHIEVABLE_PREDICATE}
+    {UNDECLARED_PARENT_TYPE, INIT_TYPE, FUNCTION_ARITY, UNACHIEVABLE_PREDICATE, UNTYPED_OUTPUT}
 )
 
 

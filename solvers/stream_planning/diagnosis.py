@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 
 from sdar_tamp.language.domain_model import Domain
 from sdar_tamp.language.formula_model import Formula
+from sdar_tamp.language.leniency import Leniency
 from sdar_tamp.language.traversal import iter_atoms, iter_effect_literals
 from solvers.solution import Status
 from solvers.stream_planning.calls import Overrun
@@ -36,12 +38,17 @@ def diagnose(
     max_time: float,
     overruns: Sequence[Overrun],
     complexity: float,
+    warnings: Sequence[Leniency] = (),
 ) -> list[str]:
     """Short sentences: goals never reachable, streams never instantiated, streams that failed.
 
     ``max_time`` [s] and ``overruns`` (calls that outlived the deadline) explain a timeout;
-    ``complexity`` is the last complexity bound of the search."""
-    reasons: list[str] = []
+    ``complexity`` is the last complexity bound of the search; the warning-level items of
+    ``warnings`` (the problem's leniencies: likely mistakes in its files) come first."""
+    noted = [
+        f"the problem has a warning: {item}" for item in warnings if item.level >= logging.WARNING
+    ]
+    reasons = list(noted)
     if status is Status.TIMEOUT:
         reasons.append(f"the time limit ({max_time:g} s) or the iteration limit ended the search")
         reasons.extend(overrun.describe() for overrun in overruns)
@@ -100,7 +107,7 @@ def diagnose(
     exhausted = sum(1 for s in states if s.instance.exhausted)
     if exhausted:
         reasons.append(f"{exhausted} stream instance(s) were exhausted")
-    if not reasons:
+    if len(reasons) == len(noted):
         reasons.append(
             f"no plan exists over every fact the streams could certify (complexity {complexity:g})"
         )

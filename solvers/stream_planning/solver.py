@@ -344,6 +344,7 @@ class StreamSolver:
                     max_time=context.options.max_time,
                     overruns=context.runner.overruns,
                     complexity=stats.complexity,
+                    warnings=context.problem.leniencies,
                 ),
             )
         cost, actions, needed = context.best
