@@ -92,9 +92,9 @@ class BatchHMax:
                 maximum[:] = 0.0
                 for column in columns:
                     head = gathered[: len(column)]
-                    np.take(cost, column, axis=0, out=head)
+                    cost.take(column, axis=0, out=head)
                     np.maximum(maximum[: len(column)], head, out=maximum[: len(column)])
-                np.take(maximum, self.pair_group, axis=0, out=reached)
+                maximum.take(self.pair_group, axis=0, out=reached)
                 reached += self.pair_cost
                 best = np.minimum.reduceat(reached, starts, axis=0)
                 if not (best < current).any():
