@@ -341,6 +341,7 @@ def run_example(
         "solve_calls": len(calls),
         "plans": len(solved),
         "solve_seconds": round(sum(float(c.get("seconds", 0.0)) for c in calls), 3),
+        "solve_cpu": round(sum(float(c.get("cpu_seconds", 0.0)) for c in calls), 3),
     }
 
 

@@ -48,15 +48,14 @@ class BatchHMax:
                 known = cheapest.get((key, fact))
                 if known is None or cost < known:
                     cheapest[(key, fact)] = cost
-        # widest precondition first: column j covers the leading groups with more than j
+        # widest precondition first (those without any last): every precondition fact of
+        # every group in one gather, each group's maximum one segment of a reduction
         groups = sorted({key for key, _fact in cheapest}, key=lambda key: (-len(key), key))
         group_of = {key: i for i, key in enumerate(groups)}
-        width = len(groups[0]) if groups else 0
         self.n_groups = len(groups)
-        self.columns = [
-            np.asarray([key[j] for key in groups if len(key) > j], dtype=np.intp)
-            for j in range(width)
-        ]
+        self.n_wide = sum(1 for key in groups if key)  # groups with a precondition
+        self.entries = np.asarray([f for key in groups for f in key], dtype=np.intp)
+        self.segments = np.cumsum([0] + [len(key) for key in groups[: self.n_wide]])[:-1]
         pairs = sorted((fact, group_of[key], cost) for (key, fact), cost in cheapest.items())
         self.pair_group = np.asarray([g for _f, g, _c in pairs], dtype=np.intp)
         self.pair_cost = np.asarray([c for _f, _g, c in pairs], dtype=np.float64)[:, None]
@@ -81,20 +80,26 @@ class BatchHMax:
             return [0.0] * len(states)
         # one row a fact, one column a state: a gather takes whole rows
         cost = np.where(self.true_facts(states), 0.0, inf)
-        achieved, starts, columns = self.achieved, self.starts, self.columns
+        achieved, starts, entries, segments = (
+            self.achieved,
+            self.starts,
+            self.entries,
+            self.segments,
+        )
         if len(achieved):
             width = len(states)
             current = cost[achieved]
-            maximum = np.empty((self.n_groups, width))
-            gathered = np.empty((len(columns[0]) if columns else 0, width))
+            wide = self.n_wide
+            maximum = np.zeros((self.n_groups, width))  # groups without preconditions: 0
+            gathered = np.empty((len(entries), width))
             reached = np.empty((len(self.pair_group), width))
             while True:
-                maximum[:] = 0.0
-                for column in columns:
-                    head = gathered[: len(column)]
-                    np.take(cost, column, axis=0, out=head)
-                    np.maximum(maximum[: len(column)], head, out=maximum[: len(column)])
-                np.take(maximum, self.pair_group, axis=0, out=reached)
+                if wide:
+                    # (costs are >= 0: a group's maximum over its facts is the maximum of 0
+                    # and those, the same floats)
+                    cost.take(entries, axis=0, out=gathered)
+                    np.maximum.reduceat(gathered, segments, axis=0, out=maximum[:wide])
+                maximum.take(self.pair_group, axis=0, out=reached)
                 reached += self.pair_cost
                 best = np.minimum.reduceat(reached, starts, axis=0)
                 if not (best < current).any():

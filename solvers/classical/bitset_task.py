@@ -27,6 +27,8 @@ JIT_AFTER_CALLS = 2000
 # conditional effect: (condition mask, negative condition mask, add mask, delete mask)
 CondMasks = tuple[tuple[int, int, int, int], ...]
 OpMasks = tuple[int, int, int, int, CondMasks, float]
+# a derived rule: (head bit, body mask, negative body mask, head fact)
+_Rule = tuple[int, int, int, int]
 # successor-generator trie node: (operators ending here, ((fact bit, child), ...))
 Trie = tuple[tuple[int, ...], tuple[tuple[int, "Trie"], ...]]
 
@@ -76,42 +78,49 @@ class _CountedStratum:
     def __init__(self, axioms: list[GroundAxiom]) -> None:
         own = {a.head for a in axioms}
         shared = Counter(f for a in axioms for f in set(a.body))
-        # (head bit, body mask, negative body mask) of each rule
-        self.rules = [(1 << a.head, mask(a.body), mask(a.negative_body)) for a in axioms]
-        self.always: list[int] = []  # rules with an empty body
-        self.triggers: dict[int, list[int]] = {}  # fact -> rules it triggers
-        self.watchers: dict[int, list[int]] = {}  # head of this stratum -> rules needing it
-        for i, axiom in enumerate(axioms):
+        # (head bit, body mask, negative body mask, head fact) of each rule
+        rules = [(1 << a.head, mask(a.body), mask(a.negative_body), a.head) for a in axioms]
+        always: list[_Rule] = []  # rules with an empty body
+        triggers: dict[int, list[_Rule]] = {}  # fact -> rules it triggers
+        watchers: dict[int, list[_Rule]] = {}  # head of this stratum -> rules needing it
+        for rule, axiom in zip(rules, axioms, strict=True):
             needs = sorted({f for f in axiom.body if f in own})
             if needs:
                 for fact in needs:
-                    self.watchers.setdefault(fact, []).append(i)
+                    watchers.setdefault(fact, []).append(rule)
             elif axiom.body:
                 trigger = min(axiom.body, key=lambda f: (shared[f], f))
-                self.triggers.setdefault(trigger, []).append(i)
+                triggers.setdefault(trigger, []).append(rule)
             else:
-                self.always.append(i)
+                always.append(rule)
+        self.always = tuple(always)
+        self.triggers = {f: tuple(r) for f, r in triggers.items()}
+        self.watchers = {f: tuple(r) for f, r in watchers.items()}
         self.trigger_mask = mask(self.triggers)
-        self.heads = [a.head for a in axioms]
 
     def close(self, state: int) -> int:
-        rules, heads, watchers = self.rules, self.heads, self.watchers
+        # one loop over the rules each true trigger fact (then each new head) names, inline:
+        # this runs for every successor a search generates
+        watchers = self.watchers
         queue: list[int] = []
-
-        def look(indices: Iterable[int], state: int) -> int:
-            for i in indices:
-                head, body, negative = rules[i]
+        for head, body, negative, fact in self.always:
+            if not state & head and state & body == body and not state & negative:
+                state |= head
+                queue.append(fact)
+        triggers = self.triggers
+        pending = state & self.trigger_mask
+        while pending:
+            low = pending & -pending
+            pending ^= low
+            for head, body, negative, fact in triggers[low.bit_length() - 1]:
                 if not state & head and state & body == body and not state & negative:
                     state |= head
-                    queue.append(heads[i])
-            return state
-
-        state = look(self.always, state)
-        triggers = self.triggers
-        for fact in bits(state & self.trigger_mask):
-            state = look(triggers[fact], state)
+                    queue.append(fact)
         while queue:
-            state = look(watchers.get(queue.pop(), ()), state)
+            for head, body, negative, fact in watchers.get(queue.pop(), ()):
+                if not state & head and state & body == body and not state & negative:
+                    state |= head
+                    queue.append(fact)
         return state
 
 

@@ -31,10 +31,7 @@ from __future__ import annotations
 
 import heapq
 import itertools
-import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
 
 from sdar_tamp.language.formula_model import Atom
 from sdar_tamp.language.generators import SINGLE_CALL
@@ -43,40 +40,21 @@ from solvers.stream_planning.assumed import Assumed, OptimisticCosts, refuted_fa
 from solvers.stream_planning.engine import Engine, first_call_level, function_guard
 from solvers.stream_planning.externals import FunctionExternal, StreamExternal
 from solvers.stream_planning.facts import FactStore, Instantiator, Query
-from solvers.stream_planning.opt_values import OptimisticValue, first_batch
+from solvers.stream_planning.opt_results import (
+    PLACEHOLDER,
+    OptimisticWorld,
+    OptResult,
+    is_placeholder,
+)
+from solvers.stream_planning.placeholder_values import PlaceholderValues
 
-PLACEHOLDER = "#o"
-
-
-def is_placeholder(name: str) -> bool:
-    return name.startswith(PLACEHOLDER)
-
-
-@dataclass(frozen=True)
-class OptResult:
-    """An optimistic result: what ``external`` would certify on ``inputs``."""
-
-    external: str
-    inputs: tuple[str, ...]
-    outputs: tuple[str, ...]
-    domain: tuple[Atom, ...]
-    certified: tuple[Atom, ...]
-    level: int
-    kind: str  # "stream", "function", "predicate" or "rule"
-
-
-@dataclass
-class OptimisticWorld:
-    facts: dict[Atom, int]
-    provenance: dict[Atom, OptResult]
-    numeric: dict[tuple[str, tuple[str, ...]], float]  # an OptimisticCosts with deferred ones
-    placeholders: list[str] = field(default_factory=list)
-    complete: bool = True  # no instance was left out for the limit or for being disabled
-    # later calls of some instance were left out for the limit (see OptimisticBuilder._further):
-    # no plan proves nothing unless the goal is not even relaxed-reachable
-    more_calls: bool = False
-    # the lowest level at which something left out for the limit would enter (inf: none)
-    next_level: float = math.inf
+__all__ = [
+    "PLACEHOLDER",
+    "OptResult",
+    "OptimisticBuilder",
+    "OptimisticWorld",
+    "is_placeholder",
+]
 
 
 class OptimisticBuilder:
@@ -93,17 +71,10 @@ class OptimisticBuilder:
         self.negated = negated
         self.pruned = pruned  # streams never assumed: only their real results count
         self.assumed = assumed if assumed is not None else Assumed({}, {})
-        self._placeholders: dict[tuple[object, ...], str] = {}
-        self.producers: dict[str, str] = {}  # placeholder -> the stream that makes it
-        # placeholder -> the value a callable opt_gen_fn gave it
-        self.values: dict[str, object] = {}
+        self.names = PlaceholderValues(engine)  # placeholders and the values behind them
         self._shared: set[str] = set()  # placeholders shared by the instances of a stream
         self.refined: set[str] = set()  # streams whose instances have placeholders of their own
-        # (stream, inputs) -> the output tuples of its callable opt_gen_fn
-        self._generated: dict[tuple[str, tuple[str, ...]], list[tuple[object, ...]]] = {}
         self._later: set[str] = set()  # placeholders of later calls (see _further)
-        # the optimistic values of deferred function terms (asked for by the search)
-        self._optimistic: dict[tuple[str, tuple[str, ...]], float] = {}
         # (external, inputs, outputs) -> its (domain, certified) facts: every build meets the
         # same instances and placeholders again (their names persist across builds)
         self._atoms: dict[
@@ -111,12 +82,7 @@ class OptimisticBuilder:
         ] = {}
 
     def placeholder(self, key: tuple[object, ...]) -> str:
-        name = self._placeholders.get(key)
-        if name is None:
-            name = f"{PLACEHOLDER}{len(self._placeholders)}"
-            self._placeholders[key] = name
-            self.producers[name] = str(key[0])
-        return name
+        return self.names.placeholder(key)
 
     def build(
         self,
@@ -139,7 +105,9 @@ class OptimisticBuilder:
                 store.add(atom, level)
         else:  # every real fact: a copy of the engine's store (the same orders)
             store = engine.store.copy()
-        numeric = OptimisticCosts(engine.numeric, frozenset(self.assumed.functions), self.value)
+        numeric = OptimisticCosts(
+            engine.numeric, frozenset(self.assumed.functions), self.names.deferred
+        )
         world = OptimisticWorld(dict(facts), {}, numeric)
         for atom in engine.refuted:
             world.facts[refuted_fact(atom)] = 0
@@ -232,7 +200,7 @@ class OptimisticBuilder:
                 return []
             generator = external.info.opt_gen_fn
             if callable(generator) and external.declaration.outputs:
-                batches = self._generated_outputs(external, inputs, generator)
+                batches = self.names.generated(external, inputs, generator)
             else:
                 shared = generator == "shared" and name not in self.refined
                 outputs = tuple(
@@ -372,38 +340,6 @@ class OptimisticBuilder:
                 k += 1
         return further
 
-    def _values(self, inputs: tuple[str, ...]) -> tuple[object, ...]:
-        return tuple(
-            (self.values[n] if n in self.values else OptimisticValue(n, self.producers.get(n, "?")))
-            if is_placeholder(n)
-            else self.engine.table.value(n)
-            for n in inputs
-        )  # fmt: skip
-
-    def _generated_outputs(
-        self, external: StreamExternal, inputs: tuple[str, ...], generator: Callable[..., Any]
-    ) -> list[tuple[str, ...]]:
-        """The placeholders of each output tuple of ``generator`` on ``inputs`` (called once).
-
-        Raises:
-            StreamError: ``generator`` raised.
-            StreamOutputError: it produced something other than a list of output tuples.
-        """
-        name = external.name
-        key = (name, inputs)
-        batch = self._generated.get(key)
-        if batch is None:
-            batch = self._generated[key] = first_batch(external, self._values(inputs), generator)
-        result = []
-        for index, values in enumerate(batch):
-            outputs = tuple(
-                self.placeholder((name, inputs, "opt", index, i)) for i in range(len(values))
-            )
-            for placeholder, value in zip(outputs, values, strict=True):
-                self.values[placeholder] = value
-            result.append(outputs)
-        return result
-
     def _function(
         self,
         function: FunctionExternal,
@@ -430,7 +366,7 @@ class OptimisticBuilder:
                     "predicate",
                 )
             ]
-        world.numeric[(function.name, inputs)] = self._opt_value(function, inputs)
+        world.numeric[(function.name, inputs)] = self.names.function_value(function, inputs)
         return [
             OptResult(
                 function.name,
@@ -442,15 +378,3 @@ class OptimisticBuilder:
                 "function",
             )
         ]
-
-    def _opt_value(self, function: FunctionExternal, inputs: tuple[str, ...]) -> float:
-        opt_fn = getattr(function.info, "opt_fn", None)
-        return float(opt_fn(*self._values(inputs))) if opt_fn is not None else 1.0
-
-    def value(self, name: str, inputs: tuple[str, ...]) -> float:
-        """The optimistic value of deferred function ``name`` on ``inputs`` (kept)."""
-        key = (name, inputs)
-        found = self._optimistic.get(key)
-        if found is None:
-            found = self._optimistic[key] = self._opt_value(self.engine.functions[name], inputs)
-        return found

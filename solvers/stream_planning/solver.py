@@ -98,15 +98,22 @@ class StreamSolver:
         lazy = self.policy.lazy
         if lazy and not any(context.fluent_streams.values()):
             return OptimisticWorld(dict(engine.planning_facts()), {}, dict(engine.numeric))
-        return self._build(level, further=False)
+        # confirming a real plan: a plan on new samples would end the search (the known plan
+        # stands), so only the real facts (deferred tests and costs still assumed) are
+        # searched, a smaller task; a cheaper real plan the optimistic one hid is found too
+        return self._build(level, further=False, lazy=lazy or self.confirming)
 
-    def _build(self, level: int, further: bool) -> OptimisticWorld:
-        """The optimistic world at ``level`` (its time counted in ``world_time``)."""
+    def _build(self, level: int, further: bool, lazy: bool | None = None) -> OptimisticWorld:
+        """The optimistic world at ``level`` (its time counted in ``world_time``); ``lazy``:
+        real streams add no optimistic results (default: the policy's)."""
         context = self.context
         start = time.perf_counter()
         try:
             return context.builder.build(
-                level, self.policy.lazy, further=further, check_time=context.check_time
+                level,
+                self.policy.lazy if lazy is None else lazy,
+                further=further,
+                check_time=context.check_time,
             )
         finally:
             context.stats.world_time += time.perf_counter() - start
@@ -247,7 +254,12 @@ class StreamSolver:
         found = None
         if context.stats.skeletons < context.options.max_skeletons:
             found = context.plan(world.facts, world.numeric, world)
-            if found is None and world.more_calls and not context.unreachable:
+            if (
+                found is None
+                and world.more_calls
+                and not context.unreachable
+                and not self.confirming
+            ):
                 # no plan with one new output per instance: offer later calls' outputs (when
                 # they all lie above the level, the same facts: the same search would fail)
                 further = self._build(level, further=True)

@@ -205,6 +205,7 @@ def test_runner_runs_an_unmodified_program_and_rechecks_its_plan(tmp_path: Path)
     assert "Solved: True" in done.stdout
     calls = json.loads(report.read_text())["calls"]
     assert [(c["algorithm"], c["solved"], c["valid"]) for c in calls] == [("focused", True, True)]
+    assert calls[0]["cpu_seconds"] > 0.0  # the solve's CPU time is recorded beside its time
 
 
 def test_the_record_holds_each_call_when_the_program_is_killed(tmp_path: Path) -> None:

@@ -429,4 +429,38 @@ def test_a_cheaper_plan_that_needs_new_samples_leaves_the_dearer_real_plan_stand
     assert solution.solved and solution.plan is not None
     assert [a.name for a in solution.plan] == ["go"] and solution.cost == 10.0
     assert sampled == []
-    assert "a cheaper plan needs new samples: the best real plan stands" in capsys.readouterr().out
+    # the search for a cheaper plan covers the real facts only: it finds none
+    assert "no plan cheaper than the best real plan" in capsys.readouterr().out
+
+
+def test_the_search_for_a_cheaper_plan_finds_a_real_one_behind_an_optimistic_one() -> None:
+    """home's plan (assumed 1) costs 10 once evaluated. Below 10, the cheapest optimistic plan
+    surveys a new sample (assumed 2), but the known spot ``near`` gives a real plan of cost 5:
+    the search for a cheaper plan covers the real facts, so that plan is found and returned
+    (a plan on new samples would have ended the search with the dearer one), still without
+    sampling."""
+    sampled: list[str] = []
+
+    def spots():  # type: ignore[no-untyped-def]
+        for k in range(3):
+            sampled.append(f"s{k}")
+            yield (f"s{k}",)
+
+    distances = {"home": 10.0, "near": 5.0}
+    problem = PDDLProblem(
+        SURVEY_DOMAIN,
+        {},
+        SURVEY_STREAMS,
+        {"sample-spot": lambda: spots(), "dist": lambda p: distances.get(p, 0.5)},
+        [("Spot", "home"), ("Known", "home"), ("Spot", "near"), ("Known", "near")],
+        ("Done",),
+    )
+    # a lower bound of every distance: exact for near, 1 elsewhere
+    info = {"dist": FunctionInfo(opt_fn=lambda p: 5.0 if p == "near" else 1.0)}
+    solution = solve(
+        problem, algorithm="focused", stream_info=info, max_time=10, initial_complexity=1
+    )
+    assert solution.solved and solution.plan is not None
+    assert [(a.name, a.args) for a in solution.plan] == [("go", ("near",))]
+    assert solution.cost == 5.0
+    assert sampled == []

@@ -50,9 +50,9 @@ class _Recorder:
         def recorded_solve(problem: Any, *args: Any, **kwargs: Any) -> Any:
             from sdar_tamp.compat.pddlstream.check import check_solution
 
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             solution = core_solve(problem, *args, **kwargs)
-            seconds = time.perf_counter() - start
+            seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
             error = check_solution(problem, solution) if solution.plan is not None else None
             self.calls.append(
                 {
@@ -64,6 +64,7 @@ class _Recorder:
                     "length": None if solution.plan is None else len(solution.plan),
                     "cost": solution.cost,
                     "seconds": round(seconds, 4),
+                    "cpu_seconds": round(cpu, 4),  # the process's, its threads included
                 }
             )
             self.write(None, finished=False)
