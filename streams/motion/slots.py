@@ -155,8 +155,10 @@ def _pick(clear: FloatArray, slots: int, limit: float, forced: Any) -> Any:
         if forced is not None and np.asarray(forced).size
         else np.zeros(0, dtype=np.int64)
     )
-    order = [int(i) for i in np.argsort(flat) if flat[i] < limit and i not in set(forced_flat)]
-    chosen = (list(dict.fromkeys(int(i) for i in forced_flat)) + order)[:slots]
+    first = list(dict.fromkeys(int(i) for i in forced_flat))
+    taken = set(first)
+    order = [int(i) for i in np.argsort(flat) if flat[i] < limit and int(i) not in taken]
+    chosen = (first + order)[:slots]
     return np.stack(np.unravel_index(np.array(chosen, dtype=np.int64), clear.shape), axis=1)
 
 
