@@ -90,13 +90,14 @@ class TrajectoryOptimiser:
         return self._library
 
     def recipe(self) -> str:
-        """What the derivatives' code is made from: the options, the arms' layout and base
-        poses, the kinematic parameters and the code that builds the expressions (the key of
-        the compiled library; a loaded library is also checked by its values)."""
+        """What the derivatives' code is made from: the options, the arm-arm slots of each pair
+        of arms (they follow the sphere models), the arms' layout and base poses, the kinematic
+        parameters and the code that builds the expressions (the key of the compiled library;
+        a loaded library is also checked by its values)."""
         from sdar_tamp.world import kinematics, ur_ik
         from streams.motion import _casadi, fk_casadi, fk_chain, nlp
 
-        parts = [repr(self.options), repr(self.ctx.layout)]
+        parts = [repr(self.options), repr(self.pair_slots), repr(self.ctx.layout)]
         for arm in self.ctx.arm_names:
             fk = self.ctx.fk[arm]
             parts.append(fk.recipe())
