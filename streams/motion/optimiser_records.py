@@ -20,7 +20,7 @@ class TrajOptOptions:
     #: per pair of arms; None: from the two arms' coarse sphere models (``slots_per_sphere``)
     arm_arm_slots: int | None = None
     #: arm-arm slots per coarse sphere, of the geometric mean of the pair's two counts
-    #: (rounded down): 24 for two UR5e arms (25 coarse spheres each), 41 for two Pandas (43)
+    #: (rounded down): 24 for two UR5e arms (25 coarse spheres each), 33 for two Pandas (35)
     slots_per_sphere: float = 0.96
     obstacle_slots: int = 12  # per arm
     table_slots: int = 6  # per arm
@@ -35,8 +35,10 @@ class TrajOptOptions:
     def __post_init__(self) -> None:
         if self.arm_arm_slots is not None and self.arm_arm_slots < 1:
             raise ParameterError(f"arm_arm_slots must be at least 1, got {self.arm_arm_slots}")
-        if not self.slots_per_sphere > 0.0:
-            raise ParameterError(f"slots_per_sphere must be > 0, got {self.slots_per_sphere}")
+        if not (math.isfinite(self.slots_per_sphere) and self.slots_per_sphere > 0.0):
+            raise ParameterError(
+                f"slots_per_sphere must be a finite number > 0, got {self.slots_per_sphere}"
+            )
 
     def pair_slots(self, coarse: tuple[int, ...]) -> tuple[int, ...]:
         """Arm-arm slots of every pair of arms (:func:`~streams.motion.sphere_pairs.arm_pairs`

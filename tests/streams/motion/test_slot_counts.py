@@ -37,8 +37,9 @@ def test_a_set_slot_count_serves_every_pair() -> None:
     ("kwargs", "message"),
     [
         ({"arm_arm_slots": 0}, "arm_arm_slots must be at least 1"),
-        ({"slots_per_sphere": 0.0}, "slots_per_sphere must be > 0"),
-        ({"slots_per_sphere": float("nan")}, "slots_per_sphere must be > 0"),
+        ({"slots_per_sphere": 0.0}, "slots_per_sphere must be a finite number > 0"),
+        ({"slots_per_sphere": float("nan")}, "slots_per_sphere must be a finite number > 0"),
+        ({"slots_per_sphere": float("inf")}, "slots_per_sphere must be a finite number > 0"),
     ],
 )
 def test_bad_slot_options_are_refused(kwargs: dict[str, float], message: str) -> None:
