@@ -12,7 +12,7 @@ direct paths, no fallbacks), timed in CPU seconds of the process (the machine ma
 and in wall seconds; its result is re-checked with coal along the optimised knots' curve.
 
 The NLP's size is reported per k: collision rows per knot are ``k (k - 1) / 2`` arm-arm
-blocks of ``arm_arm_slots`` rows, plus an arm-obstacle and an arm-table block per arm.
+blocks of the pair's arm-arm slots, plus an arm-obstacle and an arm-table block per arm.
 Derivatives are CasADi's own evaluation unless ``--compiled`` (then each k's library is
 compiled first, which takes minutes of CPU once and is cached).
 
@@ -157,7 +157,7 @@ def run_k(scene: Scene, k: int, calls: int, seed: int, compiled: bool) -> dict[s
             valid += int(validate_trajectory(ctx, world, curve).ok)
     n = len(cpu)
     o = options
-    per_knot = len(arm_pairs(k)) * o.arm_arm_slots + k * (o.obstacle_slots + o.table_slots)
+    per_knot = sum(opt.pair_slots) + k * (o.obstacle_slots + o.table_slots)
     return {
         "arms": list(ctx.arm_names),
         "calls": n,

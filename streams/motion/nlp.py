@@ -5,9 +5,10 @@ joints); ``q_0`` and ``q_{K-1}`` are parameters. Cost: squared second difference
 (smoothness) plus a small weight on squared first differences (length). Constraints at every
 interior knot: the sphere clearances of the slots (arm-arm, arm-obstacle and arm-table, see
 :mod:`streams.motion.slots`), then the per-step joint velocity and acceleration rows on the
-nominal time grid. The arm-arm rows come in one block of ``arm_arm_slots`` rows per pair of
-arms (:func:`~streams.motion.sphere_pairs.arm_pairs`: ``k (k - 1) / 2`` blocks for ``k``
-arms, none for one arm), then one arm-obstacle block and one arm-table block per arm. A slot
+nominal time grid. The arm-arm rows come in one block per pair of arms
+(:func:`~streams.motion.sphere_pairs.arm_pairs`: ``k (k - 1) / 2`` blocks for ``k`` arms, none
+for one arm), as many rows as that pair's slots (:func:`pair_slot_counts`), then one
+arm-obstacle block and one arm-table block per arm. A slot
 names one sphere of an arm by parameters (its joint frame, as a one-hot row, and its centre
 and radius in that frame), so the NLP is built once per
 :class:`~streams.motion.optimiser_records.TrajOptOptions` and each call chooses the pairs.
@@ -24,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.layout import ArmLayout
 from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
@@ -42,11 +44,20 @@ def pair_kind(pair: int) -> str:
     return f"aa{pair}"
 
 
-def slot_kinds(o: TrajOptOptions, arm: int = 0, arms: int = 2) -> tuple[tuple[str, int], ...]:
+def pair_slot_counts(ctx: WorldContext, o: TrajOptOptions) -> tuple[int, ...]:
+    """The arm-arm slots of every pair of the world's arms, from their coarse sphere models
+    (:meth:`~streams.motion.optimiser_records.TrajOptOptions.pair_slots`)."""
+    return o.pair_slots(tuple(len(ctx.fk[arm].coarse.radius) for arm in ctx.arm_names))
+
+
+def slot_kinds(
+    o: TrajOptOptions, arm: int, arms: int, pair_slots: tuple[int, ...]
+) -> tuple[tuple[str, int], ...]:
     """Slot blocks of arm ``arm`` of ``arms``, in the order of its parameter blocks: the
-    arm-arm block of every pair it belongs to, then arm-obstacle, then arm-table."""
+    arm-arm block of every pair it belongs to (``pair_slots[p]`` slots for pair ``p``),
+    then arm-obstacle, then arm-table."""
     pairs = tuple(
-        (pair_kind(p), o.arm_arm_slots) for p, ij in enumerate(arm_pairs(arms)) if arm in ij
+        (pair_kind(p), pair_slots[p]) for p, ij in enumerate(arm_pairs(arms)) if arm in ij
     )
     return (*pairs, ("ao", o.obstacle_slots), ("t", o.table_slots))
 
@@ -72,19 +83,29 @@ class ParameterLayout:
 
 
 def parameter_layout(
-    arms: ArmLayout, o: TrajOptOptions, frames: tuple[int, ...] | None = None
+    arms: ArmLayout,
+    o: TrajOptOptions,
+    frames: tuple[int, ...] | None = None,
+    pair_slots: tuple[int, ...] | None = None,
 ) -> ParameterLayout:
     """The blocks of the NLP's parameter vector: the end knots, every arm's slots (frame,
     centre, radius per kind, :func:`slot_kinds`; the obstacle spheres of its arm-obstacle
     slots) and the margin. ``frames``: per arm, the frames its spheres may hang on (default
-    :data:`FRAMES` each)."""
+    :data:`FRAMES` each); ``pair_slots``: per pair of arms (default: ``o.arm_arm_slots`` each).
+
+    Raises:
+        ParameterError: neither ``pair_slots`` nor ``o.arm_arm_slots`` is given."""
     dof = arms.dof
     per_arm = (FRAMES,) * len(arms) if frames is None else frames
+    if pair_slots is None:
+        if o.arm_arm_slots is None:
+            raise ParameterError("parameter_layout: give pair_slots or options.arm_arm_slots")
+        pair_slots = o.pair_slots((0,) * len(arms))
     lay = ParameterLayout()
     lay.add("q0", 1, dof)
     lay.add("q1", 1, dof)
     for i in range(len(arms)):
-        for kind, slots in slot_kinds(o, i, len(arms)):
+        for kind, slots in slot_kinds(o, i, len(arms), pair_slots):
             lay.add(f"{kind}_frame{i}", slots, per_arm[i])
             lay.add(f"{kind}_centre{i}", slots, 3)
             lay.add(f"{kind}_radius{i}", slots, 1)
@@ -96,11 +117,13 @@ def parameter_layout(
 @dataclass(frozen=True)
 class TransferNLP:
     """The built NLP: CasADi's problem (``nlp``), its hand-assembled derivatives (``jac_g``,
-    ``hess_lag``) and solver options, ``g_fn`` (the constraint rows of ``x`` and ``p``),
+    ``hess_lag``) and solver options, ``pair_slots`` (the arm-arm slots of each pair of
+    arms), ``g_fn`` (the constraint rows of ``x`` and ``p``),
     ``n_collision`` (the collision rows over all interior knots) and the joint bounds of the
     decision variables ``(n * dof,)``."""
 
     layout: ParameterLayout
+    pair_slots: tuple[int, ...]  # arm-arm slots per pair of arms
     nlp: dict[str, Any]
     jac_g: Any
     hess_lag: Any
@@ -149,7 +172,9 @@ def build_nlp(ctx: WorldContext, o: TrajOptOptions) -> TransferNLP:
     the clearance rows, their Jacobian and the Hessian of their weighted sum are small
     SX functions of one knot, mapped over the knots, so CasADi differentiates one knot,
     not the whole horizon (the collision Jacobian and Hessian are block diagonal)."""
-    lay = parameter_layout(ctx.layout, o, tuple(ctx.fk[a].n_frames for a in ctx.arm_names))
+    pair_slots = pair_slot_counts(ctx, o)
+    frames = tuple(ctx.fk[a].n_frames for a in ctx.arm_names)
+    lay = parameter_layout(ctx.layout, o, frames, pair_slots)
     dof, n = ctx.layout.dof, o.knots - 2
     q_k, p_k = sx_sym("q", dof), sx_sym("p", lay.size)
     rows_k = _knot_rows(ctx, lay, q_k, p_k)
@@ -206,6 +231,6 @@ def build_nlp(ctx: WorldContext, o: TrajOptOptions) -> TransferNLP:
     scene = ctx.scene
     lo, hi = scene.joint_array("lower"), scene.joint_array("upper")
     return TransferNLP(
-        lay, nlp, jac_g, hess_lag, opts, ca.Function("g", [x, p], [g]), n_rows * n,
+        lay, pair_slots, nlp, jac_g, hess_lag, opts, ca.Function("g", [x, p], [g]), n_rows * n,
         np.tile(lo, n), np.tile(hi, n),
     )  # fmt: skip

@@ -62,6 +62,7 @@ class TrajectoryOptimiser:
         self._spheres = [arm_sphere_tables(ctx, arm) for arm in ctx.arm_names]
         built = build_nlp(ctx, self.options)
         self._lay = built.layout
+        self.pair_slots = built.pair_slots
         self._n_collision = built.n_collision
         self._solver = ca.nlpsol("dual_arm_transfer", "ipopt", built.nlp, built.opts)
         self._nlp, self._jac_g, self._hess_lag = built.nlp, built.jac_g, built.hess_lag
@@ -89,13 +90,14 @@ class TrajectoryOptimiser:
         return self._library
 
     def recipe(self) -> str:
-        """What the derivatives' code is made from: the options, the arms' layout and base
-        poses, the kinematic parameters and the code that builds the expressions (the key of
-        the compiled library; a loaded library is also checked by its values)."""
+        """What the derivatives' code is made from: the options, the arm-arm slots of each pair
+        of arms (they follow the sphere models), the arms' layout and base poses, the kinematic
+        parameters and the code that builds the expressions (the key of the compiled library;
+        a loaded library is also checked by its values)."""
         from sdar_tamp.world import kinematics, ur_ik
         from streams.motion import _casadi, fk_casadi, fk_chain, nlp
 
-        parts = [repr(self.options), repr(self.ctx.layout)]
+        parts = [repr(self.options), repr(self.pair_slots), repr(self.ctx.layout)]
         for arm in self.ctx.arm_names:
             fk = self.ctx.fk[arm]
             parts.append(fk.recipe())
@@ -143,7 +145,7 @@ class TrajectoryOptimiser:
         status, iters, rounds = "not solved", 0, 0
         for rounds in range(1, o.active_set_rounds + 2):
             dense = path_spheres(self.ctx, densify(path, 3), query.held)
-            selection = select_pairs(dense, ends, query, o, forced)
+            selection = select_pairs(dense, ends, query, o, forced, self.pair_slots)
             p, lbg, ubg = self._parameters(query, selection)
             lbx = np.minimum(self._lbx, path[1:-1].reshape(-1))
             ubx = np.maximum(self._ubx, path[1:-1].reshape(-1))
@@ -201,7 +203,8 @@ class TrajectoryOptimiser:
             chosen = [(pair_kind(p), coarse, s.aa[p][:, ij.index(i)])
                       for p, ij in enumerate(arm_pairs(n)) if i in ij]  # fmt: skip
             chosen += [("ao", fine, s.ao[i][:, 0]), ("t", fine, s.table[i])]
-            for (kind, slots), (_, table, idx) in zip(slot_kinds(o, i, n), chosen, strict=True):
+            kinds = slot_kinds(o, i, n, self.pair_slots)
+            for (kind, slots), (_, table, idx) in zip(kinds, chosen, strict=True):
                 frame, centre, radius = table.slots(idx, slots)
                 lay.put(p, f"{kind}_frame{i}", frame)
                 lay.put(p, f"{kind}_centre{i}", centre)
@@ -212,7 +215,7 @@ class TrajectoryOptimiser:
             obs[: len(idx), 3] = query.obstacles[1][idx]
             lay.put(p, f"ao_obs{i}", obs)
         per_knot = np.concatenate(
-            [slot_lower_bounds(lb, o.arm_arm_slots) for lb in s.aa_lb]
+            [slot_lower_bounds(lb, n) for lb, n in zip(s.aa_lb, self.pair_slots, strict=True)]
             + [slot_lower_bounds(lb, o.obstacle_slots) for lb in s.ao_lb]
             + [slot_lower_bounds(lb, o.table_slots) for lb in s.table_lb]
         )

@@ -3,7 +3,9 @@ the choice of the closest pairs along a warm start, and the pairs without a slot
 solution brings too close (the next active-set round's forced pairs).
 
 Arm-arm pairs are chosen per pair of arms (:func:`~streams.motion.sphere_pairs.arm_pairs`),
-each pair of arms with its own ``arm_arm_slots``; arm-obstacle and arm-table pairs per arm.
+each pair of arms with its own slot count (from the two arms' coarse sphere models,
+:meth:`~streams.motion.optimiser_records.TrajOptOptions.pair_slots`); arm-obstacle and
+arm-table pairs per arm.
 
 Each slot constraint is ``|c_i - c_j|^2 - (r_i + r_j + margin)^2 >= lb`` (table:
 ``z - r - margin >= lb``) with ``lb = 0`` unless an end point itself is closer (the fixed
@@ -17,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from sdar_tamp.errors import ParameterError
 from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
 from streams.motion.optimiser_records import TrajOptOptions, TransferQuery
@@ -152,8 +155,10 @@ def _pick(clear: FloatArray, slots: int, limit: float, forced: Any) -> Any:
         if forced is not None and np.asarray(forced).size
         else np.zeros(0, dtype=np.int64)
     )
-    order = [int(i) for i in np.argsort(flat) if flat[i] < limit and i not in set(forced_flat)]
-    chosen = (list(dict.fromkeys(int(i) for i in forced_flat)) + order)[:slots]
+    first = list(dict.fromkeys(int(i) for i in forced_flat))
+    taken = set(first)
+    order = [int(i) for i in np.argsort(flat) if flat[i] < limit and int(i) not in taken]
+    chosen = (first + order)[:slots]
     return np.stack(np.unravel_index(np.array(chosen, dtype=np.int64), clear.shape), axis=1)
 
 
@@ -163,14 +168,24 @@ def select_pairs(
     query: TransferQuery,
     o: TrajOptOptions,
     forced: Selection | None,
+    pair_slots: tuple[int, ...] | None = None,
 ) -> Selection:
     """The pairs that get slots: per kind the closest along ``dense`` (the warm start's
     spheres) below ``select_distance``, ``forced`` ones first, each with its lower bound from
-    the end points ``ends``."""
+    the end points ``ends``. ``pair_slots``: the arm-arm slots of each pair of arms (default
+    ``o.arm_arm_slots`` each, see :func:`streams.motion.nlp.pair_slot_counts`).
+
+    Raises:
+        ParameterError: neither ``pair_slots`` nor ``o.arm_arm_slots`` is given."""
+    pairs = arm_pairs(dense.arms)
+    if pair_slots is None:
+        if o.arm_arm_slots is None:
+            raise ParameterError("select_pairs: give pair_slots or options.arm_arm_slots")
+        pair_slots = o.pair_slots((0,) * dense.arms)
     aa, aa_lb = [], []
-    for p, (i, j) in enumerate(arm_pairs(dense.arms)):
+    for p, (i, j) in enumerate(pairs):
         aa_c = arm_arm_clearance(dense, i, j).min(axis=0)
-        sel = _pick(aa_c, o.arm_arm_slots, o.select_distance, forced.aa[p] if forced else None)
+        sel = _pick(aa_c, pair_slots[p], o.select_distance, forced.aa[p] if forced else None)
         aa_end = arm_arm_clearance(ends, i, j)[:, sel[:, 0], sel[:, 1]]
         rl, rr = ends.coarse_radii[i][sel[:, 0]], ends.coarse_radii[j][sel[:, 1]]
         aa.append(sel)

@@ -64,13 +64,17 @@ def cylinder_spheres(
     return centres, np.full(n, np.hypot(radius, s / 2.0))
 
 
-def box_spheres(half: FloatArray, max_per_axis: int = 3) -> tuple[FloatArray, FloatArray]:
+def box_spheres(
+    half: FloatArray, max_per_axis: int = 3, coarse: bool = False
+) -> tuple[FloatArray, FloatArray]:
     """Spheres covering a box of half sides ``half`` ``(3,)`` centred at the origin.
 
-    Cells are about as long as the box's smallest side (at most ``max_per_axis`` per axis).
+    Cells are about as long as the box's smallest side (``coarse``: its middle side, as a
+    cylinder's coarse spheres are about as long as its diameter), at most ``max_per_axis``
+    per axis.
     """
     h = np.asarray(half, dtype=np.float64)
-    cell = 2.0 * h.min()
+    cell = 2.0 * (np.median(h) if coarse else h.min())
     n = np.clip(np.ceil(2.0 * h / (1.25 * cell)), 1, max_per_axis).astype(int)
     step = 2.0 * h / n
     axes = [-h[i] + step[i] * (np.arange(n[i]) + 0.5) for i in range(3)]
@@ -181,7 +185,7 @@ def _covered_shapes(
         if p.kind == "cylinder":
             c, r = cylinder_spheres(p.half[0], p.half[2], 2.0 if coarse else 1.2)
         else:
-            c, r = box_spheres(np.array(p.half))
+            c, r = box_spheres(np.array(p.half), coarse=coarse)
         world = c @ p.T_joint_shape[:3, :3].T + p.T_joint_shape[:3, 3]
         joints.extend([p.joint] * len(r))
         centres.append(world)
