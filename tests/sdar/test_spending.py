@@ -139,6 +139,23 @@ def test_the_reserve_follows_the_pace_measured_in_the_run() -> None:
     assert pace.room_for_normal(50.0, 10) and not pace.room_for_normal(25.0, 10)
 
 
+def test_the_pace_follows_the_last_decisions_when_they_slow_down() -> None:
+    pace = Pace(max_time=600.0, prior=100.0, safety=1.5, share=0.9)
+    for _ in range(6):
+        pace.decided(2.0, 2, finishing=False)  # 1 s per object
+    assert pace.per_object() == pytest.approx(1.5 * 1.0)
+    for _ in range(3):  # the load rises: 3 s per object; 30 s for 18 objects over the run
+        pace.decided(6.0, 2, finishing=False)
+    assert pace.per_object() == pytest.approx(1.5 * 3.0)  # the last three, not 1.67
+    pace.decided(0.5, 1, finishing=False)  # faster again: the last three 12.5 s for 5
+    assert pace.per_object() == pytest.approx(1.5 * 2.5)
+    for _ in range(3):  # the run's mean (33.5 s for 22 objects) is the slower one now
+        pace.decided(1.0, 1, finishing=False)
+    assert pace.per_object() == pytest.approx(1.5 * 33.5 / 22)
+    pace.decided(4.0, 0, finishing=False)  # a buffer move counts no object
+    assert pace.per_object() == pytest.approx(1.5 * 6.0 / 2)
+
+
 def test_the_pace_exists_for_finite_budgets_long_enough() -> None:
     pace = finish_pace(SdarOptions(max_time=60.0, finish_reserve=2.0, finish_share=0.5))
     assert pace is not None and pace.reserve(24) == pytest.approx(30.0)  # capped at 30 s
