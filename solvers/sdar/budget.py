@@ -9,8 +9,10 @@ grounder, the recovery, the decision loop) stops at it; :meth:`Deadline.expired`
 ``max_time`` alone.
 
 The reserve is estimated from the run's own decisions (:class:`Pace`): the seconds per object
-brought to its goal by the finish's decisions once some were measured; before that by the
-normal decisions, and at least the mean time of one executed attempt of theirs (a finishing
+brought to its goal by the finish's decisions once some were measured; before that by the normal
+decisions (in either case over the whole run, or over its last :data:`RECENT` decisions when
+those were slower: a machine whose load rises during the run, where the run's mean would start
+the finish too late), and at least the mean time of one executed attempt of theirs (a finishing
 step of one move plans about the motions a normal step plans for several); before any decision
 ``SdarOptions.finish_reserve``. Measured rates are multiplied by a safety factor; added is the
 longest single attempt of the normal search (a decision stops at the soft limit only between
@@ -18,9 +20,9 @@ attempts, so one attempt may run past it). The reserve never exceeds ``finish_re
 object (nor ``finish_share`` of ``max_time``): on a loaded machine the measured pace would start
 the finish earlier than that, and a finish's steps are not much quicker per object than a
 two-arm cell's normal ones, so the paper suite would lose plans it still completes in time
-(measured: docs/benchmarks.md). So the finish starts when the objects left need the time left
-at the pace measured, up to that ceiling, not always at the ceiling; and once its own pace
-shows room for a normal decision again, the run goes back to the normal search
+(measured: docs/benchmarks.md). So the finish starts when the objects left need the time left at
+the pace measured, up to that ceiling, not always at the ceiling; and once its own pace shows
+room for a normal decision again, the run goes back to the normal search
 (:meth:`Pace.room_for_normal`).
 """
 
@@ -28,8 +30,9 @@ from __future__ import annotations
 
 import math
 import time
+from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 Clock = Callable[[], float]
 """A monotonic clock [s] (``time.perf_counter``; tests pass a fake one)."""
@@ -72,10 +75,15 @@ class Deadline:
         return self.clock() > self._at
 
 
+#: The last decisions of a mode whose own pace :meth:`Pace.per_object` also reads.
+RECENT = 3
+
+
 @dataclass
 class _Tally:
-    """Decisions of one mode: their time [s], count, objects brought to their goals; the
-    longest single attempt [s]; the time [s] and count of the attempts that succeeded."""
+    """Decisions of one mode: their time [s], count, objects brought to their goals, and the
+    last :data:`RECENT` of them ``(seconds, objects)``; the longest single attempt [s]; the
+    time [s] and count of the attempts that succeeded."""
 
     seconds: float = 0.0
     decisions: int = 0
@@ -83,9 +91,18 @@ class _Tally:
     longest_attempt: float = 0.0
     executed_seconds: float = 0.0
     executed: int = 0
+    recent: deque[tuple[float, int]] = field(default_factory=lambda: deque(maxlen=RECENT))
 
     def per_object(self) -> float | None:
-        return self.seconds / self.objects if self.objects else None
+        """Seconds per object over the run, or over the last decisions when slower (the
+        machine got busier, or the objects left are harder); None before any object."""
+        if not self.objects:
+            return None
+        rate = self.seconds / self.objects
+        recent = sum(n for _, n in self.recent)
+        if recent:
+            rate = max(rate, sum(t for t, _ in self.recent) / recent)
+        return rate
 
     def per_execution(self) -> float:
         return self.executed_seconds / self.executed if self.executed else 0.0
@@ -112,6 +129,7 @@ class Pace:
         tally.seconds += seconds
         tally.decisions += 1
         tally.objects += objects
+        tally.recent.append((seconds, objects))
 
     def attempted(self, seconds: float, executed: bool, finishing: bool) -> None:
         """One grounding's attempt (its motions planned) took ``seconds`` [s]; ``executed``:

@@ -44,14 +44,18 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 
 from sdar_tamp.graph import strongly_connected_components
+from solvers.sdar.spending import moves_layout
 from solvers.sdar.tasks import Layout, Move, Step, TaskView
 
 #: The most seatings of a step's objects on arms :func:`meets` tries one by one (4 arms: 24).
 SEATINGS = 120
 #: [m] Two arms whose plane segments come closer than this over a step obviously meet.
 MEET = 0.02
+#: The first two-move steps of a list that :func:`merges` joins with a later one each.
+MERGE_FIRST = 4
 
 
 class TaskScene:
@@ -148,6 +152,46 @@ def extensions(scene: TaskScene, step: Step, arms: int) -> list[Step]:
             continue
         if wider is not step and all(set(w.moves) != set(wider.moves) for w in out):
             out.append(wider)
+    return out
+
+
+def merges(scene: TaskScene, steps: Sequence[Step], arms: int) -> list[Step]:
+    """Two steps of two moves each made at once, with four arms or more and a layout: each of
+    the first :data:`MERGE_FIRST` two-move ``steps`` joined with the first later two-move step
+    of other objects that fits (kind and rank of the first; none when nothing fits). It fits
+    when its objects lie in other components of the dependency graph than the first's (each
+    step breaks its own cycle or chain, so the buffer moves stay those of the minimum buffer
+    set), no object of one waits for one of the other
+    (:attr:`~solvers.sdar.tasks.TaskView.waits`) and, the four objects seated on arms
+    (:func:`_seat`; a buffer move at its object's pose:
+    :func:`~solvers.sdar.spending.moves_layout`), no arm of one step crosses an arm of the other
+    (:meth:`~solvers.sdar.tasks.Layout.crosses`; within a step as SDAR-M finds). Each step is valid
+    alone (its goals free once its own objects are lifted), so both are valid at once; two
+    cycle breaks in far regions of the table take one step instead of two. At most
+    :data:`MERGE_FIRST` x ``len(steps)`` pairs are looked at."""
+    view = scene.view
+    layout = view.layout
+    if arms < 4 or layout is None:
+        return []
+    twos = [s for s in steps if len(s.moves) == 2 and all(x in layout.places for x in s.objects)]
+    part = {x: k for k, unit in enumerate(scene.units(frozenset())) for x in unit}
+    out: list[Step] = []
+    for i, first in enumerate(twos[:MERGE_FIRST]):
+        mine = {part[x] for x in first.objects}
+        for other in twos[i + 1 :]:
+            if any(part[x] in mine for x in other.objects):
+                continue
+            if any((x, y) in view.waits or (y, x) in view.waits
+                   for x in first.objects for y in other.objects):  # fmt: skip
+                continue
+            moves = (*first.moves, *other.moves)
+            plane = moves_layout(layout, moves)
+            seats = {x: a for a, x in _seat(plane, (), tuple(m.obj for m in moves))[1]}
+            if any(plane.crosses(seats[x], x, seats[y], y)
+                   for x in first.objects for y in other.objects):  # fmt: skip
+                continue
+            out.append(Step((*first.moves, *other.moves), first.kind, first.rank, first.tie))
+            break
     return out
 
 

@@ -59,10 +59,12 @@ moves; the extended
 step and its base are both kept (the base is the fallback when the larger step cannot be
 grounded); closed components of ``3..k`` objects are proposed as ``rotate`` steps of class 1 (an
 ``m``-cycle rotated by ``m`` arms without a buffer; a component of ``3..k`` objects can still be
-broken at class 7, for when the rotation is geometrically impossible). Within a class, steps
-bringing more objects to their goals come first. So a list holds at most
-``2 max_candidates`` steps of several moves, plus one rotation per component, plus the one-move
-steps; no set of ``k`` objects is enumerated.
+broken at class 7, for when the rotation is geometrically impossible); with four arms or more
+and a layout, each of the first four two-move steps is also merged with a later one of other
+components whose arms it does not cross (:func:`~solvers.sdar.k_steps.merges`: two cycle breaks
+in far parts of the table in one step). Within a class, steps bringing more objects to their
+goals come first. So a list holds at most ``2 max_candidates + 4`` steps of several moves, plus
+one rotation per component, plus the one-move steps; no set of ``k`` objects is enumerated.
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ from itertools import combinations
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.graph import DependencyGraph
 from solvers.sdar.buffer_sets import extending_minimum, optimal_choices
-from solvers.sdar.k_steps import TaskScene, extensions, rotations
+from solvers.sdar.k_steps import TaskScene, extensions, merges, rotations
 from solvers.sdar.tasks import Move, Step, TaskView
 
 _Edges = tuple[tuple[int, int], ...]
@@ -166,14 +168,19 @@ class SdarTaskPlanner:
 
     @staticmethod
     def _more_arms(scene: _Scene, arms: int, kept: _Ranked) -> _Ranked:
-        """More than two arms: every kept step extended greedily (its base kept too), plus
-        the rotations of closed components; within a class more goal moves first; one step
+        """More than two arms: every kept step extended greedily (its base kept too), the
+        first two-move steps merged with another each (four arms or more), plus the
+        rotations of closed components; within a class more goal moves first; one step
         per set of moves (the best ranked). See :mod:`solvers.sdar.k_steps`."""
         out: _Ranked = []
         for key, step in kept:
             for wider in extensions(scene, step, arms):
                 out.append(((key[0], -wider.progress, *key[1:]), wider))
             out.append(((key[0], -step.progress, *key[1:]), step))
+        keys = {step.moves: key for key, step in kept}
+        for merged in merges(scene, [step for _, step in kept], arms):
+            key = keys[merged.moves[:2]]
+            out.append(((key[0], -merged.progress, *key[1:]), merged))
         for key, step in rotations(scene, arms):
             rotate = Step(step.moves, step.kind, GOAL_PAIR, step.tie)
             out.append(((GOAL_PAIR, -rotate.progress, *key), rotate))

@@ -22,9 +22,10 @@ Every applied action is checked against the domain's lifted precondition
 The parts, around one :class:`~solvers.sdar.cache.StreamCache` (streams bound once, their
 outputs and the lifted state): :mod:`~solvers.sdar.grounding` (options, dual-arm
 configurations), :mod:`~solvers.sdar.execution` (motions and actions),
-:mod:`~solvers.sdar.recovery` (evictions) and :mod:`~solvers.sdar.report` (records, the
-solution), with :mod:`~solvers.sdar.attempts` (the motion mode of an attempt, the tabu lists and
-the quick-stream ladder). This module holds the decision loop.
+:mod:`~solvers.sdar.recovery` (evictions), :mod:`~solvers.sdar.viewing` (the task planner's
+view of the state) and :mod:`~solvers.sdar.report` (records, the solution), with
+:mod:`~solvers.sdar.attempts` (the motion mode of an attempt, the tabu lists and the
+quick-stream ladder). This module holds the decision loop.
 """
 
 from __future__ import annotations
@@ -34,7 +35,6 @@ from collections.abc import Generator, Mapping, Sequence
 from dataclasses import dataclass
 
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.graph import DependencyGraph
 from sdar_tamp.language.formula_model import And, Atom
 from sdar_tamp.language.options import FunctionInfo, StreamInfo
 from sdar_tamp.language.problem import PDDLProblem
@@ -61,7 +61,8 @@ from solvers.sdar.spending import (
     finishing_view,
     spread_steps,
 )
-from solvers.sdar.tasks import Layout, Step, TaskPlanner, TaskView
+from solvers.sdar.tasks import Step, TaskPlanner, TaskView
+from solvers.sdar.viewing import current_view
 from solvers.solution import Solution, Status
 
 LOG = get_logger(__name__)
@@ -154,61 +155,9 @@ class SdarSolver:
         )
 
     def view(self) -> TaskView:
-        """The dependency graph of the objects not at their goals: footprint overlap (the
-        overlap test stream) and, when the domain has the grasp-blocking test, objects that
-        leave one another no grasp (see :class:`~solvers.sdar.tasks.TaskView`)."""
-        cache, voc = self.cache, self.voc
-        current = cache.current_poses()
-        remaining = tuple(sorted(o for o, g in self.goals.items() if current.get(o) != g))
-        blocks = voc.blocks_grasps if voc.blocks_grasps in cache.streams else None
-        edges = []
-        waits: set[tuple[str, str]] = set()
-        for i, a in enumerate(remaining):
-            goal = self.goals[a]
-            for j, b in enumerate(remaining):
-                if i == j or b not in current:
-                    continue
-                here = current[b]
-                if cache.test(voc.overlap, (a, goal, b, here)) or (
-                    blocks is not None
-                    and (
-                        cache.test(blocks, (a, goal, b, here))  # b could not be picked
-                        or cache.test(blocks, (b, here, a, goal))  # a could not be placed
-                        or (a in current and cache.test(blocks, (b, here, a, current[a])))
-                    )
-                ):
-                    edges.append((i, j))
-                if blocks is not None and cache.test(blocks, (a, goal, b, self.goals[b])):
-                    waits.add((a, b))
-        buffered = frozenset(
-            o for o, p in current.items() if cache.state.has(self.voc.buffer_pose, p)
-        )
-        done = frozenset(o for o, g in self.goals.items() if current.get(o) == g)
-        graph = DependencyGraph(remaining, tuple(edges))
-        layout = self._layout(remaining, current)
-        return TaskView(graph, done, buffered, frozenset(waits), len(self.home), layout)
-
-    def _layout(self, remaining: tuple[str, ...], current: dict[str, str]) -> Layout | None:
-        """With more than two arms and a :class:`~solvers.sdar.options.Plane`: the plane
-        positions of the remaining objects' poses and goals and of the arms' bases; None
-        otherwise, or when a pose is not one the plane locates."""
-        plane = self.options.plane
-        if plane is None or len(self.home) <= 2:
-            return None
-        arms = {a: self.cache.table.value(a) for a in sorted(self.home)}
-        if any(not isinstance(v, str) or v not in plane.bases for v in arms.values()):
-            return None
-        places = {}
-        for obj in remaining:
-            if obj not in current:
-                return None
-            here = plane.locate(self.cache.table.value(current[obj]))
-            goal = plane.locate(self.cache.table.value(self.goals[obj]))
-            if here is None or goal is None:
-                return None
-            places[obj] = (here, goal)
-        bases = tuple(plane.bases[str(v)] for v in arms.values())
-        return Layout(places, bases, plane.clearance)
+        """The dependency graph of the objects not at their goals, with the layout when the
+        cell has more than two arms (:func:`~solvers.sdar.viewing.current_view`)."""
+        return current_view(self.cache, self.goals, tuple(self.home), self.options.plane)
 
     # -- the loop ----------------------------------------------------------------------------
     def solve(self) -> Solution:
@@ -221,7 +170,8 @@ class SdarSolver:
         plan actions it added); the generator returns the :class:`Solution` (the plan of every
         step yielded, in order). The clock of ``max_time`` runs from the first ``next``, the
         caller's time between steps included."""
-        start = self.deadline.start()
+        self.deadline.start()  # on the budget's clock (options.clock)
+        start = time.perf_counter()  # the planning time: wall-clock seconds, whatever the budget's
         status = Status.SOLVED
         diagnosis: list[str] = []
         while True:

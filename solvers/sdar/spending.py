@@ -151,21 +151,23 @@ def moves_layout(layout: Layout, moves: Sequence[Move]) -> Layout:
 def spread_steps(view: TaskView, singles: Sequence[Step], gap: float) -> list[Step]:
     """The finish's candidates with more than two arms: ``singles`` (the one-arm candidates,
     in their order) preceded by one step that makes several of their moves at once, each
-    with the nearest arm still free (:func:`plane_seating`), when there is such a step.
+    with the nearest arm still free (:func:`plane_seating`), when there is such a step; when
+    that step holds buffer moves, then by the step grown from goal moves alone (the arm
+    nearest an object may reach no buffer, and a spread step gets that one seating).
 
-    Greedily from the first single's move, then the other singles' moves, then the goal
-    moves of the other objects left: a move joins while the step holds fewer moves than
-    ``view.arms`` and its arm's plane segments stay ``gap`` [m] from every other arm of the
-    step over the whole transfer (:meth:`~solvers.sdar.tasks.Layout.sweep_gap`: at the picks,
-    the places and between; a buffer move at its object's pose); a goal move when its goal is
-    free once the step's objects are lifted, it does not have to wait for an object still to
-    be placed (:meth:`~solvers.sdar.tasks.TaskView.must_wait`) and no object of the step waits
-    for it or it for one; a buffer move when its object lies on a dependency cycle that no
-    other buffer move of the step breaks (one buffer per cycle, as the one-arm rules spend).
-    Arms so far apart rarely meet, so the step's motion is found about as quickly as one
-    arm's, and up to ``view.arms`` one-move steps execute in the time of one. Without a
-    layout, with two arms or fewer, with ``gap`` 0 or with nothing to join: ``singles``
-    alone."""
+    Greedily from the first single's move, then the other singles' moves, then the goal moves of
+    the other objects left, pass after pass while a pass added a move (a goal freed by a move
+    added late: a chain's next link, lifted in the same step): a move joins while the step holds
+    fewer moves than ``view.arms`` and its arm's plane segments stay ``gap`` [m] from every
+    other arm of the step over the whole transfer (:meth:`~solvers.sdar.tasks.Layout.sweep_gap`:
+    at the picks, the places and between; a buffer move at its object's pose); a goal move when
+    its goal is free once the step's objects are lifted, it does not have to wait for an object
+    still to be placed (:meth:`~solvers.sdar.tasks.TaskView.must_wait`) and no object of the
+    step waits for it or it for one; a buffer move when its object lies on a dependency cycle
+    that no other buffer move of the step breaks (one buffer per cycle, as the one-arm rules
+    spend). Arms so far apart rarely meet, so the step's motion is found about as quickly as one
+    arm's, and up to ``view.arms`` one-move steps execute in the time of one. Without a layout,
+    with two arms or fewer, with ``gap`` 0 or with nothing to join: ``singles`` alone."""
     layout = view.layout
     if layout is None or view.arms <= 2 or gap <= 0 or not singles:
         return list(singles)
@@ -177,26 +179,66 @@ def spread_steps(view: TaskView, singles: Sequence[Step], gap: float) -> list[St
     }
     pool = [s.moves[0] for s in singles if len(s.moves) == 1]
     pool += [Move(o) for o in names if all(m.obj != o for m in pool)]
-    group: list[Move] = []
-    for move in pool:
-        obj = move.obj
-        if len(group) == view.arms:
-            break
-        if obj not in layout.places or any(m.obj == obj for m in group):
-            continue
-        if group and not _joins(view, group, move, cycle):
-            continue
-        trial = [*group, move]
-        seats = plane_seating(layout, trial)
-        plane = moves_layout(layout, trial)
-        if len(seats) == len(trial) and all(
-            plane.sweep_gap(seats[-1], obj, arm, m.obj) >= gap
-            for arm, m in zip(seats, group, strict=False)
-        ):
-            group.append(move)
+    group = _grow(view, layout, pool, cycle, gap)
     if len(group) < 2:
         return list(singles)
-    return [Step(tuple(group), "spread", singles[0].rank), *singles]
+    steps = [Step(tuple(group), "spread", singles[0].rank)]
+    if any(m.to_buffer for m in group):
+        to_goals = list(dict.fromkeys(Move(m.obj) for m in pool))
+        goals = _grow(view, layout, to_goals, cycle, gap, check_first=True)
+        if len(goals) >= 2 and set(goals) != set(group):
+            steps.append(Step(tuple(goals), "spread", singles[0].rank))
+    return [*steps, *singles]
+
+
+def _grow(
+    view: TaskView,
+    layout: Layout,
+    pool: Sequence[Move],
+    cycle: Mapping[str, int],
+    gap: float,
+    check_first: bool = False,
+) -> list[Move]:
+    """The moves of ``pool`` that join one step (:func:`_fits`), in pool order, pass after
+    pass while a pass added one (a goal freed by a move added late joins on the next pass: a
+    chain's next link), at most ``view.arms``. The first move is a one-arm candidate's,
+    taken as it is, unless ``check_first``."""
+    group: list[Move] = []
+    grown = True
+    while grown and len(group) < view.arms:
+        grown = False
+        for move in pool:
+            if len(group) == view.arms:
+                break
+            if _fits(view, layout, group, move, cycle, gap, check_first):
+                group.append(move)
+                grown = True
+    return group
+
+
+def _fits(
+    view: TaskView,
+    layout: Layout,
+    group: Sequence[Move],
+    move: Move,
+    cycle: Mapping[str, int],
+    gap: float,
+    check_first: bool = False,
+) -> bool:
+    """``move`` may join ``group`` (see :func:`spread_steps`): a new object the layout places,
+    allowed with the group's moves, its arm ``gap`` [m] from theirs."""
+    obj = move.obj
+    if obj not in layout.places or any(m.obj == obj for m in group):
+        return False
+    if (group or check_first) and not _joins(view, group, move, cycle):
+        return False
+    trial = [*group, move]
+    seats = plane_seating(layout, trial)
+    plane = moves_layout(layout, trial)
+    return len(seats) == len(trial) and all(
+        plane.sweep_gap(seats[-1], obj, arm, m.obj) >= gap
+        for arm, m in zip(seats, group, strict=False)
+    )
 
 
 def _joins(view: TaskView, group: Sequence[Move], move: Move, cycle: Mapping[str, int]) -> bool:

@@ -237,8 +237,9 @@ def time_parameterize(
         xv = np.min(np.where(np.abs(dq) > 1e-12, (v / np.abs(dq)) ** 2, np.inf), axis=1)
     if cap is not None:
         xv = np.minimum(xv, _grid_cap(s, cap, sg) ** 2)
-    a2 = np.concatenate([a, a])
-    rows = _accel_rows(dq, ddq, ds)
+    moving = np.any(dq != 0.0, axis=0) | np.any(ddq != 0.0, axis=0)  # a joint at rest
+    a2 = np.concatenate([a[moving], a[moving]])  # (an idle arm's) has rows of zeros that
+    rows = _accel_rows(dq[:, moving], ddq[:, moving], ds)  # bind nothing: left out
     vertices = _Vertices(*_constraints(rows, a2, ds), xv[:-1])
     xmax = np.zeros(n_grid)
     for i in range(n_grid - 2, -1, -1):

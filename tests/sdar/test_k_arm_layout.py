@@ -13,7 +13,7 @@ from sdar_tamp.app.problem import rearrangement_problem, table_plane
 from sdar_tamp.graph import DependencyGraph
 from sdar_tamp.world.instance import Pose2D, load_instance
 from solvers.sdar.abstract import view_of
-from solvers.sdar.k_steps import TaskScene, extend, extensions
+from solvers.sdar.k_steps import TaskScene, extend, extensions, merges
 from solvers.sdar.options import SdarOptions
 from solvers.sdar.sdar_t import SdarTaskPlanner
 from solvers.sdar.solver import SdarSolver
@@ -141,3 +141,44 @@ def test_assignments_whose_arms_cross_come_last() -> None:
         for arms in found
     ]
     assert crossings == sorted(crossings) and crossings[0] < crossings[-1]
+
+
+_Places = dict[str, tuple[tuple[float, float], tuple[float, float]]]
+
+
+def _ring(cx: float, cy: float, names: str) -> _Places:
+    """A tight 3-cycle at ``(cx, cy)``: each object's goal is the next one's pose."""
+    pts = [(cx, cy), (cx + 0.04, cy), (cx + 0.02, cy + 0.035)]
+    return {n: (pts[k], pts[(k + 1) % 3]) for k, n in enumerate(names)}
+
+
+def _rings_view(places: _Places, arms: int) -> TaskView:
+    names = tuple(sorted(places))
+    i = names.index
+    edges = tuple((i(x), i(y)) for x, y in ("ab", "bc", "ca", "de", "ef", "fd"))
+    layout = Layout(places, BASES[:arms], clearance=0.08)
+    return TaskView(DependencyGraph(names, edges), frozenset(), frozenset(), arms=arms,
+                    layout=layout)  # fmt: skip
+
+
+def test_two_cycle_breaks_far_apart_are_merged_into_one_step_of_four_arms() -> None:
+    """Two tight 3-cycles (their rotations meet) on the south and north halves: with four arms
+    the best step breaks both at once (two buffer moves, two goal moves); with three arms,
+    or the cycles side by side, one at a time."""
+    apart = {**_ring(-0.1, -0.3, "abc"), **_ring(0.1, 0.3, "def")}
+    four = SdarTaskPlanner().candidates(_rings_view(apart, 4))
+    best = four[0]
+    assert len(best.moves) == 4 and sum(m.to_buffer for m in best.moves) == 2
+    assert {best.objects[0], best.objects[1]} < set("abc") and set(best.objects[2:]) < set("def")
+    merged = merges(TaskScene(_rings_view(apart, 4)), four, 4)
+    assert merged and all(len(s.moves) == 4 for s in merged)
+    assert all(len(s.moves) == 2 for s in SdarTaskPlanner().candidates(_rings_view(apart, 3))[:6])
+    side_by_side = {**_ring(-0.05, -0.3, "abc"), **_ring(0.02, -0.3, "def")}
+    view = _rings_view(side_by_side, 4)
+    assert merges(TaskScene(view), SdarTaskPlanner().candidates(view), 4) == []
+    one_cycle = {**_ring(-0.1, -0.3, "abc")}
+    names = ("a", "b", "c")
+    graph = DependencyGraph(names, ((0, 1), (1, 2), (2, 0)))
+    lone = TaskView(graph, frozenset(), frozenset(), arms=4,
+                    layout=Layout(one_cycle, BASES, clearance=0.08))  # fmt: skip
+    assert merges(TaskScene(lone), SdarTaskPlanner().candidates(lone), 4) == []  # one component

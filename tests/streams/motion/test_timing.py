@@ -312,3 +312,19 @@ def test_pieces_joined_keep_the_limits_at_their_junctions(seed: int) -> None:
     assert len(traj.t) > 100
     assert np.all(np.diff(traj.t) > 0.0)
     assert _validator_ratio(traj.t, traj.q) <= 1.0 + 1e-9
+
+
+def test_joints_at_rest_stay_put_and_leave_the_others_timing_alone() -> None:
+    """An idle arm's joints (constant waypoints) bind nothing: they stay exactly where they
+    are, and the moving joints are timed as they would be alone (up to rounding)."""
+    rng = np.random.default_rng(7)
+    moving = np.cumsum(rng.normal(size=(9, 6)) * 0.2, axis=0)
+    full = np.hstack([np.full((9, 6), 0.3), moving, np.full((9, 12), -0.7)])
+    v, a = np.full(24, 3.0), np.full(24, 8.0)
+    both = time_parameterize(full, v, a)
+    alone = time_parameterize(moving, v[:6], a[:6])
+    assert np.allclose(both.q[:, :6], 0.3, rtol=0, atol=1e-12)
+    assert np.allclose(both.q[:, 12:], -0.7, rtol=0, atol=1e-12)
+    assert both.duration == pytest.approx(alone.duration, rel=1e-12)
+    assert both.t.shape == alone.t.shape and np.allclose(both.t, alone.t, rtol=0, atol=1e-12)
+    assert np.allclose(both.q[:, 6:12], alone.q, rtol=0, atol=1e-12)
