@@ -74,6 +74,7 @@ from sdar_tamp.schedule.move_records import (
     Stand,
 )
 from sdar_tamp.schedule.moves import CyclicMoves, Move, Pose, break_cycles, plan_moves
+from sdar_tamp.schedule.own_first import own_first, sync_spans
 from sdar_tamp.schedule.retiming import ArmRetimer
 from sdar_tamp.schedule.room import no_block
 from sdar_tamp.schedule.scheduler import (
@@ -84,6 +85,7 @@ from sdar_tamp.schedule.scheduler import (
     retimer,
 )
 from sdar_tamp.schedule.sweep import WorldSweep
+from sdar_tamp.schedule.sync_motions import SeededPlanner, sync_moves
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
 
@@ -132,9 +134,11 @@ class Assignment(MoveCommit):
         self.retreats = 0
         self.slack = assignment.slack
         self.estimated: dict[int, int] = {}  # move -> its estimated release [ticks]
+        self.spans = sync_spans(plan, moves)  # move -> its synchronous arm's time for it [s]
         self.in_way: set[int] = set()  # arms met by the failed attempts of the decision
         self.detours = 0
         self.detours_kept = 0
+        self.own = 0  # moves committed along the synchronous plan's own motions
         self.not_before = 0  # the least start of the reach being committed [ticks]
         self.stride = assignment.stride
         self.give_up_standing = True
@@ -177,8 +181,7 @@ class Assignment(MoveCommit):
                 raise NoPlacement(no_block(0), None, "out of collision checks or motion plans")
             if time.perf_counter() > self.deadline:
                 raise NoPlacement(no_block(0), None, "out of time")
-            arm = min(self.arms, key=lambda a: (self.horizon(a), a))
-            ranked = self.rank(arm, [m for m in pending if self.ready_move(m)])
+            arm, ranked = self.free_arm([m for m in pending if self.ready_move(m)])
             self.in_way = set()
             done = self.choose(arm, ranked[: self.options.candidates])
             for clear in (self.back_off, self.clear_way):
@@ -191,6 +194,18 @@ class Assignment(MoveCommit):
             elif not self.make_room(arm):
                 self.wait(arm)
         return self.assemble()
+
+    def free_arm(self, ready: list[Move]) -> tuple[int, list[Move]]:
+        """The arm whose timeline ends first and its ranked candidates (policy
+        ``own-first``: of the arms whose timelines end first, the first that has any)."""
+        first = sorted(self.arms, key=lambda a: (self.horizon(a), a))
+        ranked = self.rank(first[0], ready)
+        for a in first[1:]:
+            if ranked or self.policy != "own-first" or self.horizon(a) > self.horizon(first[0]):
+                break
+            if found := self.rank(a, ready):
+                return a, found
+        return first[0], ranked
 
     def make_room(self, arm: int) -> bool:
         """``arm`` found no move: it retreats when it stands at a grasp or release
@@ -225,7 +240,10 @@ class Assignment(MoveCommit):
 
     def rank(self, arm: int, ready: list[Move]) -> list[Move]:
         """``ready`` moves the arm can do, by estimated finishing time (ties: the arm's own;
-        policy ``plan-order``: by their order in the synchronous plan)."""
+        policy ``plan-order``: by their order in the synchronous plan; ``own-first``: see
+        :mod:`.own_first`)."""
+        if self.policy == "own-first":
+            return own_first(self, arm, ready)
         h = self.horizon(arm) * self.tick
         scored: list[tuple[float, int, int, Move]] = []
         for m in ready:
@@ -287,6 +305,7 @@ class Assignment(MoveCommit):
         self.grasp_tick[m.index] = self.tick_of(grasp)
         self.release_tick[m.index] = self.tick_of(release_event)
         self.carrier[m.index] = arm
+        self.own += id(planned) in getattr(self.planner, "offered", ())
         self.rest[m.obj] = m.end
         self.stand[arm] = planned.end
         self.parked[arm] = False
@@ -294,7 +313,8 @@ class Assignment(MoveCommit):
 
     def figures(self) -> tuple[tuple[str, float], ...]:
         """Moves committed and how many went to another arm than in the synchronous plan,
-        motion plans made and their time [s], waits for the next event, trips home."""
+        motion plans made and their time [s], waits for the next event, trips home, moves
+        done along the synchronous plan's own motions."""
         moved = {m.index: m.arm for m in self.moves}
         return (
             ("moves", float(len(self.carrier))),
@@ -308,6 +328,7 @@ class Assignment(MoveCommit):
             ("detours", float(self.detours)),
             ("detours_kept", float(self.detours_kept)),
             ("paused", float(self.paused)),
+            ("sync_motions", float(self.own)),
         )
 
 
@@ -335,9 +356,12 @@ def schedule_assigned(
         )
 
     try:
-        moves = break_cycles(plan_moves(plan, instance, sweep, margin), planner.buffer)
+        made = plan_moves(plan, instance, sweep, margin)
+        moves = break_cycles(made, planner.buffer)
     except CyclicMoves as exc:
         return kept(str(exc), None)
+    if assignment.sync_motions:
+        planner = SeededPlanner(planner, sync_moves(plan, moves, made))
     retimers = [retimer(scene, i, options) for i in range(len(scene.arms))]
     limited = dataclasses.replace(
         options, max_checks=assignment.max_checks, max_wait=assignment.max_wait

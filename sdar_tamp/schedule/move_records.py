@@ -77,8 +77,10 @@ class MovePlanner(Protocol):
 #: (by the planner's estimate); ``clear``: the same, and an arm leaves every grasp or release
 #: spot as soon as it has let go (its short retreat), and goes home when it finds no move, so
 #: it does not stand where another arm's move must go; ``plan-order``: the ready move that
-#: comes first in the synchronous plan (another order of the same moves).
-POLICIES = ("earliest", "clear", "plan-order")
+#: comes first in the synchronous plan (another order of the same moves); ``own-first``: the
+#: arm's own next move of the synchronous plan, another arm's only where that ends it
+#: earlier (:mod:`.own_first`).
+POLICIES = ("earliest", "clear", "plan-order", "own-first")
 
 
 @dataclass(frozen=True)
@@ -95,7 +97,8 @@ class AssignmentOptions:
     stop on the way and wait there (:mod:`.move_commit`); ``policies``: the ways of choosing
     the next move (:data:`POLICIES`), each searched in turn, the shortest schedule kept;
     ``max_seconds`` [s]: the wall-clock time of the whole search, every policy together
-    (past it the best schedule found so far is returned)."""
+    (past it the best schedule found so far is returned); ``sync_motions``: a move carried
+    by its synchronous arm is offered the plan's own motion first (:mod:`.sync_motions`)."""
 
     candidates: int = 3
     stride: int = 5
@@ -105,8 +108,9 @@ class AssignmentOptions:
     replans: int = 1
     slack: float = math.inf
     pauses: bool = True
-    policies: tuple[str, ...] = POLICIES
+    policies: tuple[str, ...] = ("own-first", "earliest", "clear", "plan-order")
     max_seconds: float = 300.0
+    sync_motions: bool = True
 
     def __post_init__(self) -> None:
         bad = [p for p in self.policies if p not in POLICIES]
