@@ -4,10 +4,11 @@ idle arm only where that ends it earlier.
 The free arm (:mod:`.assignment`, step 1) takes its own next move, the first of the moves the
 synchronous plan gave it that is not committed yet, when that move is ready: with the plan's
 own motions (:mod:`.sync_motions`) the arms then run the plan's tasks, each on its own
-timeline, without the synchronous steps. When its own next move is not ready, or it has none
-left (an arm the plan left idle), it may take another arm's ready move, a whole task planned
-for it against the others' committed trajectories as any other move: only a move it would
-finish earlier than its owner by :data:`STEAL_GAIN` or more. The owner finishes the move after
+timeline, without the synchronous steps; when that move is not ready, it waits for the next
+event. When it has no move of its own left (an arm the plan left idle, or one done with its
+share), it may take another arm's ready move, a whole task planned for it against the others'
+committed trajectories as any other move: only a move it would finish earlier than its owner
+by :data:`STEAL_GAIN` or more. The owner finishes the move after
 its own moves before it, each taking as long as in the synchronous plan (from the owner's
 previous release to the move's release; :func:`sync_spans`), from where the owner's timeline
 ends; the free arm finishes it after its rest-to-rest estimate (:meth:`MovePlanner.estimate`,
@@ -80,7 +81,9 @@ def own_first(search: Search, arm: int, ready: list[Move]) -> list[Move]:
     tick = search.tick
     dwell = search.dwell * tick
     h = search.horizon(arm) * tick
-    if own and any(m is own[0] for m in ready):
+    if own:  # its own next move, when it is ready
+        if not any(m is own[0] for m in ready):
+            return []
         search.estimated[own[0].index] = math.ceil((h + search.spans.get(own[0].index, 0.0)) / tick)
         return [own[0]]
     scored: list[tuple[float, int, Move]] = []

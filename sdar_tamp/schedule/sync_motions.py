@@ -13,9 +13,16 @@ it against the other arms' committed trajectories and the objects where they res
 other option). A move split through a buffer (:func:`~.moves.break_cycles`), or carried by
 another arm, has no such option.
 
+An arm whose own next move is not ready yet may go ahead along that move's reach to its
+pre-grasp and wait there (:meth:`SyncMove.to_pre_grasp`); an arm in the way of another's
+move goes ahead along its reach to where the plan had it when that move released its object
+(:meth:`SyncMove.until`): either way it leaves the spot it let go of, as in the plan.
+
 The arm then stands at the release configuration; its pre-grasp is the configuration where
-the plan's last rest-to-rest motion into the release began (the approach), and the way back
-out is that approach backwards.
+the plan's last rest-to-rest motion into the release began (the approach: a rest point of
+the path within :data:`APPROACH` of the release), and the way back out is that approach
+backwards. A plan whose carry is one smooth motion into the release has no such point: the
+arm's next motion (the plan's next reach, which leaves the spot as the plan did) leaves it.
 """
 
 from __future__ import annotations
@@ -28,11 +35,19 @@ import numpy as np
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.schedule.move_records import MovePlanner, PlannedMove, Stand
 from sdar_tamp.schedule.moves import Move, Pose
-from sdar_tamp.schedule.pieces import STEP_TOL
 from sdar_tamp.world.transforms import FloatArray
 
 #: [rad] an arm stands on a path when it is this close (every joint) to one of its samples
 ON_PATH = 1e-6
+#: a sample where the arm's steps on both sides are under this share of its largest step
+#: is a rest point of the path
+SLOW = 0.02
+#: [rad] the least path (summed largest joint steps) after a rest point taken for a
+#: pre-grasp (the slow straight end of an approach is shorter)
+REST_TRAVEL = 0.06
+#: [rad] a pre-grasp is this close to the grasp (every joint); a path without a rest point
+#: that close (one smooth motion into the grasp) has none
+APPROACH = 0.5
 
 
 @dataclass(frozen=True)
@@ -46,6 +61,26 @@ class SyncMove:
     carry: tuple[FloatArray, FloatArray]
     T_tcp_object: FloatArray
     end: Stand
+    t0: float = 0.0  #: [s] when the reach began in the plan
+
+    @property
+    def released(self) -> float:
+        """When the plan released the object [s]."""
+        return self.t0 + float(self.reach[0][-1] + self.carry[0][-1])
+
+    def until(self, q: FloatArray, t: float) -> tuple[FloatArray, FloatArray] | None:
+        """The reach from configuration ``q`` on it up to where the plan had the arm at time
+        ``t`` [s] (at most the sample before the grasp), or None when the arm stands there
+        already or not on the reach."""
+        planned = self.from_stand(q)
+        if planned is None:
+            return None
+        times, path = planned.reach
+        start = self.t0 + float(self.reach[0][-1] - times[-1])  # when the plan had it at q
+        j = min(int(np.searchsorted(times, t - start, side="right")) - 1, len(path) - 2)
+        if j <= 0:
+            return None
+        return times[: j + 1], np.array(path[: j + 1])
 
     def from_stand(self, q: FloatArray) -> PlannedMove | None:
         """The planned move from configuration ``q`` when the arm stands on the reach (its
@@ -60,17 +95,47 @@ class SyncMove:
         reach = (t[i:] - t[i], np.array(path[i:]))
         return PlannedMove(reach, self.carry, self.T_tcp_object, self.end)
 
+    def to_pre_grasp(self, q: FloatArray) -> tuple[FloatArray, FloatArray] | None:
+        """The reach from configuration ``q`` on it up to the pre-grasp (where the plan's last
+        rest-to-rest motion into the grasp began), or None when the arm does not stand on the
+        reach before that point."""
+        planned = self.from_stand(q)
+        if planned is None:
+            return None
+        t, path = planned.reach
+        k = _last_rest(t, path)
+        if k is None or k == 0:
+            return None
+        return t[: k + 1], np.array(path[: k + 1])
+
 
 def _last_rest(t: FloatArray, q: FloatArray) -> int | None:
-    """The last sample inside ``q`` ``(m, k)`` at ``t`` where a rest-to-rest motion begins
-    (the sampling step changes there, :mod:`.pieces`) and from which the arm moves on; None
-    when there is none."""
-    h = np.diff(t)
-    change = np.flatnonzero(np.abs(np.diff(h)) > STEP_TOL) + 1
-    for k in change[::-1]:
-        if np.abs(q[-1] - q[int(k)]).max() > ON_PATH:
-            return int(k)
+    """The last sample inside ``q`` ``(m, k)`` (times ``t``) where the arm comes to rest
+    (its steps on both sides under :data:`SLOW` of its largest, a local minimum) with more
+    than :data:`REST_TRAVEL` [rad] of its path still ahead: where its last rest-to-rest motion
+    into the end began; None when there is none."""
+    steps = np.abs(np.diff(q, axis=0)).max(axis=1)
+    peak = float(steps.max(initial=0.0))
+    ahead = np.cumsum(steps[::-1])[::-1]  # path left from each sample
+    for k in range(len(q) - 2, 0, -1):
+        if ahead[k] <= REST_TRAVEL:
+            continue
+        if np.abs(q[-1] - q[k]).max() > APPROACH:
+            return None
+        around = steps[k - 1] + steps[k]
+        if (
+            max(steps[k - 1], steps[k]) <= SLOW * peak
+            and around <= (steps[k - 2] + steps[k - 1] if k >= 2 else np.inf)
+            and around <= steps[k] + steps[k + 1]
+        ):
+            return k
     return None
+
+
+def _moving(q: FloatArray) -> FloatArray:
+    """The rows of ``q`` ``(m, k)`` without those equal to the one before (the arm still)."""
+    keep = np.concatenate([[True], np.abs(np.diff(q, axis=0)).max(axis=1) > 0.0])
+    return np.array(q[keep])
 
 
 def sync_moves(plan: PlanFile, moves: Sequence[Move], made: Sequence[Move]) -> dict[int, SyncMove]:
@@ -109,11 +174,12 @@ def sync_moves(plan: PlanFile, moves: Sequence[Move], made: Sequence[Move]) -> d
         reach = (plan.t[first : g + 1] - plan.t[first], np.array(q[first : g + 1]))
         pre = _last_rest(*carry)
         end = (
-            Stand(np.array(q[r]))
+            Stand(np.array(q[r]), event=True)
             if pre is None
-            else Stand(np.array(q[r]), np.array(carry[1][pre]), carry[1][pre:][::-1].copy())
+            else Stand(np.array(q[r]), np.array(carry[1][pre]), _moving(carry[1][pre:][::-1]))
         )
-        out[m.index] = SyncMove(reach, carry, np.array(grasp.T_tcp_object), end)
+        t0 = float(plan.t[first])
+        out[m.index] = SyncMove(reach, carry, np.array(grasp.T_tcp_object), end, t0)
     return out
 
 
@@ -155,4 +221,4 @@ class SeededPlanner:
         return self.planner.park(arm, stand, resting, others)
 
 
-__all__ = ["ON_PATH", "SeededPlanner", "SyncMove", "sync_moves"]
+__all__ = ["APPROACH", "ON_PATH", "REST_TRAVEL", "SLOW", "SeededPlanner", "SyncMove", "sync_moves"]

@@ -53,8 +53,24 @@ def test_each_move_of_the_plan_has_its_own_synchronous_motion(
         assert sync.reach[0][0] == 0.0 and np.all(np.diff(sync.carry[0]) > 0.0)
         assert np.allclose(sync.T_tcp_object, grasp.T_tcp_object)
         end = sync.end
-        assert end.pre is not None and end.back is not None
-        assert np.allclose(end.back[0], end.q) and np.allclose(end.back[-1], end.pre)
+        assert end.leaving  # its next motion leaves a gripper event
+        if end.pre is not None:  # the way back out: the approach backwards
+            assert end.back is not None and np.allclose(end.back[-1], end.pre)
+            assert np.allclose(end.back[0], end.q)
+        else:  # one smooth motion into the release
+            assert end.event and end.back is None
+        # when the plan released the object; where it had the arm at a time of the reach
+        release = next(e for e in plan.events if e.type == "release" and e.t > m.sync_t)
+        assert sync.released == pytest.approx(release.t, abs=1e-6)
+        q0 = sync.reach[1][0]
+        assert sync.until(q0, sync.t0) is None  # there already
+        half = sync.until(q0, sync.t0 + 0.5 * float(sync.reach[0][-1]))
+        if half is not None:
+            assert np.allclose(half[1][0], q0) and len(half[1]) < len(sync.reach[1])
+        whole = sync.until(q0, sync.released)
+        rest_of = sync.from_stand(q0)
+        assert rest_of is not None and whole is not None
+        assert len(whole[1]) == len(rest_of.reach[1]) - 1  # short of the grasp
         # from anywhere on the reach: the rest of it; off the path: no option
         mid = len(sync.reach[1]) // 2
         rest = sync.from_stand(sync.reach[1][mid])
@@ -148,17 +164,29 @@ def test_an_idle_arm_takes_another_s_move_only_where_that_ends_it_earlier() -> N
     assert own_first(FakeSearch(est=None), 1, list(slow.moves)) == []  # type: ignore[arg-type]
 
 
-def test_the_own_first_policy_replays_and_uses_the_plan_s_motions(
+def test_the_own_first_policy_keeps_the_plan_s_tasks_and_motions(
     ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
 ) -> None:
+    """Each arm carries its own moves of the plan along the plan's own motions, in the plan's
+    order per arm; what is returned replays (the synchronous plan when the search is stuck:
+    here the last move waits for an arm standing at its spot)."""
     instance, plan, planner = r5
     options = AssignmentOptions(policies=("own-first",), max_seconds=math.inf)
     s = schedule_assigned(plan, instance, ctx.scene, execution_options(ctx.scene), planner, options)
-    assert s.async_duration is not None, s.reason
     figures = dict(s.figures)
-    assert figures["sync_motions"] > 0  # moves done along the plan's own motions
-    if s.asynchronous:
-        assert s.plan.duration < plan.duration
-        assert validate_plan(instance, s.plan, ctx.scene).ok
+    assert figures["sync_motions"] >= 4 and figures["reassigned"] == 0.0
+    assert validate_plan(instance, s.plan, ctx.scene).ok
+    assert s.asynchronous == (s.async_duration is not None and s.async_duration < plan.duration)
     search = new_search(ctx, instance, plan, planner)
-    assert search.policy == "earliest"
+    search.planner = SeededPlanner(planner, sync_moves(plan, search.moves, search.moves))
+    search.policy = "own-first"
+    arm, ranked = search.free_arm([m for m in search.moves if search.ready_move(m)])
+    assert ranked and ranked[0].arm == arm  # its own move first
+    order = {a: [m.index for m in search.moves if m.arm == a] for a in search.arms}
+    assert ranked[0].index == order[arm][0]
+    # without the plan's motions offered, the default policies use none
+    plain = schedule_assigned(
+        plan, instance, ctx.scene, execution_options(ctx.scene), planner,
+        AssignmentOptions(policies=("earliest",), max_seconds=math.inf),
+    )  # fmt: skip
+    assert dict(plain.figures)["sync_motions"] == 0.0
