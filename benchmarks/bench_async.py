@@ -20,12 +20,13 @@ together at their synchronous pace (swap halves), ``cut`` the time [s] shortened
     python benchmarks/bench_async.py [--suite paper] [--only R4,R6,D5] [--plans DIR] [--save]
                                      [--time-limit 60] [--sync-pace] [--assign-seconds 300]
                                      [--policies own-first,earliest,clear,plan-order]
-                                     [--no-pauses] [--no-sync-motions]
+                                     [--no-pauses] [--sync-motions]
 
 ``--assign-seconds`` caps the assignment's wall-clock time per instance (the result then
 depends on the machine's load), ``--policies`` chooses its policies, ``--no-pauses`` keeps
-motions from pausing on the way, ``--no-sync-motions`` offers no move the synchronous plan's own
-motion (:mod:`sdar_tamp.schedule.sync_motions`); the note gives each policy's schedule [s].
+motions from pausing on the way, ``--sync-motions`` offers a move the synchronous plan's own
+motion first (:mod:`sdar_tamp.schedule.sync_motions`; always with ``--policies own-first``);
+the note gives each policy's schedule [s].
 
 ``--suite`` may be a suite of the shared table's cells (``table_1arm`` ... ``table_4arm``: each
 instance names its cell).
@@ -97,9 +98,9 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("--no-pauses", action="store_true", help="motions do not pause on the way")
     ap.add_argument(
-        "--no-sync-motions",
+        "--sync-motions",
         action="store_true",
-        help="no move is offered the synchronous plan's own motion first",
+        help="offer a move the synchronous plan's own motion first",
     )
     ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
     args = ap.parse_args(argv)
@@ -111,7 +112,7 @@ def main(argv: list[str] | None = None) -> None:
         max_seconds=args.assign_seconds,
         policies=tuple(p for p in args.policies.split(",") if p),
         pauses=not args.no_pauses,
-        sync_motions=not args.no_sync_motions,
+        sync_motions=args.sync_motions,
     )
     files = [p for p in shipped_suite_files(args.suite) if not only or p.stem in only]
     cache = PlannerCache()
