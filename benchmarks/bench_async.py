@@ -19,11 +19,14 @@ together at their synchronous pace (swap halves), ``cut`` the time [s] shortened
 
     python benchmarks/bench_async.py [--suite paper] [--only R4,R6,D5] [--plans DIR] [--save]
                                      [--time-limit 60] [--sync-pace] [--assign-seconds 300]
-                                     [--policies earliest,clear,plan-order] [--no-pauses]
+                                     [--policies own-first,earliest,clear,plan-order]
+                                     [--no-pauses] [--sync-motions]
 
 ``--assign-seconds`` caps the assignment's wall-clock time per instance (the result then
 depends on the machine's load), ``--policies`` chooses its policies, ``--no-pauses`` keeps
-motions from pausing on the way; the note gives each policy's schedule [s].
+motions from pausing on the way, ``--sync-motions`` offers a move the synchronous plan's own
+motion first (:mod:`sdar_tamp.schedule.sync_motions`; always with ``--policies own-first``);
+the note gives each policy's schedule [s].
 
 ``--suite`` may be a suite of the shared table's cells (``table_1arm`` ... ``table_4arm``: each
 instance names its cell).
@@ -90,10 +93,15 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument(
         "--policies",
-        default=",".join(POLICIES),
+        default=",".join(AssignmentOptions().policies),
         help=f"the assignment's policies, tried in turn (some of {','.join(POLICIES)})",
     )
     ap.add_argument("--no-pauses", action="store_true", help="motions do not pause on the way")
+    ap.add_argument(
+        "--sync-motions",
+        action="store_true",
+        help="offer a move the synchronous plan's own motion first",
+    )
     ap.add_argument("--quick", action="store_true", help="one small instance (R4): seconds")
     args = ap.parse_args(argv)
     if args.quick:  # explicit options still win
@@ -104,6 +112,7 @@ def main(argv: list[str] | None = None) -> None:
         max_seconds=args.assign_seconds,
         policies=tuple(p for p in args.policies.split(",") if p),
         pauses=not args.no_pauses,
+        sync_motions=args.sync_motions,
     )
     files = [p for p in shipped_suite_files(args.suite) if not only or p.stem in only]
     cache = PlannerCache()

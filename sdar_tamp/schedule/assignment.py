@@ -60,6 +60,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -74,6 +75,7 @@ from sdar_tamp.schedule.move_records import (
     Stand,
 )
 from sdar_tamp.schedule.moves import CyclicMoves, Move, Pose, break_cycles, plan_moves
+from sdar_tamp.schedule.own_first import own_first, sync_spans
 from sdar_tamp.schedule.retiming import ArmRetimer
 from sdar_tamp.schedule.room import no_block
 from sdar_tamp.schedule.scheduler import (
@@ -84,6 +86,7 @@ from sdar_tamp.schedule.scheduler import (
     retimer,
 )
 from sdar_tamp.schedule.sweep import WorldSweep
+from sdar_tamp.schedule.sync_motions import SeededPlanner, sync_moves
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.scene import Scene
 
@@ -132,9 +135,11 @@ class Assignment(MoveCommit):
         self.retreats = 0
         self.slack = assignment.slack
         self.estimated: dict[int, int] = {}  # move -> its estimated release [ticks]
+        self.spans = sync_spans(plan, moves)  # move -> its synchronous arm's time for it [s]
         self.in_way: set[int] = set()  # arms met by the failed attempts of the decision
         self.detours = 0
         self.detours_kept = 0
+        self.own = 0  # moves committed along the synchronous plan's own motions
         self.not_before = 0  # the least start of the reach being committed [ticks]
         self.stride = assignment.stride
         self.give_up_standing = True
@@ -177,11 +182,13 @@ class Assignment(MoveCommit):
                 raise NoPlacement(no_block(0), None, "out of collision checks or motion plans")
             if time.perf_counter() > self.deadline:
                 raise NoPlacement(no_block(0), None, "out of time")
-            arm = min(self.arms, key=lambda a: (self.horizon(a), a))
-            ranked = self.rank(arm, [m for m in pending if self.ready_move(m)])
+            arm, ranked = self.free_arm([m for m in pending if self.ready_move(m)])
             self.in_way = set()
             done = self.choose(arm, ranked[: self.options.candidates])
-            for clear in (self.back_off, self.clear_way):
+            clears: tuple[Callable[[int], bool], ...] = (self.back_off, self.clear_way)
+            if self.policy == "own-first":  # the arms in the way go ahead, as in the plan
+                clears = (self.go_ahead, *clears)
+            for clear in clears:
                 if done is None and ranked and clear(arm):
                     done = next((m for m in ranked[:1] if self.take(arm, m)), None)
             if done is not None:
@@ -192,13 +199,60 @@ class Assignment(MoveCommit):
                 self.wait(arm)
         return self.assemble()
 
+    def free_arm(self, ready: list[Move]) -> tuple[int, list[Move]]:
+        """The arm whose timeline ends first and its ranked candidates (policy
+        ``own-first``: of the arms whose timelines end first, the first whose candidate is its
+        own move, else the first that has any; when every arm's timeline ends there and none
+        has any, the first one's by ``earliest``)."""
+        first = sorted(self.arms, key=lambda a: (self.horizon(a), a))
+        ranked = self.rank(first[0], ready)
+        if self.policy != "own-first":
+            return first[0], ranked
+        now = [(a, self.rank(a, ready)) for a in first if self.horizon(a) == self.horizon(first[0])]
+        own = [(a, r) for a, r in now if r and r[0].arm == a]
+        some = [(a, r) for a, r in now if r]
+        if own or some:
+            return (own or some)[0]
+        if len(now) < len(first):
+            return first[0], ranked
+        return first[0], self.rank(first[0], ready, "earliest")  # none would move: any
+
     def make_room(self, arm: int) -> bool:
         """``arm`` found no move: it retreats when it stands at a grasp or release
         configuration, and (policy ``clear``) goes home when it stands elsewhere in the
         workspace; whether it moved."""
         if self.stand[arm].pre is not None and self.retreat(arm):
             return True
+        if self.policy == "own-first" and self.advance(arm):
+            return True
         return self.policy == "clear" and not self.parked[arm] and self.park(arm)
+
+    def advance(self, arm: int, until: float | None = None) -> bool:
+        """Move ``arm`` along its own next move's synchronous reach to the pre-grasp
+        (:meth:`~.sync_motions.SyncMove.to_pre_grasp`), or to where the plan had it at time
+        ``until`` [s] (:meth:`~.sync_motions.SyncMove.until`); whether it did."""
+        own = min((m for m in self.moves if m.arm == arm and m.index not in self.carrier),
+                  key=lambda m: m.index, default=None)  # fmt: skip
+        sync = None if own is None else getattr(self.planner, "motions", {}).get(own.index)
+        q = self.stand[arm].q
+        if sync is None:
+            return False
+        path = sync.to_pre_grasp(q) if until is None else sync.until(q, until)
+        if path is None:
+            return False
+        leaving = self.stand[arm].leaving
+        return self._commit(arm, self.retimers[arm].retime(path[0], path[1], leaving, False))
+
+    def go_ahead(self, arm: int) -> bool:
+        """Let the other arms in the way (:meth:`blocking`) go ahead along their own next
+        move's reach to where the plan had them when ``arm``'s next move released its object
+        (:meth:`advance`); whether any did."""
+        nxt = min((m for m in self.moves if m.arm == arm and m.index not in self.carrier),
+                  key=lambda m: m.index, default=None)  # fmt: skip
+        sync = None if nxt is None else getattr(self.planner, "motions", {}).get(nxt.index)
+        if sync is None:
+            return False
+        return sum(self.advance(a, sync.released) for a in self.blocking(arm)) > 0
 
     def choose(self, arm: int, ranked: list[Move]) -> Move | None:
         """Commit the first of ``ranked`` that releases its object within ``slack`` [s] of
@@ -223,9 +277,13 @@ class Assignment(MoveCommit):
                 return m
         return None
 
-    def rank(self, arm: int, ready: list[Move]) -> list[Move]:
+    def rank(self, arm: int, ready: list[Move], policy: str | None = None) -> list[Move]:
         """``ready`` moves the arm can do, by estimated finishing time (ties: the arm's own;
-        policy ``plan-order``: by their order in the synchronous plan)."""
+        policy ``plan-order``: by their order in the synchronous plan; ``own-first``: see
+        :mod:`.own_first`)."""
+        policy = policy or self.policy
+        if policy == "own-first":
+            return own_first(self, arm, ready)
         h = self.horizon(arm) * self.tick
         scored: list[tuple[float, int, int, Move]] = []
         for m in ready:
@@ -236,7 +294,7 @@ class Assignment(MoveCommit):
             finish = (
                 max(max(h, grasp) + est + self.dwell * self.tick, release) + self.dwell * self.tick
             )
-            first = m.index if self.policy == "plan-order" else round(finish / TIE)
+            first = m.index if policy == "plan-order" else round(finish / TIE)
             scored.append((first, m.arm != arm, m.index, m))
             self.estimated[m.index] = math.ceil((finish - self.dwell * self.tick) / self.tick)
         scored.sort(key=lambda s: s[:3])
@@ -260,8 +318,8 @@ class Assignment(MoveCommit):
                 arm, m, self.planner.plan(arm, self.stand[arm], m, resting, others)
             )
             for _ in range(self.options.replans):
-                if got is None or got[1] is None:
-                    break
+                if got is None or got[1] is None or self.is_own(got[0][0]):
+                    break  # the plan's own motion is not planned again
                 release, conflict = self.tick_of(got[0][2]), got[1]
                 dodge = list(others)
                 for a in self.arms:
@@ -287,14 +345,20 @@ class Assignment(MoveCommit):
         self.grasp_tick[m.index] = self.tick_of(grasp)
         self.release_tick[m.index] = self.tick_of(release_event)
         self.carrier[m.index] = arm
+        self.own += self.is_own(planned)
         self.rest[m.obj] = m.end
         self.stand[arm] = planned.end
         self.parked[arm] = False
         return True
 
+    def is_own(self, planned: PlannedMove) -> bool:
+        """Whether ``planned`` is the synchronous plan's own motion (:mod:`.sync_motions`)."""
+        return id(planned) in getattr(self.planner, "offered", ())
+
     def figures(self) -> tuple[tuple[str, float], ...]:
         """Moves committed and how many went to another arm than in the synchronous plan,
-        motion plans made and their time [s], waits for the next event, trips home."""
+        motion plans made and their time [s], waits for the next event, trips home, moves
+        done along the synchronous plan's own motions."""
         moved = {m.index: m.arm for m in self.moves}
         return (
             ("moves", float(len(self.carrier))),
@@ -308,6 +372,7 @@ class Assignment(MoveCommit):
             ("detours", float(self.detours)),
             ("detours_kept", float(self.detours_kept)),
             ("paused", float(self.paused)),
+            ("sync_motions", float(self.own)),
         )
 
 
@@ -335,9 +400,12 @@ def schedule_assigned(
         )
 
     try:
-        moves = break_cycles(plan_moves(plan, instance, sweep, margin), planner.buffer)
+        made = plan_moves(plan, instance, sweep, margin)
+        moves = break_cycles(made, planner.buffer)
     except CyclicMoves as exc:
         return kept(str(exc), None)
+    if assignment.sync_motions or "own-first" in assignment.policies:
+        planner = SeededPlanner(planner, sync_moves(plan, moves, made))
     retimers = [retimer(scene, i, options) for i in range(len(scene.arms))]
     limited = dataclasses.replace(
         options, max_checks=assignment.max_checks, max_wait=assignment.max_wait

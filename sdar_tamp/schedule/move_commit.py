@@ -71,7 +71,7 @@ class MoveCommit(Room):
             if limit is not None and n >= limit:
                 break
             self.plans += 1
-            leaving = self.stand[arm].pre is not None
+            leaving = self.stand[arm].leaving
             reach = timer.retime(*planned.reach, leaving, True)
             carry = timer.retime(*planned.carry, True, True)
             grasp = PlanEvent(0.0, name, "grasp", m.obj, planned.T_tcp_object)

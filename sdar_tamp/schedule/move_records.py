@@ -20,11 +20,18 @@ class Stand:
     configuration, ``pre`` ``(k,)`` (the pre-grasp it must retreat through), else None;
     ``back``: the path (configurations ``(m, k)``) from ``q`` out to ``pre`` along the
     approach that brought the arm there, when known (else a straight joint-space segment is
-    taken)."""
+    taken); ``event``: it stands where its gripper acted last, with no pre-grasp known (its
+    next motion leaves slowly all the same)."""
 
     q: FloatArray
     pre: FloatArray | None = None
     back: FloatArray | None = None
+    event: bool = False
+
+    @property
+    def leaving(self) -> bool:
+        """Whether the arm's next motion leaves a gripper event."""
+        return self.pre is not None or self.event
 
 
 @dataclass(frozen=True)
@@ -77,8 +84,10 @@ class MovePlanner(Protocol):
 #: (by the planner's estimate); ``clear``: the same, and an arm leaves every grasp or release
 #: spot as soon as it has let go (its short retreat), and goes home when it finds no move, so
 #: it does not stand where another arm's move must go; ``plan-order``: the ready move that
-#: comes first in the synchronous plan (another order of the same moves).
-POLICIES = ("earliest", "clear", "plan-order")
+#: comes first in the synchronous plan (another order of the same moves); ``own-first``: the
+#: arm's own next move of the synchronous plan, another arm's only where that ends it
+#: earlier (:mod:`.own_first`), and it leaves every spot it lets go of at once, as ``clear``.
+POLICIES = ("earliest", "clear", "plan-order", "own-first")
 
 
 @dataclass(frozen=True)
@@ -95,7 +104,9 @@ class AssignmentOptions:
     stop on the way and wait there (:mod:`.move_commit`); ``policies``: the ways of choosing
     the next move (:data:`POLICIES`), each searched in turn, the shortest schedule kept;
     ``max_seconds`` [s]: the wall-clock time of the whole search, every policy together
-    (past it the best schedule found so far is returned)."""
+    (past it the best schedule found so far is returned); ``sync_motions``: a move carried
+    by its synchronous arm is offered the plan's own motion first (:mod:`.sync_motions`;
+    always with policy ``own-first``)."""
 
     candidates: int = 3
     stride: int = 5
@@ -105,8 +116,9 @@ class AssignmentOptions:
     replans: int = 1
     slack: float = math.inf
     pauses: bool = True
-    policies: tuple[str, ...] = POLICIES
+    policies: tuple[str, ...] = ("earliest", "clear", "plan-order")
     max_seconds: float = 300.0
+    sync_motions: bool = False
 
     def __post_init__(self) -> None:
         bad = [p for p in self.policies if p not in POLICIES]
