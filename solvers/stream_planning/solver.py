@@ -163,7 +163,10 @@ class StreamSolver:
                 if not policy.waiting and self._complete(world):
                     self._end(f"{missed}; nothing is left out: infeasible")
                     return Status.INFEASIBLE
-                if not policy.lazy and not policy.waiting and world.more_calls:
+                if not policy.lazy and not policy.waiting and world.more_calls and world.complete:
+                    # every instance is in the world but later calls' outputs: call samplers
+                    # for real (PDDLStream calls nothing between levels; it would end here
+                    # infeasible, its instances offering one output each)
                     context.drain(level)
                 level += options.complexity_step
                 if not policy.lazy and level < world.next_level < math.inf:
