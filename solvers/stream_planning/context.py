@@ -282,8 +282,12 @@ class SolveContext:
         self.deferred_calls += calls
         return calls
 
-    def drain(self, level: int) -> int:
+    def drain(self, level: int, called_only: bool = False) -> int:
         """No new plan at ``level`` while some samplers could still give more: call them.
+        With ``called_only``, only instances called before (by a skeleton): the loop asks for
+        that while the optimistic world leaves instances out above the level, as PDDLStream
+        samples only its skeletons' streams between levels (an instance no plan wanted
+        stays optimistic, and its real values do not swell the next searches).
 
         The real instances of streams with outputs that may answer more than once (not
         fluent, not single-answer adapters, no callable ``opt_gen_fn``), within the level
@@ -316,6 +320,7 @@ class SolveContext:
                 external = instance.external
                 if (
                     instance.exhausted
+                    or (called_only and not instance.calls)
                     or instance.disabled
                     or state.next_level > limit
                     or not external.declaration.outputs

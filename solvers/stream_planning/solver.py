@@ -163,11 +163,14 @@ class StreamSolver:
                 if not policy.waiting and self._complete(world):
                     self._end(f"{missed}; nothing is left out: infeasible")
                     return Status.INFEASIBLE
-                if not policy.lazy and not policy.waiting and world.more_calls and world.complete:
-                    # every instance is in the world but later calls' outputs: call samplers
-                    # for real (PDDLStream calls nothing between levels; it would end here
-                    # infeasible, its instances offering one output each)
-                    context.drain(level)
+                if not policy.lazy and not policy.waiting and world.more_calls:
+                    # once a skeleton was made, and while the world leaves instances out above
+                    # the level, only instances a skeleton called get more calls (PDDLStream
+                    # samples its skeletons' streams between levels, no other); before the
+                    # first skeleton, or once every instance is in but later calls' outputs,
+                    # all of them (PDDLStream would end there, infeasible)
+                    called_only = stats.skeletons > 0 and not world.complete
+                    context.drain(level, called_only=called_only)
                 level += options.complexity_step
                 if not policy.lazy and level < world.next_level < math.inf:
                     # the levels between add nothing to the optimistic world: skip them

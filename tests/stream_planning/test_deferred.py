@@ -272,9 +272,7 @@ def test_navigation_and_manipulation_calls_follow_the_plan(mode: str) -> None:
         verbose=False,
     )
     assert eager.solved
-    # eager: every combination of the values known (1,296 calls, 36 squared); deferred: a few
-    # dozen (the candidate plans' instances and the siblings of a failed one)
-    assert test * 20 < eager.streams["test-collision-free"].calls
+    assert test * 100 < eager.streams["test-collision-free"].calls
     assert cost * 10 < eager.streams["handlingcost"].calls
     assert math.isfinite(deferred.cost)
 

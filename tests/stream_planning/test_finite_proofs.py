@@ -178,3 +178,17 @@ def test_a_drain_of_fast_samplers_makes_its_counted_calls() -> None:
     context.searched = 15
     assert context.drain(5) == 15  # the budget, however long the last search took
     context.runner.close()
+
+
+def test_a_drain_of_called_instances_leaves_the_others_alone() -> None:
+    """``called_only``: only instances called before get more calls (the others none)."""
+    context = _slow_sampler_context(0.0)
+    context.searched = 6
+    assert context.drain(50, called_only=True) == 0  # nothing called yet
+    first = context.engine.instances[context.engine.instance_keys[0]]
+    context.sample(first)
+    assert context.drain(50, called_only=True) == 6
+    assert first.instance.calls == 7
+    others = [context.engine.instances[k] for k in context.engine.instance_keys[1:]]
+    assert all(s.instance.calls == 0 for s in others)
+    context.runner.close()
