@@ -192,3 +192,12 @@ def test_a_drain_of_called_instances_leaves_the_others_alone() -> None:
     others = [context.engine.instances[k] for k in context.engine.instance_keys[1:]]
     assert all(s.instance.calls == 0 for s in others)
     context.runner.close()
+
+
+def test_a_guessing_drain_stops_at_drain_seconds_whatever_the_searches_took() -> None:
+    """Before the first skeleton (``guess``): samplers of 0.3 s a call after searches of 10 s
+    get DRAIN_SECONDS (0.5 s: two calls at most), not the searches' share (10 s)."""
+    context = _slow_sampler_context(0.3)
+    context.search_seconds = 10.0
+    assert 1 <= context.drain(0, guess=True) <= 2
+    context.runner.close()
