@@ -282,8 +282,14 @@ class SolveContext:
         self.deferred_calls += calls
         return calls
 
-    def drain(self, level: int) -> int:
+    def drain(self, level: int, called_only: bool = False, guess: bool = False) -> int:
         """No new plan at ``level`` while some samplers could still give more: call them.
+        With ``called_only``, only instances called before (by a skeleton): the loop asks for
+        that while the optimistic world leaves instances out above the level, as PDDLStream
+        samples only its skeletons' streams between levels (an instance no plan wanted
+        stays optimistic, and its real values do not swell the next searches). ``guess``
+        (before the first skeleton, no plan has asked for any value yet): the calls stop
+        after :data:`DRAIN_SECONDS`, whatever the searches took.
 
         The real instances of streams with outputs that may answer more than once (not
         fluent, not single-answer adapters, no callable ``opt_gen_fn``), within the level
@@ -301,6 +307,8 @@ class SolveContext:
         the calls made."""
         budget = self.options.search_sample_ratio * max(self.searched, 1)
         seconds = max(self.options.search_sample_ratio * self.search_seconds, DRAIN_SECONDS)
+        if guess:
+            seconds = DRAIN_SECONDS
         self.search_seconds = 0.0
         start = time.perf_counter()
         limit = level + self.options.complexity_step
@@ -316,6 +324,7 @@ class SolveContext:
                 external = instance.external
                 if (
                     instance.exhausted
+                    or (called_only and not instance.calls)
                     or instance.disabled
                     or state.next_level > limit
                     or not external.declaration.outputs

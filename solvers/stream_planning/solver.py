@@ -171,7 +171,15 @@ class StreamSolver:
                     self._end(f"{missed}; nothing is left out: infeasible")
                     return Status.INFEASIBLE
                 if not policy.lazy and not policy.waiting and world.more_calls:
-                    context.drain(level)
+                    # once a skeleton was made, and while the world leaves instances out above
+                    # the level, only instances a skeleton called get more calls (PDDLStream
+                    # samples its skeletons' streams between levels, no other); before the
+                    # first skeleton (for DRAIN_SECONDS at most: a guess), or once every
+                    # instance is in but later calls' outputs, all of them (PDDLStream would
+                    # end there, infeasible)
+                    called_only = stats.skeletons > 0 and not world.complete
+                    guess = stats.skeletons == 0 and not world.complete
+                    context.drain(level, called_only=called_only, guess=guess)
                 level += options.complexity_step
                 if not policy.lazy and level < world.next_level < math.inf:
                     # the levels between add nothing to the optimistic world: skip them

@@ -178,3 +178,26 @@ def test_a_drain_of_fast_samplers_makes_its_counted_calls() -> None:
     context.searched = 15
     assert context.drain(5) == 15  # the budget, however long the last search took
     context.runner.close()
+
+
+def test_a_drain_of_called_instances_leaves_the_others_alone() -> None:
+    """``called_only``: only instances called before get more calls (the others none)."""
+    context = _slow_sampler_context(0.0)
+    context.searched = 6
+    assert context.drain(50, called_only=True) == 0  # nothing called yet
+    first = context.engine.instances[context.engine.instance_keys[0]]
+    context.sample(first)
+    assert context.drain(50, called_only=True) == 6
+    assert first.instance.calls == 7
+    others = [context.engine.instances[k] for k in context.engine.instance_keys[1:]]
+    assert all(s.instance.calls == 0 for s in others)
+    context.runner.close()
+
+
+def test_a_guessing_drain_stops_at_drain_seconds_whatever_the_searches_took() -> None:
+    """Before the first skeleton (``guess``): samplers of 0.3 s a call after searches of 10 s
+    get DRAIN_SECONDS (0.5 s: two calls at most), not the searches' share (10 s)."""
+    context = _slow_sampler_context(0.3)
+    context.search_seconds = 10.0
+    assert 1 <= context.drain(0, guess=True) <= 2
+    context.runner.close()
