@@ -52,6 +52,7 @@ from sdar_tamp.app.replanning import (
 )
 from sdar_tamp.app.splicing import check_from, head_at
 from sdar_tamp.plan_file import PlanFile
+from sdar_tamp.plan_rules import TIME_TOL
 from sdar_tamp.plan_state import Cut, PlanState, cut_point, state_at
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.instance import Instance
@@ -171,17 +172,26 @@ def improve(
 
 
 def _next_cut(plan: PlanFile, t: float, arrival: Arrival, need: float) -> Cut | None:
-    """The first cut point of ``plan`` at or after ``t`` [s] that the arms reach at least
-    ``need`` [s] plus :data:`RESERVE` after now, before the plan's end (None if none)."""
+    """The first cut point of ``plan`` at or after ``t`` [s], not at grasps (see
+    :func:`at_grasps`), that the arms reach at least ``need`` [s] plus :data:`RESERVE` after
+    now, before the plan's end (None if none)."""
     end = float(plan.t[-1])
     while t < end:
         cut = cut_point(plan, t)
         if cut.t >= end - 1e-9:
             return None
-        if arrival.at(cut.t) - time.perf_counter() >= need + RESERVE:
+        if not at_grasps(plan, cut) and arrival.at(cut.t) - time.perf_counter() >= need + RESERVE:
             return cut
         t = cut.t + 1e-6
     return None
+
+
+def at_grasps(plan: PlanFile, cut: Cut) -> bool:
+    """Whether ``plan`` grasps at ``cut``'s instant: its arms stand there at their grasps,
+    fingers open. A fresh solve from there does not know them: it lifts the arms and plans
+    their way back to grasps of its own (seconds more than the grasps already reached), so
+    a fresh continuation from such a cut is longer than the plan it should shorten."""
+    return any(e.type == "grasp" and abs(e.t - cut.t) <= TIME_TOL for e in plan.events)
 
 
 def _outcome(
