@@ -142,7 +142,8 @@ def test_the_generator_gives_the_repair_first(
     """The first outcome is the repair without the comparison (its latency that of
     ``replan(..., compare=False)``); a second, if any, a shorter valid plan with the same
     executed prefix; an unchanged plan (nothing observed) gives one outcome only."""
-    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache))
+    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache,
+                                    look=0.0))  # fmt: skip
     assert 1 <= len(outs) <= 2
     assert outs[0].status == "repaired" and outs[0].changed and outs[0].valid is True
     first = outs[0].plan
@@ -185,3 +186,39 @@ def _clear_cuts(repaired: ReplanOutcome) -> list[Cut]:
         chosen.append(nxt)
         t = nxt.t + 1e-6
     return chosen
+
+
+def test_latencies_and_deadlines_follow_the_configuration_s_clock(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """A clock that stands still (``config.sdar.clock``): every latency is 0 on it, and the
+    arms, timed on it, reach no cut point before a solve ends: the fresh continuation from
+    the cut replaces the repair, as with time to spare."""
+    frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
+    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=frozen, cache=cache))
+    assert [o.status for o in outs] == ["repaired", "replanned"]
+    assert [o.latency for o in outs] == [0.0, 0.0]
+    assert outs[1].plan is not None and outs[1].valid is True
+    synchronous = replan(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache)
+    assert synchronous.plan is not None
+    assert np.array_equal(outs[1].plan.q, synchronous.plan.q)
+
+
+def test_arms_standing_at_the_cut_may_wait_the_look_for_a_fresh_continuation(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """The observation came in 1 s ago (on a clock that stands still), the arms stand at the
+    cut: within a look of 10 s the fresh continuation from the cut is given first, instead of
+    the repair (the comparison before returning keeps the same plan); with no look left the
+    repair is given first."""
+    frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
+    nudged = _o4_nudged(d5)
+    outs = list(replan_while_moving(*d5, AT, nudged, config=frozen, cache=cache,
+                                    observed_at=99.0, look=10.0))  # fmt: skip
+    synchronous = replan(*d5, AT, nudged, config=CONFIG, cache=cache)
+    assert [o.status for o in outs] == ["replanned"] and outs[0].latency == 1.0
+    assert outs[0].plan is not None and synchronous.plan is not None and outs[0].valid is True
+    assert np.array_equal(outs[0].plan.q, synchronous.plan.q)
+    late = list(replan_while_moving(*d5, AT, nudged, config=frozen, cache=cache,
+                                    observed_at=99.0, look=1.0))  # fmt: skip
+    assert late[0].status == "repaired" and late[0].changed
