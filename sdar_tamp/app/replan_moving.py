@@ -33,7 +33,8 @@ comparison runs while they execute it:
 When the repair is ready only once the arms stand at its cut (no way left to run: the
 observation came in at or just before the cut), the comparison while moving could start only
 after the repair's first steps, and a fresh plan that orders those differently would be out
-of reach. Then the arms may wait there until :data:`LOOK` after the observation: one fresh
+of reach. Then the arms may wait there :data:`LOOK` more, when a fresh solve is expected to
+end in that time (:func:`_worth_a_look`): one fresh
 solve from the cut itself, given instead of the repair when it is shorter, valid and found
 within that time; otherwise the repair is given at once and steps 1-3 follow.
 
@@ -72,11 +73,12 @@ from solvers.sdar.budget import Clock
 MIN_BUDGET = 0.3  #: [s] of wall time a fresh solve gets at least (else a later cut point)
 RESERVE = 0.2  #: [s] of wall time kept for the checks after a fresh solve, before the cut
 TRIES = 4  #: fresh solves at most (a timed-out one is tried again from a later cut point)
-#: [s] from the observation within which, when the arms already stand at the cut once the
-#: repair is ready, a fresh continuation from the cut itself may be given instead (if shorter):
-#: with no way left to run, the comparison while moving can only start after the repair's
-#: first steps, and a fresh plan that changes those (which objects go first, and with which)
-#: is then out of reach (R5 of the paper suite, o4 nudged at its cut: repair 12% longer).
+#: [s] the arms, when they already stand at the cut once the repair is ready, may wait there
+#: more for a fresh continuation from the cut itself, given instead of the repair if shorter
+#: (tried when expected to end in that time: :func:`_worth_a_look`). With no way left to
+#: run, the comparison while moving can only start after the repair's first steps, and a
+#: fresh plan that changes those (which objects go first, and with which) is then out of
+#: reach (R5 of the paper suite, o4 nudged at its cut: the repair 12% longer).
 LOOK = 1.0
 
 
@@ -109,7 +111,7 @@ def replan_while_moving(
 ) -> Iterator[ReplanOutcome]:
     """The outcomes of re-planning ``plan`` at ``at`` [s] from ``observed`` (see the module
     docstring): first :func:`~sdar_tamp.app.replanning.replan` without the comparison (or,
-    within ``look`` [s] of the observation, a shorter fresh continuation: see :data:`LOOK`),
+    found within ``look`` [s] more, a shorter fresh continuation: see :data:`LOOK`),
     then, when that is a repair that changed the plan, a shorter plan found while the arms
     execute it (at most one more). ``observed_at``: the time the observation came in on the
     configuration's clock (``config.sdar.clock``: ``time.perf_counter()``, the wall time,
@@ -125,11 +127,10 @@ def replan_while_moving(
         yield first
         return
     now = clock()
-    left = observed_at + look - now
-    if now >= observed_at + (first.resume - at) and left >= MIN_BUDGET + RESERVE:
-        # the arms stand at the cut already: they may wait there until the look is over for a
+    if now >= observed_at + (first.resume - at) and _worth_a_look(first, now - observed_at, look):
+        # the arms stand at the cut already: they may wait there up to ``look`` more for a
         # shorter fresh continuation (one solve); else they go on with the repair at once
-        waiting = Arrival(now + left, first.resume)
+        waiting = Arrival(now + look, first.resume)
         fresh = improve(instance, first, waiting, config=config, scene_path=scene_path,
                         cache=cache, validate=validate, observed_at=observed_at,
                         tries=1)  # fmt: skip
@@ -143,6 +144,15 @@ def replan_while_moving(
                      cache=cache, validate=validate, observed_at=observed_at)  # fmt: skip
     if better is not None:
         yield better
+
+
+def _worth_a_look(repaired: ReplanOutcome, spent: float, look: float) -> bool:
+    """Whether a fresh solve from ``repaired``'s cut may end within ``look`` [s]: one that
+    moves ``n`` objects is expected to take ``spent`` (the repair's time, [s]) times ``n / 2``
+    (the repair planned one task again: two objects for two arms)."""
+    assert repaired.plan is not None
+    left = {e.object for e in repaired.plan.events if e.t >= repaired.resume}
+    return look >= MIN_BUDGET + RESERVE and spent * len(left) / 2.0 <= look
 
 
 def improve(
