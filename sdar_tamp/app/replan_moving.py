@@ -148,11 +148,12 @@ def replan_while_moving(
 
 def _worth_a_look(repaired: ReplanOutcome, spent: float, look: float) -> bool:
     """Whether a fresh solve from ``repaired``'s cut may end within ``look`` [s]: one that
-    moves ``n`` objects is expected to take ``spent`` (the repair's time, [s]) times ``n / 2``
-    (the repair planned one task again: two objects for two arms)."""
+    moves ``n`` objects is expected to take ``spent`` (the repair's time, [s]) times ``n / 4``
+    (the repair planned one task again and the motion rejoining the old plan, about two steps
+    of a solve; a fresh solve makes about ``n / 2`` steps, two objects for two arms)."""
     assert repaired.plan is not None
     left = {e.object for e in repaired.plan.events if e.t >= repaired.resume}
-    return look >= MIN_BUDGET + RESERVE and spent * len(left) / 2.0 <= look
+    return look >= MIN_BUDGET + RESERVE and spent * len(left) / 4.0 <= look
 
 
 def improve(

@@ -209,8 +209,8 @@ def test_arms_standing_at_the_cut_may_wait_the_look_for_a_fresh_continuation(
 ) -> None:
     """The observation came in 1 s ago (on a clock that stands still), the arms stand at the
     cut: within a look of 10 s the fresh continuation from the cut is given first, instead of
-    the repair (the comparison before returning keeps the same plan); a look of 1 s is less
-    than a solve of the objects left is expected to take (1 s for the repair's two): the
+    the repair (the comparison before returning keeps the same plan); when the repair took
+    5 s, a look of 1 s is less than a solve of the objects left is expected to take: the
     repair is given first."""
     frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
     nudged = _o4_nudged(d5)
@@ -221,7 +221,7 @@ def test_arms_standing_at_the_cut_may_wait_the_look_for_a_fresh_continuation(
     assert outs[0].plan is not None and synchronous.plan is not None and outs[0].valid is True
     assert np.array_equal(outs[0].plan.q, synchronous.plan.q)
     late = list(replan_while_moving(*d5, AT, nudged, config=frozen, cache=cache,
-                                    observed_at=99.0, look=1.0))  # fmt: skip
+                                    observed_at=95.0, look=1.0))  # fmt: skip
     assert late[0].status == "repaired" and late[0].changed
     assert replan_moving._worth_a_look(late[0], 1.0, 10.0)
-    assert not replan_moving._worth_a_look(late[0], 1.0, 1.0)
+    assert not replan_moving._worth_a_look(late[0], 5.0, 1.0)
