@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import time
 from collections.abc import Mapping
 
 import numpy as np
@@ -107,13 +106,14 @@ def repair(
     changed (a task planned again or one more), or None when the repair fails."""
     scene = world.ctx.scene
     moved: tuple[str, ...] = ()
-    deadline = time.perf_counter() + repair_budget(config.max_time)
+    clock = config.sdar.clock
+    deadline = clock() + repair_budget(config.max_time)
     plan, emptied = without_gone(plan, state)
     for tasks in range(MAX_TASKS + 1):
         plan, bad, why = check_from(instance, plan, scene, kins, collision, state)
         if bad is None:
             return plan, moved, emptied or tasks > 0
-        left = deadline - time.perf_counter()
+        left = deadline - clock()
         if left <= 0.0:
             return None
         budget = config.replace(max_time=left)
@@ -174,14 +174,14 @@ def _repair_task(
         return None
     # an object off its goal at the end: it joins the last task (half the budget), else one
     # more task after the plan's end brings it back
-    started = time.perf_counter()
+    started = config.sdar.clock()
     if tasks:
         half = config.replace(max_time=0.5 * config.max_time)
         joined = _replan_task(world, half, instance, plan, state, kins, collision, sizes,
                               tasks[-1], why)  # fmt: skip
         if joined is not None:
             return joined
-    left = config.max_time - (time.perf_counter() - started)
+    left = config.max_time - (config.sdar.clock() - started)
     if left <= 0.0:
         return None
     return _append_task(world, config.replace(max_time=left), instance, plan, sizes)

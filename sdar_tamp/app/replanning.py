@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -145,7 +144,8 @@ def replan(
     config = config or PlannerConfig()
     cache = cache or PlannerCache()
     world = cache.world(scene_path or instance.scene_path(), config.trajopt)
-    started = time.perf_counter()
+    clock = config.sdar.clock  # wall time unless the configuration says otherwise
+    started = clock()
     scene = world.ctx.scene
     kins = dict(world.ctx.kinematics)  # the world's, built once with it
     sizes = {o.name: o.size for o in instance.objects}
@@ -183,7 +183,7 @@ def replan(
                             sizes)  # fmt: skip
         if short is None:
             return ReplanOutcome(
-                "infeasible", None, cut.t, time.perf_counter() - started,
+                "infeasible", None, cut.t, clock() - started,
                 (f"the running plan meets the observed world at t = {found.t:.3f} s before the "
                  f"arms can stop at t = {cut.t:.3f} s (nor braking on their way): "
                  f"{found.kind}: {found.message}",),
@@ -207,10 +207,10 @@ def replan(
         fixed = repair_plan(world, config, instance, rest, empty, kins, collision, sizes)
         if fixed is not None:
             kept, moved, changed = fixed
-            left = config.max_time - (time.perf_counter() - started)
+            left = config.max_time - (clock() - started)
             if not (compare and changed and left > 0.0):
-                return _finish("repaired", kept, instance, scene, cut, started, validate, moved,
-                               changed=changed, resume=t_hold)  # fmt: skip
+                return _finish("repaired", kept, instance, scene, cut, clock() - started,
+                               validate, moved, changed=changed, resume=t_hold)  # fmt: skip
             # the repair changed the plan: a fresh continuation within the time left, and
             # the shorter execution of the two (the repair on a tie or a failed fresh one)
             other = fresh_continuation(world, config.replace(max_time=left), instance, prefix,
@@ -219,11 +219,12 @@ def replan(
             if other.plan is not None and shorter(other.plan, kept, t_hold):
                 _, bad, _ = check_from(instance, other.plan, scene, kins, collision, empty)
                 if bad is None:
-                    return _finish("replanned", other.plan, instance, scene, cut, started,
-                                   validate, other.moved, kept.duration, resume=t_hold)  # fmt: skip
+                    return _finish("replanned", other.plan, instance, scene, cut,
+                                   clock() - started, validate, other.moved, kept.duration,
+                                   resume=t_hold)  # fmt: skip
                 alternative = None  # the replay rejects it: no alternative
-            return _finish("repaired", kept, instance, scene, cut, started, validate, moved,
-                           alternative, resume=t_hold)  # fmt: skip
+            return _finish("repaired", kept, instance, scene, cut, clock() - started, validate,
+                           moved, alternative, resume=t_hold)  # fmt: skip
     slices = {a: scene.layout.slice(a) for a in scene.arm_names}
     moving = prefix.q[prefix.t >= at - 1e-9]  # braked arms leave directly, not by a lift
     free = frozenset(  # an arm that put an object down leaves by a lift
@@ -235,16 +236,16 @@ def replan(
         reasons = fresh.reasons
         status = "timeout" if fresh.status == "timeout" else "infeasible"
         blocking = _objects_in(" ".join(reasons), sizes)
-        return ReplanOutcome(status, None, cut.t, time.perf_counter() - started, reasons,
+        return ReplanOutcome(status, None, cut.t, clock() - started, reasons,
                              blocking, fresh.moved)  # fmt: skip
-    out = _finish("replanned", fresh.plan, instance, scene, cut, started, validate, fresh.moved,
-                  resume=t_hold)  # fmt: skip
+    out = _finish("replanned", fresh.plan, instance, scene, cut, clock() - started, validate,
+                  fresh.moved, resume=t_hold)  # fmt: skip
     if out.valid is False and retry:  # rare: one more solve with the next seed
         again = replan(instance, plan, at, observed, config=config.replace(seed=config.seed + 1),
                        scene_path=scene_path, cache=cache, validate=True, repair=False,
                        retry=False)  # fmt: skip
         if again.valid:
-            return dataclasses.replace(again, latency=time.perf_counter() - started)
+            return dataclasses.replace(again, latency=clock() - started)
     return out
 
 
@@ -348,11 +349,10 @@ def _objects_in(text: str, sizes: dict[str, tuple[float, float, float]]) -> tupl
 
 
 def _finish(
-    status: str, plan: PlanFile, instance: Instance, scene: Scene, cut: Cut, started: float,
+    status: str, plan: PlanFile, instance: Instance, scene: Scene, cut: Cut, latency: float,
     validate: bool, moved: tuple[str, ...] = (), alternative: float | None = None, *,
     changed: bool = False, resume: float = 0.0,
 ) -> ReplanOutcome:  # fmt: skip
-    latency = time.perf_counter() - started
     plan, valid, violation = timed_and_checked(plan, latency, instance, scene, validate)
     return ReplanOutcome(status, plan, cut.t, latency, (), (), moved, valid, violation, alternative,
                          changed, resume)  # fmt: skip

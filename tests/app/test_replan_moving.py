@@ -1,45 +1,30 @@
 """Re-planning while the arms move (``sdar_tamp.app.replan_moving``) on D5 of the paper suite
-and its stored plan: the repair is given first, a shorter fresh continuation replaces it only
-when it is found before the arms reach the cut point it starts from."""
+and its stored plan (``conftest.py``): the repair is given first, a shorter fresh
+continuation replaces it only when it is found before the arms reach the cut point it starts
+from."""
 
 from __future__ import annotations
 
 import dataclasses
 import itertools
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from sdar_tamp.app import replan_moving
 from sdar_tamp.app.cache import PlannerCache
-from sdar_tamp.app.config import PlannerConfig
-from sdar_tamp.app.replan_moving import Arrival, improve, replan_while_moving
+from sdar_tamp.app.replan_moving import Arrival, at_grasps, improve, replan_while_moving
 from sdar_tamp.app.replanning import Fresh, ReplanOutcome, replan
 from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.plan_reading import load_plan
-from sdar_tamp.plan_state import state_at
+from sdar_tamp.plan_state import Cut, cut_point, state_at
 from sdar_tamp.replay import validate_plan
-from sdar_tamp.resources import domains_root
-from sdar_tamp.world.instance import Instance, load_instance
+from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.observed import ObservedState, parse_observed
 from sdar_tamp.world.scene import load_scene
+from tests.app.conftest import CONFIG
 
-SOLVED = Path(__file__).parents[1] / "plan" / "solved"
-CONFIG = PlannerConfig(max_time=60.0, seed=0)
 AT = 5.116  # o4 resting, its task still to come
-
-
-@pytest.fixture(scope="module")
-def cache() -> PlannerCache:
-    return PlannerCache()
-
-
-@pytest.fixture(scope="module")
-def d5() -> tuple[Instance, PlanFile]:
-    instance = load_instance(domains_root() / "dual_arm_rearrangement/suites/paper/D5.yaml")
-    return instance, load_plan(SOLVED / "D5.plan.json")
 
 
 def _o4_nudged(d5: tuple[Instance, PlanFile]) -> ObservedState:
@@ -102,12 +87,17 @@ def test_a_solve_out_of_time_is_tried_again_from_a_later_cut_point(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:  # fmt: skip
     """The arms far away, each solve limited by the re-plan's time limit: the next starts from
-    a later cut point, at most ``TRIES`` solves in all."""
+    a later cut point (one not at grasps), at most ``TRIES`` solves in all."""
     calls: list[tuple[float, float]] = []
     _out_of_time(monkeypatch, calls)
     later = Arrival(time.perf_counter() + 1000.0, repaired.resume)
     assert improve(d5[0], repaired, later, config=CONFIG, cache=cache) is None
-    assert len(calls) == replan_moving.TRIES
+    assert 1 < len(calls) <= replan_moving.TRIES
+    assert repaired.plan is not None
+    last = calls[-1][0]  # the end of the last try's hold: no clear cut point after it, or
+    assert len(calls) == replan_moving.TRIES or (  # no more tries
+        replan_moving._next_cut(repaired.plan, last + 1e-6, later, 0.0) is None
+    )
     starts = [c[0] for c in calls]
     assert starts == sorted(starts) and len(set(starts)) == len(starts)
     assert all(0.0 < budget <= CONFIG.max_time for _, budget in calls)
@@ -152,7 +142,8 @@ def test_the_generator_gives_the_repair_first(
     """The first outcome is the repair without the comparison (its latency that of
     ``replan(..., compare=False)``); a second, if any, a shorter valid plan with the same
     executed prefix; an unchanged plan (nothing observed) gives one outcome only."""
-    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache))
+    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache,
+                                    look=0.0))  # fmt: skip
     assert 1 <= len(outs) <= 2
     assert outs[0].status == "repaired" and outs[0].changed and outs[0].valid is True
     first = outs[0].plan
@@ -165,3 +156,72 @@ def test_the_generator_gives_the_repair_first(
                               first.q[first.t <= out.resume])  # fmt: skip
     same = list(replan_while_moving(*d5, AT, ObservedState(), config=CONFIG, cache=cache))
     assert len(same) == 1 and same[0].status == "repaired" and not same[0].changed
+
+
+def test_no_fresh_solve_starts_where_the_arms_stand_at_grasps(repaired: ReplanOutcome) -> None:
+    """The repaired plan's cut points include instants of grasps (arms at rest, fingers open
+    around the objects); the fresh continuations start only at the others."""
+    plan = repaired.plan
+    assert plan is not None
+    raw: list[Cut] = []
+    t = repaired.resume
+    while (cut := cut_point(plan, t)).t < plan.duration - 1e-9:
+        raw.append(cut)
+        t = cut.t + 1e-6
+    grasping = [c for c in raw if at_grasps(plan, c)]
+    assert grasping and all(
+        any(e.type == "grasp" and abs(e.t - c.t) < 1e-9 for e in plan.events) for c in grasping
+    )
+    chosen = _clear_cuts(repaired)
+    assert chosen == [c for c in raw if not at_grasps(plan, c)] and chosen
+
+
+def _clear_cuts(repaired: ReplanOutcome) -> list[Cut]:
+    """The cut points a fresh continuation of ``repaired`` may start from, the arms far."""
+    assert repaired.plan is not None
+    far = Arrival(time.perf_counter() + 1000.0, repaired.resume)
+    chosen: list[Cut] = []
+    t = repaired.resume
+    while (nxt := replan_moving._next_cut(repaired.plan, t, far, 0.0)) is not None:
+        chosen.append(nxt)
+        t = nxt.t + 1e-6
+    return chosen
+
+
+def test_latencies_and_deadlines_follow_the_configuration_s_clock(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """A clock that stands still (``config.sdar.clock``): every latency is 0 on it, and the
+    arms, timed on it, reach no cut point before a solve ends: the fresh continuation from
+    the cut replaces the repair, as with time to spare."""
+    frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
+    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=frozen, cache=cache))
+    assert [o.status for o in outs] == ["repaired", "replanned"]
+    assert [o.latency for o in outs] == [0.0, 0.0]
+    assert outs[1].plan is not None and outs[1].valid is True
+    synchronous = replan(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache)
+    assert synchronous.plan is not None
+    assert np.array_equal(outs[1].plan.q, synchronous.plan.q)
+
+
+def test_arms_standing_at_the_cut_may_wait_the_look_for_a_fresh_continuation(
+    d5: tuple[Instance, PlanFile], cache: PlannerCache
+) -> None:
+    """The observation came in 1 s ago (on a clock that stands still), the arms stand at the
+    cut: within a look of 10 s the fresh continuation from the cut is given first, instead of
+    the repair (the comparison before returning keeps the same plan); when the repair took
+    5 s, a look of 1 s is less than a solve of the objects left is expected to take: the
+    repair is given first."""
+    frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
+    nudged = _o4_nudged(d5)
+    outs = list(replan_while_moving(*d5, AT, nudged, config=frozen, cache=cache,
+                                    observed_at=99.0, look=10.0))  # fmt: skip
+    synchronous = replan(*d5, AT, nudged, config=CONFIG, cache=cache)
+    assert [o.status for o in outs] == ["replanned"] and outs[0].latency == 1.0
+    assert outs[0].plan is not None and synchronous.plan is not None and outs[0].valid is True
+    assert np.array_equal(outs[0].plan.q, synchronous.plan.q)
+    late = list(replan_while_moving(*d5, AT, nudged, config=frozen, cache=cache,
+                                    observed_at=95.0, look=1.0))  # fmt: skip
+    assert late[0].status == "repaired" and late[0].changed
+    assert replan_moving._worth_a_look(late[0], 1.0, 10.0)
+    assert not replan_moving._worth_a_look(late[0], 5.0, 1.0)
