@@ -123,7 +123,10 @@ def test_replan_while_moving_writes_the_repair_first(
 ) -> None:
     """o4 nudged at 5.116 s with --while-moving: the first record is the repair, valid and
     written; a second one, when the fresh continuation is found in time, is shorter and
-    written over it. --while-moving with --fresh or --no-compare is refused."""
+    written over it. Where the arms already stand at the cut when the repair is ready, a
+    fresh continuation found within the look replaces it as the only record (which one
+    happens depends on the machine's speed). --while-moving with --fresh or --no-compare is
+    refused."""
     from sdar_tamp.plan_state import state_at
     from sdar_tamp.world.instance import load_instance
     from sdar_tamp.world.scene import load_scene
@@ -138,7 +141,12 @@ def test_replan_while_moving_writes_the_repair_first(
     code, out, _ = _run([*argv, "--json", "-o", str(new)], capsys)
     records = [json.loads(line) for line in out.splitlines()]
     assert code == 0 and 1 <= len(records) <= 2
-    assert records[0]["status"] == "repaired" and records[0]["valid"] is True
+    assert all(record["valid"] is True for record in records)
+    if records[0]["status"] == "replanned":  # found within the look, at the cut
+        (looked,) = records
+        assert looked["execution_time"] < looked["alternative"]
+    else:
+        assert records[0]["status"] == "repaired"
     for later in records[1:]:
         assert later["status"] == "replanned" and later["valid"] is True
         assert later["execution_time"] < records[0]["execution_time"]
