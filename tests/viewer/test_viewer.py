@@ -1,20 +1,13 @@
-"""The plan viewers: timeline maths, the HTML page, storyboards, ``sdar show``, a real browser."""
+"""The plan viewers: timeline maths, the HTML page, storyboards, ``sdar show``."""
 
 from __future__ import annotations
 
 import base64
 import dataclasses
 import gzip
-import json
-import os
 import re
-import shutil
-import subprocess
 import sys
-import tempfile
-import time
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -22,106 +15,15 @@ from PIL import Image
 
 from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError
-from sdar_tamp.plan_building import GripperEvent, MotionSegment, build_plan_file
 from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.plan_reading import load_plan
-from sdar_tamp.plan_writing import save_plan
 from sdar_tamp.viewer import MissingDependencyError, write_html, write_storyboard
 from sdar_tamp.viewer._story import grips, joint_curves, link_poses, pose7
 from sdar_tamp.viewer._timeline import Timeline
 from sdar_tamp.viewer.storyboard import COLUMNS, DPI, PANEL_SIZE, panel_grid
-from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D, load_instance, save_instance
-from sdar_tamp.world.kinematics import ArmKinematics
-from sdar_tamp.world.scene import Scene, load_scene
-from sdar_tamp.world.transforms import FloatArray, inverse, pose_xyz_yaw, top_down_pose
-
-CHROMIUM = Path(shutil.which("chromium") or "/usr/bin/chromium")
-SIZE = (0.08, 0.04, 0.05)
-#: Left arm carries o0, right arm carries o1 (both at once); o2 starts at its goal.
-OBJECTS = (
-    ObjectSpec("o0", SIZE, Pose2D(-0.12, 0.12, 0.0), Pose2D(-0.12, -0.15, 0.6)),
-    ObjectSpec("o1", SIZE, Pose2D(0.12, -0.12, 0.0), Pose2D(0.10, 0.15, 0.0)),
-    ObjectSpec("o2", SIZE, Pose2D(0.0, 0.0, 0.3), Pose2D(0.0, 0.0, 0.3)),
-)
-
-
-# -- a hand-made plan: two simultaneous top-down pick-and-places ---------------------------------
-def _ik(kin: ArmKinematics, pose: Pose2D, z: float, q_ref: FloatArray) -> FloatArray:
-    q, ok = kin.ik_tcp(top_down_pose(pose.x, pose.y, z, pose.yaw)).closest(q_ref)
-    assert ok[0], "fixture pose out of reach"
-    return q[0]
-
-
-def _move(
-    q0: FloatArray, q1: FloatArray, duration: float, kind: str, objs: tuple[str, ...]
-) -> MotionSegment:
-    t = np.linspace(0.0, duration, round(duration / 0.02) + 1)
-    s = 0.5 - 0.5 * np.cos(np.pi * t / duration)  # rest to rest
-    return MotionSegment(t, q0 + s[:, None] * (q1 - q0), "free", objs, kind)
-
-
-def build_plan(scene: Scene, instance: Instance, slow: float = 1.0) -> PlanFile:
-    """About ``8 * slow`` seconds: approach, descend, grasp, lift, carry, lower, release,
-    retreat and go home, both arms together."""
-    kins = [ArmKinematics.from_scene(scene, a.name) for a in scene.arms]
-    home = np.concatenate([np.array(a.home) for a in scene.arms])
-    carried = (instance.objects[0], instance.objects[1])
-    hover, z_grasp = 0.15, SIZE[2] / 2
-
-    def both(which: str, z: float) -> FloatArray:
-        out = home.copy()
-        for a, (kin, obj) in enumerate(zip(kins, carried, strict=True)):
-            out[6 * a : 6 * a + 6] = _ik(kin, getattr(obj, which), z, home[6 * a : 6 * a + 6])
-        return out
-
-    above_start, at_start = both("start", hover), both("start", z_grasp)
-    above_goal, at_goal = both("goal", hover), both("goal", z_grasp)
-    names = ("o0", "o1")
-    grasps, releases = [], []
-    for a, obj in enumerate(carried):
-        T_obj = pose_xyz_yaw(obj.start.x, obj.start.y, z_grasp, obj.start.yaw)
-        T_tcp = kins[a].fk_tcp(at_start[6 * a : 6 * a + 6])
-        T_tcp_obj = inverse(T_tcp) @ T_obj
-        grasps.append(GripperEvent(scene.arms[a].name, "grasp", obj.name, T_tcp_obj))
-        releases.append(GripperEvent(scene.arms[a].name, "release", obj.name, T_tcp_obj))
-    items = [
-        _move(home, above_start, 1.5 * slow, "approach", names),
-        _move(above_start, at_start, 0.6 * slow, "approach", names),
-        *grasps,
-        _move(at_start, above_start, 0.6 * slow, "transfer", names),
-        _move(above_start, above_goal, 1.5 * slow, "transfer", names),
-        _move(above_goal, at_goal, 0.6 * slow, "transfer", names),
-        *releases,
-        _move(at_goal, above_goal, 0.6 * slow, "retreat", names),
-        _move(above_goal, home, 1.5 * slow, "retreat", names),
-    ]
-    starts = {o.name: o.start.as_tuple() for o in instance.objects}
-    sizes = {o.name: o.size for o in instance.objects}
-    return build_plan_file(scene, instance.name, starts, sizes, items, {"planning_time": 0.25})
-
-
-def write_fixture(folder: Path, slow: float = 1.0) -> tuple[Path, Path]:
-    """Write the instance and its plan; return both paths."""
-    scene = load_scene()
-    instance = Instance("V3", scene.workspace, OBJECTS)
-    inst_path = save_instance(instance, folder / "V3.yaml")
-    plan_path = save_plan(build_plan(scene, instance, slow), folder / "V3.plan.json")
-    return inst_path, plan_path
-
-
-@pytest.fixture(scope="module")
-def files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    return write_fixture(tmp_path_factory.mktemp("viewer"), slow=1.2)  # within the limits: valid
-
-
-@pytest.fixture(scope="module")
-def instance(files: tuple[Path, Path]) -> Instance:
-    return load_instance(files[0])
-
-
-@pytest.fixture(scope="module")
-def plan(files: tuple[Path, Path]) -> PlanFile:
-    return load_plan(files[1])
+from sdar_tamp.world.instance import Instance, save_instance
+from sdar_tamp.world.scene import load_scene
+from sdar_tamp.world.transforms import inverse, pose_xyz_yaw, top_down_pose
+from tests.viewer.conftest import OBJECTS, SIZE, broken, decode, page_json
 
 
 # -- the timeline -------------------------------------------------------------------------------
@@ -189,20 +91,6 @@ def test_arm_joints_come_from_the_layout(instance: Instance, plan: PlanFile) -> 
 
 
 # -- the HTML page ------------------------------------------------------------------------------
-def page_json(html: str) -> dict[str, Any]:
-    """The page's data: the JSON in its ``sdar-data`` script element."""
-    m = re.search(r'<script type="application/json" id="sdar-data">(.*?)</script>', html, re.S)
-    assert m is not None
-    data = json.loads(m.group(1))
-    assert isinstance(data, dict)
-    return data
-
-
-def decode(spec: dict[str, str]) -> np.ndarray:
-    kind = {"f4": "<f4", "i4": "<i4", "u1": "u1"}[spec["dtype"]]
-    return np.frombuffer(base64.b64decode(spec["bdata"]), dtype=np.dtype(kind))
-
-
 def test_html_is_self_contained_with_link_poses_per_frame(
     instance: Instance, plan: PlanFile, tmp_path: Path
 ) -> None:
@@ -282,14 +170,6 @@ def test_joint_curves_against_the_limits(instance: Instance, plan: PlanFile) -> 
     fd = (qb - qa)[0] / (2 * dt) / np.asarray(spec.velocity_limit)
     np.testing.assert_allclose(curves.velocity[0][k], fd, atol=0.02)
     assert np.abs(curves.velocity[0]).max() <= 1.0 + 1e-6
-
-
-def broken(plan: PlanFile) -> tuple[PlanFile, float]:
-    """``plan`` with a jump of the first arm's shoulder in the middle: too fast there."""
-    k = len(plan.t) // 2
-    q = np.array(plan.q)
-    q[k:, 0] += 0.3
-    return dataclasses.replace(plan, q=q), float(plan.t[k])
 
 
 def test_the_first_violation_is_in_the_page(
@@ -396,175 +276,3 @@ def test_cli_show_errors(
     save_instance(Instance("W1", load_scene().workspace, OBJECTS[2:]), other)
     assert main(["show", str(other), str(files[1]), "-o", str(tmp_path / "x.png")]) == 2
     assert "'o0' is not an object of instance 'W1'" in capsys.readouterr().err
-
-
-# -- a real browser -------------------------------------------------------------------------------
-def _chromium(url: str, workdir: Path, *extra: str) -> subprocess.CompletedProcess[str]:
-    profile = tempfile.mkdtemp(prefix="chromium-", dir=workdir)
-    cmd = [
-        str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-        "--no-first-run", "--disable-background-networking", "--disable-component-update",
-        "--disable-sync", f"--user-data-dir={profile}", "--use-angle=swiftshader",
-        "--enable-unsafe-swiftshader", "--enable-logging=stderr", "--v=0",
-        "--window-size=1200,900", "--virtual-time-budget=20000", "--hide-scrollbars",
-        *extra, url,
-    ]  # fmt: skip
-    env = {**os.environ, "HOME": str(workdir)}
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env, check=False)
-
-
-needs_chromium = pytest.mark.skipif(
-    not CHROMIUM.exists(), reason="chromium is not installed (apt-get install chromium)"
-)
-
-
-def _js_errors(stderr: str) -> list[str]:
-    return [
-        line
-        for line in stderr.splitlines()
-        if "Uncaught" in line or ("CONSOLE" in line and "Error" in line)
-    ]
-
-
-def _body(dom: str) -> dict[str, str]:
-    """The attributes of the page's ``<body>`` after the run (the viewer's published state)."""
-    m = re.search(r"<body([^>]*)>", dom)
-    assert m is not None
-    return dict(re.findall(r'([\w-]+)="([^"]*)"', m.group(1)))
-
-
-def _with_script(page: Path, script: str) -> Path:
-    """A copy of ``page`` running ``script`` once the viewer is ready (a user at the controls)."""
-    html = page.read_text(encoding="utf-8")
-    hook = "<script>window.addEventListener('sdar-ready', function () {" + script + "});</script>"
-    out = page.with_name(page.stem + ".driven.html")
-    out.write_text(html.replace("</body>", hook + "</body>"), encoding="utf-8")
-    return out
-
-
-@needs_chromium
-def test_page_renders_in_headless_chromium(
-    instance: Instance, plan: PlanFile, tmp_path: Path
-) -> None:
-    page = write_html(instance, plan, tmp_path / "replay.html", fps=5)
-    t_mid = plan.duration / 2  # both arms carrying
-    url = page.resolve().as_uri() + f"#t={t_mid:.2f}"
-    started = time.monotonic()
-    shot = tmp_path / "shot.png"
-    run = _chromium(url, tmp_path, f"--screenshot={shot}", "--dump-dom")
-    assert shot.is_file(), run.stderr[-2000:]
-    assert not _js_errors(run.stderr), _js_errors(run.stderr)
-    body = _body(run.stdout)
-    assert body.get("data-sdar-ready") == str(len(page_json(page.read_text())["times"]))
-    assert float(body["data-sdar-t"]) == pytest.approx(t_mid, abs=0.006)  # opened at #t=
-    text = _visible_text(run.stdout)
-    assert "WebGL" not in text and "could not" not in text
-    assert re.search(r"left : gripper closed , holding o0", text), text[-600:]
-    assert re.search(r"right : gripper closed , holding o1", text), text[-600:]
-    assert "valid (sdar validate)" in text and 'id="sdar-banner" hidden' in run.stdout
-    with Image.open(shot) as image:
-        assert image.size == (1200, 900)
-        view = np.asarray(image.convert("RGB"))[60:760, :740]  # the 3-D view
-        panel = np.asarray(image.convert("RGB"))[60:760, 780:]  # the joint panel
-    pixels = view.reshape(-1, 3)
-    not_white = np.any(pixels < 235, axis=1).mean()
-    distinct = len(np.unique(pixels // 8, axis=0))
-    arms = [_near(pixels, (0x5B, 0x8F, 0xD1)), _near(pixels, (0xE0, 0x8A, 0x4F))]  # both arms
-    assert not_white > 0.10 and distinct > 200 and min(arms) > 3000, (not_white, distinct, arms)
-    curves = np.any(panel.reshape(-1, 3) < 200, axis=1).mean()
-    assert curves > 0.01, curves  # the joint curves are drawn
-    print(
-        f"chromium: {time.monotonic() - started:.1f} s, {not_white:.0%} drawn, {distinct} colours"
-    )
-
-
-@needs_chromium
-def test_step_buttons_and_speed_drive_the_time(
-    instance: Instance, plan: PlanFile, tmp_path: Path
-) -> None:
-    page = write_html(instance, plan, tmp_path / "replay.html", fps=5)
-    script = """
-      var log = [], b = document.body;
-      function note() {
-        log.push(b.getAttribute('data-sdar-t') + '@' + b.getAttribute('data-sdar-step'));
-      }
-      note();
-      document.getElementById('sdar-next').click(); note();
-      document.getElementById('sdar-next').click(); note();
-      document.getElementById('sdar-prev').click(); note();
-      document.querySelectorAll('.sdar-step')[3].click(); note();
-      var speed = document.getElementById('sdar-speed');
-      speed.value = '4'; speed.dispatchEvent(new Event('change'));
-      b.setAttribute('data-test-steps', String(document.querySelectorAll('.sdar-step').length));
-      b.setAttribute('data-test-events', String(document.querySelectorAll('.sdar-ev').length));
-      b.setAttribute('data-test-log', log.join(' '));
-    """
-    run = _chromium(_with_script(page, script).resolve().as_uri(), tmp_path, "--dump-dom")
-    assert not _js_errors(run.stderr), _js_errors(run.stderr)
-    body = _body(run.stdout)
-    starts = [s.t_start for s in plan.steps]
-    expected = [(0.0, 0), (starts[1], 1), (starts[2], 2), (starts[1], 1), (starts[3], 3)]
-    log = [(float(t), int(k)) for t, k in (e.split("@") for e in body["data-test-log"].split())]
-    assert [k for _, k in log] == [k for _, k in expected]
-    np.testing.assert_allclose([t for t, _ in log], [t for t, _ in expected], atol=0.001)
-    assert body["data-sdar-speed"] == "4"
-    assert body["data-test-steps"] == str(len(plan.steps))
-    assert body["data-test-events"] == str(len(plan.events))
-
-
-@needs_chromium
-def test_banner_shows_the_first_violation(
-    instance: Instance, plan: PlanFile, tmp_path: Path
-) -> None:
-    bad, _ = broken(plan)
-    page = write_html(instance, bad, tmp_path / "bad.html", fps=5)
-    violation = page_json(page.read_text(encoding="utf-8"))["violation"]
-    script = "document.getElementById('sdar-goto').click();"
-    shot = tmp_path / "bad.png"
-    run = _chromium(
-        _with_script(page, script).resolve().as_uri(),
-        tmp_path,
-        f"--screenshot={shot}",
-        "--dump-dom",
-    )
-    assert not _js_errors(run.stderr), _js_errors(run.stderr)
-    banner = re.search(r'<div id="sdar-banner"([^>]*)>(.*?)</div>', run.stdout, re.S)
-    assert banner is not None and "hidden" not in banner.group(1)
-    assert f'data-kind="{violation["kind"]}"' in banner.group(1)
-    assert f"invalid at t = {violation['t']:.2f} s" in banner.group(2)
-    assert 'id="sdar-violation-mark"' in run.stdout  # on the time line
-    assert float(_body(run.stdout)["data-sdar-t"]) == pytest.approx(violation["t"], abs=0.001)
-    with Image.open(shot) as image:  # the banner is drawn: a red strip at the top
-        top = np.asarray(image.convert("RGB"))[2:20, 200:1000].reshape(-1, 3).astype(int)
-    red = (top[:, 0] > 150) & (top[:, 1] < 90) & (top[:, 2] < 90)
-    assert red.mean() > 0.5, red.mean()
-
-
-@needs_chromium
-def test_a_browser_that_cannot_unpack_the_page_is_told(
-    instance: Instance, plan: PlanFile, tmp_path: Path
-) -> None:
-    page = write_html(instance, plan, tmp_path / "replay.html", fps=5)
-    old = page.with_name("old.html")
-    html = page.read_text(encoding="utf-8")
-    old.write_text(html.replace("<body>", "<body><script>window.DecompressionStream = undefined;"
-                                "</script>", 1), encoding="utf-8")  # fmt: skip
-    run = _chromium(old.resolve().as_uri(), tmp_path, "--dump-dom")
-    banner = re.search(r'<div id="sdar-banner"([^>]*)>(.*?)</div>', run.stdout, re.S)
-    assert banner is not None and "hidden" not in banner.group(1)
-    assert "cannot unpack the page" in banner.group(2)
-    assert "data-sdar-ready" not in _body(run.stdout)  # never drawn
-
-
-def _near(pixels: np.ndarray, rgb: tuple[int, int, int], tol: int = 60) -> int:
-    """Pixels within ``tol`` of the hue family of ``rgb`` (shading changes the brightness)."""
-    p = pixels.astype(float)
-    ref = np.array(rgb, dtype=float)
-    cos = (p @ ref) / (np.linalg.norm(p, axis=1) * np.linalg.norm(ref) + 1e-9)
-    spread = p.max(axis=1) - p.min(axis=1)
-    return int(((cos > 0.985) & (spread > tol)).sum())
-
-
-def _visible_text(dom: str) -> str:
-    body = re.sub(r"<(script|style).*?</\1>", "", dom, flags=re.S)
-    return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", body))
