@@ -9,22 +9,9 @@ import pytest
 from sdar_tamp.cli import main
 from sdar_tamp.resources import domain_file
 from sdar_tamp.world.instance import load_instance
+from tests.cli.conftest import refused
 
 S4 = str(domain_file("dual_arm_rearrangement", "suites/paper/S4.yaml"))
-
-
-def refused(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
-    """Run ``sdar argv``; it must exit with status 2 and one line on stderr, which is returned."""
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code  # type: ignore[assignment]
-    captured = capsys.readouterr()
-    assert code == 2, captured
-    assert captured.out == ""
-    err = captured.err.strip()
-    assert "\n" not in err and err.startswith("sdar"), err
-    return err
 
 
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf", "0", "-1", "soon"])

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from sdar_tamp.cli import main
 from sdar_tamp.plan_reading import load_plan
 from sdar_tamp.resources import domains_root
+from tests.cli.conftest import run_cli
 
 D5 = str(domains_root() / "dual_arm_rearrangement/suites/paper/D5.yaml")
 PLAN = str(Path(__file__).parents[1] / "plan" / "solved" / "D5.plan.json")
@@ -22,38 +22,28 @@ def _observed(tmp_path: Path, text: str) -> str:
     return str(path)
 
 
-def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code  # type: ignore[assignment]
-    out = capsys.readouterr()
-    return int(code), out.out, out.err
-
-
 def test_replan_writes_a_valid_plan(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     obs = _observed(tmp_path, "removed: [o2]\n")
     new = tmp_path / "new.json"
-    code, out, _ = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs, "-o", str(new)],
-                        capsys)  # fmt: skip
+    argv = ["replan", D5, PLAN, "--at", "4.5", "--observed", obs, "-o", str(new)]
+    code, out, _ = run_cli(argv, capsys)
     assert code == 0, out
     assert out.startswith("repaired: cut at t = ") and "valid" in out and "wrote" in out
     assert "o2" not in load_plan(new).final_poses
-    code, out, _ = _run(["validate", D5, str(new)], capsys)
+    code, out, _ = run_cli(["validate", D5, str(new)], capsys)
     assert code == 0 and out.startswith("valid:")
-    code, out, err = _run(["replan", D5, PLAN, "--at", "4.5", "--observed", obs, "-o",
-                           str(new)], capsys)  # fmt: skip
+    code, out, err = run_cli(argv, capsys)
     assert code == 2 and "exists" in err  # no overwrite without --force
 
 
 def test_replan_json_and_infeasible(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """o1 nudged at 5.4 s, when the right arm is too close to brake before touching it."""
     obs = _observed(tmp_path, "poses: [{name: o1, pose: [-0.045, -0.064, 1.19]}]\n")
-    code, out, _ = _run(["replan", D5, PLAN, "--at", "5.4", "--observed", obs, "--json"], capsys)
+    code, out, _ = run_cli(["replan", D5, PLAN, "--at", "5.4", "--observed", obs, "--json"], capsys)
     record = json.loads(out)
     assert code == 1 and record["status"] == "infeasible" and record["blocking"] == ["o1"]
     assert record["plan_file"] is None and "before the arms can stop" in record["reasons"][0]
-    code, out, _ = _run(["replan", D5, PLAN, "--at", "5.4", "--observed", obs], capsys)
+    code, out, _ = run_cli(["replan", D5, PLAN, "--at", "5.4", "--observed", obs], capsys)
     assert code == 1 and out.startswith("infeasible:") and "blocking: o1" in out
 
 
@@ -74,7 +64,7 @@ def test_replan_refuses_bad_input(
 ) -> None:
     obs = _observed(tmp_path, text)
     at = [] if "--at" in argv else ["--at", "4.5"]
-    code, out, err = _run(["replan", D5, PLAN, *at, "--observed", obs, *argv], capsys)
+    code, out, err = run_cli(["replan", D5, PLAN, *at, "--observed", obs, *argv], capsys)
     assert code == 2 and out == "", out
     assert message in err, err
 
@@ -85,7 +75,7 @@ def test_replan_missing_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]
         [D5, str(tmp_path / "none.json"), "--at", "1", "--observed", obs],
         [D5, PLAN, "--at", "1", "--observed", str(tmp_path / "none.yaml")],
     ):
-        code, _, err = _run(["replan", *argv], capsys)
+        code, _, err = run_cli(["replan", *argv], capsys)
         assert code == 2 and "none." in err
 
 
@@ -105,16 +95,16 @@ def test_replan_no_compare_keeps_the_repair(
     obs = _observed(tmp_path, f"poses: [{{name: o4, pose: [{x + 0.0052}, {y + 0.0173}, "
                               f"{yaw - 0.1559}]}}]\n")  # fmt: skip
     argv = ["replan", D5, PLAN, "--at", "5.116", "--observed", obs, "--json"]
-    code, out, _ = _run(argv, capsys)
+    code, out, _ = run_cli(argv, capsys)
     compared = json.loads(out)
-    code_no, out_no, _ = _run([*argv, "--no-compare"], capsys)
+    code_no, out_no, _ = run_cli([*argv, "--no-compare"], capsys)
     kept = json.loads(out_no)
     assert code == 0 and compared["status"] == "replanned" and compared["valid"] is True
     assert code_no == 0 and kept["status"] == "repaired" and kept["valid"] is True
     assert kept["alternative"] is None
     assert compared["alternative"] == pytest.approx(kept["execution_time"])
     assert compared["execution_time"] < kept["execution_time"]
-    code, out, _ = _run(argv[:-1], capsys)
+    code, out, _ = run_cli(argv[:-1], capsys)
     assert code == 0 and "compared with: " in out and "(not kept)" in out
 
 
@@ -138,7 +128,7 @@ def test_replan_while_moving_writes_the_repair_first(
                               f"{yaw - 0.1559}]}}]\n")  # fmt: skip
     new = tmp_path / "new.json"
     argv = ["replan", D5, PLAN, "--at", "5.116", "--observed", obs, "--while-moving"]
-    code, out, _ = _run([*argv, "--json", "-o", str(new)], capsys)
+    code, out, _ = run_cli([*argv, "--json", "-o", str(new)], capsys)
     records = [json.loads(line) for line in out.splitlines()]
     assert code == 0 and 1 <= len(records) <= 2
     assert all(record["valid"] is True for record in records)
@@ -153,5 +143,5 @@ def test_replan_while_moving_writes_the_repair_first(
         assert later["alternative"] == pytest.approx(records[0]["execution_time"])
     assert load_plan(new).duration == pytest.approx(records[-1]["execution_time"])
     for other in ("--fresh", "--no-compare"):
-        code, _, err = _run([*argv, other], capsys)
+        code, _, err = run_cli([*argv, other], capsys)
         assert code == 2 and "not allowed with" in err

@@ -13,19 +13,7 @@ from sdar_tamp.cli import main
 from sdar_tamp.errors import ParameterError
 from sdar_tamp.export import default_output, export_plan, export_plan_file
 from sdar_tamp.plan_file import PlanFile, PlanFileError
-
-
-def refused(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code  # type: ignore[assignment]
-    captured = capsys.readouterr()
-    assert code == 2, captured
-    assert captured.out == ""
-    err = captured.err.strip()
-    assert "\n" not in err and err.startswith("sdar"), err
-    return err
+from tests.cli.conftest import refused
 
 
 @pytest.fixture
