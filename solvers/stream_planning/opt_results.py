@@ -42,3 +42,6 @@ class OptimisticWorld:
     more_calls: bool = False
     # the lowest level at which something left out for the limit would enter (inf: none)
     next_level: float = math.inf
+    # the lowest level of a later call's outputs a build without them left out (inf: none):
+    # above the limit, a build with them (``further``) would give the same world
+    further_level: float = math.inf

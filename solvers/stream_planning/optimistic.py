@@ -311,6 +311,7 @@ class OptimisticBuilder:
             if not wanted:
                 world.more_calls = True
                 world.next_level = min(world.next_level, result.level + 1)
+                world.further_level = min(world.further_level, result.level + 1)
                 continue
             shared = external.info.opt_gen_fn == "shared"
             k = 1

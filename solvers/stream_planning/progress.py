@@ -6,7 +6,10 @@ line the next print overwrites; anything else (a file, a pipe, a log) gets the l
 A round line::
 
     round 3 level 2: new skeleton (6 actions, 4 stream results), calls +5 (12), facts +7 (40),
-    0.021 s
+    0.021 s (world 0.004, grounding 0.006, search 0.009, sampling 0.001)
+
+The parts in brackets are the round's shares of the solve's ``world_time``, ``grounding_time``,
+``search_time`` (grounding excluded here) and ``sample_time`` (see ``Solution.statistics``).
 
 Its outcome is one of: ``new skeleton``, ``plan met before``, ``no plan`` (the level rises),
 ``solved``, ``infeasible`` or what the round's policy did with the plan.
@@ -17,11 +20,13 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from solvers.solution import StreamStatistics
 
 CLEAR_LINE = "\r\x1b[K"
+#: the parts of a round's time its line gives (``phases`` of :meth:`RoundLog.begin`)
+PHASES = ("world", "grounding", "search", "sampling")
 
 
 @dataclass
@@ -31,6 +36,7 @@ class _Round:
     calls: int
     facts: int
     start: float
+    phases: tuple[float, ...] = field(default=())
 
 
 class RoundLog:
@@ -41,24 +47,38 @@ class RoundLog:
         self._round: _Round | None = None
         self._live = False  # a transient line is on the terminal
 
-    def begin(self, number: int, level: int, calls: int, facts: int) -> None:
-        """A round starts at complexity ``level`` with ``calls`` calls and ``facts`` facts."""
+    def begin(
+        self, number: int, level: int, calls: int, facts: int, phases: Sequence[float] = ()
+    ) -> None:
+        """A round starts at complexity ``level`` with ``calls`` calls and ``facts`` facts;
+        ``phases``: the solve's world, grounding, search and sampling times [s] so far."""
         if not self.enabled:
             return
-        self._round = _Round(number, level, calls, facts, time.perf_counter())
+        self._round = _Round(number, level, calls, facts, time.perf_counter(), tuple(phases))
         self._show(f"round {number} level {level}: searching...")
 
-    def end(self, outcome: str, calls: int, facts: int) -> None:
-        """The round that began last ended with ``outcome``; prints its line."""
+    def end(self, outcome: str, calls: int, facts: int, phases: Sequence[float] = ()) -> None:
+        """The round that began last ended with ``outcome``; prints its line (with the
+        round's share of each of ``phases``, given as at :meth:`begin`)."""
         current = self._round
         if not self.enabled or current is None:
             return
         self._round = None
+        shares = ""
+        if len(phases) == len(PHASES) == len(current.phases):
+            shares = (
+                " ("
+                + ", ".join(
+                    f"{name} {now - then:.3f}"
+                    for name, now, then in zip(PHASES, phases, current.phases, strict=True)
+                )
+                + ")"
+            )
         self._print(
             f"round {current.number} level {current.level}: {outcome}, "
             f"calls +{calls - current.calls} ({calls}), "
             f"facts +{facts - current.facts} ({facts}), "
-            f"{time.perf_counter() - current.start:.3f} s"
+            f"{time.perf_counter() - current.start:.3f} s{shares}"
         )
 
     def summary(

@@ -88,7 +88,13 @@ class StreamSolver:
 
     def _end(self, outcome: str) -> None:
         """The current round ended with ``outcome`` (its line, with ``verbose``)."""
-        self.log.end(outcome, self.context.calls, len(self.context.engine.store))
+        self.log.end(outcome, self.context.calls, len(self.context.engine.store), self._phases())
+
+    def _phases(self) -> tuple[float, float, float, float]:
+        """The solve's world, grounding, search (without grounding) and sampling times [s]."""
+        stats = self.context.stats
+        search = stats.search_time - stats.grounding_time
+        return (stats.world_time, stats.grounding_time, search, stats.sample_time)
 
     def _world(self, level: int) -> OptimisticWorld:
         """The facts to plan over: the optimistic world, or in incremental without fluent
@@ -153,7 +159,9 @@ class StreamSolver:
                 return Status.TIMEOUT
             stats.iterations += 1
             stats.complexity = level
-            log.begin(stats.iterations, level, context.calls, len(context.engine.store))
+            log.begin(
+                stats.iterations, level, context.calls, len(context.engine.store), self._phases()
+            )
             policy.prepare(level)
             world, found = self._plan_at(level)
             ordered = None if found is None else self._new_plan(world, found[0], tried)
@@ -265,11 +273,13 @@ class StreamSolver:
             if (
                 found is None
                 and world.more_calls
+                and world.further_level <= level
                 and not context.unreachable
                 and not self.confirming
             ):
                 # no plan with one new output per instance: offer later calls' outputs (when
-                # they all lie above the level, the same facts: the same search would fail)
+                # they all lie above the level, the same world, not built again: the same
+                # search would fail)
                 further = self._build(level, further=True)
                 if further.facts.keys() != world.facts.keys():
                     found = context.plan(further.facts, further.numeric, further)

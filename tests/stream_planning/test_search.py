@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import random
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
 
@@ -126,3 +127,33 @@ def test_join_with_bound_arguments_matches_a_full_scan() -> None:
         level = max(store.levels[p1], store.levels[q1], store.levels[p2])
         expected.append((tuple(sorted(binding.items())), level))
     assert found == sorted(expected) and found
+
+
+def test_a_world_of_later_calls_is_built_only_when_it_can_differ(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``OptimisticWorld.further_level``: when every later call's outputs lie above the level,
+    the build with them gives the same facts (the solver skips it); else it adds some. Every
+    world of pick_place_2d's searches that leaves later calls out is built again both ways."""
+    from domains.pick_place_2d.samplers import make_problem
+    from solvers.stream_planning.optimistic import OptimisticBuilder, OptimisticWorld
+
+    build = OptimisticBuilder.build
+    seen = {"above": 0, "within": 0}
+
+    def checked(
+        self: OptimisticBuilder, limit: int, lazy: bool = False, further: bool = False, **kw: Any
+    ) -> OptimisticWorld:
+        world = build(self, limit, lazy, further, **kw)
+        if world.more_calls and not further:
+            again = build(self, limit, lazy, True, **kw)
+            above = world.further_level > limit
+            seen["above" if above else "within"] += 1
+            assert (again.facts.keys() == world.facts.keys()) is above
+        return world
+
+    monkeypatch.setattr(OptimisticBuilder, "build", checked)
+    for algorithm in ("focused", "binding"):
+        solution = solve(make_problem(seed=0), algorithm=algorithm, max_time=60, seed=0)
+        assert solution.plan is not None
+    assert seen["above"] and seen["within"]

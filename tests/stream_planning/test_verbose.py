@@ -19,7 +19,8 @@ from solvers.solve import solve
 NARROW = Path(__file__).resolve().parents[2] / "domains" / "infeasible"
 ROUND = re.compile(
     r"^round (\d+) level (\d+): (.+), calls \+(\d+) \((\d+)\), facts \+(\d+) \((\d+)\), "
-    r"\d+\.\d{3} s$"
+    r"(\d+\.\d{3}) s \(world (\d+\.\d{3}), grounding (\d+\.\d{3}), search (\d+\.\d{3}), "
+    r"sampling (\d+\.\d{3})\)$"
 )
 
 
@@ -114,3 +115,25 @@ def test_the_round_costs_are_split_into_worlds_grounding_and_search(
     assert re.search(
         r"search \d+\.\d{3} s \(grounding \d+\.\d{3} s\), worlds \d+\.\d{3} s", summary
     )
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
+def test_each_round_line_splits_its_time_into_world_grounding_search_and_sampling(
+    algorithm: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A round line's parts are that round's shares of the solve's counters: over all rounds
+    they add up to the solve's ``world_time``, ``grounding_time``, ``search_time`` minus
+    grounding and ``sample_time`` (to the printed precision)."""
+    solution = solve(_problem(cfree=True), algorithm=algorithm, max_time=60, verbose=True)
+    rounds = [ROUND.match(line) for line in capsys.readouterr().out.splitlines()]
+    parts = [[float(m.group(i)) for i in range(9, 13)] for m in rounds if m]
+    assert len(parts) == solution.statistics["iterations"]
+    statistics = solution.statistics
+    totals = (
+        statistics["world_time"],
+        statistics["grounding_time"],
+        statistics["search_time"] - statistics["grounding_time"],
+        statistics["sample_time"],
+    )
+    for column, total in zip(zip(*parts, strict=True), totals, strict=True):
+        assert sum(column) == pytest.approx(total, abs=0.0005 * len(parts) + 1e-9)
