@@ -131,10 +131,22 @@ class ArmFK:
 
     def frames(self, q: Any) -> list[Any]:
         """The world poses (SX ``4x4``) of the :attr:`n_frames` frames for the SX ``q``."""
-        frames = _frames(q, self.T_world_base, self.params, self.T_base_dh, self.chain)
+        frames = self.joint_frames(q)
         if self.chain is not None:
             frames.append(frames[-1] @ ca.SX(self.chain.T_joint_frame))
         return frames
+
+    def joint_frames(self, q: Any) -> list[Any]:
+        """The world poses (SX ``4x4``) of the :attr:`dof` joint frames for the SX ``q``: the
+        frames every sphere hangs on (a held object's on the last one, :attr:`T_last_tool`);
+        the optimiser's slots choose among these (a slot's cost grows with their number)."""
+        return _frames(q, self.T_world_base, self.params, self.T_base_dh, self.chain)
+
+    @property
+    def T_last_tool(self) -> FloatArray | None:
+        """The tool frame in the last joint frame ``(4, 4)``, or None where they are one frame
+        (the DH form: joint 6's frame is tool0)."""
+        return None if self.chain is None else np.asarray(self.chain.T_joint_frame)
 
     def recipe(self) -> str:
         """The kinematic data the symbolic functions are made of (a cache key)."""

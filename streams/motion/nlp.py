@@ -34,7 +34,7 @@ from streams.motion.optimiser_records import TrajOptOptions
 from streams.motion.sphere_pairs import arm_pairs
 
 #: Joint frames of a UR arm a sphere may hang on (frame ``j`` carries link ``j + 1``; tool0 is
-#: the last); another arm has its own count (:attr:`streams.motion.fk_casadi.ArmFK.n_frames`).
+#: the last); another arm has one per joint (:meth:`streams.motion.fk_casadi.ArmFK.joint_frames`).
 FRAMES = 6
 
 
@@ -151,7 +151,8 @@ def _knot_rows(ctx: WorldContext, lay: ParameterLayout, q: Any, p: Any) -> Any:
     arms, then arm-obstacle slots per arm, then arm-table slots per arm."""
     arms = ctx.layout
     m = lay.sym(p, "margin")
-    frames = [ctx.fk[arm].frames(q[sl]) for arm, sl in zip(ctx.arm_names, arms.slices, strict=True)]
+    frames = [ctx.fk[arm].joint_frames(q[sl])
+              for arm, sl in zip(ctx.arm_names, arms.slices, strict=True)]  # fmt: skip
     g: list[Any] = []
     for pair, ij in enumerate(arm_pairs(len(arms))):
         kind = pair_kind(pair)
@@ -173,7 +174,7 @@ def build_nlp(ctx: WorldContext, o: TrajOptOptions) -> TransferNLP:
     SX functions of one knot, mapped over the knots, so CasADi differentiates one knot,
     not the whole horizon (the collision Jacobian and Hessian are block diagonal)."""
     pair_slots = pair_slot_counts(ctx, o)
-    frames = tuple(ctx.fk[a].n_frames for a in ctx.arm_names)
+    frames = tuple(ctx.fk[a].dof for a in ctx.arm_names)  # the joint frames
     lay = parameter_layout(ctx.layout, o, frames, pair_slots)
     dof, n = ctx.layout.dof, o.knots - 2
     q_k, p_k = sx_sym("q", dof), sx_sym("p", lay.size)

@@ -37,21 +37,30 @@ from streams.motion.sphere_pairs import (
 class SphereTable:
     """Spheres of one arm as the optimiser's slots see them: frame index ``(n,)`` (0-based),
     centre in that frame ``(n, 3)`` [m], radius ``(n,)`` [m], of the arm's ``n_frames``
-    frames (a held object's spheres hang on the last, the tool frame)."""
+    joint frames (:meth:`~streams.motion.fk_casadi.ArmFK.joint_frames`; a held object's
+    spheres hang on the last, moved there from the tool frame by ``T_last_tool``, None: the
+    last joint frame is the tool frame)."""
 
     frame: Any
     centre: FloatArray
     radius: FloatArray
     n_frames: int
+    T_last_tool: FloatArray | None = None
 
     def plus(self, held: HeldSpheres) -> SphereTable:
-        """With the held spheres appended (on tool0), as :func:`path_spheres` orders them."""
+        """With the held spheres appended (on the last joint frame), as :func:`path_spheres`
+        orders them."""
         n = len(held.radius)
+        centre = np.asarray(held.centre, dtype=np.float64).reshape(n, 3)
+        if self.T_last_tool is not None:
+            T = self.T_last_tool
+            centre = centre @ T[:3, :3].T + T[:3, 3]
         return SphereTable(
             np.concatenate([self.frame, np.full(n, self.n_frames - 1, dtype=np.int64)]),
-            np.concatenate([self.centre, np.asarray(held.centre).reshape(n, 3)]),
+            np.concatenate([self.centre, centre]),
             np.concatenate([self.radius, held.radius]),
             self.n_frames,
+            self.T_last_tool,
         )
 
     def slots(self, idx: Any, slots: int) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -86,8 +95,9 @@ def arm_sphere_tables(ctx: WorldContext, arm: str) -> ArmSphereTables:
     def table(spheres: Any) -> SphereTable:
         frame = np.asarray(spheres.joint, dtype=np.int64) - 1
         return SphereTable(
-            frame, np.asarray(spheres.centre), np.asarray(spheres.radius), fk.n_frames
-        )
+            frame, np.asarray(spheres.centre), np.asarray(spheres.radius), fk.dof,
+            fk.T_last_tool,
+        )  # fmt: skip
 
     return ArmSphereTables(table(fk.spheres), table(fk.coarse))
 

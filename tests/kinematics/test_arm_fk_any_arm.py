@@ -14,6 +14,11 @@ from sdar_tamp.world.scene import Scene
 from streams.context import WorldContext
 from streams.motion._casadi import ca, function, sx_sym, to_array
 from streams.motion.fk_casadi import ArmFK
+from streams.motion.optimiser import TrajectoryOptimiser
+from streams.motion.optimiser_records import TrajOptOptions, TransferQuery
+from streams.motion.slots import Selection, select_pairs
+from streams.motion.sphere_pairs import HeldSpheres, path_spheres
+from streams.motion.waypoints import straight_line
 from tests.kinematics.conftest import ARM7_URDF
 
 LINKS = tuple(f"link{i}" for i in range(1, 8))
@@ -94,3 +99,49 @@ def test_shapes_off_the_chain_are_refused(scene7: Scene, tmp_path: Path) -> None
     kin = ArmKinematics.from_model(scene7.arm("left"), path, tcp_offset=0.1034)
     with pytest.raises(KinematicsError, match=r"gripper_left_finger_joint.*not on the chain"):
         ArmFK.from_kinematics(kin)
+
+
+def test_slots_of_a_chain_arm_hang_on_its_joint_frames(
+    ctx7: WorldContext, ctx: WorldContext
+) -> None:
+    """The optimiser's slots choose among the seven joint frames (not the tool frame too): a
+    held object's spheres, given in the tool frame, hang on the last joint frame, and every
+    arm-arm and table row equals the numeric clearance of its spheres at every knot."""
+    fk = ctx7.fk["left"]
+    assert len(fk.joint_frames(sx_sym("q", 7))) == 7 == fk.dof and fk.n_frames == 8
+    assert fk.T_last_tool is not None and ctx.fk["left"].T_last_tool is None
+    o = TrajOptOptions(knots=4, arm_arm_slots=5, obstacle_slots=1, table_slots=3,
+                       select_distance=10.0, compiled=False)  # fmt: skip
+    opt = TrajectoryOptimiser(ctx7, o)
+    assert opt._lay.blocks["aa0_frame0"][1] == (5, 7)
+    held = (HeldSpheres(np.array([[0.01, 0.02, 0.15], [-0.02, 0.0, 0.12]]), np.array([0.03, 0.02])),
+            HeldSpheres(np.array([[0.0, -0.01, 0.14]]), np.array([0.025])))  # fmt: skip
+    q_a = ctx7.scene.home
+    q_b = q_a + np.random.default_rng(4).uniform(-0.4, 0.4, q_a.size)
+    query = TransferQuery(q_a, q_b, held, (np.zeros((0, 3)), np.zeros(0)), 3.0)
+    path = straight_line(q_a, q_b, o.knots)
+    spheres = path_spheres(ctx7, path, held)
+    na, nb = len(fk.coarse), len(ctx7.fk["right"].coarse)  # the held spheres follow these
+    none, empty = np.zeros(0), np.zeros((0, 2), dtype=np.int64)
+    forced = Selection((np.array([[na, nb], [na + 1, 0], [3, nb]]),), (empty, empty),
+                       (np.array([len(fk.spheres) + 1]), np.array([len(fk.spheres)])),
+                       (none,), (none, none), (none, none))  # fmt: skip
+    sel = select_pairs(spheres, path_spheres(ctx7, path[[0, -1]], held), query, o, forced)
+    assert sel.aa[0][:3].tolist() == [[na, nb], [na + 1, 0], [3, nb]]
+    p, _, _ = opt._parameters(query, sel)
+    g = np.asarray(opt._g_fn(path[1:-1].reshape(-1), p)).reshape(-1)
+    per_knot = opt._n_collision // (o.knots - 2)
+    for knot in range(o.knots - 2):
+        rows = g[knot * per_knot : (knot + 1) * per_knot]
+        ci = spheres.coarse_centres[0][knot + 1][sel.aa[0][:, 0]]
+        cj = spheres.coarse_centres[1][knot + 1][sel.aa[0][:, 1]]
+        r = spheres.coarse_radii[0][sel.aa[0][:, 0]] + spheres.coarse_radii[1][sel.aa[0][:, 1]]
+        want = np.sum((ci - cj) ** 2, axis=1) - (r + o.margin) ** 2
+        np.testing.assert_allclose(rows[: o.arm_arm_slots], want, atol=1e-9)
+        start = o.arm_arm_slots + 2 * o.obstacle_slots
+        for arm in range(2):
+            idx = sel.table[arm]
+            c = spheres.centres[arm][knot + 1][idx]
+            want_t = c[:, 2] - spheres.radii[arm][idx] - o.margin
+            got = rows[start + arm * o.table_slots : start + (arm + 1) * o.table_slots]
+            np.testing.assert_allclose(got[: len(idx)], want_t, atol=1e-9)
