@@ -1,6 +1,7 @@
 """Shortcuts of the start-time search that must not change its answer: starts passed over
-(:meth:`~sdar_tamp.schedule.scheduler.Placement.skipped`) and a paused attempt's motion put
-back as it was (:meth:`~sdar_tamp.schedule.move_commit.MoveCommit.put_back`)."""
+(:meth:`~sdar_tamp.schedule.scheduler.Placement.skipped`), a paused attempt's motion put
+back as it was (:meth:`~sdar_tamp.schedule.move_commit.MoveCommit.put_back`) and the world
+after the same events set at once (:meth:`~sdar_tamp.schedule.sweep.WorldSweep.reset`)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.schedule.assignment import Assignment
 from sdar_tamp.schedule.room import block_of
 from sdar_tamp.schedule.scheduler import Entry, Placement
+from sdar_tamp.schedule.sweep import TimedEvent, WorldSweep
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
@@ -117,3 +119,47 @@ def test_a_paused_attempt_that_ends_no_earlier_puts_the_motion_back_as_it_was(
         np.testing.assert_array_equal(np.array(traj), kept)
     assert search.events == before[1] and search.steps == before[2]
     assert (search.delay, search.delayed_by) == delay
+
+
+def _timed(plan: PlanFile) -> list[TimedEvent]:
+    """The plan's events at their ticks with their arms' configurations."""
+    out = []
+    for e in plan.events:
+        row = int(np.argmin(np.abs(plan.t - e.t)))
+        arm = plan.arm_names.index(e.arm)
+        out.append(TimedEvent(row, e, np.array(plan.q[row, plan.layout.slice(arm)])))
+    return out
+
+
+def _state(sweep: WorldSweep) -> tuple[object, ...]:
+    held = {a: (o, T.tobytes()) for a, (o, T) in sweep.held.items()}
+    exempt = {a: (o, q.tobytes()) for a, (o, q) in sweep.exempt.items()}
+    return sweep.world.arrangement_key(), list(sweep.rest.items()), held, exempt
+
+
+def test_a_reset_to_the_same_events_again_sets_the_same_world(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> None:
+    """Resetting to events just replayed (remembered) gives the world a fresh sweep builds
+    from them: the same resting boxes in the same order, held objects at the same grasps, the
+    same exempt contacts and the same collision answers; after other events, a third reset
+    still does."""
+    instance, plan, _ = r5
+    events = _timed(plan)
+    held_at = next(i for i, e in enumerate(events) if e.event.type == "grasp") + 1
+    fresh = WorldSweep(instance, ctx.scene, 0.005)
+    for n in (held_at, len(events) // 2, len(events)):
+        fresh.reset(events[:n])
+        want = _state(fresh)
+        sweep = WorldSweep(instance, ctx.scene, 0.005)
+        sweep.reset(events[:n])
+        sweep.run(0, plan.q[:40], events[:0])  # a replay changes nothing remembered
+        if n < len(events):
+            sweep.apply(events[n], check=False)
+        sweep.reset(events[:n])  # remembered
+        assert _state(sweep) == want
+        sweep.reset(events[:1])
+        sweep.reset(events[:n])
+        assert _state(sweep) == want
+        q = plan.q[:: max(1, len(plan.q) // 50)]
+        assert [sweep.world.in_collision(x) for x in q] == [fresh.world.in_collision(x) for x in q]
