@@ -75,7 +75,7 @@ from sdar_tamp.schedule.move_records import (
     Stand,
 )
 from sdar_tamp.schedule.moves import CyclicMoves, Move, Pose, break_cycles, plan_moves
-from sdar_tamp.schedule.own_first import own_first, sync_spans
+from sdar_tamp.schedule.own_first import advance, free_arm, go_ahead, own_first, sync_spans
 from sdar_tamp.schedule.retiming import ArmRetimer
 from sdar_tamp.schedule.room import no_block
 from sdar_tamp.schedule.scheduler import (
@@ -96,8 +96,6 @@ TIE = 0.05
 #: [m] the room beside an object that fingers need to grasp or release it: moves whose poses
 #: come this close keep their synchronous order (:func:`~sdar_tamp.schedule.moves.plan_moves`)
 FINGER_ROOM = 0.03
-#: planned paths tried in such a retry
-PAIRS_TRIED = 2
 
 
 class Assignment(MoveCommit):
@@ -187,7 +185,7 @@ class Assignment(MoveCommit):
             done = self.choose(arm, ranked[: self.options.candidates])
             clears: tuple[Callable[[int], bool], ...] = (self.back_off, self.clear_way)
             if self.policy == "own-first":  # the arms in the way go ahead, as in the plan
-                clears = (self.go_ahead, *clears)
+                clears = (lambda a: go_ahead(self, a), *clears)
             for clear in clears:
                 if done is None and ranked and clear(arm):
                     done = next((m for m in ranked[:1] if self.take(arm, m)), None)
@@ -201,21 +199,11 @@ class Assignment(MoveCommit):
 
     def free_arm(self, ready: list[Move]) -> tuple[int, list[Move]]:
         """The arm whose timeline ends first and its ranked candidates (policy
-        ``own-first``: of the arms whose timelines end first, the first whose candidate is its
-        own move, else the first that has any; when every arm's timeline ends there and none
-        has any, the first one's by ``earliest``)."""
-        first = sorted(self.arms, key=lambda a: (self.horizon(a), a))
-        ranked = self.rank(first[0], ready)
-        if self.policy != "own-first":
-            return first[0], ranked
-        now = [(a, self.rank(a, ready)) for a in first if self.horizon(a) == self.horizon(first[0])]
-        own = [(a, r) for a, r in now if r and r[0].arm == a]
-        some = [(a, r) for a, r in now if r]
-        if own or some:
-            return (own or some)[0]
-        if len(now) < len(first):
-            return first[0], ranked
-        return first[0], self.rank(first[0], ready, "earliest")  # none would move: any
+        ``own-first``: :func:`~.own_first.free_arm`)."""
+        if self.policy == "own-first":
+            return free_arm(self, ready)
+        first = min(self.arms, key=lambda a: (self.horizon(a), a))
+        return first, self.rank(first, ready)
 
     def make_room(self, arm: int) -> bool:
         """``arm`` found no move: it retreats when it stands at a grasp or release
@@ -223,36 +211,9 @@ class Assignment(MoveCommit):
         workspace; whether it moved."""
         if self.stand[arm].pre is not None and self.retreat(arm):
             return True
-        if self.policy == "own-first" and self.advance(arm):
+        if self.policy == "own-first" and advance(self, arm):
             return True
         return self.policy == "clear" and not self.parked[arm] and self.park(arm)
-
-    def advance(self, arm: int, until: float | None = None) -> bool:
-        """Move ``arm`` along its own next move's synchronous reach to the pre-grasp
-        (:meth:`~.sync_motions.SyncMove.to_pre_grasp`), or to where the plan had it at time
-        ``until`` [s] (:meth:`~.sync_motions.SyncMove.until`); whether it did."""
-        own = min((m for m in self.moves if m.arm == arm and m.index not in self.carrier),
-                  key=lambda m: m.index, default=None)  # fmt: skip
-        sync = None if own is None else getattr(self.planner, "motions", {}).get(own.index)
-        q = self.stand[arm].q
-        if sync is None:
-            return False
-        path = sync.to_pre_grasp(q) if until is None else sync.until(q, until)
-        if path is None:
-            return False
-        leaving = self.stand[arm].leaving
-        return self._commit(arm, self.retimers[arm].retime(path[0], path[1], leaving, False))
-
-    def go_ahead(self, arm: int) -> bool:
-        """Let the other arms in the way (:meth:`blocking`) go ahead along their own next
-        move's reach to where the plan had them when ``arm``'s next move released its object
-        (:meth:`advance`); whether any did."""
-        nxt = min((m for m in self.moves if m.arm == arm and m.index not in self.carrier),
-                  key=lambda m: m.index, default=None)  # fmt: skip
-        sync = None if nxt is None else getattr(self.planner, "motions", {}).get(nxt.index)
-        if sync is None:
-            return False
-        return sum(self.advance(a, sync.released) for a in self.blocking(arm)) > 0
 
     def choose(self, arm: int, ranked: list[Move]) -> Move | None:
         """Commit the first of ``ranked`` that releases its object within ``slack`` [s] of
@@ -299,61 +260,6 @@ class Assignment(MoveCommit):
             self.estimated[m.index] = math.ceil((finish - self.dwell * self.tick) / self.tick)
         scored.sort(key=lambda s: s[:3])
         return [s[3] for s in scored]
-
-    def take(self, arm: int, m: Move) -> bool:
-        """Plan and commit ``m`` by ``arm``; False when no planned path can be committed.
-
-        The motions are planned against the other arms standing where their committed
-        timelines end. When the first path that commits has to wait for another arm (the
-        sweep meets that arm at the earliest start), the move is planned once more with
-        that arm standing where the sweep met it (a conflict-based retry, up to
-        ``replans`` times) and the path that releases the object first is kept."""
-        resting = {o: p for o, p in self.rest.items() if o != m.obj}
-        resting[m.obj] = m.start
-        others = [np.array(self.traj[a][-1]) for a in self.arms]
-        started = time.perf_counter()
-        mark = self.mark()
-        try:
-            got = self.commit_first(
-                arm, m, self.planner.plan(arm, self.stand[arm], m, resting, others)
-            )
-            for _ in range(self.options.replans):
-                if got is None or got[1] is None or self.is_own(got[0][0]):
-                    break  # the plan's own motion is not planned again
-                release, conflict = self.tick_of(got[0][2]), got[1]
-                dodge = list(others)
-                for a in self.arms:
-                    if a != arm and self.plan.arm_names[a] in conflict.arms:
-                        dodge[a] = np.array(self.rows(a, conflict.tick, conflict.tick)[0])
-                self.undo(mark)
-                self.detours += 1
-                plans = self.planner.plan(arm, self.stand[arm], m, resting, dodge)
-                alt = self.commit_first(arm, m, plans, limit=PAIRS_TRIED)
-                if alt is not None and self.tick_of(alt[0][2]) < release:
-                    got = alt
-                    self.detours_kept += 1
-                    continue
-                if alt is not None:
-                    self.undo(mark)
-                got = self.commit_first(arm, m, iter([got[0][0]]))
-                break
-        finally:
-            self.planning_time += time.perf_counter() - started
-        if got is None:
-            return False
-        planned, grasp, release_event = got[0]
-        self.grasp_tick[m.index] = self.tick_of(grasp)
-        self.release_tick[m.index] = self.tick_of(release_event)
-        self.carrier[m.index] = arm
-        self.own += self.is_own(planned)
-        self.rest[m.obj] = m.end
-        self.stand[arm] = planned.end
-        self.parked[arm] = False
-        return True
-
-    def is_own(self, planned: PlannedMove) -> bool:
-        """Whether ``planned`` is the synchronous plan's own motion (:mod:`.sync_motions`)."""
-        return id(planned) in getattr(self.planner, "offered", ())
 
     def figures(self) -> tuple[tuple[str, float], ...]:
         """Moves committed and how many went to another arm than in the synchronous plan,

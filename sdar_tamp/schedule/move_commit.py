@@ -18,18 +18,20 @@ decomposition, prioritised in time):
 :meth:`MoveCommit.commit_move` commits the reach, then the carry; when the carry finds no
 start because the arm, holding the object, stands in another arm's way, the grasp is tried
 later. What a move's commit reports back (the conflict that delayed it) drives the
-conflict-based retry of :meth:`sdar_tamp.schedule.assignment.Assignment.take`.
+conflict-based retry of :meth:`MoveCommit.take` (plan the move, commit it, plan it again
+around the arm that delayed it).
 """
 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Iterator
 
 import numpy as np
 
-from sdar_tamp.plan_file import PlanEvent
-from sdar_tamp.schedule.move_records import PlannedMove
+from sdar_tamp.plan_file import PlanEvent, StepRecord
+from sdar_tamp.schedule.move_records import AssignmentOptions, PlannedMove
 from sdar_tamp.schedule.moves import Move
 from sdar_tamp.schedule.room import Room, block_of
 from sdar_tamp.schedule.scheduler import Entry, NoPlacement
@@ -37,16 +39,21 @@ from sdar_tamp.schedule.sweep import Conflict, TimedEvent
 from sdar_tamp.world.transforms import FloatArray
 
 Mark = tuple[list[int], list[TimedEvent], dict[int, int], int]  #: what ``undo`` restores
+#: what was committed since a mark: per arm the new samples, then the events, their ticks and
+#: the steps
+Placed = tuple[list[list[FloatArray]], list[TimedEvent], dict[int, int], list[StepRecord]]
 
 #: starts tried for a move's grasp when the carry after it finds none
 REGRASPS = 3
 #: [s] a move whose reach or carry waits this long for another arm is planned again with
-#: that arm where the wait met it (:meth:`Assignment.take`)
+#: that arm where the wait met it (:meth:`MoveCommit.take`)
 DETOUR_AFTER = 0.2
 #: [s] how far before the point where another arm is met a paused motion stops (tried in turn)
 PAUSE_BACK = (0.1, 0.3)
 #: [s] the least motion worth making before a pause
 PAUSE_LEAST = 0.1
+#: planned paths tried in a conflict-based retry (:meth:`MoveCommit.take`)
+PAIRS_TRIED = 2
 
 
 class MoveCommit(Room):
@@ -57,6 +64,69 @@ class MoveCommit(Room):
     pauses: bool
     paused: int
     move_of: dict[int, Move]  # id(event) -> its move
+    options: AssignmentOptions
+    grasp_tick: dict[int, int]
+    release_tick: dict[int, int]
+    carrier: dict[int, int]  # move -> arm
+    planning_time: float
+    detours: int
+    detours_kept: int
+    own: int  # moves committed along the synchronous plan's own motions
+
+    def take(self, arm: int, m: Move) -> bool:
+        """Plan and commit ``m`` by ``arm``; False when no planned path can be committed.
+
+        The motions are planned against the other arms standing where their committed
+        timelines end. When the first path that commits has to wait for another arm (the
+        sweep meets that arm at the earliest start), the move is planned once more with
+        that arm standing where the sweep met it (a conflict-based retry, up to
+        ``replans`` times) and the path that releases the object first is kept."""
+        resting = {o: p for o, p in self.rest.items() if o != m.obj}
+        resting[m.obj] = m.start
+        others = [np.array(self.traj[a][-1]) for a in self.arms]
+        started = time.perf_counter()
+        mark = self.mark()
+        try:
+            got = self.commit_first(
+                arm, m, self.planner.plan(arm, self.stand[arm], m, resting, others)
+            )
+            for _ in range(self.options.replans):
+                if got is None or got[1] is None or self.is_own(got[0][0]):
+                    break  # the plan's own motion is not planned again
+                release, conflict = self.tick_of(got[0][2]), got[1]
+                dodge = list(others)
+                for a in self.arms:
+                    if a != arm and self.plan.arm_names[a] in conflict.arms:
+                        dodge[a] = np.array(self.rows(a, conflict.tick, conflict.tick)[0])
+                self.undo(mark)
+                self.detours += 1
+                plans = self.planner.plan(arm, self.stand[arm], m, resting, dodge)
+                alt = self.commit_first(arm, m, plans, limit=PAIRS_TRIED)
+                if alt is not None and self.tick_of(alt[0][2]) < release:
+                    got = alt
+                    self.detours_kept += 1
+                    continue
+                if alt is not None:
+                    self.undo(mark)
+                got = self.commit_first(arm, m, iter([got[0][0]]))
+                break
+        finally:
+            self.planning_time += time.perf_counter() - started
+        if got is None:
+            return False
+        planned, grasp, release_event = got[0]
+        self.grasp_tick[m.index] = self.tick_of(grasp)
+        self.release_tick[m.index] = self.tick_of(release_event)
+        self.carrier[m.index] = arm
+        self.own += self.is_own(planned)
+        self.rest[m.obj] = m.end
+        self.stand[arm] = planned.end
+        self.parked[arm] = False
+        return True
+
+    def is_own(self, planned: PlannedMove) -> bool:
+        """Whether ``planned`` is the synchronous plan's own motion (:mod:`.sync_motions`)."""
+        return id(planned) in getattr(self.planner, "offered", ())
 
     def commit_first(
         self, arm: int, m: Move, options: Iterator[PlannedMove], limit: int | None = None
@@ -165,37 +235,41 @@ class MoveCommit(Room):
         """Replace the committed motion (placed since ``mark``, ending at tick ``end``) by
         its first ``cut`` samples and the rest, each from rest to rest and started as early
         as the sweep lets it, when that ends earlier; whether it did (else the committed
-        motion is left as it was)."""
+        motion is put back as it was)."""
         timer = self.retimers[arm]
         t = np.arange(len(q), dtype=np.float64) * self.tick
         first = timer.retime(t[: cut + 1], q[: cut + 1], leaving, False)
         rest = timer.retime(t[cut:] - t[cut], q[cut:], False, True)
-        kept = self.mark()
+        kept, delay = self.since(mark), (self.delay, self.delayed_by)
         self.undo(mark)
         try:
             self.place([Entry(arm, block_of(arm, first), first, 0)])
             self.place([Entry(arm, block_of(arm, rest, event), rest, 0)])
         except NoPlacement:
-            self.undo(mark)
-            self.redo(kept, arm, q, event)
+            self.put_back(mark, kept)
+            self.delay, self.delayed_by = delay
             return False
         if self.horizon(arm) < end:
             return True
-        self.undo(mark)
-        self.redo(kept, arm, q, event)
+        self.put_back(mark, kept)
+        self.delay, self.delayed_by = delay
         return False
 
-    def redo(
-        self,
-        kept: Mark,
-        arm: int,
-        q: FloatArray,
-        event: PlanEvent | None,
-    ) -> None:
-        """Commit the whole motion again where it was (the sweep finds the same start)."""
-        self.place([Entry(arm, block_of(arm, q, event), q, 0)])
-        if self.horizon(arm) != kept[0][arm] - 1:  # by construction this does not happen
-            raise NoPlacement(block_of(arm, q, event), None, "the motion did not commit again")
+    def since(self, mark: Mark) -> Placed:
+        """What was committed since ``mark`` (for :meth:`put_back`)."""
+        tails = [list(traj[n:]) for traj, n in zip(self.traj, mark[0], strict=True)]
+        return tails, list(self.events), dict(self.event_tick), list(self.steps[mark[3] :])
+
+    def put_back(self, mark: Mark, placed: Placed) -> None:
+        """Take back everything since ``mark`` and commit ``placed`` (:meth:`since`) again as
+        it was: the same motions at the same ticks (a placement is a function of the state,
+        so searching again would find them)."""
+        self.undo(mark)
+        tails, events, event_tick, steps = placed
+        for traj, tail in zip(self.traj, tails, strict=True):
+            traj.extend(tail)
+        self.events, self.event_tick = list(events), dict(event_tick)
+        self.steps.extend(steps)
 
     def arm_delay(self, least: int) -> Conflict | None:
         """The conflict with another arm that delayed the last placement by ``least`` ticks
@@ -204,4 +278,4 @@ class MoveCommit(Room):
         return c if self.delay >= least and c is not None and c.arms else None
 
 
-__all__ = ["DETOUR_AFTER", "PAUSE_BACK", "REGRASPS", "MoveCommit"]
+__all__ = ["DETOUR_AFTER", "PAIRS_TRIED", "PAUSE_BACK", "REGRASPS", "MoveCommit"]

@@ -98,8 +98,9 @@ class AssignmentOptions:
     ``max_checks``: the collision queries of one policy's search that the collision world
     answers (a remembered answer costs none; past them no schedule);
     ``max_plans``: motion-planner calls of one policy's search; ``replans``: conflict-based
-    retries per move (:meth:`Assignment.take`); ``slack`` [s]: a move committed this much
-    later than estimated is compared with the next candidates (:meth:`Assignment.choose`;
+    retries per move (:meth:`~.move_commit.MoveCommit.take`); ``slack`` [s]: a move committed
+    this much later than estimated is compared with the next candidates
+    (:meth:`Assignment.choose`;
     ``inf``: the first that goes is kept); ``pauses``: a motion that another arm delays may
     stop on the way and wait there (:mod:`.move_commit`); ``policies``: the ways of choosing
     the next move (:data:`POLICIES`), each searched in turn, the shortest schedule kept;

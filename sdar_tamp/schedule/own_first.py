@@ -15,17 +15,24 @@ ends; the free arm finishes it after its rest-to-rest estimate (:meth:`MovePlann
 collisions ignored, so stretched by :data:`STEAL_STRETCH`) and two dwells, from where its own
 timeline ends or when the move's dependencies allow. The candidates are those moves, earliest
 finish first; none: the free arm waits for the next event (or retreats).
+
+:func:`free_arm` chooses the free arm among those whose timelines end first;
+:func:`advance` and :func:`go_ahead` move an arm (or the arms in another's way) along its own
+next move's synchronous reach, as the plan had it.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Protocol
 
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.schedule.move_records import MovePlanner, Stand
 from sdar_tamp.schedule.moves import Move
+from sdar_tamp.schedule.retiming import ArmRetimer
+from sdar_tamp.schedule.sync_motions import SyncMove
+from sdar_tamp.world.transforms import FloatArray
 
 #: [s] a move goes to another arm than its own only when that ends it this much earlier
 STEAL_GAIN = 0.5
@@ -49,6 +56,19 @@ class Search(Protocol):
     def horizon(self, arm: int) -> int: ...
 
     def bound(self, m: Move) -> tuple[int, int]: ...
+
+
+class Advancing(Search, Protocol):
+    """What :func:`free_arm`, :func:`advance` and :func:`go_ahead` read and do."""
+
+    arms: range
+    retimers: list[ArmRetimer]
+
+    def rank(self, arm: int, ready: list[Move], policy: str | None = None) -> list[Move]: ...
+
+    def blocking(self, arm: int) -> list[int]: ...
+
+    def _commit(self, arm: int, q: FloatArray) -> bool: ...
 
 
 def sync_spans(plan: PlanFile, moves: Sequence[Move]) -> dict[int, float]:
@@ -105,4 +125,63 @@ def own_first(search: Search, arm: int, ready: list[Move]) -> list[Move]:
     return [s[2] for s in scored]
 
 
-__all__ = ["STEAL_GAIN", "STEAL_STRETCH", "own_first", "sync_spans"]
+def free_arm(search: Advancing, ready: list[Move]) -> tuple[int, list[Move]]:
+    """Of the arms whose timelines end first, the first whose candidate is its own move,
+    else the first that has any, with its ranked candidates; when every arm's timeline ends
+    there and none has any, the first one's by the ``earliest`` policy."""
+    first = sorted(search.arms, key=lambda a: (search.horizon(a), a))
+    now = [
+        (a, search.rank(a, ready)) for a in first if search.horizon(a) == search.horizon(first[0])
+    ]
+    own = [(a, r) for a, r in now if r and r[0].arm == a]
+    some = [(a, r) for a, r in now if r]
+    if own or some:
+        return (own or some)[0]
+    if len(now) < len(first):
+        return first[0], now[0][1]
+    return first[0], search.rank(first[0], ready, "earliest")  # none would move: any
+
+
+def _next_own(search: Advancing, arm: int) -> SyncMove | None:
+    """The synchronous motions of ``arm``'s own next move not committed yet (None: none)."""
+    own = min((m for m in search.moves if m.arm == arm and m.index not in search.carrier),
+              key=lambda m: m.index, default=None)  # fmt: skip
+    motions: Mapping[int, SyncMove] = getattr(search.planner, "motions", {})
+    return None if own is None else motions.get(own.index)
+
+
+def advance(search: Advancing, arm: int, until: float | None = None) -> bool:
+    """Move ``arm`` along its own next move's synchronous reach to the pre-grasp
+    (:meth:`~.sync_motions.SyncMove.to_pre_grasp`), or to where the plan had it at time
+    ``until`` [s] (:meth:`~.sync_motions.SyncMove.until`); whether it did."""
+    sync = _next_own(search, arm)
+    q = search.stand[arm].q
+    if sync is None:
+        return False
+    path = sync.to_pre_grasp(q) if until is None else sync.until(q, until)
+    if path is None:
+        return False
+    leaving = search.stand[arm].leaving
+    return search._commit(arm, search.retimers[arm].retime(path[0], path[1], leaving, False))
+
+
+def go_ahead(search: Advancing, arm: int) -> bool:
+    """Let the other arms in the way (:meth:`~.room.Room.blocking`) go ahead along their own
+    next move's reach to where the plan had them when ``arm``'s next move released its object
+    (:func:`advance`); whether any did."""
+    sync = _next_own(search, arm)
+    if sync is None:
+        return False
+    return sum(advance(search, a, sync.released) for a in search.blocking(arm)) > 0
+
+
+__all__ = [
+    "STEAL_GAIN",
+    "STEAL_STRETCH",
+    "Advancing",
+    "advance",
+    "free_arm",
+    "go_ahead",
+    "own_first",
+    "sync_spans",
+]

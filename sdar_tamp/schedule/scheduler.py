@@ -346,7 +346,10 @@ class Placement:
         before = [e for e in self.events if e.tick < k0]
         later = [e for e in self.events if e.tick >= k0]
         conflict: Conflict | None = None
+        until = start - 1  # starts up to this one are passed over: they fail (:meth:`skipped`)
         for s in range(start, stop + 1, self.stride):
+            if s <= until:
+                continue
             ends = [s + e.offset + self.length(e) for e in entries]
             k1 = max(*ends, *(self.horizon(a) for a in self.arms))
             q = np.concatenate([self.rows(a, k0, k1) for a in self.arms], axis=1)
@@ -376,6 +379,10 @@ class Placement:
                 break
             if all(s > self.horizon(a) for a in self.arms if a not in arms):
                 break  # the other arms stand still from now on: nothing changes
+            until = s + self.skipped(entries, s, conflict.tick)
+            passed = s + (until - s) // self.stride * self.stride  # the last start passed over
+            if passed > s and all(passed > h for h in others):
+                break  # a start passed over would have ended the search there
         block = entries[0].block
         detail = (
             f"no start for a block of {self.plan.arm_names[entries[0].arm]} "
@@ -384,6 +391,18 @@ class Placement:
         if conflict is not None:
             detail += f"; at t = {conflict.tick * self.tick:.2f} s: {conflict.message}"
         raise NoPlacement(block, conflict, detail)
+
+    def skipped(self, entries: list[Entry], s: int, tick: int) -> int:
+        """Ticks of the starts after ``s`` that :meth:`place` passes over, all of which fail:
+        a single block whose replay from start ``s`` met a conflict at ``tick`` after its
+        motion (its arm standing where the motion ends, as it does at that tick from every
+        start up to ``tick`` minus the motion's ticks, in the same world: the other arms'
+        trajectories and events are fixed, the block's own event is earlier)."""
+        if len(entries) != 1:
+            return 0
+        motion = len(entries[0].q) - 1
+        last = tick - motion - entries[0].offset  # the last start whose arm stands at ``tick``
+        return max(0, last - s)
 
     def commit(
         self, entry: Entry, s: int, rows: FloatArray, k0: int, timed: TimedEvent | None

@@ -60,6 +60,18 @@ class Conflict:
     arms: tuple[str, ...] = ()
 
 
+#: what :meth:`WorldSweep.reset` remembers: the events' key, the resting boxes, the held
+#: objects' grasps, the resting poses, the held objects and the contacts exempt
+_After = tuple[
+    Hashable,
+    dict[str, ObjectBox],
+    dict[str, tuple[str, FloatArray, tuple[float, float, float]]],
+    dict[str, tuple[float, float, float]],
+    dict[str, tuple[str, FloatArray]],
+    dict[str, tuple[str, FloatArray]],
+]
+
+
 class WorldSweep:
     """The world of one instance; :meth:`run` checks a stretch of a timeline."""
 
@@ -81,23 +93,44 @@ class WorldSweep:
         self._intervals: dict[bytes, int] = {}
         self._memos: OrderedDict[Hashable, dict[bytes, bool]] = OrderedDict()
         self._memo: dict[bytes, bool] | None = None  # the current arrangement's; None: unknown
+        #: arm -> the object it holds, the configuration it grasped it at, its pose before
+        self._grasped: dict[str, tuple[str, FloatArray, tuple[float, float, float]]] = {}
+        #: the world after the last events :meth:`reset` replayed, by those events
+        self._after: _After | None = None
 
     def box(self, name: str, pose: tuple[float, float, float]) -> ObjectBox:
         size = self.sizes[name]
         return ObjectBox(pose_xyz_yaw(pose[0], pose[1], size[2] / 2.0, pose[2]), size)
 
     def reset(self, before: Sequence[TimedEvent]) -> None:
-        """The world after the events ``before`` (in time order; assumed valid)."""
+        """The world after the events ``before`` (in time order; assumed valid). The world
+        after the last ``before`` replayed is remembered: the same events again (a start
+        search resets to them once per start it tries) set it at once, the same resting
+        boxes in the same order and each held object grasped at the same configuration."""
         for arm in self.names:
             if self.world.held_by(arm) is not None:
                 self.world.detach(arm)
-        self.rest = dict(self.start)
-        self.held, self.exempt = {}, {}
         self._memo = None
+        key = tuple(
+            (e.tick, e.event.arm, e.event.type, e.event.object, e.q_arm.tobytes()) for e in before
+        )
+        if self._after is not None and self._after[0] == key:
+            _, boxes, grasped, rest, held, exempt = self._after
+            self.world.set_objects({**boxes, **{n: self.box(n, p) for n, _, p in grasped.values()}})
+            for arm, (name, q_arm, _) in grasped.items():
+                self.world.attach(arm, name, q_arm)
+            self.rest, self.held, self.exempt = dict(rest), dict(held), dict(exempt)
+            self._grasped = dict(grasped)
+            return
+        self.rest = dict(self.start)
+        self.held, self.exempt, self._grasped = {}, {}, {}
         self.world.set_objects({n: self.box(n, p) for n, p in self.rest.items()})
         for e in before:
             self.apply(e, check=False)
             self.exempt[e.event.arm] = (e.event.object, e.q_arm)
+        boxes = self.world.objects
+        self._after = (key, boxes, dict(self._grasped), dict(self.rest), dict(self.held),
+                       dict(self.exempt))  # fmt: skip
 
     def run(self, k0: int, q: FloatArray, events: Sequence[TimedEvent]) -> Conflict | None:
         """Check the configurations ``q`` ``(m, dof)`` at ticks ``k0 .. k0 + m - 1`` and the
@@ -191,8 +224,10 @@ class WorldSweep:
         if e.type == "grasp":
             if e.arm in self.held or e.object not in self.rest:
                 return Conflict(tick, "grasp", f"{e.arm} grasps {e.object}, which is not free")
-            T_obj = self.box(e.object, self.rest.pop(e.object)).T_world_obj
+            pose = self.rest.pop(e.object)
+            T_obj = self.box(e.object, pose).T_world_obj
             self.held[e.arm] = (e.object, inverse(T_world_tcp) @ T_obj)
+            self._grasped[e.arm] = (e.object, timed.q_arm, pose)
             self.world.attach(e.arm, e.object, timed.q_arm)
             self._memo = None
             return None
@@ -209,6 +244,7 @@ class WorldSweep:
             ]:
                 return Conflict(tick, "release", f"{e.object} released onto {other}")
         del self.held[e.arm]
+        self._grasped.pop(e.arm, None)
         self.world.detach(e.arm, timed.q_arm)
         self.world.set_object(e.object, self.box(e.object, pose))
         self.rest[e.object] = pose
