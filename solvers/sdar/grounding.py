@@ -10,9 +10,12 @@ arms, options are checked in pairs of arms and steps known not to ground are ski
 (:mod:`~solvers.sdar.k_grounding`).
 
 The assignments of arms to a step's moves are :mod:`~solvers.sdar.assignment`'s. The
-options of a step of ``m > 2`` moves are cut so that their combinations stay within
-:data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
-those bringing more objects to their goals come first (then the estimated motion time).
+options of a step of ``m > 2`` moves are cut so that the checks of a stage stay within
+:data:`MAX_COMBINATIONS`: per pair of moves when its options are checked in pairs of arms
+(:meth:`~solvers.sdar.k_grounding.KArmChecks.pairwise`: as many options per move as a
+two-move step's expanded stage, the combinations then only looked up), else per
+combination; and with more than two arms, among groundings of one rank, those bringing more
+objects to their goals come first (then the estimated motion time).
 """
 
 from __future__ import annotations
@@ -165,16 +168,7 @@ class Grounder:
         stage with more grasps is reached even when the earlier ones ran out of options."""
         lifted = frozenset(step.objects)
         opt = self.options
-        first, more = opt.options_per_move, opt.more_options
-        size = len(step.moves)
-        if size > 2:  # keep the combinations of a stage within MAX_COMBINATIONS
-            cut = max(1, int(MAX_COMBINATIONS ** (1.0 / size) + 1e-9))
-            first, more = min(first, cut), min(more, cut)
-        stages = [(first, opt.grasps)]
-        if step.kind in opt.expand_kinds and more > first:
-            stages.append((more, opt.grasps))
-        if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps and size <= 2:
-            stages.append((opt.pair_grasps, opt.pair_grasps))
+        stages = grounding_stages(step, opt, self.k.pairwise(step))
         found: list[Grounding] = []
         misses: Counter[str] = Counter()  # why combinations of options failed
         poses = self.cache.current_poses()
@@ -215,8 +209,7 @@ class Grounder:
     def free_pairs(
         self, step: Step, arms: tuple[str, ...], grasps: int
     ) -> tuple[frozenset[str], ...] | None:
-        """Per move of a step of two goal moves, the grasps that can belong to a grounding
-        in any arrangement (:class:`~solvers.sdar.free_pairs.FreePairs`); None for others."""
+        """:class:`~solvers.sdar.free_pairs.FreePairs` of the step (None: not two goals)."""
         return self._free(step, arms, grasps)
 
     def _move_options(
@@ -371,6 +364,22 @@ class Grounder:
             d0 = event.conf
         first, last = sequence[0].conf, sequence[-1].conf
         return Grounding(step, arms, combo, first, last, estimate, tuple(sequence))
+
+
+def grounding_stages(step: Step, opt: SdarOptions, pairwise: bool) -> list[tuple[int, int]]:
+    """``(options per move, grasps)`` per stage of :meth:`Grounder._ground` (more than two
+    moves: see the module docstring on :data:`MAX_COMBINATIONS`)."""
+    first, more = opt.options_per_move, opt.more_options
+    size = len(step.moves)
+    if size > 2:
+        cut = max(1, int(MAX_COMBINATIONS ** (1.0 / (2 if pairwise else size)) + 1e-9))
+        first, more = min(first, cut), min(more, cut)
+    stages = [(first, opt.grasps)]
+    if step.kind in opt.expand_kinds and more > first:
+        stages.append((more, opt.grasps))
+    if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps and size <= 2:
+        stages.append((opt.pair_grasps, opt.pair_grasps))
+    return stages
 
 
 #: The most combinations of options per stage grounded for a step of more than two moves (the
