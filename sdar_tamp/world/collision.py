@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from sdar_tamp.world import collision_model as cm
+from sdar_tamp.world.collision_slots import SlotGeometry
 from sdar_tamp.world.errors import ArmLayoutError, CollisionModelError
 from sdar_tamp.world.scene import Scene
 from sdar_tamp.world.transforms import FloatArray, inverse
@@ -77,17 +78,26 @@ class CollisionWorld:
     Configurations ``q`` ``(layout.dof,)`` hold every arm's joints in the scene's
     :class:`~sdar_tamp.world.layout.ArmLayout` (``scene.layout``).
     Changing objects or grasps rebuilds the geometry lazily (several milliseconds for a dozen
-    objects); queries at a fixed object set are the fast path. With ``keep`` > 0 the last
+    objects; updated in place for objects seen before, see
+    :mod:`~sdar_tamp.world.collision_slots`); queries at a fixed object set are the fast
+    path. With ``keep`` > 0 the last
     ``keep`` geometries are kept by arrangement (resting boxes and held objects, compared
     exactly), so going back to an arrangement seen before costs no rebuild (for a user that
     goes back and forth, such as the asynchronous scheduler's sweep; each kept geometry holds a
     copy of the arms' shapes, tens of MB for a dozen). With ``arm_margin`` [m] > 0, shapes of
     two different arms collide when they come closer than that (a planner's safety distance:
-    its samples then keep the arms apart between samples too).
+    its samples then keep the arms apart between samples too). With ``incremental`` False
+    (or ``keep`` > 0) every arrangement gets a geometry built afresh.
     """
 
     def __init__(
-        self, scene: Scene, *, tolerance: float = 1e-3, keep: int = 0, arm_margin: float = 0.0
+        self,
+        scene: Scene,
+        *,
+        tolerance: float = 1e-3,
+        keep: int = 0,
+        arm_margin: float = 0.0,
+        incremental: bool = True,
     ) -> None:
         if keep < 0:
             raise CollisionModelError(f"keep: expected a number of geometries >= 0, got {keep}")
@@ -97,6 +107,7 @@ class CollisionWorld:
             )
         self._arm_margin = float(arm_margin)
         self._keep = keep
+        self._incremental = incremental and not keep
         self._scene = scene
         self._tolerance = tolerance
         self._arms = _dual_arm(scene)
@@ -107,6 +118,7 @@ class CollisionWorld:
         self._q = scene.home
         self._geometry: cm.SceneGeometry | None = None
         self._built: OrderedDict[Hashable, cm.SceneGeometry] = OrderedDict()
+        self._slots: SlotGeometry | None = None  # the geometry updated in place (keep == 0)
 
     # -- objects and grasps ---------------------------------------------------------------
     @property
@@ -187,21 +199,26 @@ class CollisionWorld:
         collision-free)."""
         geometry = self._scene_geometry()
         self._set(q)
-        return tuple(
-            CollisionPair(*geometry.pair_names[i])
-            for i in cm.colliding_pairs(self._arms, geometry, self._q)
-        )
+        hits = cm.colliding_pairs(self._arms, geometry, self._q)
+        names = self._pair_names(geometry)
+        if self._slots is not None:  # results of the pairs checked now, by position
+            active = self._slots.active
+            at = np.searchsorted(active, hits)
+            hits = [
+                int(p) for p, i in zip(at, hits, strict=True) if p < active.size and active[p] == i
+            ]
+        return tuple(CollisionPair(*names[i]) for i in hits)
 
     def min_distance(self, q: FloatArray | None = None) -> Clearance:
         """Smallest signed distance over every checked pair at ``q`` (default: current) [m]
         (negative: penetration)."""
         geometry = self._scene_geometry()
         self._set(q)
-        d = cm.pair_distances(self._arms, geometry, self._q)
+        d = self._distances(geometry)
         if d.size == 0:
             return Clearance(float("inf"), None)
         i = int(np.argmin(d))
-        return Clearance(float(d[i]), CollisionPair(*geometry.pair_names[i]))
+        return Clearance(float(d[i]), CollisionPair(*self._pair_names(geometry)[i]))
 
     def owner(self, shape: str) -> str | None:
         """The arm a shape belongs to: the arm of a link or gripper shape, the arm holding a
@@ -217,14 +234,14 @@ class CollisionWorld:
         shapes realising it (an empty mapping for a cell of one arm)."""
         geometry = self._scene_geometry()
         self._set(q)
-        d = cm.pair_distances(self._arms, geometry, self._q)
+        d = self._distances(geometry)
         names = self.layout.names
         out = {
             (a, b): Clearance(float("inf"), None)
             for i, a in enumerate(names)
             for b in names[i + 1 :]
         }
-        for k, (first, second) in enumerate(geometry.pair_names):
+        for k, (first, second) in enumerate(self._pair_names(geometry)):
             a, b = self.owner(first), self.owner(second)
             if a is None or b is None or a == b:
                 continue
@@ -251,7 +268,28 @@ class CollisionWorld:
     def _shrunk(self, box: ObjectBox) -> FloatArray:
         return np.maximum(np.array(box.size) - 2.0 * self._tolerance, 1e-6)
 
+    def _pair_names(self, geometry: cm.SceneGeometry) -> tuple[tuple[str, str], ...]:
+        return geometry.pair_names if self._slots is None else self._slots.pair_names
+
+    def _distances(self, geometry: cm.SceneGeometry) -> FloatArray:
+        """Signed distance of every checked pair, in :meth:`_pair_names`' order."""
+        d = cm.pair_distances(self._arms, geometry, self._q)
+        return d if self._slots is None else d[self._slots.active]
+
     def _scene_geometry(self) -> cm.SceneGeometry:
+        if self._geometry is None and self._incremental:
+            resting = {n: (b.T_world_obj, self._shrunk(b)) for n, b in self._resting.items()}
+            held = {a: (n, T, self._shrunk(b)) for a, (n, T, b) in self._held.items()}
+            if self._slots is None or not self._slots.fits(resting, held):
+                # the objects seen before keep their slots (they may come back)
+                sizes = {} if self._slots is None else dict(self._slots.sizes)
+                sizes.update({n: s for n, (_, s) in resting.items()})
+                sizes.update({n: s for n, _, s in held.values()})
+                self._slots = SlotGeometry(
+                    self._arms, self._scene.table.size, sizes, self._arm_margin
+                )
+            self._slots.apply(resting, held)
+            self._geometry = self._slots.scene
         if self._geometry is None:
             key = self.arrangement_key()
             cached = self._built.get(key)

@@ -2,12 +2,14 @@
 
 With two arms every assignment (two at most). With more, bounded: for each move the arms that
 reach its object and its target (the first grasp option of that arm, from the grounder's
-``move_options``), by the estimated time of that arm's pick and transfer, the ``moves + 1``
-soonest; of their combinations with distinct arms the ``SdarOptions.assignments`` of least total
-estimate (with the view's :class:`~solvers.sdar.tasks.Layout`, fewest crossing pairs of arms
-first). So at most ``(moves + 1) ** moves`` combinations are ranked, never every ``k``-tuple of
-arms. With :attr:`ArmAssigner.by_plane` (the anytime finish of :mod:`~solvers.sdar.spending`)
-and a layout, a one-move step's arms come in the order of their plane reach
+``move_options``; with the view's layout the arms are asked nearest by plane reach first, and
+no more once ``moves + 1`` reach), by the estimated time of that arm's pick and transfer, the
+``moves + 1`` soonest; of their combinations with distinct arms the
+``SdarOptions.assignments`` of least total estimate (with the view's
+:class:`~solvers.sdar.tasks.Layout`, fewest crossing pairs of arms first). So at most
+``(moves + 1) ** moves`` combinations are ranked, never every ``k``-tuple of arms. With
+:attr:`ArmAssigner.by_plane` (the anytime finish of :mod:`~solvers.sdar.spending`) and a
+layout, a one-move step's arms come in the order of their plane reach
 (:meth:`~solvers.sdar.tasks.Layout.reach`), without asking IK first; a step of several moves
 gets one assignment, each move the nearest arm not taken by an earlier move
 (:func:`~solvers.sdar.spending.plane_seating`).
@@ -22,7 +24,7 @@ from typing import TYPE_CHECKING
 from solvers.sdar.cache import StreamCache
 from solvers.sdar.move_option import Option
 from solvers.sdar.report import Failures
-from solvers.sdar.spending import plane_seating
+from solvers.sdar.spending import moves_layout, plane_seating
 from solvers.sdar.tasks import Layout, Move, Step
 
 if TYPE_CHECKING:
@@ -70,7 +72,7 @@ class ArmAssigner:
             nearest = plane_seating(layout, step.moves)
             if len(nearest) == m:
                 return [tuple(arms[k] for k in nearest)]
-        cost = self.reach_costs(step)
+        cost = self.reach_costs(step, layout)
         per_move = [
             [a for _, a in sorted((cost[a, i], a) for a in arms if (a, i) in cost)][: m + 1]
             for i in range(m)
@@ -99,15 +101,31 @@ class ArmAssigner:
             tuples.sort(key=lambda t: (_total(cost, t), t))
         return tuples[: self.options.assignments]
 
-    def reach_costs(self, step: Step) -> dict[tuple[str, int], float]:
+    def reach_costs(self, step: Step, layout: Layout | None = None) -> dict[tuple[str, int], float]:
         """(arm, move index) -> the estimated time of the arm's pick and transfer with its
-        first option, for the arms that have one."""
+        first option, for the arms that have one. With a layout placing the step's objects,
+        each move asks the arms in the order of their plane reach
+        (:meth:`~solvers.sdar.tasks.Layout.reach`, a buffer move's at its object's pose) and
+        stops once ``moves + 1`` have an option (the assignment ranks no more per move)."""
         lifted = frozenset(step.objects)
+        arms = sorted(self.home)
+        m = len(step.moves)
+        plane = None
+        if layout is not None and all(o in layout.places for o in step.objects):
+            plane = moves_layout(layout, step.moves)
         cost: dict[tuple[str, int], float] = {}
         for i, move in enumerate(step.moves):
-            for a in sorted(self.home):
+            order = list(range(len(arms)))
+            if plane is not None:
+                order.sort(key=lambda k: (plane.reach(k, move.obj), k))
+            found_for = 0
+            for k in order:
+                if plane is not None and found_for > m:
+                    break
+                a = arms[k]
                 found = self.move_options(a, move, lifted, 1, self.options.grasps, None, step.moves)
                 if found:
+                    found_for += 1
                     here = self.cache.current_arm_conf(a)
                     pick, place = found[0].pick, found[0].place
                     cost[a, i] = self.cache.arm_distance(here, pick) + self.cache.arm_distance(

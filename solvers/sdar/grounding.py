@@ -10,9 +10,12 @@ arms, options are checked in pairs of arms and steps known not to ground are ski
 (:mod:`~solvers.sdar.k_grounding`).
 
 The assignments of arms to a step's moves are :mod:`~solvers.sdar.assignment`'s. The
-options of a step of ``m > 2`` moves are cut so that their combinations stay within
-:data:`MAX_COMBINATIONS` per stage, and with more than two arms, among groundings of one rank,
-those bringing more objects to their goals come first (then the estimated motion time).
+options of a step of ``m > 2`` moves are cut so that the checks of a stage stay within
+:data:`MAX_COMBINATIONS`: per pair of moves when its options are checked in pairs of arms
+(:meth:`~solvers.sdar.k_grounding.KArmChecks.pairwise`: as many options per move as a
+two-move step's expanded stage, the combinations then only looked up), else per
+combination; and with more than two arms, among groundings of one rank, those bringing more
+objects to their goals come first (then the estimated motion time).
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from solvers.sdar.assignment import ArmAssigner
 from solvers.sdar.attempts import MotionMode, TabuLists
 from solvers.sdar.budget import Deadline
 from solvers.sdar.cache import StreamCache
+from solvers.sdar.free_pairs import FreePairs
 from solvers.sdar.k_grounding import KArmChecks
 from solvers.sdar.move_option import Option
 from solvers.sdar.one_arm import one_arm_order
@@ -88,7 +92,7 @@ class Grounder:
         self.tabu = tabu
         self.failures = failures
         self.deadline = deadline
-        self._free: dict[Hashable, tuple[frozenset[str], ...]] = {}
+        self._free = FreePairs(cache, goals, self._combine)
         self.buffer_check: BufferCheck | None = None
         """Keeps only the buffers it accepts for (the step's moves, object, buffer pose)."""
         self.skip_family: FamilyCheck | None = None
@@ -164,16 +168,7 @@ class Grounder:
         stage with more grasps is reached even when the earlier ones ran out of options."""
         lifted = frozenset(step.objects)
         opt = self.options
-        first, more = opt.options_per_move, opt.more_options
-        size = len(step.moves)
-        if size > 2:  # keep the combinations of a stage within MAX_COMBINATIONS
-            cut = max(1, int(MAX_COMBINATIONS ** (1.0 / size) + 1e-9))
-            first, more = min(first, cut), min(more, cut)
-        stages = [(first, opt.grasps)]
-        if step.kind in opt.expand_kinds and more > first:
-            stages.append((more, opt.grasps))
-        if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps and size <= 2:
-            stages.append((opt.pair_grasps, opt.pair_grasps))
+        stages = grounding_stages(step, opt, self.k.pairwise(step))
         found: list[Grounding] = []
         misses: Counter[str] = Counter()  # why combinations of options failed
         poses = self.cache.current_poses()
@@ -214,52 +209,8 @@ class Grounder:
     def free_pairs(
         self, step: Step, arms: tuple[str, ...], grasps: int
     ) -> tuple[frozenset[str], ...] | None:
-        """Per move of a step of two goal moves, the grasps (of the first ``grasps``) that
-        belong to a pair whose grippers clear the other object at its target and whose arms
-        clear each other at the objects and at the targets, with no other object on the table
-        (IK without fluents, every branch). Other objects only remove IK options, so a grasp
-        outside these sets is never part of a grounding, in any arrangement. Kept while the
-        two objects rest where they are. None for other steps."""
-        if len(step.moves) != 2 or any(m.to_buffer for m in step.moves):
-            return None
-        cache, voc = self.cache, self.cache.voc
-        current = cache.current_poses()
-        key = (step.moves, arms, tuple(current[o] for o in step.objects), grasps)
-        if key in self._free:
-            return self._free[key]
-        confs: list[dict[str, tuple[list[str], list[str]]]] = []
-        for arm, m in zip(arms, step.moves, strict=True):
-            here, goal = current[m.obj], self.goals[m.obj]
-            by_grasp: dict[str, tuple[list[str], list[str]]] = {}
-            for (g,) in cache.outputs(voc.grasp, (m.obj,), grasps):
-                picks = [q for (q,) in cache.outputs(voc.ik, (arm, m.obj, here, g), _BRANCHES)]
-                places = [q for (q,) in cache.outputs(voc.ik, (arm, m.obj, goal, g), _BRANCHES)]
-                if picks and places:
-                    by_grasp[g] = (picks, places)
-            confs.append(by_grasp)
-        (a, b), (arm_a, arm_b) = step.objects, arms
-        ta, tb = self.goals[a], self.goals[b]
-        ok_a: set[str] = set()
-        ok_b: set[str] = set()
-        test = voc.grasp_cfree if voc.grasp_cfree in cache.streams else None
-
-        def clear(x: Sequence[str], y: Sequence[str]) -> bool:
-            return any(self._combine({arm_a: qa, arm_b: qb}) for qa in x for qb in y)
-
-        for ga, (pick_a, place_a) in confs[0].items():
-            for gb, (pick_b, place_b) in confs[1].items():
-                if ga in ok_a and gb in ok_b:
-                    continue
-                if test is not None and not (
-                    cache.test(test, (a, ta, ga, b, tb)) and cache.test(test, (b, tb, gb, a, ta))
-                ):
-                    continue
-                if clear(pick_a, pick_b) and clear(place_a, place_b):
-                    ok_a.add(ga)
-                    ok_b.add(gb)
-        result = (frozenset(ok_a), frozenset(ok_b))
-        self._free[key] = result
-        return result
+        """:class:`~solvers.sdar.free_pairs.FreePairs` of the step (None: not two goals)."""
+        return self._free(step, arms, grasps)
 
     def _move_options(
         self,
@@ -415,12 +366,25 @@ class Grounder:
         return Grounding(step, arms, combo, first, last, estimate, tuple(sequence))
 
 
+def grounding_stages(step: Step, opt: SdarOptions, pairwise: bool) -> list[tuple[int, int]]:
+    """``(options per move, grasps)`` per stage of :meth:`Grounder._ground` (more than two
+    moves: see the module docstring on :data:`MAX_COMBINATIONS`)."""
+    first, more = opt.options_per_move, opt.more_options
+    size = len(step.moves)
+    if size > 2:
+        cut = max(1, int(MAX_COMBINATIONS ** (1.0 / (2 if pairwise else size)) + 1e-9))
+        first, more = min(first, cut), min(more, cut)
+    stages = [(first, opt.grasps)]
+    if step.kind in opt.expand_kinds and more > first:
+        stages.append((more, opt.grasps))
+    if step.kind in opt.pair_kinds and opt.pair_grasps > opt.grasps and size <= 2:
+        stages.append((opt.pair_grasps, opt.pair_grasps))
+    return stages
+
+
 #: The most combinations of options per stage grounded for a step of more than two moves (the
 #: two-arm expanded stage's 6 x 6).
 MAX_COMBINATIONS = 36
-#: IK solutions asked per grasp and pose when no other object is on the table (every branch,
-#: and every branch of the half-turn twin where the IK stream offers it).
-_BRANCHES = 16
 _NO_FREE_PAIR = "no pair of grasps keeps the arms apart, whatever the other objects"
 _TRIED = "tried before"
 _GRIPPERS = "a gripper meets the other object at its target"

@@ -17,8 +17,10 @@ from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.instance import Instance, ObjectSpec, Pose2D
 from sdar_tamp.world.scene import Workspace
 from solvers.sdar.attempts import MotionMode
+from solvers.sdar.grounding import grounding_stages
 from solvers.sdar.planners import make_task_planner
 from solvers.sdar.solver import SdarOptions, SdarSolver
+from solvers.sdar.tasks import Move, Step
 from solvers.solution import Status
 from streams.context import WorldContext
 from streams.grasps import GraspOptions
@@ -215,3 +217,15 @@ def test_neighbours_in_a_row_trade_places_in_one_swap(
     assert plan.metrics.actions == 2
     report = validate_plan(r.instance, plan, ctx.scene)
     assert report.ok, report.violation
+
+
+def test_a_step_checked_in_pairs_gets_as_many_options_per_move_as_a_two_move_step() -> None:
+    """Four moves: two options per move when every combination is checked (36 at most), six
+    (a two-move step's expanded stage) when the options are checked in pairs of arms."""
+    opt = SdarOptions()
+    four = Step(tuple(Move(o) for o in "abcd"), "chain")
+    assert grounding_stages(four, opt, pairwise=False) == [(2, opt.grasps)]
+    assert grounding_stages(four, opt, pairwise=True) == [(2, opt.grasps), (6, opt.grasps)]
+    two = Step((Move("a"), Move("b")), "chain")
+    assert grounding_stages(two, opt, pairwise=True) == grounding_stages(two, opt, False)
+    assert grounding_stages(Step((Move("a"),), "single"), opt, pairwise=False) == [(2, opt.grasps)]

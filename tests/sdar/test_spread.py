@@ -181,3 +181,39 @@ def test_the_finish_takes_a_one_move_steps_arms_by_plane_reach_without_ik() -> N
     order = assigner.assignments(Step((Move("a"),), "single"), layout)
     assert order == [("east",), ("south",), ("north",), ("west",)]
     assert asked == []  # no IK asked to rank them
+
+
+class _Reach:
+    """A stream cache stand-in: every configuration one second from any other."""
+
+    def current_arm_conf(self, arm: str) -> str:
+        return f"q_{arm}"
+
+    def arm_distance(self, a: str, b: str) -> float:
+        return 1.0
+
+
+def test_the_normal_search_asks_ik_of_the_nearest_arms_only_until_enough_reach() -> None:
+    """A one-move step asks the arms by plane reach, nearest first, and stops once two reach
+    (``moves + 1``); an arm that reaches nothing does not count. Without a layout every arm
+    is asked."""
+    asked: list[str] = []
+    reach = {"east", "north", "south"}  # west reaches nothing
+
+    def options(arm: str, move: Move, *args: object) -> list[Option]:
+        asked.append(arm)
+        return [Option("g", "pick", "t", "place")] if arm in reach else []
+
+    home = {"east": "q", "north": "q", "south": "q", "west": "q"}
+    assigner = ArmAssigner(
+        cast(StreamCache, _Reach()), SdarOptions(), home, cast(Failures, None), options
+    )
+    bases = ((0.6, 0.0), (0.0, 0.5), (0.0, -0.5), (-0.6, 0.0))  # sorted arms: e, n, s, w
+    layout = Layout({"a": ((-0.5, -0.1), (-0.5, -0.2))}, bases)  # nearest: w, s, n, e
+    step = Step((Move("a"),), "single")
+    costs = assigner.reach_costs(step, layout)
+    assert asked == ["west", "south", "north"]
+    assert set(costs) == {("south", 0), ("north", 0)}
+    asked.clear()
+    assert set(assigner.reach_costs(step)) == {(a, 0) for a in reach}
+    assert asked == ["east", "north", "south", "west"]

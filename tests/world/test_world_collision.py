@@ -204,8 +204,8 @@ def test_an_arrangement_seen_before_reuses_its_geometry_and_answers_alike(
     world.set_objects(first)
     world.in_collision(_q(off, home))
     assert len(builds) == count + 1
-    # by default nothing is kept: every change of arrangement is a build
-    plain = CollisionWorld(scene)
+    # built afresh, nothing kept: every change of arrangement is a build
+    plain = CollisionWorld(scene, incremental=False)
     before = len(builds)
     for objects in (first, moved, first):
         plain.set_objects(objects)
@@ -230,7 +230,7 @@ def test_worlds_of_one_scene_share_the_arm_model_but_not_its_data(
 
 
 def test_pair_names_follow_the_pairs_activated(scene: Scene) -> None:
-    world = CollisionWorld(scene)
+    world = CollisionWorld(scene, incremental=False)
     world.set_objects({"o": _box(-0.2, 0.0), "p": _box(0.2, 0.1)})
     world.in_collision()
     names = world._geometry.pair_names  # type: ignore[union-attr]
@@ -241,7 +241,7 @@ def test_pair_names_follow_the_pairs_activated(scene: Scene) -> None:
 def test_pair_names_are_aligned_with_the_geometry_pairs(scene: Scene, kins: dict) -> None:
     """``pair_names[k]`` names the shapes of the ``k``-th pair of the geometry (the index
     :func:`colliding_pairs` reports), each pair oriented as :meth:`_pairs` lists it."""
-    world = CollisionWorld(scene, arm_margin=0.002)
+    world = CollisionWorld(scene, arm_margin=0.002, incremental=False)
     world.set_objects({"o": _box(-0.2, 0.0), "p": _box(0.2, 0.1)})
     world.attach("left", "o")
     world.in_collision()
