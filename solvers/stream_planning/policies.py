@@ -12,8 +12,10 @@
   search, each queued skeleton is worked on about ``search_sample_ratio`` times, and after a
   search that found no new plan the queue may go on until its stream calls reach
   ``search_sample_ratio`` times the facts that search planned over (the next search, at a
-  higher level, costs at least as much). The balance is counted in visits and calls, not
-  measured in seconds, so a seeded run is reproducible.
+  higher level, costs at least as much). The balance is counted in visits and calls, so a
+  seeded run with fast samplers is reproducible; between levels it also stops, as
+  PDDLStream's does, once the solve's sampling time reaches ``search_sample_ratio`` times its
+  search time (slow samplers: a motion planner, inverse kinematics).
 
 A stream plan with fluent streams is bound (as in binding) even by focused and incremental.
 The policy is chosen once, from ``StreamOptions.algorithm`` (:func:`policy_for`).
@@ -22,10 +24,11 @@ The policy is chosen once, from ``StreamOptions.algorithm`` (:func:`policy_for`)
 from __future__ import annotations
 
 import heapq
+import math
 from collections.abc import Callable
 from typing import Protocol
 
-from solvers.stream_planning.context import SolveContext
+from solvers.stream_planning.context import DRAIN_SECONDS, SolveContext
 from solvers.stream_planning.engine import InstanceState
 from solvers.stream_planning.skeletons import Skeleton, SkeletonBinder
 
@@ -161,14 +164,29 @@ class AdaptivePolicy:
         ``searched`` facts that found no new plan, the queue may go on until its stream calls
         reach ``search_sample_ratio * searched``: the next search (at a higher level, over a
         larger world) costs at least as much as this one did, so sampling gets a share that
-        grows with the search's (as PDDLStream's sample time follows its search time, here
-        counted, so a seeded run is reproducible). A visit counts at least one call.
+        grows with the search's (counted, so a seeded run with fast samplers is
+        reproducible). A visit counts at least one call.
+
+        Between levels the work also stops (after one visit at least) once the solve's
+        sampling time reaches ``search_sample_ratio`` times its search time, or after
+        :data:`~.context.DRAIN_SECONDS` when it already has: PDDLStream gives its skeletons,
+        between levels, the time that balance leaves. Samplers that take a fraction of a
+        second a call would otherwise make thousands of facts no plan asked for (each visit
+        of a failing skeleton samples afresh), slowing every later search.
         """
         context = self.context
         ratio = context.options.search_sample_ratio
         budget = max(ratio * len(self.queue), ratio * searched, 1.0)  # inf: until solved
+        stats = context.stats
+        start = stats.sample_time
+        # [s] of sampling this work may take (the balance's share, or the least)
+        seconds = math.inf
+        if searched and math.isfinite(ratio):
+            seconds = max(ratio * stats.search_time - start, DRAIN_SECONDS)
         spent = 0
         while spent < budget and self.queue:
+            if spent and stats.sample_time - start >= seconds:
+                break
             context.check_time()
             skeleton = heapq.heappop(self.queue)
             before = context.calls

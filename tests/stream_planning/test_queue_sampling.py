@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
 from collections.abc import Iterator
 
 import pytest
@@ -19,6 +20,7 @@ from sdar_tamp.language.generators import from_fn, from_gen_fn, from_test
 from sdar_tamp.language.problem import PDDLProblem
 from solvers.solution import Status
 from solvers.solve import solve
+from solvers.stream_planning import context as context_module
 
 DOMAIN = """
 (define (domain feedback)
@@ -88,3 +90,47 @@ def test_queue_work_stays_bounded_when_no_value_passes(ratio: float) -> None:
     assert solution.status is Status.INFEASIBLE
     assert solution.statistics["complexity"] == 2
     assert 1 <= solution.streams["sample-x"].calls <= 100
+
+
+class _SlowClock:
+    """The ``time`` module as the solve's context reads it, where each sampler call takes
+    ``step`` seconds (the test's own clock: no real waiting)."""
+
+    def __init__(self, step: float) -> None:
+        self.step = step
+        self.offset = 0.0
+
+    def perf_counter(self) -> float:
+        return time.perf_counter() + self.offset
+
+
+@pytest.mark.parametrize("step", [0.0, 10.0])
+def test_between_levels_the_queue_samples_within_the_time_balance(
+    monkeypatch: pytest.MonkeyPatch, step: float
+) -> None:
+    # No value passes; between levels the queue works in proportion to the search, and
+    # with samplers that take 10 s a call, only until its sampling time reaches the
+    # searches' (PDDLStream's balance): one visit a level, not hundreds of calls.
+    clock = _SlowClock(step)
+    monkeypatch.setattr(context_module, "time", clock)
+
+    def slow_counting() -> Iterator[tuple[int]]:
+        for k in itertools.count(1):
+            clock.offset += clock.step
+            yield (k,)
+
+    stream_map = {
+        "sample-x": from_gen_fn(slow_counting),
+        "add": from_fn(lambda a, b: (a + b,)),
+        "test-good": from_test(lambda x: False),
+    }
+    problem = PDDLProblem(DOMAIN, {}, STREAMS, stream_map, [], ("done",))
+    solution = solve(
+        problem, algorithm="adaptive", max_complexity=3, search_sample_ratio=1.0, verbose=False
+    )
+    assert solution.status is Status.INFEASIBLE
+    calls = solution.streams["sample-x"].calls
+    if step:
+        assert calls <= 6, calls
+    else:
+        assert calls > 6, calls
