@@ -264,7 +264,6 @@ def improvements(
         rate = AHEAD * spent / left
         if not shorter(fresh.plan, best.plan, repaired.resume):
             continue
-        t = _moving_on(fresh.plan, float(start.prefix.t[-1]))  # the same on the new plan
         q0 = start.prefix.q[-1]
         begin = PlanState(float(start.prefix.t[-1]), q0, {}, dict(start.resting))
         _, bad, _ = check_from(instance, fresh.plan, scene, kins, collision, begin)
@@ -276,6 +275,7 @@ def improvements(
             continue
         yield out
         best = out
+        t = _moving_on(fresh.plan, float(start.prefix.t[-1]))  # the same on the new plan
 
 
 def _per_object(repair_time: float) -> float:
