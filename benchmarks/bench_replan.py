@@ -20,14 +20,15 @@ states (every ``infeasible`` or ``timeout`` there counts as a failure).
 
 ``--compare`` says when a repair that changed the plan is compared with a fresh continuation:
 ``moving`` (default) while the arms execute the repair
-(:func:`sdar_tamp.app.replan_moving.replan_while_moving`: the repair is given first, a
-shorter fresh continuation from a later cut point replaces it only when found before the
-arms get there), ``sync`` before ``replan`` returns (``replan(..., compare=True)``, the
-measure of the releases before this option), ``none`` never. Latencies, wall time from the
-call (the observation) on, the final validation of each plan excluded:
+(:func:`sdar_tamp.app.replan_moving.replan_while_moving`: the repair is given first, each
+shorter fresh continuation from a later start, a clear cut or a braked stop, replaces the plan
+followed only when found before the arms get there), ``sync`` before ``replan`` returns
+(``replan(..., compare=True)``, the measure of the releases before this option), ``none``
+never. Latencies, wall time from the call (the observation) on, the final validation of each
+plan excluded:
 ``latency_median_s`` until the first plan, when the arms can move on (with ``sync`` or
 ``none`` the only plan, as before); ``latency_final_median_s`` until the plan finally kept
-(with ``moving``: the fresh continuation's when it replaced the repair);
+(with ``moving``: the last fresh continuation's when one replaced the repair);
 ``latency_done_median_s`` (and ``latency_done_p90_s``) until the re-plan is over, the
 comparison and the validations included (with ``sync``: ``latency``, the old definition, plus
 the final validation). ``improved``: re-plans where a fresh continuation found while moving replaced

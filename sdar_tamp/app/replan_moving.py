@@ -1,4 +1,4 @@
-"""Re-plan while the arms move: the first valid plan as soon as there is one, a shorter one
+"""Re-plan while the arms move: the first valid plan as soon as there is one, shorter ones
 while the arms execute it (:func:`replan_while_moving`).
 
 :func:`~sdar_tamp.app.replanning.replan` with its comparison compares a repair that changed
@@ -12,23 +12,28 @@ comparison runs while they execute it:
    its cut while the repair is planned (``observed``: the wall time the observation came in,
    at plan time ``at``), and the continuation starts when both the arms are there and the
    plan is (``first``: the wall time it was yielded).
-2. The fresh continuation (:func:`~sdar_tamp.app.replanning.fresh_continuation`, without
-   infeasibility proofs) starts at a cut point of the repaired plan (every arm still with an
-   empty gripper, not at grasps: :func:`at_grasps`): the first, from ``resume`` on, that
-   leaves the solve at least :data:`MIN_BUDGET` before the arms get there, from the objects
-   where the repaired plan leaves them there; its solve's time limit is the time until the
-   arms reach it, less :data:`RESERVE` for the checks (times on the configuration's clock,
-   ``config.sdar.clock``: the wall time unless set otherwise). A solve that runs out of
-   that time is tried again from the first cut point that leaves twice that time (at most
-   :data:`TRIES` solves, none past the re-plan's time limit): the earlier the cut point, the
-   more a fresh plan may save, and the time a solve needs is not known before it ends (a
-   fraction of a second to tens of seconds on the paper suite, depending on the objects left
-   and the machine's load).
-3. It replaces the repair, yielded as a second outcome (``replanned``, its ``alternative``
-   the repair's execution), when it ends more than :data:`~sdar_tamp.app.replanning.SAVING`
-   of the repair's execution from ``resume`` earlier, replays without violation from its cut,
-   and all that is done before the arms reach the cut; otherwise nothing more is yielded: the
-   arms go on with the repair.
+2. A fresh continuation (:func:`~sdar_tamp.app.replanning.fresh_continuation`, without
+   infeasibility proofs) starts where the arms can leave the plan with empty grippers
+   (:func:`~sdar_tamp.app.replan_starts.next_start`: a clear cut, not at grasps, or a
+   braked stop on the way to the next grasps): the first one, from ``resume`` on, the arms
+   reach once a solve of the objects left is expected to end (at least :data:`MIN_BUDGET`;
+   expected: :data:`AHEAD` times the time per object of the last solve, before any the
+   repair's time per object, :func:`_per_object`), from the objects where the plan leaves
+   them there; its solve's time limit is the time until the arms get there, less
+   :data:`RESERVE` for the checks (times on the configuration's clock, ``config.sdar.clock``:
+   the wall time unless set otherwise). A solve out of time doubles the time expected per
+   object. The earlier the start, the more a fresh plan may save; the time a solve needs is
+   not known before it ends (a fraction of a second to tens of seconds on the paper suite,
+   depending on the objects left and the machine's load), and one start gives a plan that
+   may be 10-20% longer or shorter than from a state a rounding error away (motions planned
+   from other ends: the solve's outcome is a draw), so the search goes on.
+3. A fresh plan replaces the plan the arms execute, yielded as the next outcome
+   (``replanned``, its ``alternative`` the replaced plan's execution), when it ends more than
+   :data:`~sdar_tamp.app.replanning.SAVING` of that execution from ``resume`` earlier,
+   replays without violation from its start, and all that is done before the arms get there.
+   Either way the next solve starts from a later state of the plan kept, at most
+   :data:`TRIES` solves in all, none past the re-plan's time limit: each outcome after the
+   first is shorter than the one before.
 
 When the repair is ready only once the arms stand at its cut (no way left to run: the
 observation came in at or just before the cut), the comparison while moving could start only
@@ -36,7 +41,9 @@ after the repair's first steps, and a fresh plan that orders those differently w
 of reach. Then the arms may wait there :data:`LOOK` more, when a fresh solve is expected to
 end in that time (:func:`_worth_a_look`): one fresh
 solve from the cut itself, given instead of the repair when it is shorter, valid and found
-within that time; otherwise the repair is given at once and steps 1-3 follow.
+within that time; otherwise the repair is given at once and steps 1-3 follow (then with
+braked stops too, which let a solve that ends while the arms are on their way to the
+repair's first grasps still change them).
 
 A fresh solve from a cut point after ``resume`` plans fewer objects than one from ``resume``
 (the repair's first steps are done by then), so the plan kept may be longer than the
@@ -47,12 +54,14 @@ that of the old definition, the time until the final plan.
 from __future__ import annotations
 
 import dataclasses
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
+
 from sdar_tamp.app.cache import PlannerCache
 from sdar_tamp.app.config import PlannerConfig
+from sdar_tamp.app.replan_starts import next_start
 from sdar_tamp.app.replanning import (
     ReplanOutcome,
     fresh_continuation,
@@ -60,19 +69,28 @@ from sdar_tamp.app.replanning import (
     shorter,
     timed_and_checked,
 )
-from sdar_tamp.app.splicing import check_from, head_at
+from sdar_tamp.app.splicing import check_from
+from sdar_tamp.logs import get_logger
 from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.plan_rules import TIME_TOL
-from sdar_tamp.plan_state import Cut, PlanState, cut_point, state_at
+from sdar_tamp.plan_rules import STILL_TOL, TIME_TOL
+from sdar_tamp.plan_state import PlanState, cut_point
 from sdar_tamp.world.collision import CollisionWorld
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.observed import ObservedState
 from sdar_tamp.world.scene import Scene
-from solvers.sdar.budget import Clock
 
-MIN_BUDGET = 0.3  #: [s] of wall time a fresh solve gets at least (else a later cut point)
+LOG = get_logger(__name__)
+MIN_BUDGET = 0.3  #: [s] of wall time a fresh solve gets at least (else a later start)
 RESERVE = 0.2  #: [s] of wall time kept for the checks after a fresh solve, before the cut
-TRIES = 4  #: fresh solves at most (a timed-out one is tried again from a later cut point)
+TRIES = 8  #: fresh solves at most (a timed-out one is tried again from a later start)
+#: A fresh solve's expected time [s] is this times the last one's (which planned as many
+#: objects or more): the next start is the first the arms reach that much later.
+AHEAD = 1.25
+#: [m] a braked stop's moving tools are at least this much over the tallest object (lower,
+#: their fingers reach down around the objects: they come down to grasps or leave
+#: placements, :mod:`~sdar_tamp.app.replan_starts`): the margin of the optimiser's lifts
+#: over the objects (``streams.motion.shape.ShapeOptions.lift_margin``).
+ABOVE = 0.015
 #: [s] the arms, when they already stand at the cut once the repair is ready, may wait there
 #: more for a fresh continuation from the cut itself, given instead of the repair if shorter
 #: (tried when expected to end in that time: :func:`_worth_a_look`). With no way left to
@@ -112,11 +130,11 @@ def replan_while_moving(
     """The outcomes of re-planning ``plan`` at ``at`` [s] from ``observed`` (see the module
     docstring): first :func:`~sdar_tamp.app.replanning.replan` without the comparison (or,
     found within ``look`` [s] more, a shorter fresh continuation: see :data:`LOOK`),
-    then, when that is a repair that changed the plan, a shorter plan found while the arms
-    execute it (at most one more). ``observed_at``: the time the observation came in on the
-    configuration's clock (``config.sdar.clock``: ``time.perf_counter()``, the wall time,
-    unless set otherwise; default: the call). Each outcome's ``latency`` is the time from
-    then to its plan; the other arguments are :func:`replan`'s."""
+    then, when that is a repair that changed the plan, each shorter plan found while the arms
+    execute the one before (:func:`improvements`). ``observed_at``: the time the observation
+    came in on the configuration's clock (``config.sdar.clock``: ``time.perf_counter()``,
+    the wall time, unless set otherwise; default: the call). Each outcome's ``latency`` is
+    the time from then to its plan; the other arguments are :func:`replan`'s."""
     config = config or PlannerConfig()
     cache = cache or PlannerCache()
     clock = config.sdar.clock
@@ -133,17 +151,15 @@ def replan_while_moving(
         waiting = Arrival(now + look, first.resume)
         fresh = improve(instance, first, waiting, config=config, scene_path=scene_path,
                         cache=cache, validate=validate, observed_at=observed_at,
-                        tries=1)  # fmt: skip
+                        tries=1, brakes=False)  # fmt: skip
         if fresh is not None:
             yield fresh
             return
     yielded = clock()
     yield first
     arrival = Arrival(max(yielded, observed_at + (first.resume - at)), first.resume)
-    better = improve(instance, first, arrival, config=config, scene_path=scene_path,
-                     cache=cache, validate=validate, observed_at=observed_at)  # fmt: skip
-    if better is not None:
-        yield better
+    yield from improvements(instance, first, arrival, config=config, scene_path=scene_path,
+                            cache=cache, validate=validate, observed_at=observed_at)  # fmt: skip
 
 
 def _worth_a_look(repaired: ReplanOutcome, spent: float, look: float) -> bool:
@@ -152,8 +168,8 @@ def _worth_a_look(repaired: ReplanOutcome, spent: float, look: float) -> bool:
     (the repair planned one task again and the motion rejoining the old plan, about two steps
     of a solve; a fresh solve makes about ``n / 2`` steps, two objects for two arms)."""
     assert repaired.plan is not None
-    left = {e.object for e in repaired.plan.events if e.t >= repaired.resume}
-    return look >= MIN_BUDGET + RESERVE and spent * len(left) / 4.0 <= look
+    left = _left(repaired.plan, repaired.resume - 1e-6)
+    return look >= MIN_BUDGET + RESERVE and _per_object(spent) * left <= look
 
 
 def improve(
@@ -167,14 +183,35 @@ def improve(
     validate: bool = True,
     observed_at: float | None = None,
     tries: int = TRIES,
+    brakes: bool = True,
 ) -> ReplanOutcome | None:
-    """A fresh continuation shorter than ``repaired``'s plan from one of its cut points,
-    found before the arms (timed by ``arrival``) reach that cut point (see the module
-    docstring), as a ``replanned`` outcome; None when there is none in time. ``tries``: the
-    fresh solves at most."""
-    plan = repaired.plan
-    if plan is None:
-        return None
+    """The first plan :func:`improvements` gives (None when it gives none)."""
+    return next(improvements(instance, repaired, arrival, config=config, scene_path=scene_path,
+                             cache=cache, validate=validate, observed_at=observed_at,
+                             tries=tries, brakes=brakes), None)  # fmt: skip
+
+
+def improvements(
+    instance: Instance,
+    repaired: ReplanOutcome,
+    arrival: Arrival,
+    *,
+    config: PlannerConfig,
+    scene_path: Path | None = None,
+    cache: PlannerCache | None = None,
+    validate: bool = True,
+    observed_at: float | None = None,
+    tries: int = TRIES,
+    brakes: bool = True,
+) -> Iterator[ReplanOutcome]:
+    """Fresh continuations, each shorter than the plan before it (``repaired``'s first), from
+    starts of that plan (:func:`~sdar_tamp.app.replan_starts.next_start`: clear cuts, and
+    braked stops unless ``brakes`` is False) found before the arms (timed by ``arrival``)
+    reach them (see the module docstring), as ``replanned`` outcomes. ``tries``: the fresh
+    solves at most."""
+    if repaired.plan is None:
+        return
+    best = repaired
     clock = config.sdar.clock
     observed_at = clock() if observed_at is None else observed_at
     cache = cache or PlannerCache()
@@ -183,73 +220,96 @@ def improve(
     kins = dict(world.ctx.kinematics)  # the world's, built once with it
     collision = CollisionWorld(scene)
     sizes = {o.name: o.size for o in instance.objects}
-    for seen in plan.observations:
+    for seen in repaired.plan.observations:
         sizes.update(seen.added)
     starts = {o.name: o.start.as_tuple() for o in instance.objects}
     deadline = observed_at + config.max_time
+    above = max(size[2] for size in sizes.values()) + ABOVE  # braked stops' tools at least
     t = repaired.resume
-    need = MIN_BUDGET
-    for _ in range(tries):
-        cut = _next_cut(plan, t, arrival, need, clock)
-        if cut is None:
-            return None
-        by = min(arrival.at(cut.t), deadline)
-        budget = by - clock() - RESERVE
-        if budget < MIN_BUDGET:
-            return None
-        prefix = head_at(plan, cut)
-        resting = dict(state_at(plan, starts, scene, cut.t, kins).resting)
-        fresh = fresh_continuation(world, config.replace(max_time=budget), instance, prefix,
-                                   resting, sizes, prove=False)  # fmt: skip
-        if fresh.plan is None:
-            if fresh.status != "timeout":
-                return None
-            # out of time: a cut point after this one's hold (those within a gripper's dwell
-            # start where it ends), with twice the time
-            t, need = float(prefix.t[-1]) + 1e-6, 2.0 * budget
+    rate = AHEAD * _per_object(repaired.latency)  # [s] a solve is expected to take per object
+    k = 0  # fresh solves so far
+    while k < tries:
+        assert best.plan is not None
+        # the earliest plan time the arms reach once a solve of the objects left could end
+        need = max(MIN_BUDGET, rate * _left(best.plan, t))
+        now = clock()
+        earliest = max(t, arrival.resume + now + need + RESERVE - arrival.start)
+        start = next_start(best.plan, earliest, starts, scene, kins, brakes=brakes, above=above)
+        if start is None or not _left(best.plan, start.t):
+            return  # no start left, or nothing left to plan from it
+        by = min(arrival.at(start.t), deadline)
+        budget = by - clock() - RESERVE  # (the search for the start took some of it)
+        if by - now - RESERVE < MIN_BUDGET or budget <= 0.0:  # the time limit is near
+            if now + MIN_BUDGET + RESERVE > deadline:
+                return
+            t = start.t + 1e-6
             continue
-        if not shorter(fresh.plan, plan, repaired.resume):
-            return None
-        start = PlanState(float(prefix.t[-1]), prefix.q[-1], {}, resting)
-        _, bad, _ = check_from(instance, fresh.plan, scene, kins, collision, start)
+        k += 1
+        began = clock()
+        fresh = fresh_continuation(world, config.replace(max_time=budget, seed=config.seed + k - 1),
+                                   instance, start.prefix, dict(start.resting), sizes,
+                                   start.free, prove=False)  # fmt: skip
+        spent = clock() - began
+        ends = "none" if fresh.plan is None else f"{fresh.plan.duration:.3f} s"
+        LOG.debug("fresh solve %d from %s %.3f s (%.3f s on): %s %s (best %.3f s) in %.3f s "
+                  "of %.3f s", k - 1, "a braked stop at" if start.braked else "the clear cut",
+                  start.t, start.t - repaired.resume, fresh.status, ends, best.plan.duration,
+                  spent, budget)  # fmt: skip
+        # the next try starts once the arms move on from there (no state tried twice)
+        t = _moving_on(best.plan, cut_point(best.plan, start.t).t if start.braked else start.t)
+        left = _left(best.plan, start.t)
+        if fresh.plan is None:  # out of time: twice the time; else no plan from there
+            rate = max(rate, 2.0 * budget / left) if fresh.status == "timeout" else rate
+            continue
+        rate = AHEAD * spent / left
+        if not shorter(fresh.plan, best.plan, repaired.resume):
+            continue
+        q0 = start.prefix.q[-1]
+        begin = PlanState(float(start.prefix.t[-1]), q0, {}, dict(start.resting))
+        _, bad, _ = check_from(instance, fresh.plan, scene, kins, collision, begin)
         if bad is not None or clock() > by:
-            return None
-        out = _outcome(instance, scene, repaired, fresh.plan, clock() - observed_at, validate)
-        return None if out.valid is False else out  # never a plan the replay rejects
-    return None
+            continue
+        out = _outcome(instance, scene, repaired, best, fresh.plan, clock() - observed_at,
+                       validate)  # fmt: skip
+        if out.valid is False:  # never a plan the replay rejects
+            continue
+        yield out
+        best = out
+        t = _moving_on(fresh.plan, float(start.prefix.t[-1]))  # the same on the new plan
 
 
-def _next_cut(
-    plan: PlanFile, t: float, arrival: Arrival, need: float, clock: Clock = time.perf_counter
-) -> Cut | None:
-    """The first cut point of ``plan`` at or after ``t`` [s], not at grasps (see
-    :func:`at_grasps`), that the arms reach at least ``need`` [s] plus :data:`RESERVE` after
-    now (``clock``), before the plan's end (None if none)."""
-    end = float(plan.t[-1])
-    while t < end:
-        cut = cut_point(plan, t)
-        if cut.t >= end - 1e-9:
-            return None
-        if not at_grasps(plan, cut) and arrival.at(cut.t) - clock() >= need + RESERVE:
-            return cut
-        t = cut.t + 1e-6
-    return None
+def _per_object(repair_time: float) -> float:
+    """A fresh solve's expected time [s] per object to move, from the repair's ``repair_time``
+    [s]: the repair planned one task again and the motion rejoining the old plan, about two
+    steps of a solve, where a fresh solve makes about one step per two objects (two arms)."""
+    return repair_time / 4.0
 
 
-def at_grasps(plan: PlanFile, cut: Cut) -> bool:
-    """Whether ``plan`` grasps at ``cut``'s instant: its arms stand there at their grasps,
-    fingers open. A fresh solve from there does not know them: it lifts the arms and plans
-    their way back to grasps of its own (seconds more than the grasps already reached), so
-    a fresh continuation from such a cut is longer than the plan it should shorten."""
-    return any(e.type == "grasp" and abs(e.t - cut.t) <= TIME_TOL for e in plan.events)
+def _moving_on(plan: PlanFile, t: float) -> float:
+    """The first sample time [s] of ``plan`` at which its arms, at rest at ``t`` [s] (or,
+    moving, once at rest again), have moved on (the plan's end if never)."""
+    moves = np.abs(np.diff(plan.q, axis=0)).max(axis=1) > STILL_TOL  # (n - 1,) intervals
+    i = int(np.searchsorted(plan.t, t - TIME_TOL))
+    rest = np.flatnonzero(~moves[i:])  # at rest from there on ...
+    if not len(rest):
+        return float(plan.t[-1])
+    after = np.flatnonzero(moves[i + rest[0] :])  # ... until the first motion after that
+    return float(plan.t[i + rest[0] + after[0] + 1]) if len(after) else float(plan.t[-1])
+
+
+def _left(plan: PlanFile, t: float) -> int:
+    """The objects ``plan`` grasps after ``t`` [s]."""
+    return len({e.object for e in plan.events if e.type == "grasp" and e.t > t})
 
 
 def _outcome(
-    instance: Instance, scene: Scene, repaired: ReplanOutcome, plan: PlanFile, latency: float,
-    validate: bool,
+    instance: Instance, scene: Scene, repaired: ReplanOutcome, replaced: ReplanOutcome,
+    plan: PlanFile, latency: float, validate: bool,
 ) -> ReplanOutcome:  # fmt: skip
+    """The ``replanned`` outcome of ``plan``, a fresh continuation of ``repaired`` that
+    replaces ``replaced`` (its execution the ``alternative``)."""
     plan, valid, violation = timed_and_checked(plan, latency, instance, scene, validate)
-    assert repaired.plan is not None
+    assert replaced.plan is not None
     known = {o.name for o in instance.objects}
     moved = tuple(dict.fromkeys(
         e.object for e in plan.events
@@ -257,5 +317,5 @@ def _outcome(
     ))  # fmt: skip
     return ReplanOutcome(
         "replanned", plan, repaired.cut, latency, (), (), moved, valid, violation,
-        repaired.plan.duration, False, repaired.resume,
+        replaced.plan.duration, False, repaired.resume,
     )  # fmt: skip

@@ -19,8 +19,8 @@ def cmd_replan(args: argparse.Namespace) -> int:
     written with -o. Exit status 0 when re-planned and valid, 1 when no plan (infeasible, with
     the blocking objects) or invalid, 2 for a bad file (an impossible observed state is
     located in its file). With --while-moving the repair is written (and reported) as soon as
-    it is valid, and a shorter fresh continuation found before the arms reach its start is
-    written over it afterwards (a second record)."""
+    it is valid, and each shorter fresh continuation found before the arms reach its start is
+    written over it afterwards (a record each)."""
     from sdar_tamp.app.config import PlannerConfig
     from sdar_tamp.app.replan_moving import replan_while_moving
     from sdar_tamp.app.replanning import replan

@@ -1,6 +1,7 @@
 """Shared cases of the re-planning tests: D5 of the paper suite with its stored plan, one
 planner cache per module, and helpers that re-plan it from an observation written as YAML
-(``test_replanning.py``, ``test_replanning_braking.py``, ``test_replan_moving.py``)."""
+(``test_replanning.py``, ``test_replanning_braking.py``, ``test_replan_moving.py``,
+``test_replan_starts.py``)."""
 
 from __future__ import annotations
 
@@ -15,15 +16,17 @@ from sdar_tamp.app.config import PlannerConfig
 from sdar_tamp.app.replanning import ReplanOutcome, replan
 from sdar_tamp.plan_file import PlanFile
 from sdar_tamp.plan_reading import load_plan
+from sdar_tamp.plan_state import state_at
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.resources import domains_root
 from sdar_tamp.world.instance import Instance, ObjectSpec, load_instance
 from sdar_tamp.world.kinematics import ArmKinematics
-from sdar_tamp.world.observed import parse_observed
+from sdar_tamp.world.observed import ObservedState, parse_observed
 from sdar_tamp.world.scene import load_scene
 
 SOLVED = Path(__file__).parents[1] / "plan" / "solved"
 AT = 4.5  # D5's plan: o3/o0 swapped, o4/o1 on their way; o2 rests until the last task
+O4_AT = 5.116  # D5's plan: o4 resting, its task still to come
 CONFIG = PlannerConfig(max_time=60.0, seed=0)
 
 
@@ -36,6 +39,16 @@ def cache() -> PlannerCache:
 def d5() -> tuple[Instance, PlanFile]:
     instance = load_instance(domains_root() / "dual_arm_rearrangement/suites/paper/D5.yaml")
     return instance, load_plan(SOLVED / "D5.plan.json")
+
+
+def o4_nudged(d5: tuple[Instance, PlanFile]) -> ObservedState:
+    """o4 nudged at :data:`O4_AT`: the repair plans its task again (13.70 s in all), a fresh
+    continuation from the same cut ends 0.5 s earlier (``test_replanning.py``)."""
+    instance, plan = d5
+    starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    x, y, yaw = state_at(plan, starts, load_scene(), O4_AT).resting["o4"]
+    text = f"poses: [{{name: o4, pose: [{x + 0.0052}, {y + 0.0173}, {yaw - 0.1559}]}}]"
+    return parse_observed(text, "obs.yaml")
 
 
 def obj(instance: Instance, name: str) -> ObjectSpec:

@@ -14,32 +14,24 @@ import pytest
 
 from sdar_tamp.app import replan_moving
 from sdar_tamp.app.cache import PlannerCache
-from sdar_tamp.app.replan_moving import Arrival, at_grasps, improve, replan_while_moving
+from sdar_tamp.app.replan_moving import Arrival, improve, replan_while_moving
+from sdar_tamp.app.replan_starts import Start, at_grasps, next_start
 from sdar_tamp.app.replanning import Fresh, ReplanOutcome, replan
 from sdar_tamp.plan_file import PlanFile
-from sdar_tamp.plan_state import Cut, cut_point, state_at
+from sdar_tamp.plan_state import Cut, cut_point
 from sdar_tamp.replay import validate_plan
 from sdar_tamp.world.instance import Instance
-from sdar_tamp.world.observed import ObservedState, parse_observed
+from sdar_tamp.world.kinematics import ArmKinematics
+from sdar_tamp.world.observed import ObservedState
 from sdar_tamp.world.scene import load_scene
-from tests.app.conftest import CONFIG
+from tests.app.conftest import CONFIG, O4_AT, o4_nudged
 
-AT = 5.116  # o4 resting, its task still to come
-
-
-def _o4_nudged(d5: tuple[Instance, PlanFile]) -> ObservedState:
-    """o4 nudged: the repair plans its task again (13.70 s in all), a fresh continuation from
-    the same cut ends 0.5 s earlier (``test_replanning.py``)."""
-    instance, plan = d5
-    starts = {o.name: o.start.as_tuple() for o in instance.objects}
-    x, y, yaw = state_at(plan, starts, load_scene(), AT).resting["o4"]
-    text = f"poses: [{{name: o4, pose: [{x + 0.0052}, {y + 0.0173}, {yaw - 0.1559}]}}]"
-    return parse_observed(text, "obs.yaml")
+AT = O4_AT
 
 
 @pytest.fixture(scope="module")
 def repaired(d5: tuple[Instance, PlanFile], cache: PlannerCache) -> ReplanOutcome:
-    out = replan(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache, compare=False)
+    out = replan(*d5, AT, o4_nudged(d5), config=CONFIG, cache=cache, compare=False)
     assert out.status == "repaired" and out.changed and out.valid is True
     return out
 
@@ -51,7 +43,7 @@ def test_with_time_to_spare_the_fresh_continuation_from_the_cut_replaces_the_rep
     cut itself, the same plan as the comparison before returning keeps."""
     later = Arrival(time.perf_counter() + 1000.0, repaired.resume)
     better = improve(d5[0], repaired, later, config=CONFIG, cache=cache)
-    synchronous = replan(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache)
+    synchronous = replan(*d5, AT, o4_nudged(d5), config=CONFIG, cache=cache)
     assert better is not None and better.status == "replanned" and better.valid is True
     assert synchronous.status == "replanned" and synchronous.plan is not None
     assert better.plan is not None and repaired.plan is not None
@@ -82,43 +74,48 @@ def _out_of_time(
     monkeypatch.setattr(replan_moving, "fresh_continuation", out_of_time)
 
 
-def test_a_solve_out_of_time_is_tried_again_from_a_later_cut_point(
+def test_a_solve_out_of_time_is_tried_again_from_a_later_start(
     d5: tuple[Instance, PlanFile], cache: PlannerCache, repaired: ReplanOutcome,
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:  # fmt: skip
-    """The arms far away, each solve limited by the re-plan's time limit: the next starts from
-    a later cut point (one not at grasps), at most ``TRIES`` solves in all."""
+    """The arms far away, each solve limited by the re-plan's time limit: the next starts
+    later (a clear cut not at grasps, or a braked stop), from a state no try had: at most
+    ``TRIES`` solves in all, until no start is left with a grasp after it."""
     calls: list[tuple[float, float]] = []
     _out_of_time(monkeypatch, calls)
     later = Arrival(time.perf_counter() + 1000.0, repaired.resume)
     assert improve(d5[0], repaired, later, config=CONFIG, cache=cache) is None
     assert 1 < len(calls) <= replan_moving.TRIES
     assert repaired.plan is not None
-    last = calls[-1][0]  # the end of the last try's hold: no clear cut point after it, or
-    assert len(calls) == replan_moving.TRIES or (  # no more tries
-        replan_moving._next_cut(repaired.plan, last + 1e-6, later, 0.0) is None
-    )
-    starts = [c[0] for c in calls]
-    assert starts == sorted(starts) and len(set(starts)) == len(starts)
+    ends = [c[0] for c in calls]  # the end of each try's prefix
+    assert ends == sorted(ends) and len(set(ends)) == len(ends)
+    clear = [float(c.prefix.t[-1]) for c in _starts(d5[0], repaired)]
+    assert ends[0] == clear[0] and set(clear) <= set(ends) | {e for e in clear if e > ends[-1]}
     assert all(0.0 < budget <= CONFIG.max_time for _, budget in calls)
 
 
-def test_a_later_try_leaves_twice_the_time(
+def test_a_later_try_leaves_twice_the_time_per_object(
     d5: tuple[Instance, PlanFile], cache: PlannerCache, repaired: ReplanOutcome,
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:  # fmt: skip
-    """The arms on their way now (the repair given at once): the first solve starts at the
-    first cut point they reach at least ``MIN_BUDGET`` + ``RESERVE`` from now, each next one
-    where they leave it twice the time the last had."""
+    """The arms on their way now (the repair given at once, in no time: no expected time
+    yet; a clock that stands still): the first solve starts where they arrive
+    ``MIN_BUDGET`` + ``RESERVE`` from now (a braked stop on their way to o1 and o4), each
+    next one, later, where they leave at least twice the time per object the last had."""
     calls: list[tuple[float, float]] = []
     _out_of_time(monkeypatch, calls)
     now = dataclasses.replace(repaired, latency=0.0)
-    moving = Arrival(time.perf_counter(), repaired.resume)
-    assert improve(d5[0], now, moving, config=CONFIG, cache=cache) is None
+    frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
+    moving = Arrival(100.0, repaired.resume)  # on a clock that stands still
+    assert improve(d5[0], now, moving, config=frozen, cache=cache) is None
     assert 2 <= len(calls) <= replan_moving.TRIES
+    assert repaired.plan is not None
     budgets = [c[1] for c in calls]
-    assert budgets[0] >= replan_moving.MIN_BUDGET
-    assert all(b >= 2.0 * a for a, b in itertools.pairwise(budgets))
+    assert 0.99 * replan_moving.MIN_BUDGET <= budgets[0] < 1.0
+    assert calls[0][0] < 6.99  # before the grasps of o1 and o4
+    left = [replan_moving._left(repaired.plan, c[0]) for c in calls]
+    per_object = [b / n for b, n in zip(budgets, left, strict=True)]
+    assert all(b >= 0.99 * 2.0 * a for a, b in itertools.pairwise(per_object))
     assert [c[0] for c in calls] == sorted(c[0] for c in calls)
 
 
@@ -140,27 +137,30 @@ def test_the_generator_gives_the_repair_first(
     d5: tuple[Instance, PlanFile], cache: PlannerCache
 ) -> None:
     """The first outcome is the repair without the comparison (its latency that of
-    ``replan(..., compare=False)``); a second, if any, a shorter valid plan with the same
-    executed prefix; an unchanged plan (nothing observed) gives one outcome only."""
-    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache,
+    ``replan(..., compare=False)``); each next one, if any, a valid plan shorter than the one
+    before it (its ``alternative``), with the same executed prefix; an unchanged plan
+    (nothing observed) gives one outcome only."""
+    outs = list(replan_while_moving(*d5, AT, o4_nudged(d5), config=CONFIG, cache=cache,
                                     look=0.0))  # fmt: skip
-    assert 1 <= len(outs) <= 2
     assert outs[0].status == "repaired" and outs[0].changed and outs[0].valid is True
     first = outs[0].plan
     assert first is not None
-    for out in outs[1:]:
+    for before, out in itertools.pairwise(outs):
         assert out.status == "replanned" and out.valid is True and out.plan is not None
-        assert out.plan.duration < 0.99 * first.duration
-        assert out.latency >= outs[0].latency
+        assert before.plan is not None and out.alternative == before.plan.duration
+        assert out.plan.duration < 0.99 * before.plan.duration
+        assert out.latency >= before.latency
         assert np.array_equal(out.plan.q[out.plan.t <= out.resume],
                               first.q[first.t <= out.resume])  # fmt: skip
     same = list(replan_while_moving(*d5, AT, ObservedState(), config=CONFIG, cache=cache))
     assert len(same) == 1 and same[0].status == "repaired" and not same[0].changed
 
 
-def test_no_fresh_solve_starts_where_the_arms_stand_at_grasps(repaired: ReplanOutcome) -> None:
+def test_no_fresh_solve_starts_where_the_arms_stand_at_grasps(
+    d5: tuple[Instance, PlanFile], repaired: ReplanOutcome
+) -> None:
     """The repaired plan's cut points include instants of grasps (arms at rest, fingers open
-    around the objects); the fresh continuations start only at the others."""
+    around the objects); the clear cuts a fresh continuation starts from are the others."""
     plan = repaired.plan
     assert plan is not None
     raw: list[Cut] = []
@@ -172,17 +172,20 @@ def test_no_fresh_solve_starts_where_the_arms_stand_at_grasps(repaired: ReplanOu
     assert grasping and all(
         any(e.type == "grasp" and abs(e.t - c.t) < 1e-9 for e in plan.events) for c in grasping
     )
-    chosen = _clear_cuts(repaired)
-    assert chosen == [c for c in raw if not at_grasps(plan, c)] and chosen
+    chosen = [s.t for s in _starts(d5[0], repaired)]
+    assert chosen == [c.t for c in raw if not at_grasps(plan, c)] and chosen
 
 
-def _clear_cuts(repaired: ReplanOutcome) -> list[Cut]:
-    """The cut points a fresh continuation of ``repaired`` may start from, the arms far."""
+def _starts(instance: Instance, repaired: ReplanOutcome) -> list[Start]:
+    """The clear cuts a fresh continuation of ``repaired`` may start from."""
     assert repaired.plan is not None
-    far = Arrival(time.perf_counter() + 1000.0, repaired.resume)
-    chosen: list[Cut] = []
+    instance_starts = {o.name: o.start.as_tuple() for o in instance.objects}
+    scene = load_scene()
+    kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
+    chosen: list[Start] = []
     t = repaired.resume
-    while (nxt := replan_moving._next_cut(repaired.plan, t, far, 0.0)) is not None:
+    while (nxt := next_start(repaired.plan, t, instance_starts, scene, kins,
+                             brakes=False)) is not None:  # fmt: skip
         chosen.append(nxt)
         t = nxt.t + 1e-6
     return chosen
@@ -195,11 +198,11 @@ def test_latencies_and_deadlines_follow_the_configuration_s_clock(
     arms, timed on it, reach no cut point before a solve ends: the fresh continuation from
     the cut replaces the repair, as with time to spare."""
     frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
-    outs = list(replan_while_moving(*d5, AT, _o4_nudged(d5), config=frozen, cache=cache))
+    outs = list(replan_while_moving(*d5, AT, o4_nudged(d5), config=frozen, cache=cache))
     assert [o.status for o in outs] == ["repaired", "replanned"]
     assert [o.latency for o in outs] == [0.0, 0.0]
     assert outs[1].plan is not None and outs[1].valid is True
-    synchronous = replan(*d5, AT, _o4_nudged(d5), config=CONFIG, cache=cache)
+    synchronous = replan(*d5, AT, o4_nudged(d5), config=CONFIG, cache=cache)
     assert synchronous.plan is not None
     assert np.array_equal(outs[1].plan.q, synchronous.plan.q)
 
@@ -213,7 +216,7 @@ def test_arms_standing_at_the_cut_may_wait_the_look_for_a_fresh_continuation(
     5 s, a look of 1 s is less than a solve of the objects left is expected to take: the
     repair is given first."""
     frozen = CONFIG.replace(sdar=dataclasses.replace(CONFIG.sdar, clock=lambda: 100.0))
-    nudged = _o4_nudged(d5)
+    nudged = o4_nudged(d5)
     outs = list(replan_while_moving(*d5, AT, nudged, config=frozen, cache=cache,
                                     observed_at=99.0, look=10.0))  # fmt: skip
     synchronous = replan(*d5, AT, nudged, config=CONFIG, cache=cache)

@@ -3,6 +3,7 @@ every bad input (exit status 2 with a located error)."""
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 
@@ -112,11 +113,11 @@ def test_replan_while_moving_writes_the_repair_first(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """o4 nudged at 5.116 s with --while-moving: the first record is the repair, valid and
-    written; a second one, when the fresh continuation is found in time, is shorter and
-    written over it. Where the arms already stand at the cut when the repair is ready, a
-    fresh continuation found within the look replaces it as the only record (which one
-    happens depends on the machine's speed). --while-moving with --fresh or --no-compare is
-    refused."""
+    written; each next one, when a fresh continuation is found in time, is shorter than the
+    one before and written over it. Where the arms already stand at the cut when the repair
+    is ready, a fresh continuation found within the look replaces it as the only record
+    (which one happens depends on the machine's speed). --while-moving with --fresh or
+    --no-compare is refused."""
     from sdar_tamp.plan_state import state_at
     from sdar_tamp.world.instance import load_instance
     from sdar_tamp.world.scene import load_scene
@@ -130,17 +131,17 @@ def test_replan_while_moving_writes_the_repair_first(
     argv = ["replan", D5, PLAN, "--at", "5.116", "--observed", obs, "--while-moving"]
     code, out, _ = run_cli([*argv, "--json", "-o", str(new)], capsys)
     records = [json.loads(line) for line in out.splitlines()]
-    assert code == 0 and 1 <= len(records) <= 2
+    assert code == 0 and len(records) >= 1
     assert all(record["valid"] is True for record in records)
     if records[0]["status"] == "replanned":  # found within the look, at the cut
         (looked,) = records
         assert looked["execution_time"] < looked["alternative"]
     else:
         assert records[0]["status"] == "repaired"
-    for later in records[1:]:
+    for before, later in itertools.pairwise(records):
         assert later["status"] == "replanned" and later["valid"] is True
-        assert later["execution_time"] < records[0]["execution_time"]
-        assert later["alternative"] == pytest.approx(records[0]["execution_time"])
+        assert later["execution_time"] < before["execution_time"]
+        assert later["alternative"] == pytest.approx(before["execution_time"])
     assert load_plan(new).duration == pytest.approx(records[-1]["execution_time"])
     for other in ("--fresh", "--no-compare"):
         code, _, err = run_cli([*argv, other], capsys)
