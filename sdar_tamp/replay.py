@@ -94,7 +94,9 @@ class PlanValidator:
         self.scene, self.step, self.dwell = scene, max_tcp_step, dwell
         self.v_tol, self.a_tol = velocity_tolerance, acceleration_tolerance
         self.kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
-        self.world = CollisionWorld(scene)
+        # the replay builds each arrangement's geometry afresh: it does not rely on the
+        # planner's in-place updates (collision_slots) that it is there to check
+        self.world = CollisionWorld(scene, incremental=False)
 
     def validate(self, instance: Instance, plan: PlanFile) -> ReplayReport:
         """Replay ``plan`` on ``instance``: ok, or the first violation in time."""

@@ -46,7 +46,8 @@ class StepValidator:
             raise ParameterError(f"max_tcp_step: expected a number > 0 [m], got {max_tcp_step!r}")
         self.scene, self.v_tol = scene, velocity_tolerance
         kins = {a: ArmKinematics.from_scene(scene, a) for a in scene.arm_names}
-        self.walk = ReplayWalk(instance, None, scene, max_tcp_step, kins, CollisionWorld(scene))
+        world = CollisionWorld(scene, incremental=False)  # built afresh, as in replay.py
+        self.walk = ReplayWalk(instance, None, scene, max_tcp_step, kins, world)
         self._last: tuple[FloatArray, FloatArray] | None = None  # the last sample checked
         self.failed: Violation | None = None
 
