@@ -80,3 +80,19 @@ def first_move(search: Assignment, planner: StraightMoves, arm: int) -> Move:
         m for m in search.moves if not m.blockers and m.previous is None
         and planner.estimate(arm, stand, m) is not None
     )  # fmt: skip
+
+
+def pre_grasps(
+    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
+) -> tuple[FloatArray, FloatArray]:
+    """Both arms' pre-grasps of the same object (close to each other)."""
+    instance, plan, planner = r5
+    probe = new_search(ctx, instance, plan, planner)
+    m = first_move(probe, planner, 0)
+    resting = {**probe.rest, m.obj: m.start}
+    pre = []
+    for a in (0, 1):
+        stand = next(planner.plan(a, probe.stand[a], m, resting)).end
+        assert stand.pre is not None
+        pre.append(stand.pre)
+    return pre[0], pre[1]

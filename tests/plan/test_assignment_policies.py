@@ -26,7 +26,13 @@ from sdar_tamp.schedule.room import block_of, rest_to_rest
 from sdar_tamp.schedule.scheduler import Entry, NoPlacement
 from sdar_tamp.world.instance import Instance
 from streams.context import WorldContext
-from tests.plan.assignment_base import StraightMoves, first_move, new_search, solved
+from tests.plan.assignment_base import (
+    StraightMoves,
+    first_move,
+    new_search,
+    pre_grasps,
+    solved,
+)
 
 
 @pytest.fixture(scope="module")
@@ -102,14 +108,7 @@ def test_a_motion_met_by_another_arm_pauses_on_the_way_and_ends_earlier(
     whole motion fits after the left arm has gone; paused on the way (it swings away at once
     and stops short of the left arm), it ends earlier, and the schedule replays."""
     instance, plan, planner = r5
-    probe = new_search(ctx, instance, plan, planner)
-    m = first_move(probe, planner, 0)
-    resting = {**probe.rest, m.obj: m.start}
-    pre = []
-    for a in (0, 1):
-        stand = next(planner.plan(a, probe.stand[a], m, resting)).end
-        assert stand.pre is not None
-        pre.append(stand.pre)
+    pre = pre_grasps(ctx, r5)
     ends = []
     for pauses in (False, True):
         search = new_search(ctx, instance, plan, planner)

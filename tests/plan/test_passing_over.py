@@ -16,29 +16,18 @@ from sdar_tamp.schedule.sweep import TimedEvent, WorldSweep
 from sdar_tamp.world.instance import Instance
 from sdar_tamp.world.transforms import FloatArray
 from streams.context import WorldContext
-from tests.plan.assignment_base import StraightMoves, first_move, new_search, solved
+from tests.plan.assignment_base import (
+    StraightMoves,
+    new_search,
+    pre_grasps,
+    solved,
+)
 
 
 @pytest.fixture(scope="module")
 def r5(ctx: WorldContext) -> tuple[Instance, PlanFile, StraightMoves]:
     instance, plan = solved("R5")
     return instance, plan, StraightMoves(instance, ctx.scene)
-
-
-def _pre_grasps(
-    ctx: WorldContext, r5: tuple[Instance, PlanFile, StraightMoves]
-) -> tuple[FloatArray, FloatArray]:
-    """Both arms' pre-grasps of the same object (close to each other)."""
-    instance, plan, planner = r5
-    probe = new_search(ctx, instance, plan, planner)
-    m = first_move(probe, planner, 0)
-    resting = {**probe.rest, m.obj: m.start}
-    pre = []
-    for a in (0, 1):
-        stand = next(planner.plan(a, probe.stand[a], m, resting)).end
-        assert stand.pre is not None
-        pre.append(stand.pre)
-    return pre[0], pre[1]
 
 
 def _left_visits(search: Assignment, pre: FloatArray) -> None:
@@ -65,7 +54,7 @@ def test_starts_passed_over_all_fail_and_the_start_found_is_the_same(
     found and the schedule are those of the search that tries every start, with fewer
     replays."""
     instance, plan, planner = r5
-    pre = _pre_grasps(ctx, r5)
+    pre = pre_grasps(ctx, r5)
     results = []
     passed: list[int] = []
     real = Placement.skipped
@@ -103,7 +92,7 @@ def test_a_paused_attempt_that_ends_no_earlier_puts_the_motion_back_as_it_was(
     """A pause that does not end the motion earlier than ``end`` is taken back and the whole
     motion committed again: the same samples, events and steps as before the attempt."""
     instance, plan, planner = r5
-    pre = _pre_grasps(ctx, r5)
+    pre = pre_grasps(ctx, r5)
     search = new_search(ctx, instance, plan, planner)
     _left_visits(search, pre[0])
     home = np.array(search.stand[1].q)
